@@ -1,0 +1,208 @@
+//! `robodyn info ROBOT`: frames table, structure type, branches, loops, actuated/passive joints.
+
+use crate::common::CliResult;
+use robodyn::model::{
+    validate_structure, RobotDescription, GEOMETRIC_PARAMETERS, STANDARD_PARAMETERS,
+};
+use serde_json::json;
+use std::path::PathBuf;
+
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    /// Robot file (.toml, .par or .urdf).
+    pub robot: PathBuf,
+    /// Output format.
+    #[arg(long, value_enum, default_value = "text")]
+    pub format: Format,
+}
+
+#[derive(clap::ValueEnum, Clone, Copy, Debug)]
+pub enum Format {
+    Text,
+    Json,
+}
+
+pub fn run(a: Args) -> CliResult {
+    let desc = robodyn::io::load_description(&a.robot)?;
+    let s = validate_structure(&desc)?;
+    match a.format {
+        Format::Json => println!("{}", serde_json::to_string_pretty(&to_json(&desc, &s))?),
+        Format::Text => print_text(&desc, &s),
+    }
+    Ok(())
+}
+
+fn joint_kind(d: &RobotDescription, j: usize) -> &'static str {
+    let f = d.frame(j);
+    match f.joint.sigma() {
+        0 => "revolute",
+        1 => "prismatic",
+        _ => "fixed",
+    }
+}
+
+fn to_json(d: &RobotDescription, s: &robodyn::model::Structure) -> serde_json::Value {
+    let frames: Vec<_> = d
+        .frames
+        .iter()
+        .enumerate()
+        .map(|(i, f)| {
+            let mut o = json!({
+                "j": i + 1,
+                "name": f.name,
+                "ant": f.ant,
+                "sigma": f.joint.sigma(),
+                "mu": u8::from(f.actuated),
+                "type": joint_kind(d, i + 1),
+                "role": role(d, i + 1),
+            });
+            for (k, e) in f.geometric().iter().enumerate() {
+                o[GEOMETRIC_PARAMETERS[k]] = json!(e.to_string());
+            }
+            o
+        })
+        .collect();
+    let links: Vec<_> = d
+        .links
+        .iter()
+        .enumerate()
+        .map(|(i, l)| {
+            let mut o = json!({ "j": i + 1, "name": l.name });
+            for (k, e) in l.params.iter().enumerate() {
+                o[STANDARD_PARAMETERS[k]] = json!(e.to_string());
+            }
+            for (k, e) in l.wrench.iter().enumerate() {
+                o[robodyn::model::WRENCH_COMPONENTS[k]] = json!(e.to_string());
+            }
+            o
+        })
+        .collect();
+    json!({
+        "name": d.name,
+        "structure": s.kind,
+        "nl": d.nl,
+        "nj": d.nj,
+        "nf": d.nf(),
+        "gravity": d.gravity.iter().map(|e| e.to_string()).collect::<Vec<_>>(),
+        "symbols": d.symbols,
+        "frames": frames,
+        "links": links,
+        "main_branches": s.main_branches,
+        "loops": s.loops,
+        "actuated": (1..=d.nl).filter(|&j| d.frame(j).actuated).collect::<Vec<_>>(),
+        "passive": (1..=d.nl).filter(|&j| !d.frame(j).actuated && d.frame(j).joint.is_movable()).collect::<Vec<_>>(),
+        "notes": d.notes,
+    })
+}
+
+fn role(d: &RobotDescription, j: usize) -> &'static str {
+    if j <= d.nl {
+        "tree"
+    } else if j <= d.nj {
+        "cut joint"
+    } else {
+        "cut-joint twin"
+    }
+}
+
+fn print_text(d: &RobotDescription, s: &robodyn::model::Structure) {
+    println!(
+        "{}: {} structure, NL = {}, NJ = {}, NF = {}",
+        d.name,
+        s.kind,
+        d.nl,
+        d.nj,
+        d.nf()
+    );
+    for n in &d.notes {
+        println!("  note: {n}");
+    }
+    let g: Vec<String> = d.gravity.iter().map(|e| e.to_string()).collect();
+    println!("gravity: [{}]", g.join(", "));
+    println!();
+    let mut rows = vec![[
+        "j", "name", "a(j)", "sigma", "mu", "gamma", "b", "alpha", "d", "theta", "r", "role",
+    ]
+    .map(String::from)
+    .to_vec()];
+    for (i, f) in d.frames.iter().enumerate() {
+        let mut r = vec![
+            (i + 1).to_string(),
+            f.name.clone(),
+            f.ant.to_string(),
+            f.joint.sigma().to_string(),
+            u8::from(f.actuated).to_string(),
+        ];
+        for (k, e) in f.geometric().iter().enumerate() {
+            let var = match (k, f.joint.sigma(), i + 1 <= d.nj) {
+                (4, 0, true) => Some(format!("th{}", i + 1)),
+                (5, 1, true) => Some(format!("r{}", i + 1)),
+                _ => None,
+            };
+            r.push(match var {
+                Some(v) if e.is_zero() => v,
+                Some(v) => format!("{v} + {e}"),
+                None => e.to_string(),
+            });
+        }
+        r.push(role(d, i + 1).into());
+        rows.push(r);
+    }
+    print_rows(&rows);
+    println!();
+    println!("main branches:");
+    for b in &s.main_branches {
+        let p: Vec<String> = b.iter().map(|x| x.to_string()).collect();
+        println!("  0 - {}", p.join(" - "));
+    }
+    if s.loops.is_empty() {
+        println!("loops: none");
+    } else {
+        println!("loops:");
+        for (l, lp) in s.loops.iter().enumerate() {
+            println!(
+                "  loop {}: cut joint {} joins link {} and link {} (twin frame {}), root {}, branches {:?} / {:?}",
+                l + 1, lp.cut, lp.link_i, lp.link_j, lp.twin, lp.root, lp.branch_i, lp.branch_j
+            );
+        }
+    }
+    let act: Vec<String> = (1..=d.nl)
+        .filter(|&j| d.frame(j).actuated)
+        .map(|j| j.to_string())
+        .collect();
+    let pas: Vec<String> = (1..=d.nl)
+        .filter(|&j| !d.frame(j).actuated && d.frame(j).joint.is_movable())
+        .map(|j| j.to_string())
+        .collect();
+    println!(
+        "actuated joints: {}",
+        if act.is_empty() {
+            "none".into()
+        } else {
+            act.join(", ")
+        }
+    );
+    println!(
+        "passive tree joints: {}",
+        if pas.is_empty() {
+            "none".into()
+        } else {
+            pas.join(", ")
+        }
+    );
+}
+
+fn print_rows(rows: &[Vec<String>]) {
+    let n = rows[0].len();
+    let w: Vec<usize> = (0..n)
+        .map(|c| rows.iter().map(|r| r[c].chars().count()).max().unwrap_or(0))
+        .collect();
+    for r in rows {
+        let line: Vec<String> = r
+            .iter()
+            .enumerate()
+            .map(|(c, x)| format!("{x:<width$}", width = w[c]))
+            .collect();
+        println!("{}", line.join("  ").trim_end());
+    }
+}

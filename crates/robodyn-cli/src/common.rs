@@ -1,0 +1,174 @@
+//! Options and helpers shared by the commands: loading a robot, reading and writing state tables.
+
+use clap::Args;
+use robodyn::{Error, Robot};
+use std::collections::BTreeMap;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+pub type CliResult<T = ()> = Result<T, Box<dyn std::error::Error>>;
+
+/// The robot file and symbol overrides.
+#[derive(Args, Debug, Clone)]
+pub struct RobotArgs {
+    /// Robot file (.toml, .par or .urdf).
+    pub robot: PathBuf,
+    /// Give or override a symbol value, e.g. `--set d3=0.6` (repeatable).
+    #[arg(long = "set", value_name = "NAME=VALUE")]
+    pub set: Vec<String>,
+}
+
+impl RobotArgs {
+    pub fn overrides(&self) -> CliResult<BTreeMap<String, f64>> {
+        let mut m = BTreeMap::new();
+        for s in &self.set {
+            let (k, v) = s
+                .split_once('=')
+                .ok_or_else(|| format!("--set {s}: expected NAME=VALUE"))?;
+            let x: f64 = v
+                .trim()
+                .parse()
+                .map_err(|_| format!("--set {s}: `{v}` is not a number"))?;
+            if !x.is_finite() {
+                return Err(format!("--set {s}: value is not finite").into());
+            }
+            m.insert(k.trim().to_string(), x);
+        }
+        Ok(m)
+    }
+
+    /// Load and validate the robot (all symbols need values).
+    pub fn load(&self) -> CliResult<Robot> {
+        Ok(robodyn::io::load_with(&self.robot, &self.overrides()?)?)
+    }
+}
+
+/// Parse a comma-separated list of numbers (`--q 0.1,0.2,...`).
+pub fn parse_list(name: &str, s: &str) -> CliResult<Vec<f64>> {
+    s.split(',')
+        .map(|t| {
+            let t = t.trim();
+            robodyn::Expr::parse(t)
+                .ok()
+                .and_then(|e| e.eval(&|_| None).ok())
+                .ok_or_else(|| format!("--{name}: `{t}` is not a number").into())
+        })
+        .collect()
+}
+
+/// A table of named columns read from CSV.
+pub struct Table {
+    pub headers: Vec<String>,
+    pub rows: Vec<Vec<f64>>,
+    pub file: String,
+}
+
+impl Table {
+    pub fn read(path: &Path) -> CliResult<Table> {
+        let file = path.display().to_string();
+        let mut rdr = csv::ReaderBuilder::new()
+            .trim(csv::Trim::All)
+            .comment(Some(b'#'))
+            .from_path(path)
+            .map_err(|e| format!("{file}: {e}"))?;
+        let headers: Vec<String> = rdr
+            .headers()
+            .map_err(|e| format!("{file}: {e}"))?
+            .iter()
+            .map(str::to_string)
+            .collect();
+        let mut rows = Vec::new();
+        for (i, rec) in rdr.records().enumerate() {
+            let rec = rec.map_err(|e| format!("{file}: {e}"))?;
+            let line = rec.position().map(|p| p.line()).unwrap_or(i as u64 + 2);
+            let mut row = Vec::with_capacity(rec.len());
+            for (k, field) in rec.iter().enumerate() {
+                let x: f64 = field.parse().map_err(|_| {
+                    format!(
+                        "{file}:{line}: column `{}`: `{field}` is not a number",
+                        headers[k]
+                    )
+                })?;
+                if !x.is_finite() {
+                    return Err(format!(
+                        "{file}:{line}: column `{}`: {x} is not finite",
+                        headers[k]
+                    )
+                    .into());
+                }
+                row.push(x);
+            }
+            rows.push(row);
+        }
+        Ok(Table {
+            headers,
+            rows,
+            file,
+        })
+    }
+
+    /// Index of a column, or an error naming the file and the column.
+    pub fn column(&self, name: &str) -> CliResult<usize> {
+        self.headers
+            .iter()
+            .position(|h| h == name)
+            .ok_or_else(|| format!("{}: missing column `{name}`", self.file).into())
+    }
+
+    /// Index of a column if present.
+    pub fn find(&self, name: &str) -> Option<usize> {
+        self.headers.iter().position(|h| h == name)
+    }
+}
+
+/// Output format of tables.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum TableFormat {
+    #[default]
+    Csv,
+    Json,
+}
+
+/// Write rows of named columns as CSV or JSON (a list of objects) to a file or stdout.
+pub fn write_table(
+    path: Option<&Path>,
+    format: TableFormat,
+    headers: &[String],
+    rows: &[Vec<f64>],
+) -> CliResult {
+    let mut out: Box<dyn Write> = match path {
+        Some(p) => Box::new(std::io::BufWriter::new(
+            std::fs::File::create(p).map_err(|e| format!("{}: {e}", p.display()))?,
+        )),
+        None => Box::new(std::io::stdout().lock()),
+    };
+    match format {
+        TableFormat::Csv => {
+            writeln!(out, "{}", headers.join(","))?;
+            for r in rows {
+                let line: Vec<String> = r.iter().map(|x| format!("{x:.12e}")).collect();
+                writeln!(out, "{}", line.join(","))?;
+            }
+        }
+        TableFormat::Json => {
+            let v: Vec<serde_json::Map<String, serde_json::Value>> = rows
+                .iter()
+                .map(|r| {
+                    headers
+                        .iter()
+                        .zip(r)
+                        .map(|(h, x)| (h.clone(), serde_json::json!(x)))
+                        .collect()
+                })
+                .collect();
+            serde_json::to_writer_pretty(&mut out, &v)?;
+            writeln!(out)?;
+        }
+    }
+    Ok(())
+}
+
+/// Turn a library error into a CLI error.
+pub fn lib(e: Error) -> Box<dyn std::error::Error> {
+    Box::new(e)
+}

@@ -1,0 +1,216 @@
+//! Parser for the expressions found in robot files: numbers, symbols, `pi`, `+ - * / ^ **`,
+//! parentheses and the functions `sin cos tan sqrt abs sign`.
+
+use crate::expr::{Expr, Func};
+
+/// A parse error with the byte offset (0-based) of the offending character in the input.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("column {}: {message}", .offset + 1)]
+pub struct ParseError {
+    pub offset: usize,
+    pub message: String,
+}
+
+impl Expr {
+    /// Parse an expression such as `-pi/2`, `d12*cos(g12)`, `0.45`, `RL4`.
+    pub fn parse(text: &str) -> Result<Expr, ParseError> {
+        let mut p = Parser {
+            s: text.as_bytes(),
+            pos: 0,
+        };
+        p.skip_ws();
+        if p.pos >= p.s.len() {
+            return Err(p.err("empty expression"));
+        }
+        let e = p.sum()?;
+        p.skip_ws();
+        if p.pos < p.s.len() {
+            return Err(p.err(&format!("unexpected `{}`", p.s[p.pos] as char)));
+        }
+        Ok(e)
+    }
+}
+
+struct Parser<'a> {
+    s: &'a [u8],
+    pos: usize,
+}
+
+impl Parser<'_> {
+    fn err(&self, m: &str) -> ParseError {
+        ParseError {
+            offset: self.pos,
+            message: m.to_string(),
+        }
+    }
+
+    fn skip_ws(&mut self) {
+        while self.pos < self.s.len() && self.s[self.pos].is_ascii_whitespace() {
+            self.pos += 1;
+        }
+    }
+
+    fn peek(&mut self) -> Option<u8> {
+        self.skip_ws();
+        self.s.get(self.pos).copied()
+    }
+
+    fn sum(&mut self) -> Result<Expr, ParseError> {
+        let mut acc = self.product()?;
+        while let Some(c) = self.peek() {
+            match c {
+                b'+' => {
+                    self.pos += 1;
+                    acc = acc + self.product()?;
+                }
+                b'-' => {
+                    self.pos += 1;
+                    acc = acc - self.product()?;
+                }
+                _ => break,
+            }
+        }
+        Ok(acc)
+    }
+
+    fn product(&mut self) -> Result<Expr, ParseError> {
+        let mut acc = self.unary()?;
+        loop {
+            match self.peek() {
+                Some(b'*') if self.s.get(self.pos + 1) != Some(&b'*') => {
+                    self.pos += 1;
+                    acc = acc * self.unary()?;
+                }
+                Some(b'/') => {
+                    self.pos += 1;
+                    let at = self.pos;
+                    let d = self.unary()?;
+                    if d.is_zero() {
+                        return Err(ParseError {
+                            offset: at,
+                            message: "division by zero".into(),
+                        });
+                    }
+                    acc = acc / d;
+                }
+                _ => break,
+            }
+        }
+        Ok(acc)
+    }
+
+    fn unary(&mut self) -> Result<Expr, ParseError> {
+        match self.peek() {
+            Some(b'-') => {
+                self.pos += 1;
+                Ok(-self.unary()?)
+            }
+            Some(b'+') => {
+                self.pos += 1;
+                self.unary()
+            }
+            _ => self.power(),
+        }
+    }
+
+    fn power(&mut self) -> Result<Expr, ParseError> {
+        let base = self.atom()?;
+        let is_pow = match self.peek() {
+            Some(b'^') => {
+                self.pos += 1;
+                true
+            }
+            Some(b'*') if self.s.get(self.pos + 1) == Some(&b'*') => {
+                self.pos += 2;
+                true
+            }
+            _ => false,
+        };
+        if !is_pow {
+            return Ok(base);
+        }
+        let at = self.pos;
+        let exp = self.unary()?;
+        match exp.as_rational() {
+            Some(r) if r.is_integer() && r.numer().abs() <= 64 => Ok(base.powi(*r.numer() as i32)),
+            Some(r) if *r.denom() == 2 && *r.numer() == 1 => Ok(base.sqrt()),
+            _ => Err(ParseError {
+                offset: at,
+                message: "only integer exponents (or 1/2) are supported".into(),
+            }),
+        }
+    }
+
+    fn atom(&mut self) -> Result<Expr, ParseError> {
+        let c = match self.peek() {
+            Some(c) => c,
+            None => return Err(self.err("unexpected end of expression")),
+        };
+        if c == b'(' {
+            self.pos += 1;
+            let e = self.sum()?;
+            if self.peek() != Some(b')') {
+                return Err(self.err("expected `)`"));
+            }
+            self.pos += 1;
+            return Ok(e);
+        }
+        if c.is_ascii_digit() || c == b'.' {
+            return self.number();
+        }
+        if c.is_ascii_alphabetic() || c == b'_' {
+            let start = self.pos;
+            while self.pos < self.s.len()
+                && (self.s[self.pos].is_ascii_alphanumeric() || self.s[self.pos] == b'_')
+            {
+                self.pos += 1;
+            }
+            let name = std::str::from_utf8(&self.s[start..self.pos]).unwrap_or("");
+            if self.peek() == Some(b'(') {
+                let f = Func::from_name(name).ok_or(ParseError {
+                    offset: start,
+                    message: format!("unknown function `{name}`"),
+                })?;
+                self.pos += 1;
+                let a = self.sum()?;
+                if self.peek() != Some(b')') {
+                    return Err(self.err("expected `)`"));
+                }
+                self.pos += 1;
+                return Ok(Expr::func(f, a));
+            }
+            return Ok(match name {
+                "pi" | "Pi" | "PI" => Expr::pi(),
+                _ => Expr::symbol(name),
+            });
+        }
+        Err(self.err(&format!("unexpected `{}`", c as char)))
+    }
+
+    fn number(&mut self) -> Result<Expr, ParseError> {
+        let start = self.pos;
+        let s = self.s;
+        let mut i = self.pos;
+        while i < s.len() && (s[i].is_ascii_digit() || s[i] == b'.') {
+            i += 1;
+        }
+        if i < s.len() && (s[i] == b'e' || s[i] == b'E') {
+            let mut k = i + 1;
+            if k < s.len() && (s[k] == b'+' || s[k] == b'-') {
+                k += 1;
+            }
+            if k < s.len() && s[k].is_ascii_digit() {
+                while k < s.len() && s[k].is_ascii_digit() {
+                    k += 1;
+                }
+                i = k;
+            }
+        }
+        let text = std::str::from_utf8(&s[start..i]).unwrap_or("");
+        self.pos = i;
+        text.parse::<f64>().map(Expr::num).map_err(|_| ParseError {
+            offset: start,
+            message: format!("bad number `{text}`"),
+        })
+    }
+}

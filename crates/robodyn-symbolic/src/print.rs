@@ -1,0 +1,188 @@
+//! Plain-text printing of expressions (`d3^2*(M3 + M4) - MX8/d3`), with minimal parentheses.
+
+use crate::expr::{Expr, Node};
+use num_rational::Rational64;
+use num_traits::{One, Signed};
+use std::fmt;
+
+const PREC_SUM: u8 = 0;
+const PREC_PRODUCT: u8 = 1;
+const PREC_POWER: u8 = 2;
+
+impl fmt::Display for Expr {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write_expr(f, self, PREC_SUM)
+    }
+}
+
+fn write_rational(f: &mut fmt::Formatter<'_>, r: &Rational64, prec: u8) -> fmt::Result {
+    let needs = (r.is_negative() && prec > PREC_SUM) || (!r.is_integer() && prec > PREC_PRODUCT);
+    if needs {
+        write!(f, "(")?;
+    }
+    if r.is_integer() {
+        write!(f, "{}", r.numer())?;
+    } else {
+        write!(f, "{}/{}", r.numer(), r.denom())?;
+    }
+    if needs {
+        write!(f, ")")?;
+    }
+    Ok(())
+}
+
+fn write_expr(f: &mut fmt::Formatter<'_>, e: &Expr, prec: u8) -> fmt::Result {
+    match e.node() {
+        Node::Rational(r) => write_rational(f, r, prec),
+        Node::Float(x) => {
+            if *x < 0.0 && prec > PREC_SUM {
+                write!(f, "({x})")
+            } else {
+                write!(f, "{x}")
+            }
+        }
+        Node::Pi => write!(f, "pi"),
+        Node::Symbol(s) => write!(f, "{s}"),
+        Node::Add(terms) => {
+            if prec > PREC_SUM {
+                write!(f, "(")?;
+            }
+            for (i, t) in terms.iter().enumerate() {
+                let negative = term_is_negative(t);
+                if i == 0 {
+                    write_expr(f, t, PREC_SUM)?;
+                    // a leading product with a negative coefficient prints its own minus sign
+                } else if negative {
+                    write!(f, " - ")?;
+                    write_expr(f, &-t.clone(), PREC_SUM)?;
+                } else {
+                    write!(f, " + ")?;
+                    write_expr(f, t, PREC_SUM)?;
+                }
+            }
+            if prec > PREC_SUM {
+                write!(f, ")")?;
+            }
+            Ok(())
+        }
+        Node::Mul(_) | Node::Pow(..) => write_product(f, e, prec),
+        Node::Func(func, a) => {
+            write!(f, "{}(", func.name())?;
+            write_expr(f, a, PREC_SUM)?;
+            write!(f, ")")
+        }
+    }
+}
+
+/// True when a term prints with a leading minus sign.
+pub(crate) fn term_is_negative(t: &Expr) -> bool {
+    match t.node() {
+        Node::Rational(r) => r.is_negative(),
+        Node::Float(x) => *x < 0.0,
+        Node::Mul(v) => match v[0].node() {
+            Node::Rational(r) => r.is_negative(),
+            Node::Float(x) => *x < 0.0,
+            _ => false,
+        },
+        _ => false,
+    }
+}
+
+/// Split a product into (numeric coefficient, numerator factors, denominator factors).
+pub(crate) fn product_parts(e: &Expr) -> (Option<Expr>, Vec<Expr>, Vec<Expr>) {
+    let factors: Vec<Expr> = match e.node() {
+        Node::Mul(v) => v.clone(),
+        _ => vec![e.clone()],
+    };
+    let mut coef = None;
+    let mut num = Vec::new();
+    let mut den = Vec::new();
+    for fa in factors {
+        match fa.node() {
+            Node::Rational(_) | Node::Float(_) => coef = Some(fa.clone()),
+            Node::Pow(b, n) if *n < 0 => den.push(b.powi(-n)),
+            _ => num.push(fa.clone()),
+        }
+    }
+    (coef, num, den)
+}
+
+fn write_product(f: &mut fmt::Formatter<'_>, e: &Expr, prec: u8) -> fmt::Result {
+    if let Node::Pow(b, n) = e.node() {
+        if *n > 0 {
+            write_expr(f, b, PREC_POWER + 1)?;
+            return write!(f, "^{n}");
+        }
+    }
+    let (coef, num, den) = product_parts(e);
+    let mut num_coef: Option<Expr> = None;
+    let mut den_coef: Option<i64> = None;
+    let mut negative = false;
+    if let Some(c) = coef {
+        match c.node() {
+            Node::Rational(r) => {
+                negative = r.is_negative();
+                let a = r.abs();
+                if !a.numer().is_one() || num.is_empty() {
+                    num_coef = Some(Expr::int(*a.numer()));
+                }
+                if !a.denom().is_one() {
+                    den_coef = Some(*a.denom());
+                }
+            }
+            Node::Float(x) => {
+                negative = *x < 0.0;
+                num_coef = Some(Expr::num(x.abs()));
+            }
+            _ => unreachable!(),
+        }
+    }
+    let wrap = prec > PREC_PRODUCT || (negative && prec > PREC_SUM + 1);
+    if wrap {
+        write!(f, "(")?;
+    }
+    if negative {
+        write!(f, "-")?;
+    }
+    let mut first = true;
+    if let Some(c) = &num_coef {
+        write_expr(f, c, PREC_PRODUCT)?;
+        first = false;
+    }
+    for x in &num {
+        if !first {
+            write!(f, "*")?;
+        }
+        write_expr(f, x, PREC_PRODUCT + 1)?;
+        first = false;
+    }
+    if first {
+        write!(f, "1")?;
+    }
+    let den_count = den.len() + usize::from(den_coef.is_some());
+    if den_count > 0 {
+        write!(f, "/")?;
+        if den_count > 1 {
+            write!(f, "(")?;
+        }
+        let mut first = true;
+        if let Some(d) = den_coef {
+            write!(f, "{d}")?;
+            first = false;
+        }
+        for x in &den {
+            if !first {
+                write!(f, "*")?;
+            }
+            write_expr(f, x, PREC_PRODUCT + 1)?;
+            first = false;
+        }
+        if den_count > 1 {
+            write!(f, ")")?;
+        }
+    }
+    if wrap {
+        write!(f, ")")?;
+    }
+    Ok(())
+}

@@ -1,0 +1,58 @@
+use crate::Expr;
+
+fn p(s: &str) -> Expr {
+    Expr::parse(s).unwrap()
+}
+
+#[test]
+fn parses_and_prints() {
+    assert_eq!(p("-pi/2").to_string(), "-pi/2");
+    assert_eq!(p("d12*cos(g12)").to_string(), "d12*cos(g12)");
+    assert_eq!(p("2*x + 3*x").to_string(), "5*x");
+    assert_eq!(p("x - x").to_string(), "0");
+    assert_eq!(p("MX8/d3").to_string(), "MX8/d3");
+    assert_eq!(p("d3^2*(M3 + M4)").to_string(), "d3^2*(M3 + M4)");
+    assert_eq!(p("XX2 - YY2").to_string(), "XX2 - YY2");
+    assert_eq!(p("-d8").to_string(), "-d8");
+    assert_eq!(p("0.45").to_string(), "9/20");
+}
+
+#[test]
+fn exact_trigonometry_of_half_pi_multiples() {
+    assert!(p("cos(pi/2)").is_zero());
+    assert!(p("sin(pi/2)").is_one());
+    assert_eq!(p("sin(-pi/2)").as_f64(), Some(-1.0));
+    assert_eq!(p("cos(3*pi)").as_f64(), Some(-1.0));
+    assert_eq!(p("sin(-x)").to_string(), "-sin(x)");
+    assert_eq!(p("cos(-x)").to_string(), "cos(x)");
+}
+
+#[test]
+fn evaluates_with_symbols() {
+    let e = p("d3*cos(g) + RL4^2");
+    let v = e
+        .eval(&|s| match s {
+            "d3" => Some(2.0),
+            "g" => Some(0.0),
+            "RL4" => Some(3.0),
+            _ => None,
+        })
+        .unwrap();
+    assert_eq!(v, 11.0);
+    assert!(p("a + b").eval(&|s| (s == "a").then_some(1.0)).is_err());
+}
+
+#[test]
+fn parse_errors_carry_offsets() {
+    let e = Expr::parse("d3 + * 2").unwrap_err();
+    assert_eq!(e.offset, 5);
+    assert!(Expr::parse("foo(2)").is_err());
+    assert!(Expr::parse("(a + b").is_err());
+    assert!(Expr::parse("").is_err());
+    assert!(Expr::parse("1/0").is_err());
+}
+
+#[test]
+fn expand_distributes() {
+    assert_eq!(p("(a + b)*(a - b)").expand().to_string(), "a^2 - b^2");
+}

@@ -1,0 +1,157 @@
+//! Inverse dynamic model of tree structures by the recursive Newton–Euler algorithm
+//! (eqs 10.3–10.12), with gravity as a base acceleration, rotor inertia, Coulomb and viscous
+//! friction and external wrenches.
+
+use crate::error::{Error, Result};
+use crate::model::{DynModel, JointType, Robot};
+use crate::scalar::DynScalar;
+use crate::workspace::Workspace;
+use nalgebra::{DVector, Vector3};
+
+/// `z x (s v)` is needed as `w x (qd * z)`: returns `w x [0, 0, s]`.
+#[inline]
+fn cross_z<T: DynScalar>(w: &Vector3<T>, s: &T) -> Vector3<T> {
+    Vector3::new(
+        w.y.clone() * s.clone(),
+        -(w.x.clone() * s.clone()),
+        T::zero(),
+    )
+}
+
+/// Forward recursion (eqs 10.3–10.8): fills `ws.rot`, `ws.pos`, `ws.w`, `ws.wd`, `ws.vd` and the
+/// link wrenches `ws.f` = jF_j + jfe_j, `ws.m` = jM_j + jme_j for links 1..NL.
+pub fn forward_recursion<T: DynScalar>(
+    model: &DynModel<T>,
+    ws: &mut Workspace<T>,
+    q: &[T],
+    qd: &[T],
+    qdd: &[T],
+) {
+    ws.w[0] = model.w0.clone();
+    ws.wd[0] = model.wp0.clone();
+    ws.vd[0] = &model.vp0 - &model.gravity;
+    for j in 1..=model.nl {
+        let fr = model.frame(j);
+        let i = fr.ant;
+        let (rot, pos) = fr.transform(&q[j - 1]);
+        // jA_i = (iA_j)^T
+        let jai = rot.transpose();
+        // iU_i iP_j = wd_i x P + w_i x (w_i x P)
+        let up = ws.wd[i].cross(&pos) + ws.w[i].cross(&ws.w[i].cross(&pos));
+        let wi = &jai * &ws.w[i]; // (10.3)
+        let mut vd = &jai * (&ws.vd[i] + up); // (10.6), first part
+        let mut wd = &jai * &ws.wd[i];
+        let mut w = wi.clone();
+        match fr.joint {
+            JointType::Revolute => {
+                // (10.4), (10.5)
+                w.z += qd[j - 1].clone();
+                wd += cross_z(&wi, &qd[j - 1]);
+                wd.z += qdd[j - 1].clone();
+            }
+            JointType::Prismatic => {
+                // (10.6), second part: qdd a + 2 w_i x qd a
+                vd += cross_z(&wi, &(qd[j - 1].clone() + qd[j - 1].clone()));
+                vd.z += qdd[j - 1].clone();
+            }
+            JointType::Fixed => {}
+        }
+        let l = model.link(j);
+        // (10.7): F = M vd + U MS, U MS = wd x MS + w x (w x MS)
+        let f = &vd * l.mass.clone() + wd.cross(&l.ms) + w.cross(&w.cross(&l.ms));
+        // (10.8): M = J wd + w x (J w) + MS x vd
+        let jw = &l.inertia * &w;
+        let m = &l.inertia * &wd + w.cross(&jw) + l.ms.cross(&vd);
+        ws.f[j] = f + &l.fe;
+        ws.m[j] = m + &l.me;
+        ws.rot[j] = rot;
+        ws.pos[j] = pos;
+        ws.w[j] = w;
+        ws.wd[j] = wd;
+        ws.vd[j] = vd;
+    }
+}
+
+/// Backward recursion (eqs 10.9–10.12) after [`forward_recursion`]: accumulates the wrenches
+/// towards the base and writes the joint torques of the tree joints 1..NL into `tau`
+/// (0 for fixed frames).
+pub fn backward_recursion<T: DynScalar>(
+    model: &DynModel<T>,
+    ws: &mut Workspace<T>,
+    qd: &[T],
+    qdd: &[T],
+    tau: &mut [T],
+) {
+    for j in (1..=model.nl).rev() {
+        let fr = model.frame(j);
+        let l = model.link(j);
+        tau[j - 1] = match fr.joint {
+            JointType::Revolute | JointType::Prismatic => {
+                let proj = if fr.joint == JointType::Revolute {
+                    ws.m[j].z.clone()
+                } else {
+                    ws.f[j].z.clone()
+                };
+                // (10.12)
+                proj + l.fs.clone() * qd[j - 1].sign()
+                    + l.fv.clone() * qd[j - 1].clone()
+                    + l.ia.clone() * qdd[j - 1].clone()
+            }
+            JointType::Fixed => T::zero(),
+        };
+        let i = fr.ant;
+        if i > 0 {
+            // (10.10), (10.11)
+            let fi = &ws.rot[j] * &ws.f[j];
+            let mi = &ws.rot[j] * &ws.m[j] + ws.pos[j].cross(&fi);
+            ws.f[i] += fi;
+            ws.m[i] += mi;
+        }
+    }
+}
+
+/// Torques of the tree joints 1..NL (`tau.len() == NL`) by recursive Newton–Euler.
+/// Allocation-free: all intermediate values live in `ws`. Entries of fixed frames are ignored in
+/// the inputs and zero in the output.
+pub fn rnea<T: DynScalar>(
+    model: &DynModel<T>,
+    ws: &mut Workspace<T>,
+    q: &[T],
+    qd: &[T],
+    qdd: &[T],
+    tau: &mut [T],
+) {
+    forward_recursion(model, ws, q, qd, qdd);
+    backward_recursion(model, ws, qd, qdd, tau);
+}
+
+/// Check that a state vector has NL entries, all finite.
+pub fn check_state(robot: &Robot, name: &str, v: &[f64]) -> Result<()> {
+    if v.len() != robot.nl() {
+        return Err(Error::Input(format!(
+            "{name} has {} entries, the robot has NL = {} tree joints",
+            v.len(),
+            robot.nl()
+        )));
+    }
+    if let Some(k) = v.iter().position(|x| !x.is_finite()) {
+        return Err(Error::Input(format!(
+            "{name}{} = {} is not a finite number",
+            k + 1,
+            v[k]
+        )));
+    }
+    Ok(())
+}
+
+/// Inverse dynamic model of the (equivalent) tree: Gamma_tr(q, qd, qdd) for joints 1..NL.
+/// Convenience wrapper that checks its inputs and allocates; use [`rnea`] in loops.
+pub fn inverse_dynamics(robot: &Robot, q: &[f64], qd: &[f64], qdd: &[f64]) -> Result<DVector<f64>> {
+    check_state(robot, "q", q)?;
+    check_state(robot, "qd", qd)?;
+    check_state(robot, "qdd", qdd)?;
+    let mut ws = Workspace::new(robot.numeric());
+    let mut tau = DVector::zeros(robot.nl());
+    rnea(robot.numeric(), &mut ws, q, qd, qdd, tau.as_mut_slice());
+    Ok(tau)
+}

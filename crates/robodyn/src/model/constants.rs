@@ -1,0 +1,170 @@
+//! The robot's constants in a scalar type `T`: what the recursive algorithms run on.
+//!
+//! `DynModel<f64>` is built once when a [`crate::Robot`] is validated; `DynModel<Expr>` is built by
+//! the symbolic model generator from the same description, so the same recursion serves both.
+
+use crate::model::{JointType, RobotDescription};
+use crate::scalar::DynScalar;
+use nalgebra::{Matrix3, Vector3};
+use robodyn_symbolic::Expr;
+
+/// Constant part of frame j's placement: iT_j = [pre_rot * Rz(theta), pre_pos + pre_rot * [0 0 r]].
+#[derive(Clone, Debug)]
+pub struct FrameConstants<T: DynScalar> {
+    /// a(j).
+    pub ant: usize,
+    pub joint: JointType,
+    /// Rz(gamma) Rx(alpha).
+    pub pre_rot: Matrix3<T>,
+    /// Rz(gamma) ([0 0 b] + Rx(alpha) [d 0 0]).
+    pub pre_pos: Vector3<T>,
+    /// Constant part of theta (the revolute joint variable is added to it).
+    pub theta0: T,
+    /// Constant part of r (the prismatic joint variable is added to it).
+    pub r0: T,
+}
+
+impl<T: DynScalar> FrameConstants<T> {
+    /// Build from the six geometric parameters, already in scalar `T`.
+    pub fn new(ant: usize, joint: JointType, g: [T; 6]) -> Self {
+        let [gamma, b, alpha, d, theta, r] = g;
+        let (cg, sg, ca, sa) = (gamma.cos(), gamma.sin(), alpha.cos(), alpha.sin());
+        let z = T::zero;
+        let o = T::one;
+        let rz = Matrix3::new(cg.clone(), -sg.clone(), z(), sg, cg, z(), z(), z(), o());
+        let rx = Matrix3::new(o(), z(), z(), z(), ca.clone(), -sa.clone(), z(), sa, ca);
+        let pre_rot = &rz * rx;
+        let pre_pos = &rz * Vector3::new(d, z(), b);
+        FrameConstants {
+            ant,
+            joint,
+            pre_rot,
+            pre_pos,
+            theta0: theta,
+            r0: r,
+        }
+    }
+
+    /// iA_j and iP_j for joint value q (eq 10.18 for the position).
+    #[inline]
+    pub fn transform(&self, q: &T) -> (Matrix3<T>, Vector3<T>) {
+        let (theta, r) = match self.joint {
+            JointType::Revolute => (self.theta0.clone() + q.clone(), self.r0.clone()),
+            JointType::Prismatic => (self.theta0.clone(), self.r0.clone() + q.clone()),
+            JointType::Fixed => (self.theta0.clone(), self.r0.clone()),
+        };
+        self.transform_at(theta, r)
+    }
+
+    /// iA_j and iP_j for explicit theta and r.
+    #[inline]
+    pub fn transform_at(&self, theta: T, r: T) -> (Matrix3<T>, Vector3<T>) {
+        let (c, s) = (theta.cos(), theta.sin());
+        let z = T::zero;
+        let rz = Matrix3::new(c.clone(), -s.clone(), z(), s, c, z(), z(), z(), T::one());
+        let rot = &self.pre_rot * rz;
+        let pos = &self.pre_pos + self.pre_rot.column(2) * r;
+        (rot, pos)
+    }
+}
+
+/// Inertial, drive and external-wrench parameters of link j in scalar `T`.
+#[derive(Clone, Debug)]
+pub struct LinkConstants<T: DynScalar> {
+    /// jJ_j about O_j.
+    pub inertia: Matrix3<T>,
+    /// jMS_j.
+    pub ms: Vector3<T>,
+    pub mass: T,
+    pub ia: T,
+    pub fs: T,
+    pub fv: T,
+    /// Force and moment exerted by the link on the environment, in R_j.
+    pub fe: Vector3<T>,
+    pub me: Vector3<T>,
+}
+
+impl<T: DynScalar> LinkConstants<T> {
+    /// From the 13 standard parameters (XX XY XZ YY YZ ZZ MX MY MZ M IA FS FV) and the wrench.
+    pub fn new(p: [T; 13], w: [T; 6]) -> Self {
+        let [xx, xy, xz, yy, yz, zz, mx, my, mz, m, ia, fs, fv] = p;
+        let [fx, fy, fz, cx, cy, cz] = w;
+        LinkConstants {
+            inertia: Matrix3::new(xx, xy.clone(), xz.clone(), xy, yy, yz.clone(), xz, yz, zz),
+            ms: Vector3::new(mx, my, mz),
+            mass: m,
+            ia,
+            fs,
+            fv,
+            fe: Vector3::new(fx, fy, fz),
+            me: Vector3::new(cx, cy, cz),
+        }
+    }
+}
+
+/// All constants of a robot in scalar `T`.
+#[derive(Clone, Debug)]
+pub struct DynModel<T: DynScalar> {
+    pub nl: usize,
+    /// Frames 1..NF at index j-1.
+    pub frames: Vec<FrameConstants<T>>,
+    /// Links 1..NL at index j-1.
+    pub links: Vec<LinkConstants<T>>,
+    /// Gravity g in R_0.
+    pub gravity: Vector3<T>,
+    pub w0: Vector3<T>,
+    pub wp0: Vector3<T>,
+    pub v0: Vector3<T>,
+    pub vp0: Vector3<T>,
+}
+
+impl<T: DynScalar> DynModel<T> {
+    /// Build from a description, mapping every geometric entry with `geo` and every link entry
+    /// (link j, index in the 13 standard parameters or 13..19 for the wrench) with `link`.
+    pub fn build(
+        desc: &RobotDescription,
+        mut geo: impl FnMut(&Expr) -> T,
+        mut link: impl FnMut(usize, usize, &Expr) -> T,
+    ) -> Self {
+        let frames = desc
+            .frames
+            .iter()
+            .map(|f| FrameConstants::new(f.ant, f.joint, f.geometric().map(&mut geo)))
+            .collect();
+        let links = desc
+            .links
+            .iter()
+            .enumerate()
+            .map(|(i, l)| {
+                let p = std::array::from_fn(|k| link(i + 1, k, &l.params[k]));
+                let w = std::array::from_fn(|k| link(i + 1, 13 + k, &l.wrench[k]));
+                LinkConstants::new(p, w)
+            })
+            .collect();
+        let v3 = |a: &[Expr; 3], geo: &mut dyn FnMut(&Expr) -> T| {
+            Vector3::new(geo(&a[0]), geo(&a[1]), geo(&a[2]))
+        };
+        DynModel {
+            nl: desc.nl,
+            frames,
+            links,
+            gravity: v3(&desc.gravity, &mut geo),
+            w0: v3(&desc.w0, &mut geo),
+            wp0: v3(&desc.wp0, &mut geo),
+            v0: v3(&desc.v0, &mut geo),
+            vp0: v3(&desc.vp0, &mut geo),
+        }
+    }
+
+    /// Frame j (1-based).
+    #[inline]
+    pub fn frame(&self, j: usize) -> &FrameConstants<T> {
+        &self.frames[j - 1]
+    }
+
+    /// Link j (1-based).
+    #[inline]
+    pub fn link(&self, j: usize) -> &LinkConstants<T> {
+        &self.links[j - 1]
+    }
+}

@@ -1,0 +1,255 @@
+//! The robot description as written in a file: every entry an expression over named symbols.
+
+use robodyn_symbolic::Expr;
+use serde::Serialize;
+use std::collections::BTreeMap;
+
+/// Joint type sigma_j (0 revolute, 1 prismatic, 2 fixed).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum JointType {
+    Revolute,
+    Prismatic,
+    Fixed,
+}
+
+impl JointType {
+    /// sigma_j as in the notation (0, 1, 2).
+    pub fn sigma(self) -> u8 {
+        match self {
+            JointType::Revolute => 0,
+            JointType::Prismatic => 1,
+            JointType::Fixed => 2,
+        }
+    }
+
+    pub fn from_sigma(s: i64) -> Option<JointType> {
+        match s {
+            0 => Some(JointType::Revolute),
+            1 => Some(JointType::Prismatic),
+            2 => Some(JointType::Fixed),
+            _ => None,
+        }
+    }
+
+    /// sigma_bar_j = 1 - sigma_j for movable joints, 0 for fixed ones.
+    pub fn is_revolute(self) -> bool {
+        self == JointType::Revolute
+    }
+
+    pub fn is_prismatic(self) -> bool {
+        self == JointType::Prismatic
+    }
+
+    pub fn is_movable(self) -> bool {
+        self != JointType::Fixed
+    }
+}
+
+/// The six geometric parameters of a frame, in the order of the transformation
+/// iT_j = Rot(z,gamma) Trans(z,b) Rot(x,alpha) Trans(x,d) Rot(z,theta) Trans(z,r).
+pub const GEOMETRIC_PARAMETERS: [&str; 6] = ["gamma", "b", "alpha", "d", "theta", "r"];
+
+/// Frame j of the Khalil–Kleinfinger description.
+///
+/// `theta` and `r` hold the *constant* part only: for a revolute joint the joint variable q_j is
+/// added to `theta`, for a prismatic joint to `r` (q_j = sigma_bar theta_j + sigma r_j).
+#[derive(Clone, Debug, PartialEq)]
+pub struct FrameDesc {
+    /// Name (URDF joint name, or `j<j>` when the file gives none).
+    pub name: String,
+    /// Antecedent a(j): 0 for the base.
+    pub ant: usize,
+    pub joint: JointType,
+    /// mu_j: true when the joint is actuated.
+    pub actuated: bool,
+    pub gamma: Expr,
+    pub b: Expr,
+    pub alpha: Expr,
+    pub d: Expr,
+    pub theta: Expr,
+    pub r: Expr,
+}
+
+impl FrameDesc {
+    /// A frame with all six parameters zero.
+    pub fn new(name: impl Into<String>, ant: usize, joint: JointType, actuated: bool) -> Self {
+        FrameDesc {
+            name: name.into(),
+            ant,
+            joint,
+            actuated,
+            gamma: Expr::zero(),
+            b: Expr::zero(),
+            alpha: Expr::zero(),
+            d: Expr::zero(),
+            theta: Expr::zero(),
+            r: Expr::zero(),
+        }
+    }
+
+    /// The six parameters in [`GEOMETRIC_PARAMETERS`] order.
+    pub fn geometric(&self) -> [&Expr; 6] {
+        [
+            &self.gamma,
+            &self.b,
+            &self.alpha,
+            &self.d,
+            &self.theta,
+            &self.r,
+        ]
+    }
+
+    pub fn geometric_mut(&mut self) -> [&mut Expr; 6] {
+        [
+            &mut self.gamma,
+            &mut self.b,
+            &mut self.alpha,
+            &mut self.d,
+            &mut self.theta,
+            &mut self.r,
+        ]
+    }
+}
+
+/// Names of the 13 standard parameters of a link, in SYMORO's order.
+pub const STANDARD_PARAMETERS: [&str; 13] = [
+    "XX", "XY", "XZ", "YY", "YZ", "ZZ", "MX", "MY", "MZ", "M", "IA", "FS", "FV",
+];
+
+/// Index of each standard parameter in [`STANDARD_PARAMETERS`].
+pub mod param {
+    pub const XX: usize = 0;
+    pub const XY: usize = 1;
+    pub const XZ: usize = 2;
+    pub const YY: usize = 3;
+    pub const YZ: usize = 4;
+    pub const ZZ: usize = 5;
+    pub const MX: usize = 6;
+    pub const MY: usize = 7;
+    pub const MZ: usize = 8;
+    pub const M: usize = 9;
+    pub const IA: usize = 10;
+    pub const FS: usize = 11;
+    pub const FV: usize = 12;
+}
+
+/// Names of the external wrench components (exerted by the link on the environment, in R_j).
+pub const WRENCH_COMPONENTS: [&str; 6] = ["FX", "FY", "FZ", "CX", "CY", "CZ"];
+
+/// Link j: 13 standard inertial/drive parameters and the external wrench.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LinkDesc {
+    pub name: String,
+    /// XX XY XZ YY YZ ZZ MX MY MZ M IA FS FV, about O_j in R_j.
+    pub params: [Expr; 13],
+    /// FX FY FZ CX CY CZ: force and moment the link exerts on the environment, in R_j.
+    pub wrench: [Expr; 6],
+}
+
+impl LinkDesc {
+    /// A link whose parameters are the symbols `XX<j>`, ..., `FV<j>` (SYMORO's default).
+    pub fn symbolic(j: usize) -> Self {
+        LinkDesc {
+            name: format!("link{j}"),
+            params: std::array::from_fn(|k| Expr::symbol(format!("{}{j}", STANDARD_PARAMETERS[k]))),
+            wrench: std::array::from_fn(|_| Expr::zero()),
+        }
+    }
+
+    /// A link with all parameters zero.
+    pub fn zero(name: impl Into<String>) -> Self {
+        LinkDesc {
+            name: name.into(),
+            params: std::array::from_fn(|_| Expr::zero()),
+            wrench: std::array::from_fn(|_| Expr::zero()),
+        }
+    }
+}
+
+/// A complete robot description: what a file says. Validate it with [`crate::Robot::new`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct RobotDescription {
+    pub name: String,
+    /// NL: number of links (the equivalent tree has joints 1..NL).
+    pub nl: usize,
+    /// NJ: number of joints, NJ - NL = B cut joints.
+    pub nj: usize,
+    /// Frames 1..NF (index j-1), NF = 2 NJ - NL.
+    pub frames: Vec<FrameDesc>,
+    /// Links 1..NL (index j-1).
+    pub links: Vec<LinkDesc>,
+    /// Gravity acceleration g in frame 0 (e.g. [0, 0, -9.81]).
+    pub gravity: [Expr; 3],
+    /// Base angular velocity, angular acceleration, linear velocity and acceleration, in R_0.
+    pub w0: [Expr; 3],
+    pub wp0: [Expr; 3],
+    pub v0: [Expr; 3],
+    pub vp0: [Expr; 3],
+    /// Whether the base is mobile (SYMORO's `is_mobile`).
+    pub mobile_base: bool,
+    /// Numeric values of the symbols used in the expressions.
+    pub symbols: BTreeMap<String, f64>,
+    /// Notes carried with the description (source of numbers, comments).
+    pub notes: Vec<String>,
+}
+
+impl RobotDescription {
+    /// An empty description with NL links and NJ joints: frames default to revolute, actuated
+    /// (cut-joint frames passive, their twins fixed), all geometric parameters zero, symbolic
+    /// inertial parameters, gravity `[0, 0, -G3]` with G3 = 9.81.
+    pub fn new(name: impl Into<String>, nl: usize, nj: usize) -> Self {
+        let nf = 2 * nj - nl;
+        let frames = (1..=nf)
+            .map(|j| {
+                let (joint, actuated) = if j <= nl {
+                    (JointType::Revolute, true)
+                } else if j <= nj {
+                    (JointType::Revolute, false)
+                } else {
+                    (JointType::Fixed, false)
+                };
+                FrameDesc::new(format!("j{j}"), j.saturating_sub(1), joint, actuated)
+            })
+            .collect();
+        let zero3 = || std::array::from_fn(|_| Expr::zero());
+        RobotDescription {
+            name: name.into(),
+            nl,
+            nj,
+            frames,
+            links: (1..=nl).map(LinkDesc::symbolic).collect(),
+            gravity: [Expr::zero(), Expr::zero(), Expr::num(-9.81)],
+            w0: zero3(),
+            wp0: zero3(),
+            v0: zero3(),
+            vp0: zero3(),
+            mobile_base: false,
+            symbols: BTreeMap::new(),
+            notes: Vec::new(),
+        }
+    }
+
+    /// NF = 2 NJ - NL.
+    pub fn nf(&self) -> usize {
+        2 * self.nj - self.nl
+    }
+
+    /// Frame j (1-based).
+    pub fn frame(&self, j: usize) -> &FrameDesc {
+        &self.frames[j - 1]
+    }
+
+    pub fn frame_mut(&mut self, j: usize) -> &mut FrameDesc {
+        &mut self.frames[j - 1]
+    }
+
+    /// Link j (1-based).
+    pub fn link(&self, j: usize) -> &LinkDesc {
+        &self.links[j - 1]
+    }
+
+    pub fn link_mut(&mut self, j: usize) -> &mut LinkDesc {
+        &mut self.links[j - 1]
+    }
+}

@@ -1,0 +1,312 @@
+//! What a robot IS: the description (frames, links, symbols), its validated topology and its
+//! numeric constants. Immutable once built; per-evaluation buffers live in [`crate::workspace`].
+
+mod constants;
+mod description;
+mod structure;
+
+pub use constants::{DynModel, FrameConstants, LinkConstants};
+pub use description::{
+    param, FrameDesc, JointType, LinkDesc, RobotDescription, GEOMETRIC_PARAMETERS,
+    STANDARD_PARAMETERS, WRENCH_COMPONENTS,
+};
+pub use structure::{path_from_base, ClosedLoop, Structure, StructureType};
+
+use crate::error::{Error, Item, Result};
+use robodyn_symbolic::Expr;
+
+/// A validated robot: description, topology and numeric model (every symbol has a value).
+#[derive(Clone, Debug)]
+pub struct Robot {
+    desc: RobotDescription,
+    structure: Structure,
+    numeric: DynModel<f64>,
+}
+
+/// Check counts and antecedents and derive the topology. Needs no numeric values, so it also
+/// serves purely symbolic descriptions.
+pub fn validate_structure(desc: &RobotDescription) -> Result<Structure> {
+    let (nl, nj) = (desc.nl, desc.nj);
+    if nl == 0 {
+        return Err(Error::invalid(
+            Item::Robot,
+            "the robot has no link (NL = 0)",
+        ));
+    }
+    if nj < nl {
+        return Err(Error::invalid(
+            Item::Robot,
+            format!("NJ = {nj} is smaller than NL = {nl}: a robot has at least one joint per link"),
+        ));
+    }
+    let nf = desc.nf();
+    if desc.frames.len() != nf {
+        return Err(Error::invalid(
+            Item::Robot,
+            format!(
+                "{} frames given, NF = 2 NJ - NL = {nf} expected",
+                desc.frames.len()
+            ),
+        ));
+    }
+    if desc.links.len() != nl {
+        return Err(Error::invalid(
+            Item::Robot,
+            format!("{} links given, NL = {nl} expected", desc.links.len()),
+        ));
+    }
+    let mut ant = vec![0; nf + 1];
+    for (idx, f) in desc.frames.iter().enumerate() {
+        let j = idx + 1;
+        let item = || Item::Frame(j, Some("ant".into()));
+        if j <= nl {
+            if f.ant >= j {
+                return Err(Error::invalid(
+                    item(),
+                    format!(
+                        "antecedent a({j}) = {} must be smaller than {j} (frames are numbered \
+                         from the base; a(j) >= j makes a cycle or a forward reference)",
+                        f.ant
+                    ),
+                ));
+            }
+        } else if f.ant > nl {
+            return Err(Error::invalid(
+                item(),
+                format!(
+                    "antecedent a({j}) = {} of a cut-joint frame must be a link (0..{nl})",
+                    f.ant
+                ),
+            ));
+        }
+        if j > nl && j <= nj {
+            if f.joint == JointType::Fixed {
+                return Err(Error::invalid(
+                    Item::Frame(j, Some("sigma".into())),
+                    "a cut joint must be revolute or prismatic (sigma 0 or 1)",
+                ));
+            }
+            if f.actuated {
+                return Err(Error::invalid(
+                    Item::Frame(j, Some("mu".into())),
+                    "a cut joint must be passive (mu = 0)",
+                ));
+            }
+        }
+        if j > nj && f.joint != JointType::Fixed {
+            return Err(Error::invalid(
+                Item::Frame(j, Some("sigma".into())),
+                format!(
+                    "frame {j} is the twin of cut joint {} and must be fixed (sigma = 2)",
+                    j - (nj - nl)
+                ),
+            ));
+        }
+        if j <= nl && f.joint == JointType::Fixed && f.actuated {
+            return Err(Error::invalid(
+                Item::Frame(j, Some("mu".into())),
+                "a fixed frame (sigma = 2) cannot be actuated",
+            ));
+        }
+        ant[j] = f.ant;
+    }
+    let b = nj - nl;
+    for k in nl + 1..=nj {
+        if ant[k] == ant[k + b] {
+            return Err(Error::invalid(
+                Item::Frame(k, Some("ant".into())),
+                format!(
+                    "cut joint {k} and its twin frame {} are on the same link {}: not a loop",
+                    k + b,
+                    ant[k]
+                ),
+            ));
+        }
+    }
+    Ok(Structure::new(ant, nl, nj))
+}
+
+impl Robot {
+    /// Validate a description and build its numeric model. Every symbol must have a value, every
+    /// value must be finite, masses, rotor inertias and friction coefficients non-negative.
+    pub fn new(desc: RobotDescription) -> Result<Robot> {
+        let structure = validate_structure(&desc)?;
+        for (name, v) in &desc.symbols {
+            if !v.is_finite() {
+                return Err(Error::invalid(
+                    Item::Symbol(name.clone()),
+                    format!("value {v} is not a finite number"),
+                ));
+            }
+        }
+        let env = |s: &str| desc.symbols.get(s).copied();
+        let eval = |e: &Expr, item: Item| -> Result<f64> {
+            e.eval(&env).map_err(|err| {
+                Error::invalid(
+                    item,
+                    match err {
+                        robodyn_symbolic::EvalError::UnknownSymbol(s) => format!(
+                            "symbol `{s}` in `{e}` has no numeric value (define it in the \
+                             file's symbol values or with --set {s}=VALUE)"
+                        ),
+                        other => other.to_string(),
+                    },
+                )
+            })
+        };
+        // Evaluate everything first so that the first error is reported with its item.
+        for (idx, f) in desc.frames.iter().enumerate() {
+            for (k, e) in f.geometric().iter().enumerate() {
+                eval(
+                    e,
+                    Item::Frame(idx + 1, Some(GEOMETRIC_PARAMETERS[k].into())),
+                )?;
+            }
+        }
+        for (idx, l) in desc.links.iter().enumerate() {
+            for (k, e) in l.params.iter().enumerate() {
+                let v = eval(e, Item::Link(idx + 1, Some(STANDARD_PARAMETERS[k].into())))?;
+                if matches!(k, param::M | param::IA | param::FS | param::FV) && v < 0.0 {
+                    return Err(Error::invalid(
+                        Item::Link(idx + 1, Some(STANDARD_PARAMETERS[k].into())),
+                        format!("{} = {v} is negative", STANDARD_PARAMETERS[k]),
+                    ));
+                }
+            }
+            for (k, e) in l.wrench.iter().enumerate() {
+                eval(e, Item::Link(idx + 1, Some(WRENCH_COMPONENTS[k].into())))?;
+            }
+        }
+        for (name, v) in [
+            ("G", &desc.gravity),
+            ("W0", &desc.w0),
+            ("WP0", &desc.wp0),
+            ("V0", &desc.v0),
+            ("VP0", &desc.vp0),
+        ] {
+            for (k, e) in v.iter().enumerate() {
+                eval(e, Item::Base(format!("{name}[{}]", k + 1)))?;
+            }
+        }
+        let value = |e: &Expr| e.eval(&env).expect("checked above");
+        let numeric = DynModel::build(&desc, value, |_, _, e| value(e));
+        Ok(Robot {
+            desc,
+            structure,
+            numeric,
+        })
+    }
+
+    pub fn description(&self) -> &RobotDescription {
+        &self.desc
+    }
+
+    pub fn into_description(self) -> RobotDescription {
+        self.desc
+    }
+
+    pub fn structure(&self) -> &Structure {
+        &self.structure
+    }
+
+    /// The numeric model the algorithms run on.
+    #[inline]
+    pub fn numeric(&self) -> &DynModel<f64> {
+        &self.numeric
+    }
+
+    pub fn name(&self) -> &str {
+        &self.desc.name
+    }
+
+    /// NL: links of the equivalent tree (joint variables 1..NL).
+    #[inline]
+    pub fn nl(&self) -> usize {
+        self.desc.nl
+    }
+
+    pub fn nj(&self) -> usize {
+        self.desc.nj
+    }
+
+    pub fn nf(&self) -> usize {
+        self.desc.nf()
+    }
+
+    /// B = NJ - NL, the number of closed loops.
+    pub fn n_loops(&self) -> usize {
+        self.desc.nj - self.desc.nl
+    }
+
+    pub fn is_tree(&self) -> bool {
+        self.desc.nj == self.desc.nl
+    }
+
+    /// a(j).
+    #[inline]
+    pub fn ant(&self, j: usize) -> usize {
+        self.structure.ant[j]
+    }
+
+    pub fn frame(&self, j: usize) -> &FrameDesc {
+        self.desc.frame(j)
+    }
+
+    pub fn link(&self, j: usize) -> &LinkDesc {
+        self.desc.link(j)
+    }
+
+    /// Numeric value of an expression with this robot's symbols.
+    pub fn value(&self, e: &Expr) -> Result<f64> {
+        e.eval(&|s| self.desc.symbols.get(s).copied())
+            .map_err(|err| Error::Input(err.to_string()))
+    }
+
+    /// Tree joints 1..NL that are movable (not fixed).
+    pub fn movable_joints(&self) -> Vec<usize> {
+        (1..=self.nl())
+            .filter(|&j| self.frame(j).joint.is_movable())
+            .collect()
+    }
+
+    /// Actuated tree joints (mu = 1), in increasing order: q_a.
+    pub fn actuated_joints(&self) -> Vec<usize> {
+        (1..=self.nl())
+            .filter(|&j| self.frame(j).actuated)
+            .collect()
+    }
+
+    /// Passive movable tree joints (mu = 0): q_p.
+    pub fn passive_joints(&self) -> Vec<usize> {
+        (1..=self.nl())
+            .filter(|&j| !self.frame(j).actuated && self.frame(j).joint.is_movable())
+            .collect()
+    }
+
+    /// Numeric standard parameters, 13 per link (XX..FV), link 1 first.
+    pub fn standard_parameters(&self) -> Vec<f64> {
+        self.desc
+            .links
+            .iter()
+            .flat_map(|l| l.params.iter().map(|e| self.value(e).expect("validated")))
+            .collect()
+    }
+
+    /// The same robot with the given numeric standard parameters (13 per link).
+    pub fn with_standard_parameters(&self, k: &[f64]) -> Result<Robot> {
+        if k.len() != 13 * self.nl() {
+            return Err(Error::Input(format!(
+                "{} standard parameters given, {} expected (13 per link)",
+                k.len(),
+                13 * self.nl()
+            )));
+        }
+        let mut desc = self.desc.clone();
+        for (j, l) in desc.links.iter_mut().enumerate() {
+            for (p, e) in l.params.iter_mut().enumerate() {
+                *e = Expr::num(k[13 * j + p]);
+            }
+        }
+        Robot::new(desc)
+    }
+}
