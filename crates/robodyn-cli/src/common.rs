@@ -1,7 +1,7 @@
 //! Options and helpers shared by the commands: loading a robot, reading and writing state tables.
 
 use clap::Args;
-use robodyn::{Error, Robot};
+use robodyn::Robot;
 use std::collections::BTreeMap;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -116,6 +116,7 @@ impl Table {
     }
 
     /// Index of a column if present.
+    #[allow(dead_code)]
     pub fn find(&self, name: &str) -> Option<usize> {
         self.headers.iter().position(|h| h == name)
     }
@@ -166,9 +167,4 @@ pub fn write_table(
         }
     }
     Ok(())
-}
-
-/// Turn a library error into a CLI error.
-pub fn lib(e: Error) -> Box<dyn std::error::Error> {
-    Box::new(e)
 }

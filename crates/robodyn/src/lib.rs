@@ -8,6 +8,10 @@
 //! - [`io`]: robot files (TOML, SYMORO .par, URDF) with positioned errors;
 //! - [`geometry`]: iT_j and 0T_j.
 
+// Joint and link numbers are 1-based indices into several parallel arrays (a(j), frames, links):
+// index loops read like the equations.
+#![allow(clippy::needless_range_loop)]
+
 pub mod algorithms;
 pub mod error;
 pub mod geometry;
