@@ -164,6 +164,15 @@ fn a_wrong_parameter_is_caught() {
         desc.links[5].params[k] = Expr::num(rng.random_range(0.2..1.0));
     }
     desc.links[5].wrench = std::array::from_fn(|_| Expr::num(rng.random_range(1.0..3.0)));
+    // A moving base, so that its terms are tested too (v0 has no effect on the torques: NE does
+    // not use it, the Lagrangian route must cancel it).
+    let base = |rng: &mut rand_chacha::ChaCha8Rng| -> [Expr; 3] {
+        std::array::from_fn(|_| Expr::num(rng.random_range(0.5..1.5)))
+    };
+    desc.w0 = base(&mut rng);
+    desc.wp0 = base(&mut rng);
+    desc.v0 = base(&mut rng);
+    desc.vp0 = base(&mut rng);
     let good = Robot::new(desc.clone()).unwrap();
     let s = random_state(&mut rng, 6);
     let tau_l = lagrangian_torques(&good, &s[0], &s[1], &s[2]).unwrap();
@@ -198,6 +207,9 @@ fn a_wrong_parameter_is_caught() {
     alter("d4", &|d| d.frames[3].d = neg(&d.frames[3].d));
     alter("r5", &|d| d.frames[4].r = neg(&d.frames[4].r));
     alter("gravity", &|d| d.gravity[2] = neg(&d.gravity[2]));
+    alter("W0", &|d| d.w0[0] = neg(&d.w0[0]));
+    alter("WP0", &|d| d.wp0[1] = neg(&d.wp0[1]));
+    alter("VP0", &|d| d.vp0[2] = neg(&d.vp0[2]));
     eprintln!("teeth: smallest relative change {:.2e}", smallest.get());
 }
 
