@@ -1,3 +1,5 @@
 //! One module per algorithm, named as the chapter names it.
 
+pub mod closed_chain;
 pub mod inverse_dynamics;
+pub mod loop_closure;
