@@ -29,7 +29,7 @@ const ROBOTS: &[(&str, &[f64], &[f64], f64, &[usize])] = &[
     ("fourbar.toml", &[0.0], &[0.0, 0.0], 1.0, &[2]),
     ("fivebar.toml", &[0.0, 0.0], &[0.0, 0.0], 0.3, &[2]),
     ("spatial_loop.toml", &[0.0], &[0.0; 5], 0.3, &[5]),
-    ("twoloops.toml", &[0.0], &[0.0; 4], 0.3, &[2, 2]),
+    ("twoloops.toml", &[0.0], &[0.0; 4], 1.0, &[2, 2]),
 ];
 
 /// A random reachable q_a near the reference and its q_p (by continuation from the reference).
@@ -275,4 +275,30 @@ fn wrong_number_of_actuators_is_reported() {
         e.contains("2 independent closure equations") && e.contains("passive"),
         "{e}"
     );
+}
+
+#[test]
+fn grashof_cranks_turn_fully() {
+    // the four-bar and both loops of the Watt six-bar are Grashof with the driving link
+    // shortest: continuation over a full crank turn never meets a singular Wp
+    for name in ["fourbar.toml", "twoloops.toml"] {
+        let r = robot(name);
+        let cc = ClosedChain::new(&r).unwrap();
+        let mut ws = cc.workspace();
+        let mut qp = vec![0.0; cc.passive_joints().len()];
+        for s in 1..=72 {
+            let qa = [s as f64 * 2.0 * PI / 72.0];
+            let sol = cc.solve_positions(&mut ws, &qa, Some(&qp)).unwrap();
+            cc.constraints(&mut ws, &sol.q_tr).unwrap();
+            qp = sol.q_p;
+        }
+        // back to the start after one turn, up to 2 pi on passive joints that turn fully
+        for x in &qp {
+            let m = x.rem_euclid(2.0 * PI);
+            assert!(
+                m.min(2.0 * PI - m) < 1e-9,
+                "{name}: q_p after a turn {qp:?}"
+            );
+        }
+    }
 }
