@@ -262,10 +262,10 @@ fn idm_of_ddm_is_identity() {
                 .inverse_dynamics(&mut ws, &qa, &qd, &qdd, Some(&qp))
                 .unwrap();
             let scale = tau.iter().fold(0.0_f64, |a, b| a.max(b.abs()));
-            for k in 0..tau.len() {
-                let e = (idm.gamma_cl[k] - tau[k]).abs() / scale;
+            for (k, t) in tau.iter().enumerate() {
+                let e = (idm.gamma_cl[k] - t).abs() / scale;
                 worst = worst.max(e);
-                assert!(e < 1e-9, "{name}: tau {} vs {}", idm.gamma_cl[k], tau[k]);
+                assert!(e < 1e-9, "{name}: tau {} vs {t}", idm.gamma_cl[k]);
             }
             // the passive accelerations of the ddm are the consistent ones (10.42)
             for (k, &j) in cc.passive_joints().iter().enumerate() {

@@ -18,7 +18,16 @@ fn robot(name: &str) -> Robot {
 
 /// Bundled closed robots: file, reference q_a, q_p where the loops are closed, random range of q_a
 /// around it, and the number of kept equations per loop.
-const ROBOTS: &[(&str, &[f64], &[f64], f64, &[usize])] = &[
+/// (file, q_a0, q_p0, range, rows per loop)
+type Case = (
+    &'static str,
+    &'static [f64],
+    &'static [f64],
+    f64,
+    &'static [usize],
+);
+
+const ROBOTS: &[Case] = &[
     (
         "sr400.toml",
         &[0.0, 0.0, 0.0, 0.0, 0.0, FRAC_PI_2],

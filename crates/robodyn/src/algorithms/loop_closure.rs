@@ -525,6 +525,7 @@ impl LoopClosure {
             }
             None => ws.last_qp.clone().unwrap_or_else(|| vec![0.0; p]),
         };
+        let initial = qp.clone();
         let nl = self.robot.nl();
         let mut q = std::mem::take(&mut ws.q);
         let mut r = DVector::zeros(p);
@@ -596,7 +597,7 @@ impl LoopClosure {
                 fmt_vec(q_a),
                 self.actuated,
                 worst.0.max(r.amax()),
-                fmt_vec(guess.unwrap_or(&qp)),
+                fmt_vec(&initial),
                 self.passive
             )));
         }
@@ -674,7 +675,7 @@ impl LoopClosure {
     pub fn check_wp(&self, wp: &DMatrix<f64>, q_tr: &[f64]) -> Result<()> {
         let sv = wp.clone().svd(false, false).singular_values;
         let (smin, smax) = (sv.min(), sv.max());
-        if !(smin > 1e-9 * smax.max(1.0)) {
+        if smin.is_nan() || smin <= 1e-9 * smax.max(1.0) {
             let labels: Vec<String> = self.loops.iter().map(|l| l.label()).collect();
             return Err(Error::Numerical(format!(
                 "Wp (derivative of the closure equations of {} with respect to the passive joints \
