@@ -31,6 +31,89 @@ const ROBOTS: &[(&str, &[f64], &[f64], f64)] = &[
     ("twoloops.toml", &[0.0], &[0.0; 4], 1.0),
 ];
 
+/// Slider-crank with a PRISMATIC cut joint: crank 1 (0.1 m, actuated) and rod 2 (0.3 m) in the
+/// plane z0 = 0, slider link 3 pinned to the rod; cut joint 4 is the slider's prismatic joint along
+/// x0, its twin frame 5 fixed on the base. Assembled at q = 0 (crank along y0, sin beta = -1/3).
+const SLIDER_CRANK: &str = r#"
+name = "slider-crank (prismatic cut)"
+nl = 3
+nj = 4
+gravity = [0, -9.81, 0]
+[[frame]]
+j = 1
+ant = 0
+sigma = 0
+mu = 1
+theta = "pi/2"
+[[frame]]
+j = 2
+ant = 1
+sigma = 0
+mu = 0
+d = 0.1
+theta = "-pi/2 - 0.3398369094541219"
+[[frame]]
+j = 3
+ant = 2
+sigma = 0
+mu = 0
+d = 0.3
+theta = 0.3398369094541219
+[[frame]]
+j = 4
+ant = 3
+sigma = 1
+mu = 0
+gamma = "pi/2"
+alpha = "pi/2"
+[[frame]]
+j = 5
+ant = 0
+sigma = 2
+mu = 0
+gamma = "pi/2"
+alpha = "pi/2"
+[[link]]
+j = 1
+XX = 0.0002
+YY = 0.0034
+ZZ = 0.0034
+MX = 0.05
+M = 1.0
+IA = 0.01
+FV = 0.1
+[[link]]
+j = 2
+XX = 0.0003
+YY = 0.045
+ZZ = 0.045
+XY = 0.001
+MX = 0.225
+MY = 0.01
+M = 1.5
+[[link]]
+j = 3
+XX = 0.002
+YY = 0.003
+ZZ = 0.002
+MZ = 0.02
+M = 2.0
+"#;
+
+fn slider_crank() -> Robot {
+    robodyn::io::toml_format::parse_robot(SLIDER_CRANK, None).unwrap()
+}
+
+/// The bundled robots and the slider-crank: (label, robot, q_a0, q_p0, range).
+fn cases() -> Vec<(&'static str, Robot, &'static [f64], &'static [f64], f64)> {
+    let mut v: Vec<_> = ROBOTS
+        .iter()
+        .map(|c| (c.0, robot(c.0), c.1, c.2, c.3))
+        .collect();
+    v.push(("slider-crank", slider_crank(), &[0.0], &[0.0, 0.0], 1.0));
+    v
+}
+
 fn uniform(rng: &mut impl Rng, n: usize, s: f64) -> Vec<f64> {
     (0..n).map(|_| rng.random_range(-s..s)).collect()
 }
@@ -103,13 +186,12 @@ fn sr400_example_10_1_torque_relations() {
 #[test]
 fn virtual_power_and_lagrange_form() {
     let mut rng = robodyn::testing::rng(11);
-    for (name, qa0, qp0, range) in ROBOTS {
-        let r = robot(name);
+    for (name, r, qa0, qp0, range) in cases() {
         let cc = ClosedChain::new(&r).unwrap();
         let mut ws = cc.workspace();
         let (mut w_vp, mut w_l): (f64, f64) = (0.0, 0.0);
         for _ in 0..20 {
-            let [qa, qp, qd, qdd] = random_state(&cc, &mut rng, qa0, qp0, *range);
+            let [qa, qp, qd, qdd] = random_state(&cc, &mut rng, qa0, qp0, range);
             let idm = cc
                 .inverse_dynamics(&mut ws, &qa, &qd, &qdd, Some(&qp))
                 .unwrap();
@@ -164,13 +246,12 @@ fn energy(r: &Robot, lc: &LoopClosure, s: &ClosedState) -> (f64, f64) {
 #[test]
 fn kinetic_energy_matches_a_cl() {
     let mut rng = robodyn::testing::rng(12);
-    for (name, qa0, qp0, range) in ROBOTS {
-        let r = robot(name);
+    for (name, r, qa0, qp0, range) in cases() {
         let cc = ClosedChain::new(&r).unwrap();
         let mut ws = cc.workspace();
         let mut worst: f64 = 0.0;
         for _ in 0..10 {
-            let [qa, qp, qd, _] = random_state(&cc, &mut rng, qa0, qp0, *range);
+            let [qa, qp, qd, _] = random_state(&cc, &mut rng, qa0, qp0, range);
             let tau = vec![0.0; qa.len()];
             let ddm = cc
                 .direct_dynamics(&mut ws, &qa, &qd, &tau, Some(&qp))
@@ -194,8 +275,8 @@ fn power_balance_matches_gamma_cl_along_smooth_paths() {
     // dE/dt = Γ_cl' qd_a without friction and external wrenches: checks G, Ψ and the projection
     // against energies computed from link velocities (no Newton–Euler involved).
     let mut rng = robodyn::testing::rng(13);
-    for (name, qa0, qp0, range) in ROBOTS {
-        let mut d = robot(name).into_description();
+    for (name, r, qa0, qp0, range) in cases() {
+        let mut d = r.into_description();
         for l in d.links.iter_mut() {
             l.params[11] = robodyn::Expr::zero();
             l.params[12] = robodyn::Expr::zero();
@@ -246,13 +327,12 @@ fn power_balance_matches_gamma_cl_along_smooth_paths() {
 #[test]
 fn idm_of_ddm_is_identity() {
     let mut rng = robodyn::testing::rng(14);
-    for (name, qa0, qp0, range) in ROBOTS {
-        let r = robot(name);
+    for (name, r, qa0, qp0, range) in cases() {
         let cc = ClosedChain::new(&r).unwrap();
         let mut ws = cc.workspace();
         let mut worst: f64 = 0.0;
         for _ in 0..20 {
-            let [qa, qp, qd, _] = random_state(&cc, &mut rng, qa0, qp0, *range);
+            let [qa, qp, qd, _] = random_state(&cc, &mut rng, qa0, qp0, range);
             let tau = uniform(&mut rng, qa.len(), 20.0);
             let ddm = cc
                 .direct_dynamics(&mut ws, &qa, &qd, &tau, Some(&qp))
@@ -319,4 +399,91 @@ fn bad_inputs_are_errors() {
         &robodyn::testing::TreeOptions::default(),
     );
     assert!(ClosedChain::new(&tree).is_err());
+}
+
+/// One RK4 step of (q_a, qd_a) under zero torques.
+fn rk4(sys: &mut ClosedDynamics, q: &[f64], v: &[f64], dt: f64) -> (Vec<f64>, Vec<f64>) {
+    let n = q.len();
+    let zero = vec![0.0; n];
+    let add = |a: &[f64], b: &[f64], h: f64| -> Vec<f64> {
+        a.iter().zip(b).map(|(x, y)| x + h * y).collect()
+    };
+    let acc = |sys: &mut ClosedDynamics, q: &[f64], v: &[f64]| -> Vec<f64> {
+        sys.accel(q, v, &zero).unwrap().iter().copied().collect()
+    };
+    let (k1q, k1v) = (v.to_vec(), acc(sys, q, v));
+    let (q2, v2) = (add(q, &k1q, dt / 2.0), add(v, &k1v, dt / 2.0));
+    let (k2q, k2v) = (v2.clone(), acc(sys, &q2, &v2));
+    let (q3, v3) = (add(q, &k2q, dt / 2.0), add(v, &k2v, dt / 2.0));
+    let (k3q, k3v) = (v3.clone(), acc(sys, &q3, &v3));
+    let (q4, v4) = (add(q, &k3q, dt), add(v, &k3v, dt));
+    let (k4q, k4v) = (v4.clone(), acc(sys, &q4, &v4));
+    let comb = |x: &[f64], a: &[f64], b: &[f64], c: &[f64], d: &[f64]| -> Vec<f64> {
+        (0..n)
+            .map(|i| x[i] + dt / 6.0 * (a[i] + 2.0 * b[i] + 2.0 * c[i] + d[i]))
+            .collect()
+    };
+    (
+        comb(q, &k1q, &k2q, &k3q, &k4q),
+        comb(v, &k1v, &k2v, &k3v, &k4v),
+    )
+}
+
+#[test]
+fn conservative_simulation_keeps_energy_and_closure() {
+    // 10 s without friction and torques (RK4, dt = 2 ms), loops re-solved at every call from the
+    // previous solution: the energy from link velocities must stay constant. The five-bar is
+    // mounted upside down (gravity +y0) so that it swings about a regular equilibrium instead of
+    // falling into its parallel singularity; the SR400 moves without gravity (a free drift that
+    // keeps the parallelogram away from its flat configurations for 10 s).
+    for (name, qa0, qp0, v0, g) in [
+        (
+            "fivebar.toml",
+            vec![0.0, 0.0],
+            vec![0.0, 0.0],
+            vec![1.0, -0.5],
+            [0.0, 9.81, 0.0],
+        ),
+        (
+            "sr400.toml",
+            vec![0.0, 0.0, 0.0, 0.0, 0.0, FRAC_PI_2],
+            vec![PI, -FRAC_PI_2],
+            vec![0.1, 0.05, -0.1, 0.2, 0.3, -0.05],
+            [0.0, 0.0, 0.0],
+        ),
+    ] {
+        let mut d = robot(name).into_description();
+        d.gravity = g.map(robodyn::Expr::num);
+        for l in d.links.iter_mut() {
+            l.params[11] = robodyn::Expr::zero();
+            l.params[12] = robodyn::Expr::zero();
+        }
+        let r = Robot::new(d).unwrap();
+        let mut sys = ClosedDynamics::new(&r).unwrap();
+        sys.set_guess(&qp0);
+        let e_of = |sys: &mut ClosedDynamics, q: &[f64], v: &[f64]| {
+            let z = vec![0.0; q.len()];
+            let s = sys.model.state(&mut sys.ws, q, v, &z, None).unwrap();
+            let (ke, pe) = energy(&r, sys.model.closure(), &s);
+            (ke + pe, ke)
+        };
+        let (mut q, mut v) = (qa0.clone(), v0.clone());
+        let (e0, ke0) = e_of(&mut sys, &q, &v);
+        let dt = 2e-3;
+        let mut drift: f64 = 0.0;
+        let mut residual: f64 = 0.0;
+        for step in 1..=5000 {
+            (q, v) = rk4(&mut sys, &q, &v, dt);
+            if step % 100 == 0 {
+                let (e, _) = e_of(&mut sys, &q, &v);
+                drift = drift.max((e - e0).abs() / ke0.max(e0.abs()));
+                residual = residual.max(sys.closure_residual(&q).unwrap());
+            }
+        }
+        println!(
+            "{name}: 10 s conservative: energy drift {drift:.2e}, closure residual {residual:.1e}"
+        );
+        assert!(drift < 1e-6, "{name}: relative energy drift {drift}");
+        assert!(residual < 1e-11, "{name}: closure residual {residual}");
+    }
 }

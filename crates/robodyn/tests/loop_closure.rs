@@ -41,6 +41,89 @@ const ROBOTS: &[Case] = &[
     ("twoloops.toml", &[0.0], &[0.0; 4], 1.0, &[2, 2]),
 ];
 
+/// Slider-crank with a PRISMATIC cut joint: crank 1 (0.1 m, actuated) and rod 2 (0.3 m) in the
+/// plane z0 = 0, slider link 3 pinned to the rod; cut joint 4 is the slider's prismatic joint along
+/// x0, its twin frame 5 fixed on the base. Assembled at q = 0 (crank along y0, sin beta = -1/3).
+const SLIDER_CRANK: &str = r#"
+name = "slider-crank (prismatic cut)"
+nl = 3
+nj = 4
+gravity = [0, -9.81, 0]
+[[frame]]
+j = 1
+ant = 0
+sigma = 0
+mu = 1
+theta = "pi/2"
+[[frame]]
+j = 2
+ant = 1
+sigma = 0
+mu = 0
+d = 0.1
+theta = "-pi/2 - 0.3398369094541219"
+[[frame]]
+j = 3
+ant = 2
+sigma = 0
+mu = 0
+d = 0.3
+theta = 0.3398369094541219
+[[frame]]
+j = 4
+ant = 3
+sigma = 1
+mu = 0
+gamma = "pi/2"
+alpha = "pi/2"
+[[frame]]
+j = 5
+ant = 0
+sigma = 2
+mu = 0
+gamma = "pi/2"
+alpha = "pi/2"
+[[link]]
+j = 1
+XX = 0.0002
+YY = 0.0034
+ZZ = 0.0034
+MX = 0.05
+M = 1.0
+IA = 0.01
+FV = 0.1
+[[link]]
+j = 2
+XX = 0.0003
+YY = 0.045
+ZZ = 0.045
+XY = 0.001
+MX = 0.225
+MY = 0.01
+M = 1.5
+[[link]]
+j = 3
+XX = 0.002
+YY = 0.003
+ZZ = 0.002
+MZ = 0.02
+M = 2.0
+"#;
+
+fn slider_crank() -> Robot {
+    robodyn::io::toml_format::parse_robot(SLIDER_CRANK, None).unwrap()
+}
+
+/// The bundled robots and the slider-crank: (label, robot, q_a0, q_p0, range).
+fn cases() -> Vec<(&'static str, Robot, &'static [f64], &'static [f64], f64)> {
+    let mut v: Vec<_> = ROBOTS
+        .iter()
+        .map(|c| (c.0, robot(c.0), c.1, c.2, c.3))
+        .collect();
+    v.push(("slider-crank", slider_crank(), &[0.0], &[0.0, 0.0], 1.0));
+    v
+}
+
 /// A random reachable q_a near the reference and its q_p (by continuation from the reference).
 fn random_config(
     lc: &LoopClosure,
@@ -122,12 +205,11 @@ fn bundled_robots_close_at_reference_with_rank_chosen_rows() {
 #[test]
 fn random_solutions_close_the_loops_as_frames() {
     let mut rng = robodyn::testing::rng(2);
-    for (name, qa0, qp0, range, _) in ROBOTS {
-        let r = robot(name);
+    for (name, r, qa0, qp0, range) in cases() {
         let lc = LoopClosure::new(&r).unwrap();
         let mut ws = lc.workspace();
         for _ in 0..10 {
-            let (qa, qp) = random_config(&lc, &mut ws, &mut rng, qa0, qp0, *range);
+            let (qa, qp) = random_config(&lc, &mut ws, &mut rng, qa0, qp0, range);
             // perturbed guess converges back to the same solution
             let g: Vec<f64> = qp
                 .iter()
@@ -152,8 +234,7 @@ fn random_solutions_close_the_loops_as_frames() {
 #[test]
 fn w_matches_finite_differences_of_the_closure_solution() {
     let mut rng = robodyn::testing::rng(3);
-    for (name, qa0, qp0, range, _) in ROBOTS {
-        let r = robot(name);
+    for (name, r, qa0, qp0, range) in cases() {
         let mut lc = LoopClosure::new(&r).unwrap();
         lc.tolerance = 1e-14;
         let cc = ClosedChain::new(&r).unwrap();
@@ -161,7 +242,7 @@ fn w_matches_finite_differences_of_the_closure_solution() {
         let mut ws = lc.workspace();
         let mut worst: f64 = 0.0;
         for _ in 0..5 {
-            let (qa, qp) = random_config(&lc, &mut ws, &mut rng, qa0, qp0, *range);
+            let (qa, qp) = random_config(&lc, &mut ws, &mut rng, qa0, qp0, range);
             let s = lc.solve(&mut ws, &qa, Some(&qp)).unwrap();
             let c = cc.constraints(&mut cws, &s.q_tr).unwrap();
             let h = 1e-5;
@@ -191,8 +272,7 @@ fn w_matches_finite_differences_of_the_closure_solution() {
 #[test]
 fn psi_matches_second_derivative_along_smooth_paths() {
     let mut rng = robodyn::testing::rng(4);
-    for (name, qa0, qp0, range, _) in ROBOTS {
-        let r = robot(name);
+    for (name, r, qa0, qp0, range) in cases() {
         let mut lc = LoopClosure::new(&r).unwrap();
         lc.tolerance = 1e-14;
         let cc = ClosedChain::new(&r).unwrap();
@@ -200,7 +280,7 @@ fn psi_matches_second_derivative_along_smooth_paths() {
         let mut ws = lc.workspace();
         let mut worst: f64 = 0.0;
         for _ in 0..5 {
-            let (c0, qp) = random_config(&lc, &mut ws, &mut rng, qa0, qp0, *range * 0.5);
+            let (c0, qp) = random_config(&lc, &mut ws, &mut rng, qa0, qp0, range * 0.5);
             let n = c0.len();
             // q_a(t) = c0 + A sin(om t + ph) - A sin(ph): a smooth path through c0 at t = 0
             let amp: Vec<f64> = (0..n).map(|_| rng.random_range(-0.2..0.2)).collect();
@@ -310,4 +390,36 @@ fn grashof_cranks_turn_fully() {
             );
         }
     }
+}
+
+#[test]
+fn prismatic_cut_slider_crank_closed_form() {
+    // slider position x_B = a cos(phi) + sqrt(L^2 - a^2 sin^2(phi)), phi = pi/2 + q1; the cut
+    // variable is the slide of R_4 along z_4 = x_0 to the twin at the origin: q_c = -x_B
+    let r = slider_crank();
+    let lc = LoopClosure::new(&r).unwrap();
+    assert_eq!(lc.loops()[0].rows.len(), 2);
+    let mut ws = lc.workspace();
+    let mut rng = robodyn::testing::rng(5);
+    let mut qp = vec![0.0, 0.0];
+    let mut worst: f64 = 0.0;
+    for s in 1..=36 {
+        let q1 = s as f64 * 2.0 * PI / 36.0;
+        let sol = lc.solve(&mut ws, &[q1], Some(&qp)).unwrap();
+        qp = sol.q_p.clone();
+        let phi = FRAC_PI_2 + q1;
+        let xb = 0.1 * phi.cos() + (0.09 - 0.01 * phi.sin().powi(2)).sqrt();
+        worst = worst.max((sol.q_c[0] + xb).abs());
+        assert!(
+            (sol.q_c[0] + xb).abs() < 1e-12,
+            "q_c {} vs {}",
+            sol.q_c[0],
+            -xb
+        );
+        // from a perturbed guess too
+        let g: Vec<f64> = qp.iter().map(|x| x + rng.random_range(-0.1..0.1)).collect();
+        let again = lc.solve(&mut ws, &[q1], Some(&g)).unwrap();
+        assert!((again.q_c[0] + xb).abs() < 1e-12);
+    }
+    println!("slider-crank: cut slide vs closed form, max error {worst:.2e}");
 }
