@@ -105,7 +105,9 @@ fn slider_crank() -> Robot {
 }
 
 /// The bundled robots and the slider-crank: (label, robot, q_a0, q_p0, range).
-fn cases() -> Vec<(&'static str, Robot, &'static [f64], &'static [f64], f64)> {
+type Loaded = (&'static str, Robot, &'static [f64], &'static [f64], f64);
+
+fn cases() -> Vec<Loaded> {
     let mut v: Vec<_> = ROBOTS
         .iter()
         .map(|c| (c.0, robot(c.0), c.1, c.2, c.3))
