@@ -14,10 +14,12 @@ use std::path::PathBuf;
 pub struct Args {
     #[command(flatten)]
     pub robot: RobotArgs,
-    /// CSV of states with columns q<j>, qd<j>, qdd<j> for the movable joints.
+    /// CSV of states with columns q<j>, qd<j>, qdd<j> for the movable joints (closed chains:
+    /// the actuated joints).
     #[arg(long, conflicts_with_all = ["q", "qd", "qdd"])]
     pub input: Option<PathBuf>,
-    /// One state: joint positions, comma separated (movable joints in frame order).
+    /// One state: joint positions, comma separated (movable joints in frame order; closed
+    /// chains: the actuated joints).
     #[arg(long, allow_hyphen_values = true)]
     pub q: Option<String>,
     /// Joint velocities (default zeros).
