@@ -23,6 +23,8 @@ enum Command {
     Info(commands::info::Args),
     /// Inverse dynamic model: joint torques for given states (Newton-Euler).
     Idm(commands::idm::Args),
+    /// Loop closure of a closed-chain robot: q_p for given q_a (and W with --jacobian).
+    Closure(commands::closure::Args),
 }
 
 fn main() {
@@ -30,6 +32,7 @@ fn main() {
     let result = match cli.command {
         Command::Info(a) => commands::info::run(a),
         Command::Idm(a) => commands::idm::run(a),
+        Command::Closure(a) => commands::closure::run(a),
     };
     if let Err(e) = result {
         eprintln!("robodyn: error: {e}");

@@ -1,0 +1,427 @@
+//! Loop closure (§10.3.1, eqs 10.27–10.30, 10.42): closure solutions against Example 10.1, W
+//! against central finite differences of the solved q_p, Ψ against the second derivative of the
+//! solved q_p along random smooth paths q_a(t), and the errors (unreachable, singular Wp).
+
+use rand::Rng;
+use robodyn::algorithms::closed_chain::ClosedChain;
+use robodyn::algorithms::loop_closure::LoopClosure;
+use robodyn::{Error, Robot};
+use std::f64::consts::{FRAC_PI_2, FRAC_PI_6, PI};
+use std::path::PathBuf;
+
+fn robot(name: &str) -> Robot {
+    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../robots")
+        .join(name);
+    robodyn::io::load(&p).unwrap_or_else(|e| panic!("{name}: {e}"))
+}
+
+/// Bundled closed robots: file, reference q_a, q_p where the loops are closed, random range of q_a
+/// around it, and the number of kept equations per loop.
+/// (file, q_a0, q_p0, range, rows per loop)
+type Case = (
+    &'static str,
+    &'static [f64],
+    &'static [f64],
+    f64,
+    &'static [usize],
+);
+
+const ROBOTS: &[Case] = &[
+    (
+        "sr400.toml",
+        &[0.0, 0.0, 0.0, 0.0, 0.0, FRAC_PI_2],
+        &[PI, -FRAC_PI_2],
+        0.5,
+        &[2],
+    ),
+    ("fourbar.toml", &[0.0], &[0.0, 0.0], 1.0, &[2]),
+    ("fivebar.toml", &[0.0, 0.0], &[0.0, 0.0], 0.3, &[2]),
+    ("spatial_loop.toml", &[0.0], &[0.0; 5], 0.3, &[5]),
+    ("twoloops.toml", &[0.0], &[0.0; 4], 1.0, &[2, 2]),
+];
+
+/// Slider-crank with a PRISMATIC cut joint: crank 1 (0.1 m, actuated) and rod 2 (0.3 m) in the
+/// plane z0 = 0, slider link 3 pinned to the rod; cut joint 4 is the slider's prismatic joint along
+/// x0, its twin frame 5 fixed on the base. Assembled at q = 0 (crank along y0, sin beta = -1/3).
+const SLIDER_CRANK: &str = r#"
+name = "slider-crank (prismatic cut)"
+nl = 3
+nj = 4
+gravity = [0, -9.81, 0]
+[[frame]]
+j = 1
+ant = 0
+sigma = 0
+mu = 1
+theta = "pi/2"
+[[frame]]
+j = 2
+ant = 1
+sigma = 0
+mu = 0
+d = 0.1
+theta = "-pi/2 - 0.3398369094541219"
+[[frame]]
+j = 3
+ant = 2
+sigma = 0
+mu = 0
+d = 0.3
+theta = 0.3398369094541219
+[[frame]]
+j = 4
+ant = 3
+sigma = 1
+mu = 0
+gamma = "pi/2"
+alpha = "pi/2"
+[[frame]]
+j = 5
+ant = 0
+sigma = 2
+mu = 0
+gamma = "pi/2"
+alpha = "pi/2"
+[[link]]
+j = 1
+XX = 0.0002
+YY = 0.0034
+ZZ = 0.0034
+MX = 0.05
+M = 1.0
+IA = 0.01
+FV = 0.1
+[[link]]
+j = 2
+XX = 0.0003
+YY = 0.045
+ZZ = 0.045
+XY = 0.001
+MX = 0.225
+MY = 0.01
+M = 1.5
+[[link]]
+j = 3
+XX = 0.002
+YY = 0.003
+ZZ = 0.002
+MZ = 0.02
+M = 2.0
+"#;
+
+fn slider_crank() -> Robot {
+    robodyn::io::toml_format::parse_robot(SLIDER_CRANK, None).unwrap()
+}
+
+/// The bundled robots and the slider-crank: (label, robot, q_a0, q_p0, range).
+type Loaded = (&'static str, Robot, &'static [f64], &'static [f64], f64);
+
+fn cases() -> Vec<Loaded> {
+    let mut v: Vec<_> = ROBOTS
+        .iter()
+        .map(|c| (c.0, robot(c.0), c.1, c.2, c.3))
+        .collect();
+    v.push(("slider-crank", slider_crank(), &[0.0], &[0.0, 0.0], 1.0));
+    v
+}
+
+/// A random reachable q_a near the reference and its q_p (by continuation from the reference).
+fn random_config(
+    lc: &LoopClosure,
+    ws: &mut robodyn::algorithms::loop_closure::LoopWorkspace,
+    rng: &mut impl Rng,
+    qa0: &[f64],
+    qp0: &[f64],
+    range: f64,
+) -> (Vec<f64>, Vec<f64>) {
+    let qa: Vec<f64> = qa0
+        .iter()
+        .map(|x| x + rng.random_range(-range..range))
+        .collect();
+    let s = lc.solve_continuation(ws, &qa, qa0, qp0, 8).unwrap();
+    (qa, s.q_p)
+}
+
+#[test]
+fn sr400_example_10_1() {
+    let r = robot("sr400.toml");
+    let lc = LoopClosure::new(&r).unwrap();
+    assert_eq!(lc.actuated_joints(), &[1, 2, 4, 5, 6, 7]);
+    assert_eq!(lc.passive_joints(), &[3, 8]);
+    let mut ws = lc.workspace();
+    let mut rng = robodyn::testing::rng(1);
+    let mut worst: f64 = 0.0;
+    for _ in 0..50 {
+        let qa: Vec<f64> = (0..6).map(|_| rng.random_range(-1.5..1.5)).collect();
+        let (t2, t7) = (qa[1], qa[5]);
+        let guess = [
+            t7 + FRAC_PI_2 - t2 + rng.random_range(-0.3..0.3),
+            t2 - t7 + rng.random_range(-0.3..0.3),
+        ];
+        let s = lc.solve(&mut ws, &qa, Some(&guess)).unwrap();
+        let d3 = s.q_tr[2] - (t7 + FRAC_PI_2 - t2);
+        let d8 = s.q_tr[7] - (t2 - t7);
+        worst = worst.max(d3.abs()).max(d8.abs());
+        assert!(d3.abs() < 1e-10, "theta3 off by {d3}");
+        assert!(d8.abs() < 1e-10, "theta8 off by {d8}");
+        // the closed frames coincide as frames: 0T_9(q9) = 0T_10
+        let mut q = s.q_tr.clone();
+        q.extend_from_slice(&s.q_c);
+        let t = robodyn::geometry::frame_transforms(&r, &q);
+        assert!((t[8].rot - t[9].rot).amax() < 1e-10);
+        assert!((t[8].pos - t[9].pos).amax() < 1e-10);
+    }
+    println!("SR400 closure vs Example 10.1: max error {worst:.2e}");
+}
+
+#[test]
+fn bundled_robots_close_at_reference_with_rank_chosen_rows() {
+    for (name, qa0, qp0, _, rows) in ROBOTS {
+        let r = robot(name);
+        let lc = LoopClosure::new(&r).unwrap();
+        let kept: Vec<usize> = lc.loops().iter().map(|l| l.rows.len()).collect();
+        assert_eq!(&kept, rows, "{name}: independent equations per loop");
+        let mut ws = lc.workspace();
+        let s = lc.solve(&mut ws, qa0, Some(qp0)).unwrap();
+        assert!(s.residual < 1e-12, "{name}: residual {}", s.residual);
+        for (a, b) in s.q_p.iter().zip(qp0.iter()) {
+            assert!((a - b).abs() < 1e-10, "{name}: q_p {:?}", s.q_p);
+        }
+        // the cut frame and its twin coincide as frames (with the cut variable)
+        let mut q = s.q_tr.clone();
+        q.extend_from_slice(&s.q_c);
+        let t = robodyn::geometry::frame_transforms(&r, &q);
+        for l in lc.loops() {
+            let (k, tw) = (l.topology.cut, l.topology.twin);
+            assert!((t[k - 1].rot - t[tw - 1].rot).amax() < 1e-10, "{name}");
+            assert!((t[k - 1].pos - t[tw - 1].pos).amax() < 1e-10, "{name}");
+        }
+        // regular reference configuration
+        let cc = ClosedChain::new(&r).unwrap();
+        let mut cws = cc.workspace();
+        cc.constraints(&mut cws, &s.q_tr).unwrap();
+    }
+}
+
+#[test]
+fn random_solutions_close_the_loops_as_frames() {
+    let mut rng = robodyn::testing::rng(2);
+    for (name, r, qa0, qp0, range) in cases() {
+        let lc = LoopClosure::new(&r).unwrap();
+        let mut ws = lc.workspace();
+        for _ in 0..10 {
+            let (qa, qp) = random_config(&lc, &mut ws, &mut rng, qa0, qp0, range);
+            // perturbed guess converges back to the same solution
+            let g: Vec<f64> = qp
+                .iter()
+                .map(|x| x + rng.random_range(-0.05..0.05))
+                .collect();
+            let s = lc.solve(&mut ws, &qa, Some(&g)).unwrap();
+            for (a, b) in s.q_p.iter().zip(&qp) {
+                assert!((a - b).abs() < 1e-9, "{name}");
+            }
+            let mut q = s.q_tr.clone();
+            q.extend_from_slice(&s.q_c);
+            let t = robodyn::geometry::frame_transforms(&r, &q);
+            for l in lc.loops() {
+                let (k, tw) = (l.topology.cut, l.topology.twin);
+                assert!((t[k - 1].rot - t[tw - 1].rot).amax() < 1e-10, "{name}");
+                assert!((t[k - 1].pos - t[tw - 1].pos).amax() < 1e-10, "{name}");
+            }
+        }
+    }
+}
+
+#[test]
+fn w_matches_finite_differences_of_the_closure_solution() {
+    let mut rng = robodyn::testing::rng(3);
+    for (name, r, qa0, qp0, range) in cases() {
+        let mut lc = LoopClosure::new(&r).unwrap();
+        lc.tolerance = 1e-14;
+        let cc = ClosedChain::new(&r).unwrap();
+        let mut cws = cc.workspace();
+        let mut ws = lc.workspace();
+        let mut worst: f64 = 0.0;
+        for _ in 0..5 {
+            let (qa, qp) = random_config(&lc, &mut ws, &mut rng, qa0, qp0, range);
+            let s = lc.solve(&mut ws, &qa, Some(&qp)).unwrap();
+            let c = cc.constraints(&mut cws, &s.q_tr).unwrap();
+            let h = 1e-5;
+            for col in 0..qa.len() {
+                let mut qp_ = qa.clone();
+                qp_[col] += h;
+                let mut qm = qa.clone();
+                qm[col] -= h;
+                let sp = lc.solve(&mut ws, &qp_, Some(&s.q_p)).unwrap();
+                let sm = lc.solve(&mut ws, &qm, Some(&s.q_p)).unwrap();
+                for row in 0..qp.len() {
+                    let fd = (sp.q_p[row] - sm.q_p[row]) / (2.0 * h);
+                    let e = (fd - c.w[(row, col)]).abs() / c.w[(row, col)].abs().max(1.0);
+                    worst = worst.max(e);
+                    assert!(
+                        e < 1e-6,
+                        "{name}: W[{row},{col}] = {} vs {fd}",
+                        c.w[(row, col)]
+                    );
+                }
+            }
+        }
+        println!("{name}: W vs central differences, max relative error {worst:.2e}");
+    }
+}
+
+#[test]
+fn psi_matches_second_derivative_along_smooth_paths() {
+    let mut rng = robodyn::testing::rng(4);
+    for (name, r, qa0, qp0, range) in cases() {
+        let mut lc = LoopClosure::new(&r).unwrap();
+        lc.tolerance = 1e-14;
+        let cc = ClosedChain::new(&r).unwrap();
+        let mut cws = cc.workspace();
+        let mut ws = lc.workspace();
+        let mut worst: f64 = 0.0;
+        for _ in 0..5 {
+            let (c0, qp) = random_config(&lc, &mut ws, &mut rng, qa0, qp0, range * 0.5);
+            let n = c0.len();
+            // q_a(t) = c0 + A sin(om t + ph) - A sin(ph): a smooth path through c0 at t = 0
+            let amp: Vec<f64> = (0..n).map(|_| rng.random_range(-0.2..0.2)).collect();
+            let om: Vec<f64> = (0..n).map(|_| rng.random_range(0.5..3.0)).collect();
+            let ph: Vec<f64> = (0..n).map(|_| rng.random_range(-3.0..3.0)).collect();
+            let qa_at = |t: f64| -> Vec<f64> {
+                (0..n)
+                    .map(|i| c0[i] + amp[i] * ((om[i] * t + ph[i]).sin() - ph[i].sin()))
+                    .collect()
+            };
+            let qd: Vec<f64> = (0..n).map(|i| amp[i] * om[i] * ph[i].cos()).collect();
+            let qdd: Vec<f64> = (0..n)
+                .map(|i| -amp[i] * om[i] * om[i] * ph[i].sin())
+                .collect();
+            let st = cc.state(&mut cws, &c0, &qd, &qdd, Some(&qp)).unwrap();
+            let mut solve = |t: f64| lc.solve(&mut ws, &qa_at(t), Some(&qp)).unwrap().q_p;
+            let second = |h: f64, solve: &mut dyn FnMut(f64) -> Vec<f64>| -> Vec<f64> {
+                let (a, b, c) = (solve(-h), solve(0.0), solve(h));
+                (0..a.len())
+                    .map(|k| (a[k] - 2.0 * b[k] + c[k]) / (h * h))
+                    .collect()
+            };
+            // Richardson extrapolation of the central second difference: O(h^4)
+            let (d1, d2) = (second(2e-3, &mut solve), second(1e-3, &mut solve));
+            for (k, &j) in lc.passive_joints().iter().enumerate() {
+                let fd = (4.0 * d2[k] - d1[k]) / 3.0;
+                let an = st.qdd[j - 1];
+                let e = (fd - an).abs() / an.abs().max(1.0);
+                worst = worst.max(e);
+                assert!(e < 1e-5, "{name}: qdd_{j} = {an} (10.42) vs {fd}");
+            }
+        }
+        println!("{name}: W qdd_a - Wp^-1 Psi vs second differences, max rel. error {worst:.2e}");
+    }
+}
+
+#[test]
+fn unreachable_configuration_names_the_loop() {
+    let r = robot("fivebar.toml");
+    let lc = LoopClosure::new(&r).unwrap();
+    let mut ws = lc.workspace();
+    // proximal tips 0.447 m apart, distal links reach 0.4 m together
+    let e = lc
+        .solve(&mut ws, &[0.0, -FRAC_PI_2], Some(&[0.0, 0.0]))
+        .unwrap_err();
+    let msg = e.to_string();
+    assert!(matches!(e, Error::Numerical(_)), "{msg}");
+    assert!(
+        msg.contains("loop 1 (cut joint 5 between links 2 and 4)") && msg.contains("q_a = "),
+        "{msg}"
+    );
+}
+
+#[test]
+fn singular_wp_is_an_error_naming_the_loop() {
+    let r = robot("fivebar.toml");
+    let cc = ClosedChain::new(&r).unwrap();
+    let mut ws = cc.workspace();
+    // distal links aligned (a parallel singularity): q = [pi/6, -pi/2, -pi/6, pi/2] is closed
+    let q = [FRAC_PI_6, -FRAC_PI_2, -FRAC_PI_6, FRAC_PI_2];
+    let s = cc
+        .solve_positions(&mut ws, &[q[0], q[2]], Some(&[q[1], q[3]]))
+        .unwrap();
+    assert!(s.residual < 1e-9);
+    let e = cc.constraints(&mut ws, &q).unwrap_err();
+    let msg = e.to_string();
+    assert!(matches!(e, Error::Numerical(_)), "{msg}");
+    assert!(
+        msg.contains("Wp") && msg.contains("loop 1 (cut joint 5"),
+        "{msg}"
+    );
+}
+
+#[test]
+fn wrong_number_of_actuators_is_reported() {
+    let mut d = robot("fourbar.toml").into_description();
+    d.frame_mut(2).actuated = true;
+    let r = Robot::new(d).unwrap();
+    let e = LoopClosure::new(&r).unwrap_err().to_string();
+    assert!(
+        e.contains("2 independent closure equations") && e.contains("passive"),
+        "{e}"
+    );
+}
+
+#[test]
+fn grashof_cranks_turn_fully() {
+    // the four-bar and both loops of the Watt six-bar are Grashof with the driving link
+    // shortest: continuation over a full crank turn never meets a singular Wp
+    for name in ["fourbar.toml", "twoloops.toml"] {
+        let r = robot(name);
+        let cc = ClosedChain::new(&r).unwrap();
+        let mut ws = cc.workspace();
+        let mut qp = vec![0.0; cc.passive_joints().len()];
+        for s in 1..=72 {
+            let qa = [s as f64 * 2.0 * PI / 72.0];
+            let sol = cc.solve_positions(&mut ws, &qa, Some(&qp)).unwrap();
+            cc.constraints(&mut ws, &sol.q_tr).unwrap();
+            qp = sol.q_p;
+        }
+        // back to the start after one turn, up to 2 pi on passive joints that turn fully
+        for x in &qp {
+            let m = x.rem_euclid(2.0 * PI);
+            assert!(
+                m.min(2.0 * PI - m) < 1e-9,
+                "{name}: q_p after a turn {qp:?}"
+            );
+        }
+    }
+}
+
+#[test]
+fn prismatic_cut_slider_crank_closed_form() {
+    // slider position x_B = a cos(phi) + sqrt(L^2 - a^2 sin^2(phi)), phi = pi/2 + q1; the cut
+    // variable is the slide of R_4 along z_4 = x_0 to the twin at the origin: q_c = -x_B
+    let r = slider_crank();
+    let lc = LoopClosure::new(&r).unwrap();
+    assert_eq!(lc.loops()[0].rows.len(), 2);
+    let mut ws = lc.workspace();
+    let mut rng = robodyn::testing::rng(5);
+    let mut qp = vec![0.0, 0.0];
+    let mut worst: f64 = 0.0;
+    for s in 1..=36 {
+        let q1 = s as f64 * 2.0 * PI / 36.0;
+        let sol = lc.solve(&mut ws, &[q1], Some(&qp)).unwrap();
+        qp = sol.q_p.clone();
+        let phi = FRAC_PI_2 + q1;
+        let xb = 0.1 * phi.cos() + (0.09 - 0.01 * phi.sin().powi(2)).sqrt();
+        worst = worst.max((sol.q_c[0] + xb).abs());
+        assert!(
+            (sol.q_c[0] + xb).abs() < 1e-12,
+            "q_c {} vs {}",
+            sol.q_c[0],
+            -xb
+        );
+        // from a perturbed guess too
+        let g: Vec<f64> = qp.iter().map(|x| x + rng.random_range(-0.1..0.1)).collect();
+        let again = lc.solve(&mut ws, &[q1], Some(&g)).unwrap();
+        assert!((again.q_c[0] + xb).abs() < 1e-12);
+    }
+    println!("slider-crank: cut slide vs closed form, max error {worst:.2e}");
+}
