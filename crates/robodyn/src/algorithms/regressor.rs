@@ -15,7 +15,7 @@
 //! ([`closed_chain_regressor`]).
 
 use crate::error::{Error, Result};
-use crate::model::{DynModel, JointType, Robot, STANDARD_PARAMETERS};
+use crate::model::{DynModel, JointType, Robot, RobotDescription, STANDARD_PARAMETERS};
 use crate::workspace::Workspace;
 use nalgebra::{DMatrix, Matrix3, SMatrix, Vector3};
 
@@ -56,8 +56,13 @@ impl ParameterSelection {
     /// Rotor inertias by `rotor`; Coulomb and viscous friction on the actuated joints when
     /// `friction` (passive joints of closed loops are assumed frictionless).
     pub fn new(robot: &Robot, rotor: RotorMode, friction: bool) -> Self {
-        let nl = robot.nl();
-        let f = |j: usize| robot.frame(j);
+        Self::from_description(robot.description(), rotor, friction)
+    }
+
+    /// As [`ParameterSelection::new`], from a description (symbols may lack values).
+    pub fn from_description(desc: &RobotDescription, rotor: RotorMode, friction: bool) -> Self {
+        let nl = desc.nl;
+        let f = |j: usize| desc.frame(j);
         ParameterSelection {
             rotor: (1..=nl)
                 .map(|j| match rotor {
