@@ -9,6 +9,7 @@ use robodyn::algorithms::base_parameters::{
 use robodyn::algorithms::regressor::{
     parameter_name, regressor, ParameterSelection, RotorMode, PARAMS_PER_LINK,
 };
+use robodyn::model::JointType;
 use robodyn::testing::{random_inertial, random_tree, rng, TreeOptions};
 use robodyn::{Expr, Robot, RobotDescription, Workspace};
 use std::f64::consts::FRAC_PI_2;
@@ -348,4 +349,126 @@ fn sr400_symbolic_matches_table_10_2_and_the_chapter_listing() {
     // values: symbolic grouped values reproduce the closed-chain torques
     let err = check_symbolic_reproduces(&robot, &sb, &mut Sr400Sampler, 5);
     assert!(err < 1e-9, "SR400 symbolic base model error {err:e}");
+}
+
+#[test]
+fn rx90_symbolic_has_40_base_parameters() {
+    let robot = rx90(5);
+    let sel = ParameterSelection::new(&robot, RotorMode::Actuated, false);
+    let sb = symbolic_base_parameters(robot.description(), &sel).unwrap();
+    let mut table = expected("ZZ1 XX2 XY2 XZ2 YZ2 ZZ2 MX2 MY2");
+    for j in 3..=6 {
+        for p in ["XX", "XY", "XZ", "YZ", "ZZ", "MX", "MY", "IA"] {
+            table.push(format!("{p}{j}"));
+        }
+    }
+    assert_eq!(names(&sb.base), table);
+    // R suffix exactly where the conventions say: ZZR1, XXR2, XZR2, ZZR2, MXR2; XXR, ZZR, MYR of
+    // links 3-5; XXR6.
+    let regrouped: Vec<String> = (0..sb.count())
+        .filter(|&r| sb.is_regrouped(r))
+        .map(|r| parameter_name(sb.base[r]))
+        .collect();
+    assert_eq!(
+        regrouped,
+        expected("ZZ1 XX2 XZ2 ZZ2 MX2 XX3 ZZ3 MY3 XX4 ZZ4 MY4 XX5 ZZ5 MY5 XX6")
+    );
+    let err = check_symbolic_reproduces(&robot, &sb, &mut TreeSampler, 6);
+    assert!(err < 1e-9, "RX-90 symbolic base model error {err:e}");
+}
+
+/// Bound b_m of eq 10.24 (10.57 without parallelograms) for the inertial parameters of a tree.
+fn bound_bm(robot: &Robot) -> usize {
+    let d = robot.description();
+    let (mut nr, mut np, mut nr0, mut np0, mut ng0) = (0i64, 0, 0, 0, 0);
+    let g = nalgebra::Vector3::new(
+        robot.value(&d.gravity[0]).unwrap(),
+        robot.value(&d.gravity[1]).unwrap(),
+        robot.value(&d.gravity[2]).unwrap(),
+    );
+    for j in 1..=robot.nl() {
+        let f = robot.frame(j);
+        let at_base = f.ant == 0;
+        match f.joint {
+            JointType::Revolute => {
+                nr += 1;
+                if at_base {
+                    nr0 += 1;
+                    let (rot, _) = robot.numeric().frame(j).transform(&0.0);
+                    if rot.column(2).cross(&g).norm() < 1e-9 * g.norm().max(1.0) {
+                        ng0 += 1;
+                    }
+                }
+            }
+            JointType::Prismatic => {
+                np += 1;
+                if at_base {
+                    np0 += 1;
+                }
+            }
+            JointType::Fixed => {}
+        }
+    }
+    (7 * nr + 4 * np - 4 * nr0 - 3 * np0 - 2 * ng0).max(0) as usize
+}
+
+#[test]
+fn random_trees_symbolic_agrees_with_numeric() {
+    let mut worst: f64 = 0.0;
+    for seed in 0..400u64 {
+        let mut r = rng(5000 + seed);
+        let n = 2 + (seed as usize % 9);
+        let opt = TreeOptions {
+            gravity: if seed % 3 == 0 {
+                None
+            } else {
+                Some([0.0, 0.0, -9.81])
+            },
+            p_prismatic: if seed % 2 == 0 { 0.25 } else { 0.0 },
+            ..TreeOptions::default()
+        };
+        let robot = random_tree(&mut r, n, &opt);
+        let (rotor, friction) = match seed % 3 {
+            0 => (RotorMode::None, false),
+            1 => (RotorMode::All, false),
+            _ => (RotorMode::Actuated, true),
+        };
+        let sel = ParameterSelection::new(&robot, rotor, friction);
+        let nopt = NumericOptions {
+            selection: sel.clone(),
+            samples: None,
+            seed,
+        };
+        let nb = numeric_base_parameters(&robot, &mut TreeSampler, &nopt).unwrap();
+        let sb = symbolic_base_parameters(robot.description(), &sel).unwrap();
+        let geometry: Vec<String> = (1..=n)
+            .map(|j| {
+                let f = robot.frame(j);
+                format!(
+                    "{j}: a={} {:?} g={} b={} al={} d={} th={} r={}",
+                    f.ant, f.joint, f.gamma, f.b, f.alpha, f.d, f.theta, f.r
+                )
+            })
+            .collect();
+        assert_eq!(
+            names(&sb.base),
+            names(&nb.base),
+            "seed {seed}: symbolic vs numeric base sets differ\n{}",
+            geometry.join("\n")
+        );
+        // b_m bound on the inertial parameters (+ drive parameters kept)
+        let inertial = sb
+            .base
+            .iter()
+            .filter(|&&c| c % PARAMS_PER_LINK < 10)
+            .count();
+        assert!(
+            inertial <= bound_bm(&robot),
+            "seed {seed}: {inertial} > b_m"
+        );
+        let err = check_symbolic_reproduces(&robot, &sb, &mut TreeSampler, seed + 11);
+        worst = worst.max(err);
+        assert!(err < 1e-9, "seed {seed}: symbolic base model error {err:e}");
+    }
+    eprintln!("random trees: symbolic = numeric, worst symbolic base-model error {worst:e}");
 }

@@ -1,5 +1,5 @@
-//! The dynamic model is linear in the standard parameters (§10.2.4): Gamma_tr = Phi(q, qd, qdd) K
-//! + Gamma_e, with K = [XX XY XZ YY YZ ZZ MX MY MZ M IA FS FV] per link (13 NL entries, link 1
+//! The dynamic model is linear in the standard parameters (§10.2.4):
+//! Gamma_tr = Phi(q, qd, qdd) K + Gamma_e, with K = [XX XY XZ YY YZ ZZ MX MY MZ M IA FS FV] per link (13 NL entries, link 1
 //! first) and Phi the regressor.
 //!
 //! Phi is computed recursively, not by finite differences: after the forward Newton–Euler

@@ -7,7 +7,7 @@
 //! 2. Parameters with no effect: columns with ||W_c|| <= [`NO_EFFECT_TOLERANCE`] max_c ||W_c||.
 //! 3. The remaining columns are scaled to unit norm (so the tolerance does not depend on units).
 //!    The rank r (the number of base parameters) comes from the singular values of the scaled W:
-//!    sigma_k > tol with tol = max(rows, cols) * eps * sigma_max (the usual numerical rank).
+//!    sigma_k > tol with tol = [`RANK_TOLERANCE`] * sigma_max.
 //! 4. Which parameters are kept: an *unpivoted* Householder QR of the scaled W in the column
 //!    order of K (link 1 first, XX XY XZ YY YZ ZZ MX MY MZ M IA FS FV in each link). |R_kk| is the
 //!    distance of column k from the span of the columns before it, so a column is kept when
@@ -32,6 +32,12 @@ use rand::{Rng, RngCore};
 /// A column whose norm is at most this fraction of the largest column norm of W is a parameter
 /// with no effect.
 pub const NO_EFFECT_TOLERANCE: f64 = 1e-10;
+
+/// Relative rank tolerance on the unit-column W: tol = RANK_TOLERANCE * sigma_max. Rounding
+/// leaves dependent columns at 1e-14..1e-12 (the textbook max(m, n) eps sigma_max proved too
+/// tight on random trees), while independent columns of randomly sampled states are many orders
+/// above 1e-9.
+pub const RANK_TOLERANCE: f64 = 1e-9;
 
 /// A consistent state of the equivalent tree with the Jacobian G = dq_tr/dq_a.
 #[derive(Clone, Debug)]
@@ -247,11 +253,14 @@ pub fn numeric_base_parameters(
     }
     let qr = ws_mat.clone().qr();
     let r = qr.r();
-    let sv = r.clone().singular_values();
-    let mut singular_values: Vec<f64> = sv.iter().cloned().collect();
+    let mut singular_values: Vec<f64> = if live.is_empty() {
+        Vec::new()
+    } else {
+        r.clone().singular_values().iter().cloned().collect()
+    };
     singular_values.sort_by(|a, b| b.partial_cmp(a).unwrap());
     let smax = singular_values.first().cloned().unwrap_or(0.0);
-    let tol = rows.max(live.len()) as f64 * f64::EPSILON * smax;
+    let tol = RANK_TOLERANCE * smax;
     let rank = singular_values.iter().filter(|&&x| x > tol).count();
     // 4. ordered selection (unpivoted QR in K order)
     let mut kept = Vec::new();

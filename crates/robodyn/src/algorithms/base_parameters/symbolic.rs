@@ -14,12 +14,15 @@
 //!   and MX_j, MY_j are grouped into link a(j) as a rigid body at q_j = 0 (eq 10.23, derived
 //!   from first principles: with z_j parallel to every rotation axis of a(j) the q_j-dependent
 //!   terms vanish); not parallel, Table 10.1 (eq 10.21 relation);
-//! - rules 5–7 eliminate XX XY XZ YZ (rule 5), MX MY (rule 6) of revolute links between r1 and
-//!   r2, and the first moments of prismatic links before r1 (rule 7);
+//! - rules 5–7 eliminate XX XY XZ YZ (rule 5), MX MY (rule 6: axis on the line of r1's) of
+//!   revolute links between r1 and r2, and the first moments of prismatic links before r1 (rule 7);
 //! - rotor inertias (§9.4.2.5, derived): IA_j is grouped into ZZ_j when w_j . z_j = qd_j
 //!   identically, i.e. every revolute axis before j on its branch is perpendicular to z_j (r1
-//!   always; r2 when perpendicular to r1); the IA of a prismatic joint with no movable joint
-//!   before it and perpendicular to the effective gravity is grouped into its M.
+//!   always; r2 when perpendicular to r1). IA_j of a prismatic joint is grouped into M_j when
+//!   every revolute axis before j is parallel to z_j, every prismatic axis before j is
+//!   perpendicular to it and z_j is perpendicular to the effective gravity: then the column of
+//!   M_j is qdd_j in row j plus that of a point mass fixed on a(j) at q_j = 0 (derived), so
+//!   MR_j = M_j + IA_j and a point mass -IA_j is added to link a(j).
 //!
 //! The geometric conditions (parallel or perpendicular axes, parallelogram shape) are evaluated
 //! numerically at random configurations with the robot's symbol values; a symbol without value
@@ -440,20 +443,28 @@ pub fn symbolic_base_parameters(
                 .filter(|&&k| joint(k) == JointType::Revolute)
                 .all(|&k| geo.perpendicular(k, j)),
             JointType::Prismatic => {
-                before.iter().all(|&k| joint(k) == JointType::Fixed)
-                    && geo.perpendicular_to_gravity(j)
+                before.iter().all(|&k| match joint(k) {
+                    JointType::Revolute => geo.parallel(k, j),
+                    JointType::Prismatic => geo.perpendicular(k, j),
+                    JointType::Fixed => true,
+                }) && geo.perpendicular_to_gravity(j)
             }
             JointType::Fixed => false,
         };
         if group {
-            let target = if joint(j) == JointType::Revolute {
-                ZZ
-            } else {
-                M
-            };
             let e = s.get(j, IA);
             s.kill(j, IA);
-            s.add(j, target, e);
+            if joint(j) == JointType::Revolute {
+                s.add(j, ZZ, e);
+            } else {
+                // the mass column of j is qdd_j in row j plus that of a point mass fixed on a(j)
+                // at q_j = 0: MR_j = M_j + IA_j and a point mass -IA_j on a(j)
+                s.add(j, M, e.clone());
+                let (a, p) = frame_expr(desc, j);
+                let z = Matrix3::from_element(Expr::zero());
+                let zv = Vector3::from_element(Expr::zero());
+                s.add_all(st.ant[j], transfer(&a, &p, &z, &zv, &-e));
+            }
         }
     }
 
@@ -586,7 +597,7 @@ pub fn symbolic_base_parameters(
                         let mut rot = Matrix3::<Expr>::identity();
                         for k in path(j).into_iter().filter(|&k| k > r1) {
                             let (ak, _) = frame_expr(desc, k);
-                            rot = rot * ak;
+                            rot *= ak;
                         }
                         // z_r1 in R_j = (r1 A_j)^T e3
                         let u: Vec<Expr> = (0..3).map(|c| rot[(2, c)].clone()).collect();
@@ -629,12 +640,19 @@ pub fn symbolic_base_parameters(
             }
             // rule 6
             let r1 = r1_of(j).unwrap();
-            let all_vertical = path(j)
-                .into_iter()
-                .filter(|&k| joint(k) != JointType::Fixed)
-                .all(|k| {
-                    geo.parallel(k, r1) && (geo.g.norm() == 0.0 || geo.parallel_to_gravity(k))
-                });
+            // "a_j along a_r1": the same line, not only parallel
+            let coaxial = (0..geo.configs.len()).all(|c| {
+                let z = geo.z(c, r1);
+                let dp = geo.poses[c][j].1 - geo.poses[c][r1].1;
+                geo.parallel(j, r1) && dp.cross(&z).norm() < GEOMETRY_TOLERANCE
+            });
+            let all_vertical = coaxial
+                && path(j)
+                    .into_iter()
+                    .filter(|&k| joint(k) != JointType::Fixed)
+                    .all(|k| {
+                        geo.parallel(k, r1) && (geo.g.norm() == 0.0 || geo.parallel_to_gravity(k))
+                    });
             if all_vertical {
                 s.kill(j, MX);
                 s.kill(j, MY);
@@ -754,8 +772,6 @@ pub fn collect_by_coefficient(e: &Expr, nl: usize) -> String {
             body.trim_start_matches('(')
                 .trim_end_matches(')')
                 .to_string()
-        } else if ks.len() == 1 {
-            format!("{}*{body}", paren(&mag))
         } else {
             format!("{}*{body}", paren(&mag))
         };
