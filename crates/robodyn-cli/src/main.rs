@@ -23,6 +23,10 @@ enum Command {
     Info(commands::info::Args),
     /// Inverse dynamic model: joint torques for given states (Newton-Euler).
     Idm(commands::idm::Args),
+    /// Base inertial parameters: table, grouping equations, values (symbolic and/or numeric).
+    BaseParams(commands::base_params::Args),
+    /// Regressor Phi of the tree (Gamma = Phi K + Gamma_e) for states from a CSV file.
+    Regressor(commands::regressor::Args),
 }
 
 fn main() {
@@ -30,6 +34,8 @@ fn main() {
     let result = match cli.command {
         Command::Info(a) => commands::info::run(a),
         Command::Idm(a) => commands::idm::run(a),
+        Command::BaseParams(a) => commands::base_params::run(a),
+        Command::Regressor(a) => commands::regressor::run(a),
     };
     if let Err(e) = result {
         eprintln!("robodyn: error: {e}");

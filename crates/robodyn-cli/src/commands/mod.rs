@@ -1,4 +1,6 @@
 //! One module per subcommand.
 
+pub mod base_params;
 pub mod idm;
 pub mod info;
+pub mod regressor;

@@ -11,3 +11,6 @@ pub use numeric::{
 pub mod symbolic;
 
 pub use symbolic::{collect_by_coefficient, symbolic_base_parameters, SymbolicBase};
+pub mod report;
+
+pub use report::{base_robot, Report};
