@@ -472,3 +472,80 @@ fn random_trees_symbolic_agrees_with_numeric() {
     }
     eprintln!("random trees: symbolic = numeric, worst symbolic base-model error {worst:e}");
 }
+
+/// The base robot written to TOML and read back gives the torques of the full model
+/// (closed chain: G^T Gamma_tr with the test sampler; RX-90: Gamma_tr directly).
+#[test]
+fn base_robot_file_reproduces_the_full_model() {
+    use robodyn::algorithms::base_parameters::{base_robot, Report};
+    use robodyn::algorithms::inverse_dynamics::inverse_dynamics;
+    let dir = std::env::temp_dir().join(format!("robodyn-basep-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for (name, robot, closed) in [("sr400", sr400(), true), ("rx90", rx90(9), false)] {
+        let sel = ParameterSelection::new(&robot, RotorMode::Actuated, true);
+        // the full model restricted to the selection (drive parameters outside it are zero)
+        let mut k = robot.standard_parameters();
+        let cols: std::collections::BTreeSet<usize> = sel.columns().into_iter().collect();
+        for (i, v) in k.iter_mut().enumerate() {
+            if !cols.contains(&i) {
+                *v = 0.0;
+            }
+        }
+        let full = robot.with_standard_parameters(&k).unwrap();
+        let sb = symbolic_base_parameters(robot.description(), &sel).unwrap();
+        let report = Report::from_symbolic(full.description(), &sb);
+        let values: Vec<f64> = report.base.iter().map(|b| b.value.unwrap()).collect();
+        let desc = base_robot(robot.description(), &sb.base, &values).unwrap();
+        let path = dir.join(format!("{name}-base.toml"));
+        robodyn::io::save_description(&desc, &path).unwrap();
+        let based = robodyn::io::load(&path).unwrap();
+        let mut r = rng(77);
+        for _ in 0..10 {
+            let s = if closed {
+                Sr400Sampler.sample(&robot, &mut r).unwrap()
+            } else {
+                TreeSampler.sample(&robot, &mut r).unwrap()
+            };
+            let t_full = inverse_dynamics(&full, &s.q, &s.qd, &s.qdd).unwrap();
+            let t_base = inverse_dynamics(&based, &s.q, &s.qd, &s.qdd).unwrap();
+            let g =
+                s.g.clone()
+                    .unwrap_or_else(|| DMatrix::identity(robot.nl(), robot.nl()));
+            let (a, b) = (g.transpose() * t_full, g.transpose() * t_base);
+            let scale = a.amax().max(1.0);
+            for i in 0..a.len() {
+                assert!(
+                    (a[i] - b[i]).abs() <= 1e-9 * scale,
+                    "{name}: row {i}: full {} vs base robot {}",
+                    a[i],
+                    b[i]
+                );
+            }
+        }
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn report_formats_carry_count_and_lists() {
+    use robodyn::algorithms::base_parameters::Report;
+    let robot = sr400();
+    let sel = ParameterSelection::new(&robot, RotorMode::Actuated, false);
+    let sb = symbolic_base_parameters(robot.description(), &sel).unwrap();
+    let rep = Report::from_symbolic(robot.description(), &sb);
+    let j = rep.to_json();
+    assert_eq!(j["count"], 42);
+    assert_eq!(j["base"].as_array().unwrap().len(), 42);
+    assert_eq!(j["base"][0]["name"], "ZZR1");
+    assert_eq!(j["no_effect"].as_array().unwrap().len(), 11);
+    assert_eq!(j["grouped"].as_array().unwrap().len(), 33);
+    // Table 10.2 layout: link 8 row has only MY8; link 1 only ZZR1; IA4 on link 4
+    let t = rep.table();
+    let row = |j: usize| t[j].join(" ");
+    assert_eq!(row(1), "1 0 0 0 0 0 ZZR1 0 0 0 0 0");
+    assert_eq!(row(7), "7 0 0 0 0 0 0 MXR7 MY7 0 0 0");
+    assert_eq!(row(8), "8 0 0 0 0 0 0 0 MY8 0 0 -");
+    assert!(row(4).ends_with("IA4"));
+    let latex = rep.to_latex();
+    assert!(latex.contains("ZZR_{1} &="), "{latex}");
+}
