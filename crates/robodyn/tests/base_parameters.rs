@@ -344,6 +344,14 @@ fn sr400_symbolic_matches_table_10_2_and_the_chapter_listing() {
         }
     }
     // the collected printing of ZZR2 reads like the chapter
+    // bound 10.57: 7 nr - 4 nr0 - 11 npar - 2 ng0 = 56 - 4 - 11 - 2 = 39 inertial parameters
+    let inertial = sb
+        .base
+        .iter()
+        .filter(|&&c| c % PARAMS_PER_LINK < 10)
+        .count();
+    assert_eq!(inertial, 39);
+    assert_eq!(sb.parallelograms, vec![9]);
     let zz2 = base_names.iter().position(|n| n == "ZZ2").unwrap();
     eprintln!("{}", collect_by_coefficient(&sb.equations[zz2], 8));
     // values: symbolic grouped values reproduce the closed-chain torques

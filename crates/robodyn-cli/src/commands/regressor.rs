@@ -39,6 +39,13 @@ pub fn run(a: Args) -> CliResult {
     let joints = robot.movable_joints();
     let t = Table::read(&a.input)?;
     let sel = ParameterSelection::new(&robot, RotorMode::Actuated, !a.no_friction);
+    if a.base && !robot.is_tree() {
+        eprintln!(
+            "robodyn: note: {} is a closed chain: its base parameters hold for the closed-chain \
+             model G^T Phi_b K_b (eq 10.40), not for the tree torques of each row",
+            robot.name()
+        );
+    }
     let (cols, names): (Vec<usize>, Vec<String>) = if a.base {
         let sb = symbolic_base_parameters(robot.description(), &sel)?;
         (0..sb.count())
