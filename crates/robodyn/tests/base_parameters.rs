@@ -574,3 +574,29 @@ fn report_formats_carry_count_and_lists() {
     let latex = rep.to_latex();
     assert!(latex.contains("ZZR_{1} &="), "{latex}");
 }
+
+/// The symbolic method needs no numeric values: the RX-90 with D3 and RL4 left symbolic gives the
+/// same base set, equations in D3 and RL4, and no value where a symbol is missing.
+#[test]
+fn symbolic_method_on_a_description_without_values() {
+    let robot = rx90(5);
+    let mut desc = robot.description().clone();
+    desc.symbols.clear();
+    for j in 1..=6 {
+        *desc.link_mut(j) = robodyn::model::LinkDesc::symbolic(j);
+    }
+    let sel = ParameterSelection::from_description(&desc, RotorMode::Actuated, false);
+    let sb = symbolic_base_parameters(&desc, &sel).unwrap();
+    assert_eq!(sb.count(), 40);
+    let names = names(&sb.base);
+    let zz2 = names.iter().position(|n| n == "ZZ2").unwrap();
+    // ZZR2 = ZZ2 + IA2 + D3^2 (M3 + M4 + M5 + M6), derived by hand from Theorem 10.1 (link 3 at
+    // d = D3 on the x axis of frame 2, alpha3 = 0)
+    let diff = (sb.equations[zz2].clone() - parse("ZZ2 + IA2 + D3^2*(M3 + M4 + M5 + M6)")).expand();
+    assert!(diff.is_zero(), "ZZR2 = {}", sb.equations[zz2]);
+    let values = sb.values(&desc, &vec![None; 13 * 6]);
+    assert!(values.iter().all(|v| v.is_none()));
+    // a selection of the wrong size is an error, not a panic
+    let bad = ParameterSelection::all(3);
+    assert!(symbolic_base_parameters(&desc, &bad).is_err());
+}
