@@ -600,3 +600,50 @@ fn symbolic_method_on_a_description_without_values() {
     let bad = ParameterSelection::all(3);
     assert!(symbolic_base_parameters(&desc, &bad).is_err());
 }
+
+/// SR400 with other parameter selections (rotors on every joint, friction on every joint, none):
+/// symbolic set = numeric set, values agree parameter by parameter, and the symbolic base model
+/// reproduces the closed-chain torques. With rotors on the passive joints, IA8 groups into IA3
+/// (qd8 = -qd3 in the parallelogram).
+#[test]
+fn sr400_other_selections_symbolic_equals_numeric() {
+    let robot = sr400();
+    let every = ParameterSelection {
+        rotor: vec![true; 8],
+        friction: vec![true; 8],
+    };
+    let cases = [
+        ParameterSelection::new(&robot, RotorMode::All, true),
+        ParameterSelection::new(&robot, RotorMode::None, false),
+        ParameterSelection::new(&robot, RotorMode::Actuated, true),
+        every,
+    ];
+    for (n, sel) in cases.into_iter().enumerate() {
+        let opt = NumericOptions {
+            selection: sel.clone(),
+            samples: None,
+            seed: 4,
+        };
+        let nb = numeric_base_parameters(&robot, &mut Sr400Sampler, &opt).unwrap();
+        let sb = symbolic_base_parameters(robot.description(), &sel).unwrap();
+        assert_eq!(names(&sb.base), names(&nb.base), "case {n}");
+        assert_eq!(names(&sb.no_effect), names(&nb.no_effect), "case {n}");
+        let k = robot.standard_parameters();
+        let kopt: Vec<Option<f64>> = k.iter().map(|&v| Some(v)).collect();
+        let vs = sb.values(robot.description(), &kopt);
+        for (r, (a, b)) in vs.iter().zip(nb.base_values(&k)).enumerate() {
+            let a = a.unwrap();
+            assert!(
+                (a - b).abs() <= 1e-8 * (1.0 + b.abs()),
+                "case {n}: {}: symbolic {a} vs numeric {b}",
+                parameter_name(sb.base[r])
+            );
+        }
+        let err = check_symbolic_reproduces(&robot, &sb, &mut Sr400Sampler, 40 + n as u64);
+        assert!(err < 1e-9, "case {n}: error {err:e}");
+        if n == 0 {
+            let ia3 = names(&sb.base).iter().position(|x| x == "IA3").unwrap();
+            assert_eq!(sb.equations[ia3], parse("IA3 + IA8"));
+        }
+    }
+}

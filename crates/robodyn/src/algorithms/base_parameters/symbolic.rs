@@ -7,6 +7,8 @@
 //! - rule 1, parallelogram loops (§10.3.5): eq 10.51c eliminates MX (or MY) of the
 //!   higher-numbered of the two links holding the cut joint and its twin; eqs 10.55–10.56 group
 //!   the inertia tensor of the higher-numbered link of each pair of parallel links into the lower;
+//!   the rotor inertia (and friction) of the higher of the two joints inside the loop is grouped
+//!   into the lower one's, as their velocities are opposite (derived from 10.54);
 //! - rule 2: Theorem 10.1 (revolute j: YY_j, MZ_j, M_j into XX_j and link a(j), eqs 10.14–10.19,
 //!   any gamma and b) and Theorem 10.2 (prismatic j: J_j into J_a(j), eq 10.20b). A fixed frame
 //!   (sigma = 2) moves all ten parameters of its link into a(j) (rigid body, the full lambda);
@@ -318,6 +320,8 @@ fn rz(delta: &Expr) -> Matrix3<Expr> {
 /// the two links holding the cut joint and its twin.
 struct Parallelogram {
     cut: usize,
+    /// The two tree joints inside the loop (of links b and e): qd_b = -qd_e.
+    inner: (usize, usize),
     pairs: Vec<(usize, usize, Matrix3<Expr>)>,
 }
 
@@ -378,7 +382,11 @@ fn detect_parallelogram(
         };
         pairs.push((lo, hi, rz(&exact_angle(plo - phi_hi))));
     }
-    Some(Parallelogram { cut: k, pairs })
+    Some(Parallelogram {
+        cut: k,
+        inner: (b.min(e), b.max(e)),
+        pairs,
+    })
 }
 
 /// Run the symbolic method on a description (symbols may lack values).
@@ -475,6 +483,20 @@ pub fn symbolic_base_parameters(
         match detect_parallelogram(desc, &st, &geo, l) {
             Some(p) => parallelograms.push((p, l.clone())),
             None => unhandled_loops.push(l.cut),
+        }
+    }
+
+    // inner joints of a parallelogram: w_b = w_c and w_e = w_a give qd_e = -qd_b, so the drive
+    // parameters (energy 1/2 IA qd^2, friction through G^T) of the higher joint group into the
+    // lower one's (derived from 10.54)
+    for (p, _) in &parallelograms {
+        let (lo, hi) = p.inner;
+        for q in [IA, IA + 1, IA + 2] {
+            if s.alive[hi - 1][q] && s.alive[lo - 1][q] {
+                let e = s.get(hi, q);
+                s.kill(hi, q);
+                s.add(lo, q, e);
+            }
         }
     }
 
