@@ -134,7 +134,7 @@ impl Report {
             no_effect: nb.no_effect.iter().map(|&i| parameter_name(i)).collect(),
             grouped: nb.grouped.iter().map(|&i| parameter_name(i)).collect(),
             notes: vec![format!(
-                "{} samples rows, rank tolerance {:.3e} on unit columns; coefficients are \
+                "{} sample rows, rank tolerance {:.3e} on unit columns; coefficients are \
                  numbers for the robot's geometry (rounded for display only)",
                 nb.rows, nb.tolerance
             )],
@@ -209,7 +209,14 @@ impl Report {
         s.push_str("\nValues:\n");
         for b in &self.base {
             match b.value {
-                Some(v) => s.push_str(&format!("  {:<6} = {v:.9}\n", b.name)),
+                Some(v) => {
+                    let v = if format!("{v:.9}") == "-0.000000000" {
+                        0.0
+                    } else {
+                        v
+                    };
+                    s.push_str(&format!("  {:<6} = {v:.9}\n", b.name))
+                }
                 None => s.push_str(&format!("  {:<6} = (symbols without value)\n", b.name)),
             }
         }
