@@ -25,6 +25,10 @@ enum Command {
     Idm(commands::idm::Args),
     /// Loop closure of a closed-chain robot: q_p for given q_a (and W with --jacobian).
     Closure(commands::closure::Args),
+    /// Base inertial parameters: table, grouping equations, values (symbolic and/or numeric).
+    BaseParams(commands::base_params::Args),
+    /// Regressor Phi of the tree (Gamma = Phi K + Gamma_e) for states from a CSV file.
+    Regressor(commands::regressor::Args),
 }
 
 fn main() {
@@ -33,6 +37,8 @@ fn main() {
         Command::Info(a) => commands::info::run(a),
         Command::Idm(a) => commands::idm::run(a),
         Command::Closure(a) => commands::closure::run(a),
+        Command::BaseParams(a) => commands::base_params::run(a),
+        Command::Regressor(a) => commands::regressor::run(a),
     };
     if let Err(e) = result {
         eprintln!("robodyn: error: {e}");

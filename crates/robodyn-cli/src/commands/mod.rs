@@ -1,5 +1,7 @@
 //! One module per subcommand.
 
+pub mod base_params;
 pub mod closure;
 pub mod idm;
 pub mod info;
+pub mod regressor;

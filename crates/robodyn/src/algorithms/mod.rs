@@ -1,6 +1,8 @@
 //! One module per algorithm, named as the chapter names it.
 
+pub mod base_parameters;
 pub mod closed_chain;
 pub mod energy;
 pub mod inverse_dynamics;
 pub mod loop_closure;
+pub mod regressor;

@@ -1,0 +1,38 @@
+//! Numerical method for the base parameters on 30-joint random trees, and the symbolic rules.
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use robodyn::algorithms::base_parameters::{
+    numeric_base_parameters, symbolic_base_parameters, NumericOptions, TreeSampler,
+};
+use robodyn::algorithms::regressor::{regressor, ParameterSelection, RotorMode, PARAMS_PER_LINK};
+use robodyn::testing::{random_state, random_tree, rng, TreeOptions};
+use robodyn::Workspace;
+
+fn bench(c: &mut Criterion) {
+    let mut r = rng(30);
+    let robot = random_tree(&mut r, 30, &TreeOptions::default());
+    let sel = ParameterSelection::new(&robot, RotorMode::All, true);
+    let opt = NumericOptions {
+        selection: sel.clone(),
+        samples: None,
+        seed: 1,
+    };
+    let mut g = c.benchmark_group("base_parameters");
+    g.sample_size(10);
+    g.bench_function("numeric_30_joint_tree", |b| {
+        b.iter(|| numeric_base_parameters(&robot, &mut TreeSampler, &opt).unwrap())
+    });
+    g.bench_function("symbolic_30_joint_tree", |b| {
+        b.iter(|| symbolic_base_parameters(robot.description(), &sel).unwrap())
+    });
+    g.finish();
+    let [q, qd, qdd] = random_state(&mut r, 30);
+    let mut ws = Workspace::new(robot.numeric());
+    let mut phi = nalgebra::DMatrix::zeros(30, PARAMS_PER_LINK * 30);
+    c.bench_function("regressor_30_joint_tree", |b| {
+        b.iter(|| regressor(robot.numeric(), &mut ws, &q, &qd, &qdd, &mut phi))
+    });
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

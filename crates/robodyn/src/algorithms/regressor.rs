@@ -1,0 +1,248 @@
+//! The dynamic model is linear in the standard parameters (§10.2.4):
+//! Gamma_tr = Phi(q, qd, qdd) K + Gamma_e, with K = [XX XY XZ YY YZ ZZ MX MY MZ M IA FS FV] per link (13 NL entries, link 1
+//! first) and Phi the regressor.
+//!
+//! Phi is computed recursively, not by finite differences: after the forward Newton–Euler
+//! recursion (eqs 10.3–10.6) the wrench of link j is linear in its 10 inertial parameters
+//! (eqs 10.7–10.8): [jF_j; jM_j] = Y_j [J; MS; M] with Y_j a 6x10 matrix. Y_j is projected on
+//! joint j and carried to the ancestors k of j with the backward transformation (10.10)–(10.11);
+//! its z row (moment for a revolute joint k, force for a prismatic one) is the block of Phi in row
+//! k and the columns of link j. IA_j, FS_j, FV_j add qdd_j, sign(qd_j), qd_j in row j (10.12).
+//!
+//! External wrenches are not parameters: [`regressor`] gives Phi with Phi K = Gamma - Gamma_e,
+//! and [`wrench_torques`] gives Gamma_e, the torques that the external wrenches (fe_j, me_j) alone
+//! produce. For a closed chain, Gamma_cl = G^T Gamma_tr (10.40), so its regressor is G^T Phi
+//! ([`closed_chain_regressor`]).
+
+use crate::error::{Error, Result};
+use crate::model::{DynModel, JointType, Robot, RobotDescription, STANDARD_PARAMETERS};
+use crate::workspace::Workspace;
+use nalgebra::{DMatrix, Matrix3, SMatrix, Vector3};
+
+use super::inverse_dynamics::{check_state, forward_recursion};
+
+/// Number of standard parameters per link.
+pub const PARAMS_PER_LINK: usize = 13;
+
+/// Name of standard parameter `index` of the vector K (0-based, 13 per link): `XX1`, ..., `FV<NL>`.
+pub fn parameter_name(index: usize) -> String {
+    format!(
+        "{}{}",
+        STANDARD_PARAMETERS[index % PARAMS_PER_LINK],
+        index / PARAMS_PER_LINK + 1
+    )
+}
+
+/// Which rotor inertias are parameters of the model.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RotorMode {
+    /// IA_j for the actuated joints (mu_j = 1).
+    Actuated,
+    /// IA_j for every movable joint.
+    All,
+    /// No rotor inertia.
+    None,
+}
+
+/// Which of the drive parameters IA, FS, FV are kept, joint by joint (index j-1). The ten
+/// inertial parameters of every link are always in K.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ParameterSelection {
+    pub rotor: Vec<bool>,
+    pub friction: Vec<bool>,
+}
+
+impl ParameterSelection {
+    /// Rotor inertias by `rotor`; Coulomb and viscous friction on the actuated joints when
+    /// `friction` (passive joints of closed loops are assumed frictionless).
+    pub fn new(robot: &Robot, rotor: RotorMode, friction: bool) -> Self {
+        Self::from_description(robot.description(), rotor, friction)
+    }
+
+    /// As [`ParameterSelection::new`], from a description (symbols may lack values).
+    pub fn from_description(desc: &RobotDescription, rotor: RotorMode, friction: bool) -> Self {
+        let nl = desc.nl;
+        let f = |j: usize| desc.frame(j);
+        ParameterSelection {
+            rotor: (1..=nl)
+                .map(|j| match rotor {
+                    RotorMode::Actuated => f(j).actuated && f(j).joint.is_movable(),
+                    RotorMode::All => f(j).joint.is_movable(),
+                    RotorMode::None => false,
+                })
+                .collect(),
+            friction: (1..=nl)
+                .map(|j| friction && f(j).actuated && f(j).joint.is_movable())
+                .collect(),
+        }
+    }
+
+    /// Every drive parameter of every link.
+    pub fn all(nl: usize) -> Self {
+        ParameterSelection {
+            rotor: vec![true; nl],
+            friction: vec![true; nl],
+        }
+    }
+
+    /// Indices in K (13 per link) of the selected parameters, in K's order.
+    pub fn columns(&self) -> Vec<usize> {
+        let mut c = Vec::new();
+        for j in 0..self.rotor.len() {
+            for p in 0..PARAMS_PER_LINK {
+                let keep = match p {
+                    10 => self.rotor[j],
+                    11 | 12 => self.friction[j],
+                    _ => true,
+                };
+                if keep {
+                    c.push(PARAMS_PER_LINK * j + p);
+                }
+            }
+        }
+        c
+    }
+}
+
+/// Unit inertia tensor of inertial parameter p (0..6: XX XY XZ YY YZ ZZ).
+fn unit_inertia(p: usize) -> Matrix3<f64> {
+    let (r, c) = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)][p];
+    let mut m = Matrix3::zeros();
+    m[(r, c)] = 1.0;
+    m[(c, r)] = 1.0;
+    m
+}
+
+/// Y_j: [F; M] = Y_j [XX XY XZ YY YZ ZZ MX MY MZ M]^T (eqs 10.7–10.8).
+fn link_wrench_map(w: &Vector3<f64>, wd: &Vector3<f64>, vd: &Vector3<f64>) -> SMatrix<f64, 6, 10> {
+    let mut y = SMatrix::<f64, 6, 10>::zeros();
+    for p in 0..6 {
+        let j = unit_inertia(p);
+        let m = j * wd + w.cross(&(j * w));
+        y.fixed_view_mut::<3, 1>(3, p).copy_from(&m);
+    }
+    for a in 0..3 {
+        let mut e = Vector3::zeros();
+        e[a] = 1.0;
+        // F = U MS, M = MS x vd
+        let f = wd.cross(&e) + w.cross(&w.cross(&e));
+        y.fixed_view_mut::<3, 1>(0, 6 + a).copy_from(&f);
+        y.fixed_view_mut::<3, 1>(3, 6 + a).copy_from(&e.cross(vd));
+    }
+    y.fixed_view_mut::<3, 1>(0, 9).copy_from(vd);
+    y
+}
+
+/// Regressor of the tree, Phi (NL x 13 NL), written into `phi`, such that
+/// Phi K = Gamma_tr - Gamma_e. Allocation-free: intermediate values live in `ws` (the forward
+/// recursion of [`forward_recursion`] runs first; the parameters of `model` only affect buffers
+/// the regressor does not read). Rows of fixed frames are zero.
+pub fn regressor(
+    model: &DynModel<f64>,
+    ws: &mut Workspace<f64>,
+    q: &[f64],
+    qd: &[f64],
+    qdd: &[f64],
+    phi: &mut DMatrix<f64>,
+) {
+    let nl = model.nl;
+    assert_eq!(phi.shape(), (nl, PARAMS_PER_LINK * nl), "regressor size");
+    forward_recursion(model, ws, q, qd, qdd);
+    phi.fill(0.0);
+    for j in 1..=nl {
+        let mut y = link_wrench_map(&ws.w[j], &ws.wd[j], &ws.vd[j]);
+        let col = PARAMS_PER_LINK * (j - 1);
+        let mut k = j;
+        loop {
+            let fr = model.frame(k);
+            let row = match fr.joint {
+                JointType::Revolute => Some(5),
+                JointType::Prismatic => Some(2),
+                JointType::Fixed => None,
+            };
+            if let Some(r) = row {
+                for c in 0..10 {
+                    phi[(k - 1, col + c)] = y[(r, c)];
+                }
+            }
+            let i = fr.ant;
+            if i == 0 {
+                break;
+            }
+            // (10.10)–(10.11): iF = iA_k kF, iM = iA_k kM + iP_k x iF
+            let rot = &ws.rot[k];
+            let pos = &ws.pos[k];
+            for c in 0..10 {
+                let f = rot * y.fixed_view::<3, 1>(0, c);
+                let m = rot * y.fixed_view::<3, 1>(3, c) + pos.cross(&f);
+                y.fixed_view_mut::<3, 1>(0, c).copy_from(&f);
+                y.fixed_view_mut::<3, 1>(3, c).copy_from(&m);
+            }
+            k = i;
+        }
+        if model.frame(j).joint.is_movable() {
+            let s = qd[j - 1];
+            phi[(j - 1, col + 10)] = qdd[j - 1];
+            phi[(j - 1, col + 11)] = if s > 0.0 {
+                1.0
+            } else if s < 0.0 {
+                -1.0
+            } else {
+                0.0
+            };
+            phi[(j - 1, col + 12)] = s;
+        }
+    }
+}
+
+/// Gamma_e: torques of the tree joints produced by the external wrenches (fe_j, me_j) alone, at
+/// configuration q (they do not depend on qd, qdd). Overwrites the buffers of `ws`.
+pub fn wrench_torques(model: &DynModel<f64>, ws: &mut Workspace<f64>, q: &[f64], tau: &mut [f64]) {
+    let nl = model.nl;
+    for j in 1..=nl {
+        let (rot, pos) = model.frame(j).transform(&q[j - 1]);
+        ws.rot[j] = rot;
+        ws.pos[j] = pos;
+        ws.f[j] = model.link(j).fe;
+        ws.m[j] = model.link(j).me;
+    }
+    for j in (1..=nl).rev() {
+        let fr = model.frame(j);
+        tau[j - 1] = match fr.joint {
+            JointType::Revolute => ws.m[j].z,
+            JointType::Prismatic => ws.f[j].z,
+            JointType::Fixed => 0.0,
+        };
+        let i = fr.ant;
+        if i > 0 {
+            let fi = ws.rot[j] * ws.f[j];
+            let mi = ws.rot[j] * ws.m[j] + ws.pos[j].cross(&fi);
+            ws.f[i] += fi;
+            ws.m[i] += mi;
+        }
+    }
+}
+
+/// Regressor of a closed chain: G^T Phi (eq 10.40), with G = d q_tr / d q_a (NL x N) given by
+/// the loop-closure solver (identity for a tree).
+pub fn closed_chain_regressor(g: &DMatrix<f64>, phi: &DMatrix<f64>) -> Result<DMatrix<f64>> {
+    if g.nrows() != phi.nrows() {
+        return Err(Error::Input(format!(
+            "G has {} rows, the regressor has {} (one per tree joint)",
+            g.nrows(),
+            phi.nrows()
+        )));
+    }
+    Ok(g.transpose() * phi)
+}
+
+/// Convenience: the regressor (NL x 13 NL) of a robot at one state, with input checks.
+pub fn regressor_at(robot: &Robot, q: &[f64], qd: &[f64], qdd: &[f64]) -> Result<DMatrix<f64>> {
+    check_state(robot, "q", q)?;
+    check_state(robot, "qd", qd)?;
+    check_state(robot, "qdd", qdd)?;
+    let mut ws = Workspace::new(robot.numeric());
+    let mut phi = DMatrix::zeros(robot.nl(), PARAMS_PER_LINK * robot.nl());
+    regressor(robot.numeric(), &mut ws, q, qd, qdd, &mut phi);
+    Ok(phi)
+}
