@@ -35,13 +35,14 @@ type Iso = nalgebra::Isometry3<f64>;
 /// Below this |z_i x z_j| the axes are taken as parallel (the error is then below 1e-12 rad).
 pub const PARALLEL: f64 = 1e-12;
 
-/// Whether z_i and z_j are nearly but not exactly parallel (1e-12 < |z_i x z_j| < 1e-4): the
+/// Whether z_i and z_j are nearly but not exactly parallel (1e-12 < |z_i x z_j| < 1e-2): the
 /// common normal is then far away (b, r ~ distance / angle) and the six parameters lose
-/// precision, so the placement is split in two with a fixed frame rotated by Rx(pi/2).
+/// precision (~1e-16 |b|), so the placement is split in two with a fixed frame rotated by
+/// Rx(pi/2).
 pub fn needs_auxiliary_frame(t: &Iso) -> bool {
     let u = t.rotation * Vector3::z();
     let c = Vector3::z().cross(&u).norm();
-    c > PARALLEL && c < 1e-4
+    c > PARALLEL && c < 1e-2
 }
 
 /// The six parameters (gamma, b, alpha, d, theta, r) of a frame placed at `t` in its
@@ -74,9 +75,10 @@ pub fn decompose(t: &Iso) -> [f64; 6] {
         let (qa, qb) = (e3.dot(&q), u.dot(&q));
         let den = cross.norm_squared(); // = 1 - c^2, without cancellation
                                         // t e3 + r u = q: dot with e3 gives t + r c = qa, with u gives t c + r = qb
-        let tt = (qa - c * qb) / den;
         let r_ = (qb - c * qa) / den;
-        b = tt;
+        // b from r (not from its own formula) keeps t e3 + d n + r u = p consistent: the
+        // residual is then dr sin(alpha), not dr, for an error dr ~ eps / sin^2 in r
+        b = e3.dot(&(p - d * n - r_ * u));
         rr = r_;
     } else {
         let w = Vector3::new(p.x, p.y, 0.0);
@@ -211,14 +213,20 @@ struct ULink<'a> {
     inertial: Option<(Iso, f64, Matrix3<f64>, roxmltree::Node<'a, 'a>)>,
 }
 
-/// The minimal rotation taking z to the unit vector `a`.
+/// The minimal rotation taking z to the unit vector `a`: the half-way quaternion
+/// (1 + z.a, z x a) normalised, which stays accurate for small angles (an `acos` would lose
+/// half the digits); for a in the lower half-space, a half turn about x first.
 fn axis_rotation(a: &Vector3<f64>) -> UnitQuaternion<f64> {
-    let z = Vector3::z();
-    if a.dot(&z) < -1.0 + 1e-15 && a.cross(&z).norm() < 1e-15 {
-        // z -> -z: a half turn about x
-        return UnitQuaternion::from_axis_angle(&Vector3::x_axis(), std::f64::consts::PI);
+    let half_way = |from: Vector3<f64>| {
+        let v = from.cross(a);
+        UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(1.0 + from.dot(a), v.x, v.y, v.z))
+    };
+    if a.z >= 0.0 {
+        half_way(Vector3::z())
+    } else {
+        half_way(-Vector3::z())
+            * UnitQuaternion::from_axis_angle(&Vector3::x_axis(), std::f64::consts::PI)
     }
-    UnitQuaternion::rotation_between(&z, a).unwrap_or_else(UnitQuaternion::identity)
 }
 
 /// Parse a URDF tree robot. `file` names the source in error messages.
