@@ -23,6 +23,8 @@ enum Command {
     Info(commands::info::Args),
     /// Inverse dynamic model: joint torques for given states (Newton-Euler).
     Idm(commands::idm::Args),
+    /// Convert a robot file: TOML, SYMORO .par or URDF -> TOML or .par (by extension).
+    Convert(commands::convert::Args),
 }
 
 fn main() {
@@ -30,6 +32,7 @@ fn main() {
     let result = match cli.command {
         Command::Info(a) => commands::info::run(a),
         Command::Idm(a) => commands::idm::run(a),
+        Command::Convert(a) => commands::convert::run(a),
     };
     if let Err(e) = result {
         eprintln!("robodyn: error: {e}");

@@ -134,7 +134,7 @@ fn print_text(d: &RobotDescription, s: &robodyn::model::Structure) {
             u8::from(f.actuated).to_string(),
         ];
         for (k, e) in f.geometric().iter().enumerate() {
-            let var = match (k, f.joint.sigma(), i + 1 <= d.nj) {
+            let var = match (k, f.joint.sigma(), i < d.nj) {
                 (4, 0, true) => Some(format!("th{}", i + 1)),
                 (5, 1, true) => Some(format!("r{}", i + 1)),
                 _ => None,

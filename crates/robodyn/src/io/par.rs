@@ -479,11 +479,15 @@ pub fn parse_description(text: &str, file: Option<&str>) -> Result<(RobotDescrip
                 if st.entries.len() != n {
                     return Err(ctx.err_line(
                         st.at,
-                        format!(
-                            "{} has {} entries, {what} = {n} expected",
-                            st.key,
-                            st.entries.len()
-                        ),
+                        if what.parse::<usize>().is_ok() {
+                            format!("{} has {} entries, {n} expected", st.key, st.entries.len())
+                        } else {
+                            format!(
+                                "{} has {} entries, {what} = {n} expected",
+                                st.key,
+                                st.entries.len()
+                            )
+                        },
                     ));
                 }
                 Ok(Some(st))
@@ -723,16 +727,11 @@ fn structure_type(desc: &RobotDescription) -> u8 {
     }
 }
 
+/// A name safe inside a comment and a `;`-separated list.
 fn clean_name(s: &str) -> String {
-    s.chars()
-        .map(|c| {
-            if c == ';' || c == '\n' || c == '*' || c == '(' || c == ')' {
-                '_'
-            } else {
-                c
-            }
-        })
-        .collect()
+    s.replace([';', '\n'], "_")
+        .replace("(*", "( *")
+        .replace("*)", "* )")
 }
 
 /// Write a description as a SYMORO `.par` file (plus our values/names in comments).
