@@ -430,7 +430,15 @@ pub fn parse_description(text: &str, file: Option<&str>) -> Result<(RobotDescrip
         [] => {
             return Err(ctx.err(
                 robot,
-                "every link has a parent joint: the joints form a cycle and there is no root link",
+                format!(
+                    "every link has a parent joint: the joints {} form a cycle and there is no \
+                     root link",
+                    joints
+                        .iter()
+                        .map(|j| format!("`{}` (line {})", j.name, ctx.line(j.node)))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ),
             ));
         }
         many => {
