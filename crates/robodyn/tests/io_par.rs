@@ -237,3 +237,13 @@ fn values_missing_are_reported_by_symbol_and_line() {
     // XX1.. are symbolic (no values) too; the first reported is frame 2's d
     assert!(e.starts_with("test.par:5:") && e.contains("`L2`"), "{e}");
 }
+
+#[test]
+fn documented_example_is_the_bundled_sr400() {
+    let doc = std::fs::read_to_string(robots().join("../docs/robot-format.md")).unwrap();
+    let start = doc.find("```toml\n").expect("a toml block") + "```toml\n".len();
+    let end = start + doc[start..].find("```").unwrap();
+    let r = toml_format::parse_robot(&doc[start..end], Some("robot-format.md")).unwrap();
+    let e = torque_difference(&r, &load("sr400.toml"), 9);
+    assert!(e == 0.0, "{e:e}");
+}
