@@ -247,3 +247,43 @@ fn documented_example_is_the_bundled_sr400() {
     let e = torque_difference(&r, &load("sr400.toml"), 9);
     assert!(e == 0.0, "{e:e}");
 }
+
+#[test]
+fn opensymoro_mobile_base_flexibility_and_floating() {
+    // OpenSYMORO lists link 0 first when the base is mobile, and writes eta/k (NJ entries)
+    let text = "NL = 2\nNJ = 2\nNF = 2\nType = 0\nis_floating = 0\nis_mobile = 1\n\
+                M = {M0, 1, 2}\nMX = {0, 0.1, 0.2}\neta = {0, 0}\nk = {0, 0}\n\
+                VP0 = {0, 0, 1}\n";
+    let d = parse(text).unwrap();
+    assert!(d.mobile_base);
+    let m: Vec<String> = d
+        .links
+        .iter()
+        .map(|l| l.params[param::M].to_string())
+        .collect();
+    assert_eq!(m, ["1", "2"]);
+    assert!(
+        d.notes.iter().any(|n| n.contains("link 0")),
+        "{:?}",
+        d.notes
+    );
+    // written back with the link-0 entry, read again identically
+    let back = parse(&par::write_description(&d)).unwrap();
+    assert_eq!(back.links, d.links);
+    assert!(back.mobile_base);
+    // the NL-entry form is accepted too
+    let d2 = parse("NL = 2\nNJ = 2\nNF = 2\nis_mobile = 1\nM = {1, 2}\n").unwrap();
+    assert_eq!(d2.links[1].params[param::M].to_string(), "2");
+    // flexible joints are noted, floating bases refused
+    let d3 = parse("NL = 2\nNJ = 2\nNF = 2\neta = {1, 0}\nk = {k1, 0}\n").unwrap();
+    assert!(
+        d3.notes.iter().any(|n| n.contains("flexib")),
+        "{:?}",
+        d3.notes
+    );
+    let m = err("NL = 2\nNJ = 2\nNF = 2\nis_floating = 1\n");
+    assert!(
+        m.starts_with("test.par:4:") && m.contains("floating"),
+        "{m}"
+    );
+}

@@ -237,12 +237,12 @@ fn key_kind(k: &str) -> Option<KeyKind> {
     Some(match k.to_ascii_lowercase().as_str() {
         "nl" | "nj" | "nf" => KeyKind::Count,
         "type" => KeyKind::Type,
-        "is_mobile" => KeyKind::Mobile,
+        "is_mobile" | "is_floating" => KeyKind::Mobile,
         "robotname" | "name" => KeyKind::Name,
         "ant" | "sigma" | "b" | "d" | "r" | "gamma" | "alpha" | "mu" | "theta" => KeyKind::PerFrame,
         "xx" | "xy" | "xz" | "yy" | "yz" | "zz" | "mx" | "my" | "mz" | "m" | "ia" | "fv" | "fs"
         | "fx" | "fy" | "fz" | "cx" | "cy" | "cz" => KeyKind::PerLink,
-        "qp" | "qdp" | "gam" => KeyKind::PerJoint,
+        "qp" | "qdp" | "gam" | "eta" | "k" => KeyKind::PerJoint,
         "w0" | "wp0" | "v0" | "vp0" | "g" => KeyKind::Base,
         "z" => KeyKind::ZMatrix,
         _ => return None,
@@ -461,6 +461,17 @@ pub fn parse_description(text: &str, file: Option<&str>) -> Result<(RobotDescrip
             _ => return Err(ctx.err_line(at, format!("is_mobile = {m} (0 or 1)"))),
         };
     }
+    if let Some((m, at)) = int_of("is_floating")? {
+        if m != 0 {
+            return Err(ctx.err_line(
+                at,
+                format!(
+                    "is_floating = {m}: a floating (free) base is not supported; robodyn's base \
+                     is fixed or moves as given by W0 WP0 V0 VP0 (is_mobile = 1)"
+                ),
+            ));
+        }
+    }
     let mut ex = Extras::default();
     for (c, at) in &comments {
         parse_robodyn_comment(&ctx, c, *at, &mut ex, &mut map)?;
@@ -576,11 +587,24 @@ pub fn parse_description(text: &str, file: Option<&str>) -> Result<(RobotDescrip
         .chain(WRENCH_COMPONENTS.iter())
         .enumerate()
     {
-        let Some(st) = list(&pname.to_ascii_lowercase(), nl, "NL")? else {
+        // with a mobile base, OpenSYMORO lists link 0 (the base) first: NL + 1 entries
+        let key = pname.to_ascii_lowercase();
+        let skip = match by_key.get(key.as_str()) {
+            Some(st) if desc.mobile_base && st.entries.len() == nl + 1 => 1,
+            _ => 0,
+        };
+        let Some(st) = list(&key, nl + skip, "NL")? else {
             continue;
         };
+        if skip == 1 && !st.entries[0].0.trim().eq("0") {
+            desc.notes.push(format!(
+                "{}: the entry of link 0 (the mobile base) is not used: the base motion is \
+                 prescribed by W0 WP0 V0 VP0",
+                st.key
+            ));
+        }
         for j in 1..=nl {
-            let (v, at) = &st.entries[j - 1];
+            let (v, at) = &st.entries[j - 1 + skip];
             let e = ctx.expr(&format!("{} of link {j}", st.key), v, *at)?;
             map.set_link(j, Some(pname), ctx.line(*at));
             if k < 13 {
@@ -595,10 +619,18 @@ pub fn parse_description(text: &str, file: Option<&str>) -> Result<(RobotDescrip
             desc.links[j - 1].name = n;
         }
     }
-    for k in ["qp", "qdp", "gam"] {
+    for k in ["qp", "qdp", "gam", "eta", "k"] {
         if let Some(st) = list(k, nj, "NJ")? {
             for (v, at) in &st.entries {
-                ctx.expr(&st.key, v, *at)?;
+                let e = ctx.expr(&st.key, v, *at)?;
+                if k == "eta" && !e.is_zero() {
+                    desc.notes.push(
+                        "the file declares flexible joints (eta, k): robodyn ignores joint \
+                         flexibility"
+                            .into(),
+                    );
+                    break;
+                }
             }
         }
     }
@@ -784,11 +816,7 @@ pub fn write_description(desc: &RobotDescription) -> String {
             .unwrap_or(cands[0])
     };
     let (rev, pri) = (prefix(JointType::Revolute), prefix(JointType::Prismatic));
-    for (k, p) in ["b", "d", "r", "gamma", "alpha", "mu", "theta"]
-        .iter()
-        .enumerate()
-    {
-        let _ = k;
+    for p in ["b", "d", "r", "gamma", "alpha", "mu", "theta"].iter() {
         let items: Vec<String> = desc
             .frames
             .iter()
@@ -823,11 +851,13 @@ pub fn write_description(desc: &RobotDescription) -> String {
         "FZ", "CX", "CY", "CZ",
     ];
     for name in order {
-        let items: Vec<String> = desc
-            .links
-            .iter()
-            .map(
-                |l| match STANDARD_PARAMETERS.iter().position(|p| *p == name) {
+        // a mobile base is link 0 of the lists (OpenSYMORO's convention); robodyn has no
+        // parameters for it (its motion is prescribed), so it is written as 0
+        let base = desc.mobile_base.then(|| "0".to_string());
+        let items: Vec<String> = base
+            .into_iter()
+            .chain(desc.links.iter().map(|l| {
+                match STANDARD_PARAMETERS.iter().position(|p| *p == name) {
                     Some(k) => l.params[k].to_string(),
                     None => {
                         let k = WRENCH_COMPONENTS
@@ -836,8 +866,8 @@ pub fn write_description(desc: &RobotDescription) -> String {
                             .expect("known");
                         l.wrench[k].to_string()
                     }
-                },
-            )
+                }
+            }))
             .collect();
         s.push_str(&format!("{name} = {}\n", list(items)));
     }
