@@ -287,3 +287,25 @@ fn opensymoro_mobile_base_flexibility_and_floating() {
         "{m}"
     );
 }
+
+#[test]
+fn latin1_symoro_files_load() {
+    // SYMORO+ headers carry Latin-1 text ("Noë"); the loader falls back to Latin-1
+    let dir = std::env::temp_dir().join(format!("robodyn_io_par_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let p = dir.join("latin1.par");
+    let mut bytes = b"(* 1 rue de la No".to_vec();
+    bytes.push(0xeb);
+    bytes.extend_from_slice(b" *)\nNL = 1\nNJ = 1\nNF = 1\nM = {2}\nZZ = {1}\n");
+    for k in [
+        "XX", "XY", "XZ", "YY", "YZ", "MX", "MY", "MZ", "IA", "FV", "FS",
+    ] {
+        bytes.extend_from_slice(format!("{k} = {{0}}\n").as_bytes());
+    }
+    std::fs::write(&p, bytes).unwrap();
+    let r = robodyn::io::load(&p).unwrap();
+    // a single revolute joint about the vertical: tau = ZZ qdd
+    let tau = inverse_dynamics(&r, &[0.3], &[0.0], &[2.0]).unwrap();
+    assert_eq!(tau[0], 2.0);
+    let _ = std::fs::remove_dir_all(&dir);
+}

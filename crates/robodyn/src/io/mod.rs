@@ -43,10 +43,16 @@ impl Format {
     }
 }
 
+/// Read a text file; files that are not UTF-8 (SYMORO+ writes Latin-1 comments such as
+/// "Noë") are decoded as Latin-1.
 fn read(path: &Path) -> Result<String> {
-    std::fs::read_to_string(path).map_err(|e| Error::Io {
+    let bytes = std::fs::read(path).map_err(|e| Error::Io {
         path: path.display().to_string(),
         reason: e.to_string(),
+    })?;
+    Ok(match String::from_utf8(bytes) {
+        Ok(s) => s,
+        Err(e) => e.as_bytes().iter().map(|&b| b as char).collect(),
     })
 }
 
