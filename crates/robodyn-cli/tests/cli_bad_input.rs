@@ -195,6 +195,16 @@ fn negative_mass() {
     let e = fails(&["idm", path(&f), "--q", "0,0"]);
     assert!(e.contains(&format!("{}:15", path(&f))), "{e}");
     assert!(e.contains("link 2, M") && e.contains("negative"), "{e}");
+    // in a URDF: the line of the <mass> element
+    let f = tmp(
+        "mass.urdf",
+        "<robot name=\"r\">\n<link name=\"b\"/>\n<link name=\"a\"><inertial>\n<mass value=\"-3\"/>\n\
+         <inertia ixx=\"1\" iyy=\"1\" izz=\"1\"/></inertial></link>\n\
+         <joint name=\"j\" type=\"revolute\"><parent link=\"b\"/><child link=\"a\"/></joint>\n</robot>\n",
+    );
+    let e = fails(&["idm", path(&f), "--q", "0"]);
+    assert!(e.contains(&format!("{}:4", path(&f))), "{e}");
+    assert!(e.contains("link 1, M") && e.contains("negative"), "{e}");
 }
 
 fn robot() -> String {
