@@ -29,6 +29,8 @@ enum Command {
     BaseParams(commands::base_params::Args),
     /// Regressor Phi of the tree (Gamma = Phi K + Gamma_e) for states from a CSV file.
     Regressor(commands::regressor::Args),
+    /// Convert a robot file: TOML, SYMORO .par or URDF -> TOML or .par (by extension).
+    Convert(commands::convert::Args),
 }
 
 fn main() {
@@ -39,6 +41,7 @@ fn main() {
         Command::Closure(a) => commands::closure::run(a),
         Command::BaseParams(a) => commands::base_params::run(a),
         Command::Regressor(a) => commands::regressor::run(a),
+        Command::Convert(a) => commands::convert::run(a),
     };
     if let Err(e) = result {
         eprintln!("robodyn: error: {e}");

@@ -141,7 +141,7 @@ fn print_text(d: &RobotDescription, s: &robodyn::model::Structure) {
             };
             r.push(match var {
                 Some(v) if e.is_zero() => v,
-                Some(v) => format!("{v} + {e}"),
+                Some(v) => (robodyn::Expr::symbol(v) + (*e).clone()).to_string(),
                 None => e.to_string(),
             });
         }

@@ -2,6 +2,7 @@
 
 pub mod base_params;
 pub mod closure;
+pub mod convert;
 pub mod idm;
 pub mod info;
 pub mod regressor;

@@ -3,7 +3,9 @@
 //! [`load_description`] reads any of them (chosen by extension) into a [`RobotDescription`];
 //! [`load`] also validates it into a [`Robot`], which needs a numeric value for every symbol.
 
+pub mod par;
 pub mod toml_format;
+pub mod urdf;
 
 pub use toml_format::SourceMap;
 
@@ -41,10 +43,16 @@ impl Format {
     }
 }
 
+/// Read a text file; files that are not UTF-8 (SYMORO+ writes Latin-1 comments such as
+/// "Noë") are decoded as Latin-1.
 fn read(path: &Path) -> Result<String> {
-    std::fs::read_to_string(path).map_err(|e| Error::Io {
+    let bytes = std::fs::read(path).map_err(|e| Error::Io {
         path: path.display().to_string(),
         reason: e.to_string(),
+    })?;
+    Ok(match String::from_utf8(bytes) {
+        Ok(s) => s,
+        Err(e) => e.as_bytes().iter().map(|&b| b as char).collect(),
     })
 }
 
@@ -54,12 +62,8 @@ pub fn load_description_mapped(path: &Path) -> Result<(RobotDescription, SourceM
     let file = path.display().to_string();
     match Format::from_path(path)? {
         Format::Toml => toml_format::parse_description(&text, Some(&file)),
-        Format::Par => Err(Error::Input(format!(
-            "{file}: .par reading is not available yet"
-        ))),
-        Format::Urdf => Err(Error::Input(format!(
-            "{file}: URDF reading is not available yet"
-        ))),
+        Format::Par => par::parse_description(&text, Some(&file)),
+        Format::Urdf => urdf::parse_description(&text, Some(&file)),
     }
 }
 
@@ -85,7 +89,7 @@ pub fn load(path: &Path) -> Result<Robot> {
 pub fn save_description(desc: &RobotDescription, path: &Path) -> Result<()> {
     let text = match Format::from_path(path)? {
         Format::Toml => toml_format::write_description(desc),
-        Format::Par => return Err(Error::Input(".par writing is not available yet".into())),
+        Format::Par => par::write_description(desc),
         Format::Urdf => {
             return Err(Error::Input(
                 "writing URDF is not supported: convert to .toml or .par".into(),

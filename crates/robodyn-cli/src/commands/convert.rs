@@ -1,0 +1,19 @@
+//! `robodyn convert IN OUT`: convert a robot file (TOML, SYMORO .par, URDF) to TOML or .par,
+//! formats chosen by the extensions.
+
+use crate::common::CliResult;
+use std::path::PathBuf;
+
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    /// Input robot file (.toml, .par or .urdf).
+    pub input: PathBuf,
+    /// Output robot file (.toml or .par).
+    pub output: PathBuf,
+}
+
+pub fn run(a: Args) -> CliResult {
+    let desc = robodyn::io::load_description(&a.input)?;
+    robodyn::io::save_description(&desc, &a.output)?;
+    Ok(())
+}

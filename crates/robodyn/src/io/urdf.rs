@@ -1,0 +1,597 @@
+//! URDF import for tree robots.
+//!
+//! XML is parsed with `roxmltree` rather than `urdf-rs`: roxmltree keeps the byte range of every
+//! node, so each error names the line of the offending `<joint>`/`<link>`, and it does not reject
+//! the extension tags real URDFs carry (`<gazebo>`, `<transmission>`, ...).
+//!
+//! Conversion (exact, derived from first principles; conventions.md, eq 10.18):
+//! - joints are numbered depth-first from the root link (children in file order), so a(j) < j;
+//!   frame j keeps the URDF joint's name, link j the child link's name;
+//! - frame R_j is placed at the joint origin with z_j along the axis (minimal rotation S_j taking
+//!   z to the axis); the URDF child link frame is then R_j(q) C_j with the constant C_j = S_j^-1,
+//!   because a rotation (translation) about (along) the axis in the joint frame is the rotation
+//!   (translation) about (along) z_j in R_j, with the same q;
+//! - the placement of R_j in R_i (i = a(j)) is T = C_i O_j S_j (O_j = joint origin xyz/rpy), and
+//!   T is decomposed into Rz(gamma) Tz(b) Rx(alpha) Tx(d) Rz(theta) Tz(r) via the common normal of
+//!   z_i and z_j ([`decompose`]); parallel or coincident axes take the normal through R_j's
+//!   origin (r = 0);
+//! - `fixed` joints become sigma = 2 frames, `revolute`/`continuous` sigma = 0, `prismatic`
+//!   sigma = 1; `floating` and `planar` are refused;
+//! - `<inertial>` (COM frame xyz/rpy, mass, inertia about the COM) becomes the standard
+//!   parameters about O_j in R_j: c = C_j xyz, R = C_j Rot(rpy), J_O = R J_G R^T + m (c'c I - c c'),
+//!   MS = m c; `<dynamics damping friction>` give FV and FS;
+//! - `mimic` joints are imported as independent joints and flagged in the notes;
+//! - the root link is the fixed base (link 0); gravity is [0, 0, -9.81].
+
+use crate::error::{Error, Location, Result};
+use crate::io::SourceMap;
+use crate::model::{param, FrameDesc, JointType, LinkDesc, RobotDescription};
+use nalgebra::{Matrix3, Rotation3, Translation3, UnitQuaternion, Vector3};
+use robodyn_symbolic::Expr;
+use std::collections::HashMap;
+
+type Iso = nalgebra::Isometry3<f64>;
+
+/// Below this |z_i x z_j| the axes are taken as parallel (the error is then below 1e-12 rad).
+pub const PARALLEL: f64 = 1e-12;
+
+/// Whether z_i and z_j are nearly but not exactly parallel (1e-12 < |z_i x z_j| < 1e-2): the
+/// common normal is then far away (b, r ~ distance / angle) and the six parameters lose
+/// precision (~1e-16 |b|), so the placement is split in two with a fixed frame rotated by
+/// Rx(pi/2).
+pub fn needs_auxiliary_frame(t: &Iso) -> bool {
+    let u = t.rotation * Vector3::z();
+    let c = Vector3::z().cross(&u).norm();
+    c > PARALLEL && c < 1e-2
+}
+
+/// The six parameters (gamma, b, alpha, d, theta, r) of a frame placed at `t` in its
+/// antecedent frame: t = Rz(gamma) Tz(b) Rx(alpha) Tx(d) Rz(theta) Tz(r).
+///
+/// The x axis of the intermediate frame is the common normal n of z_i (through the origin) and
+/// z_j = u (through p): n = e3 x u / |e3 x u|, with its sign chosen so that |gamma| <= pi/2.
+/// Its feet are t e3 and t e3 + d n, with t e3 + d n + r u = p. For parallel axes
+/// (|e3 x u| <= [`PARALLEL`]) the normal through p is used (r = 0); for coincident axes n = x_i.
+/// Nearly parallel axes make b and r huge and inexact: [`parse_description`] avoids them by
+/// inserting an auxiliary fixed frame (see [`needs_auxiliary_frame`]).
+pub fn decompose(t: &Iso) -> [f64; 6] {
+    let rot = t.rotation.to_rotation_matrix();
+    let r = rot.matrix();
+    let p = t.translation.vector;
+    let e3 = Vector3::z();
+    let u = r.column(2).into_owned();
+    let xf = r.column(0).into_owned();
+    let cross = e3.cross(&u);
+    let (n, b, d, rr);
+    if cross.norm() > PARALLEL {
+        let mut nn = cross / cross.norm();
+        if nn.x < 0.0 || (nn.x == 0.0 && nn.y < 0.0) {
+            nn = -nn;
+        }
+        n = nn;
+        d = n.dot(&p);
+        let c = e3.dot(&u);
+        let q = p - d * n;
+        let (qa, qb) = (e3.dot(&q), u.dot(&q));
+        let den = cross.norm_squared(); // = 1 - c^2, without cancellation
+                                        // t e3 + r u = q: dot with e3 gives t + r c = qa, with u gives t c + r = qb
+        let r_ = (qb - c * qa) / den;
+        // b from r (not from its own formula) keeps t e3 + d n + r u = p consistent: the
+        // residual is then dr sin(alpha), not dr, for an error dr ~ eps / sin^2 in r
+        b = e3.dot(&(p - d * n - r_ * u));
+        rr = r_;
+    } else {
+        let w = Vector3::new(p.x, p.y, 0.0);
+        if w.norm() > 1e-12 {
+            let mut nn = w / w.norm();
+            if nn.x < 0.0 || (nn.x == 0.0 && nn.y < 0.0) {
+                nn = -nn;
+            }
+            n = nn;
+            d = n.dot(&w);
+        } else {
+            n = Vector3::x();
+            d = 0.0;
+        }
+        b = p.z;
+        rr = 0.0;
+    }
+    let gamma = n.y.atan2(n.x);
+    let alpha = e3.cross(&u).dot(&n).atan2(e3.dot(&u));
+    let theta = n.cross(&xf).dot(&u).atan2(n.dot(&xf));
+    [gamma, b, alpha, d, theta, rr]
+}
+
+/// A number as an expression: exact multiples of pi/2 for angles within 1e-12, exact 0 for
+/// lengths below 1e-15.
+fn num_expr(x: f64, angle: bool) -> Expr {
+    if angle {
+        let k = (x / std::f64::consts::FRAC_PI_2).round();
+        if (x - k * std::f64::consts::FRAC_PI_2).abs() < 1e-12 && k.abs() <= 4.0 {
+            let k = k as i64;
+            return if k == 0 {
+                Expr::zero()
+            } else {
+                Expr::int(k) * Expr::pi() / Expr::int(2)
+            };
+        }
+    } else if x.abs() < 1e-15 {
+        return Expr::zero();
+    }
+    Expr::num(x)
+}
+
+struct Ctx<'a> {
+    doc: &'a roxmltree::Document<'a>,
+    file: Option<&'a str>,
+}
+
+impl Ctx<'_> {
+    fn line(&self, node: roxmltree::Node) -> usize {
+        self.doc.text_pos_at(node.range().start).row as usize
+    }
+    fn err(&self, node: roxmltree::Node, reason: impl Into<String>) -> Error {
+        Error::parse(self.file, self.line(node), reason)
+    }
+    fn numbers<const N: usize>(
+        &self,
+        node: roxmltree::Node,
+        attr: &str,
+        default: [f64; N],
+        what: &str,
+    ) -> Result<[f64; N]> {
+        let Some(s) = node.attribute(attr) else {
+            return Ok(default);
+        };
+        let v: Vec<&str> = s.split_whitespace().collect();
+        if v.len() != N {
+            return Err(self.err(
+                node,
+                format!(
+                    "{what}: {attr}=\"{s}\" has {} numbers, {N} expected",
+                    v.len()
+                ),
+            ));
+        }
+        let mut out = [0.0; N];
+        for (k, t) in v.iter().enumerate() {
+            out[k] = self.number(node, t, &format!("{what}: {attr}"))?;
+        }
+        Ok(out)
+    }
+    fn number(&self, node: roxmltree::Node, t: &str, what: &str) -> Result<f64> {
+        let x: f64 = t
+            .trim()
+            .parse()
+            .map_err(|_| self.err(node, format!("{what}: `{t}` is not a number")))?;
+        if !x.is_finite() {
+            return Err(self.err(node, format!("{what}: {x} is not a finite number")));
+        }
+        Ok(x)
+    }
+    fn attr<'n>(&self, node: roxmltree::Node<'n, 'n>, a: &str, what: &str) -> Result<&'n str> {
+        node.attribute(a)
+            .ok_or_else(|| self.err(node, format!("{what}: missing attribute `{a}`")))
+    }
+}
+
+fn child<'a>(n: roxmltree::Node<'a, 'a>, tag: &str) -> Option<roxmltree::Node<'a, 'a>> {
+    n.children().find(|c| c.is_element() && c.has_tag_name(tag))
+}
+
+fn origin(ctx: &Ctx, n: roxmltree::Node, what: &str) -> Result<Iso> {
+    Ok(match child(n, "origin") {
+        None => Iso::identity(),
+        Some(o) => {
+            let xyz = ctx.numbers(o, "xyz", [0.0; 3], what)?;
+            let rpy = ctx.numbers(o, "rpy", [0.0; 3], what)?;
+            Iso::from_parts(
+                Translation3::new(xyz[0], xyz[1], xyz[2]),
+                UnitQuaternion::from_euler_angles(rpy[0], rpy[1], rpy[2]),
+            )
+        }
+    })
+}
+
+struct UJoint<'a> {
+    name: String,
+    node: roxmltree::Node<'a, 'a>,
+    joint: JointType,
+    parent: usize,
+    child: usize,
+    origin: Iso,
+    axis: Vector3<f64>,
+    mimic: Option<String>,
+    damping: f64,
+    friction: f64,
+}
+
+struct ULink<'a> {
+    name: String,
+    node: roxmltree::Node<'a, 'a>,
+    /// (COM frame in the link frame, mass, inertia about the COM in the COM frame, mass node)
+    inertial: Option<(Iso, f64, Matrix3<f64>, roxmltree::Node<'a, 'a>)>,
+}
+
+/// The minimal rotation taking z to the unit vector `a`: the half-way quaternion
+/// (1 + z.a, z x a) normalised, which stays accurate for small angles (an `acos` would lose
+/// half the digits); for a in the lower half-space, a half turn about x first.
+fn axis_rotation(a: &Vector3<f64>) -> UnitQuaternion<f64> {
+    let half_way = |from: Vector3<f64>| {
+        let v = from.cross(a);
+        UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(1.0 + from.dot(a), v.x, v.y, v.z))
+    };
+    if a.z >= 0.0 {
+        half_way(Vector3::z())
+    } else {
+        half_way(-Vector3::z())
+            * UnitQuaternion::from_axis_angle(&Vector3::x_axis(), std::f64::consts::PI)
+    }
+}
+
+/// Parse a URDF tree robot. `file` names the source in error messages.
+pub fn parse_description(text: &str, file: Option<&str>) -> Result<(RobotDescription, SourceMap)> {
+    let doc = roxmltree::Document::parse(text).map_err(|e| Error::Parse {
+        location: Location {
+            file: file.map(str::to_string),
+            line: Some(e.pos().row as usize),
+            column: Some(e.pos().col as usize),
+        },
+        reason: format!("invalid XML: {e}"),
+    })?;
+    let ctx = Ctx { doc: &doc, file };
+    let robot = doc.root_element();
+    if !robot.has_tag_name("robot") {
+        return Err(ctx.err(
+            robot,
+            format!(
+                "the root element is <{}>, <robot> expected",
+                robot.tag_name().name()
+            ),
+        ));
+    }
+    let robot_name = robot.attribute("name").unwrap_or("robot").to_string();
+
+    // links
+    let mut links: Vec<ULink> = Vec::new();
+    let mut link_index: HashMap<String, usize> = HashMap::new();
+    for n in robot
+        .children()
+        .filter(|c| c.is_element() && c.has_tag_name("link"))
+    {
+        let name = ctx.attr(n, "name", "<link>")?.to_string();
+        if let Some(&prev) = link_index.get(&name) {
+            return Err(ctx.err(
+                n,
+                format!(
+                    "link `{name}` is defined twice (first on line {})",
+                    ctx.line(links[prev].node)
+                ),
+            ));
+        }
+        let what = format!("link `{name}`, <inertial>");
+        let inertial = match child(n, "inertial") {
+            None => None,
+            Some(i) => {
+                let com = origin(&ctx, i, &what)?;
+                let mass_node = child(i, "mass")
+                    .ok_or_else(|| ctx.err(i, format!("{what}: missing <mass>")))?;
+                let m = ctx.number(
+                    mass_node,
+                    ctx.attr(mass_node, "value", &what)?,
+                    &format!("{what}: mass"),
+                )?;
+                let inode = child(i, "inertia")
+                    .ok_or_else(|| ctx.err(i, format!("{what}: missing <inertia>")))?;
+                let mut v = [0.0; 6];
+                for (k, a) in ["ixx", "ixy", "ixz", "iyy", "iyz", "izz"]
+                    .iter()
+                    .enumerate()
+                {
+                    v[k] = match inode.attribute(*a) {
+                        Some(s) => ctx.number(inode, s, &format!("{what}: {a}"))?,
+                        None => 0.0,
+                    };
+                }
+                let jg = Matrix3::new(v[0], v[1], v[2], v[1], v[3], v[4], v[2], v[4], v[5]);
+                Some((com, m, jg, mass_node))
+            }
+        };
+        link_index.insert(name.clone(), links.len());
+        links.push(ULink {
+            name,
+            node: n,
+            inertial,
+        });
+    }
+
+    // joints
+    let mut joints: Vec<UJoint> = Vec::new();
+    let mut joint_names: HashMap<String, usize> = HashMap::new();
+    for n in robot
+        .children()
+        .filter(|c| c.is_element() && c.has_tag_name("joint"))
+    {
+        let name = ctx.attr(n, "name", "<joint>")?.to_string();
+        let what = format!("joint `{name}`");
+        if let Some(&prev) = joint_names.get(&name) {
+            return Err(ctx.err(
+                n,
+                format!(
+                    "{what} is defined twice (first on line {})",
+                    ctx.line(joints[prev].node)
+                ),
+            ));
+        }
+        let kind = ctx.attr(n, "type", &what)?;
+        let joint = match kind {
+            "revolute" | "continuous" => JointType::Revolute,
+            "prismatic" => JointType::Prismatic,
+            "fixed" => JointType::Fixed,
+            "floating" | "planar" => {
+                return Err(ctx.err(n, format!("{what}: type `{kind}` has several degrees of freedom; robodyn imports revolute, continuous, prismatic and fixed joints only (model a floating base with the base velocity/acceleration, or a planar joint as two prismatic and one revolute joint)")))
+            }
+            other => return Err(ctx.err(n, format!("{what}: unknown joint type `{other}`"))),
+        };
+        let link_of = |tag: &str| -> Result<usize> {
+            let e = child(n, tag).ok_or_else(|| ctx.err(n, format!("{what}: missing <{tag}>")))?;
+            let l = ctx.attr(e, "link", &format!("{what}, <{tag}>"))?;
+            link_index
+                .get(l)
+                .copied()
+                .ok_or_else(|| ctx.err(e, format!("{what}: {tag} link `{l}` is not defined")))
+        };
+        let parent = link_of("parent")?;
+        let childl = link_of("child")?;
+        if parent == childl {
+            return Err(ctx.err(
+                n,
+                format!(
+                    "{what}: parent and child are the same link `{}` (a cycle)",
+                    links[parent].name
+                ),
+            ));
+        }
+        let axis = match child(n, "axis") {
+            None => Vector3::x(),
+            Some(a) => {
+                let v = ctx.numbers(a, "xyz", [1.0, 0.0, 0.0], &format!("{what}, <axis>"))?;
+                let v = Vector3::new(v[0], v[1], v[2]);
+                if v.norm() < 1e-12 && joint.is_movable() {
+                    return Err(ctx.err(a, format!("{what}: the axis is the zero vector")));
+                }
+                if v.norm() < 1e-12 {
+                    Vector3::z()
+                } else {
+                    v / v.norm()
+                }
+            }
+        };
+        let mimic = match child(n, "mimic") {
+            None => None,
+            Some(m) => {
+                let other = ctx.attr(m, "joint", &format!("{what}, <mimic>"))?;
+                let mult = m.attribute("multiplier").unwrap_or("1");
+                let off = m.attribute("offset").unwrap_or("0");
+                Some(format!("joint {name} mimics {other} (q = {mult} * q_{other} + {off}); imported as an independent joint"))
+            }
+        };
+        let (mut damping, mut friction) = (0.0, 0.0);
+        if let Some(dn) = child(n, "dynamics") {
+            if let Some(s) = dn.attribute("damping") {
+                damping = ctx.number(dn, s, &format!("{what}, damping"))?;
+            }
+            if let Some(s) = dn.attribute("friction") {
+                friction = ctx.number(dn, s, &format!("{what}, friction"))?;
+            }
+        }
+        joint_names.insert(name.clone(), joints.len());
+        joints.push(UJoint {
+            origin: origin(&ctx, n, &what)?,
+            name,
+            node: n,
+            joint,
+            parent,
+            child: childl,
+            axis,
+            mimic,
+            damping,
+            friction,
+        });
+    }
+
+    // tree check: each link at most one parent joint, exactly one root, everything reachable
+    let mut parent_joint: Vec<Option<usize>> = vec![None; links.len()];
+    for (k, jt) in joints.iter().enumerate() {
+        if let Some(prev) = parent_joint[jt.child] {
+            return Err(ctx.err(
+                jt.node,
+                format!(
+                    "link `{}` has two parents: joint `{}` (line {}) makes it a child of `{}` and joint `{}` a child of `{}`; a URDF must be a tree (close loops in a .toml or .par file)",
+                    links[jt.child].name,
+                    joints[prev].name,
+                    ctx.line(joints[prev].node),
+                    links[joints[prev].parent].name,
+                    jt.name,
+                    links[jt.parent].name
+                ),
+            ));
+        }
+        parent_joint[jt.child] = Some(k);
+    }
+    let roots: Vec<usize> = (0..links.len())
+        .filter(|&l| parent_joint[l].is_none())
+        .collect();
+    if links.is_empty() {
+        return Err(ctx.err(robot, "the robot has no <link>"));
+    }
+    let root = match roots.as_slice() {
+        [r] => *r,
+        [] => {
+            return Err(ctx.err(
+                robot,
+                format!(
+                    "every link has a parent joint: the joints {} form a cycle and there is no \
+                     root link",
+                    joints
+                        .iter()
+                        .map(|j| format!("`{}` (line {})", j.name, ctx.line(j.node)))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ),
+            ));
+        }
+        many => {
+            return Err(ctx.err(
+                links[many[1]].node,
+                format!(
+                    "several root links (links without a parent joint): {}; a URDF tree has one root",
+                    many.iter().map(|&l| format!("`{}` (line {})", links[l].name, ctx.line(links[l].node))).collect::<Vec<_>>().join(", ")
+                ),
+            ));
+        }
+    };
+    let mut children: Vec<Vec<usize>> = vec![Vec::new(); links.len()];
+    for (k, jt) in joints.iter().enumerate() {
+        children[jt.parent].push(k);
+    }
+    // depth-first numbering: order[j-1] = joint index
+    let mut order = Vec::with_capacity(joints.len());
+    let mut stack: Vec<usize> = children[root].iter().rev().copied().collect();
+    while let Some(k) = stack.pop() {
+        order.push(k);
+        stack.extend(children[joints[k].child].iter().rev().copied());
+    }
+    if order.len() != joints.len() {
+        let mut reached = vec![false; joints.len()];
+        for &k in &order {
+            reached[k] = true;
+        }
+        let lost: Vec<&UJoint> = joints
+            .iter()
+            .enumerate()
+            .filter(|(k, _)| !reached[*k])
+            .map(|(_, j)| j)
+            .collect();
+        return Err(ctx.err(
+            lost[0].node,
+            format!(
+                "the joints {} form a cycle not connected to the root link `{}`",
+                lost.iter()
+                    .map(|j| format!("`{}`", j.name))
+                    .collect::<Vec<_>>()
+                    .join(", "),
+                links[root].name
+            ),
+        ));
+    }
+    if order.is_empty() {
+        return Err(ctx.err(robot, "the robot has no joint (NL = 0)"));
+    }
+
+    // frames and links (frame j carries link j; auxiliary fixed frames carry massless links)
+    let mut frames: Vec<FrameDesc> = Vec::with_capacity(order.len());
+    let mut dlinks: Vec<LinkDesc> = Vec::with_capacity(order.len());
+    let mut notes = Vec::new();
+    let mut map = SourceMap::default();
+    map.file = file.map(str::to_string);
+    let mut number_of_link: Vec<usize> = vec![0; links.len()]; // URDF link -> our link number
+                                                               // c_of[j]: orientation of the URDF link frame in R_j (index 0: the base)
+    let mut c_of: Vec<UnitQuaternion<f64>> = vec![UnitQuaternion::identity()];
+    let frame_of = |name: String, ant: usize, joint: JointType, t: &Iso| {
+        let p = decompose(t);
+        let mut f = FrameDesc::new(name, ant, joint, joint.is_movable());
+        for (kk, e) in f.geometric_mut().into_iter().enumerate() {
+            *e = num_expr(p[kk], kk % 2 == 0);
+        }
+        f
+    };
+    for &k in &order {
+        let jt = &joints[k];
+        let mut i = number_of_link[jt.parent];
+        let s = if jt.joint.is_movable() {
+            axis_rotation(&jt.axis)
+        } else {
+            UnitQuaternion::identity()
+        };
+        let mut t = Iso::from_parts(Translation3::identity(), c_of[i])
+            * jt.origin
+            * Iso::from_parts(Translation3::identity(), s);
+        if needs_auxiliary_frame(&t) {
+            let aux = Iso::from_parts(
+                Translation3::identity(),
+                UnitQuaternion::from_axis_angle(&Vector3::x_axis(), std::f64::consts::FRAC_PI_2),
+            );
+            frames.push(frame_of(
+                format!("{}_aux", jt.name),
+                i,
+                JointType::Fixed,
+                &aux,
+            ));
+            dlinks.push(LinkDesc::zero(format!("{}_aux", jt.name)));
+            c_of.push(UnitQuaternion::identity());
+            let a = frames.len();
+            map.set_frame(a, None, ctx.line(jt.node));
+            map.set_link(a, None, ctx.line(jt.node));
+            notes.push(format!(
+                "frame {a} ({}_aux) is an auxiliary fixed frame: the axis of joint {} is nearly \
+                 parallel to its antecedent's",
+                jt.name, jt.name
+            ));
+            t = aux.inverse() * t;
+            i = a;
+        }
+        frames.push(frame_of(jt.name.clone(), i, jt.joint, &t));
+        let j = frames.len();
+        c_of.push(s.inverse());
+        number_of_link[jt.child] = j;
+        map.set_frame(j, None, ctx.line(jt.node));
+        if let Some(m) = &jt.mimic {
+            notes.push(m.clone());
+        }
+
+        let ul = &links[jt.child];
+        let mut ld = LinkDesc::zero(ul.name.clone());
+        map.set_link(j, None, ctx.line(ul.node));
+        if let Some((com, m, jg, mass_node)) = &ul.inertial {
+            map.set_link(j, Some("M"), ctx.line(*mass_node));
+            let cj = c_of[j].to_rotation_matrix();
+            let c = cj * com.translation.vector;
+            let rot: Rotation3<f64> = cj * com.rotation.to_rotation_matrix();
+            let jo = rot.matrix() * jg * rot.matrix().transpose()
+                + *m * (c.dot(&c) * Matrix3::identity() - c * c.transpose());
+            let vals = [
+                jo[(0, 0)],
+                jo[(0, 1)],
+                jo[(0, 2)],
+                jo[(1, 1)],
+                jo[(1, 2)],
+                jo[(2, 2)],
+                m * c.x,
+                m * c.y,
+                m * c.z,
+                *m,
+            ];
+            for (kk, v) in vals.iter().enumerate() {
+                ld.params[kk] = num_expr(*v, false);
+            }
+        }
+        ld.params[param::FV] = num_expr(jt.damping, false);
+        ld.params[param::FS] = num_expr(jt.friction, false);
+        dlinks.push(ld);
+    }
+    let nl = frames.len();
+    let mut desc = RobotDescription::new(robot_name, nl, nl);
+    desc.frames = frames;
+    desc.links = dlinks;
+    desc.notes = notes;
+    desc.gravity = [Expr::zero(), Expr::zero(), Expr::num(-9.81)];
+    desc.notes.insert(
+        0,
+        format!(
+            "imported from URDF; root link `{}` is the fixed base (frame 0)",
+            links[root].name
+        ),
+    );
+    Ok((desc, map))
+}

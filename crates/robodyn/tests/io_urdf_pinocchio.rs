@@ -1,0 +1,199 @@
+//! Real URDFs (example-robot-data) load, and our inverse dynamics on them agrees with
+//! `pinocchio.rnea` (an independent implementation) to 1e-9 relative on random states.
+//!
+//! Needs `python3` with `pin` and `example-robot-data` (`pip install pin example-robot-data`,
+//! done by `.ci/run`, which sets ROBODYN_REQUIRE_PINOCCHIO=1 so that a missing install fails
+//! instead of skipping). `ROBODYN_PYTHON` selects the interpreter.
+
+use robodyn::algorithms::inverse_dynamics::inverse_dynamics;
+use robodyn::model::param;
+use robodyn::{testing, Expr, Robot};
+use serde_json::{json, Value};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn python() -> String {
+    std::env::var("ROBODYN_PYTHON").unwrap_or_else(|_| "python3".into())
+}
+
+/// The example-robot-data `robots` folder, or None (with the reason) when unavailable.
+fn robots_dir() -> Option<PathBuf> {
+    let out = Command::new(python())
+        .args([
+            "-c",
+            "import pinocchio, cmeel, os; print(os.path.join(os.path.dirname(os.path.dirname(\
+             cmeel.__file__)), 'cmeel.prefix', 'share', 'example-robot-data', 'robots'))",
+        ])
+        .output();
+    let found = match out {
+        Ok(o) if o.status.success() => {
+            let p = PathBuf::from(String::from_utf8_lossy(&o.stdout).trim());
+            p.is_dir().then_some(p)
+        }
+        _ => None,
+    };
+    if found.is_none() {
+        let msg = "pinocchio / example-robot-data not found: pip install pin example-robot-data";
+        if std::env::var("ROBODYN_REQUIRE_PINOCCHIO").is_ok() {
+            panic!("{msg}");
+        }
+        eprintln!("SKIPPED: {msg}");
+    }
+    found
+}
+
+fn find(dir: &Path, name: &str) -> Option<PathBuf> {
+    for e in std::fs::read_dir(dir).ok()?.flatten() {
+        let p = e.path();
+        if p.is_dir() {
+            if let Some(f) = find(&p, name) {
+                return Some(f);
+            }
+        } else if p.file_name().is_some_and(|f| f == name) {
+            return Some(p);
+        }
+    }
+    None
+}
+
+fn all_urdfs(dir: &Path, out: &mut Vec<PathBuf>) {
+    for e in std::fs::read_dir(dir).unwrap().flatten() {
+        let p = e.path();
+        if p.is_dir() {
+            all_urdfs(&p, out);
+        } else if p.extension().is_some_and(|x| x == "urdf") {
+            out.push(p);
+        }
+    }
+}
+
+/// Load a URDF without joint friction (Pinocchio's rnea has none).
+fn load_frictionless(path: &Path) -> Robot {
+    let mut d = robodyn::io::load_description(path).unwrap();
+    for l in &mut d.links {
+        l.params[param::FS] = Expr::zero();
+        l.params[param::FV] = Expr::zero();
+    }
+    Robot::new(d).unwrap()
+}
+
+#[test]
+fn every_example_robot_data_urdf_loads_or_says_why() {
+    let Some(dir) = robots_dir() else { return };
+    let mut files = Vec::new();
+    all_urdfs(&dir, &mut files);
+    assert!(
+        files.len() > 20,
+        "only {} URDFs found in {}",
+        files.len(),
+        dir.display()
+    );
+    let mut loaded = 0;
+    for f in &files {
+        match robodyn::io::load(f) {
+            Ok(r) => {
+                assert!(r.nl() > 0);
+                loaded += 1;
+            }
+            Err(e) => {
+                // the only acceptable failures: files that are not robots (no link / no joint)
+                let m = e.to_string();
+                assert!(
+                    m.contains("has no <link>") || m.contains("has no joint"),
+                    "{}: {m}",
+                    f.display()
+                );
+                assert!(m.contains(&f.display().to_string()), "{m}");
+            }
+        }
+    }
+    assert!(
+        loaded + 2 >= files.len(),
+        "{loaded} of {} loaded",
+        files.len()
+    );
+}
+
+#[test]
+fn inverse_dynamics_matches_pinocchio_rnea() {
+    let Some(dir) = robots_dir() else { return };
+    let names = [
+        "ur5_robot.urdf",
+        "panda.urdf",
+        "hyq_no_sensors.urdf",
+        "baxter.urdf",
+        "talos_reduced.urdf",
+        "double_pendulum_continuous.urdf",
+        "romeo_small.urdf", // has nearly parallel axes: auxiliary fixed frames
+    ];
+    let mut rng = testing::rng(20261122);
+    let mut robots = Vec::new();
+    let mut spec = Vec::new();
+    for n in names {
+        let path = find(&dir, n).unwrap_or_else(|| panic!("{n} not in {}", dir.display()));
+        let robot = load_frictionless(&path);
+        let nl = robot.nl();
+        let mut states = Vec::new();
+        let mut ours = Vec::new();
+        for _ in 0..5 {
+            let [q, qd, qdd] = testing::random_state(&mut rng, nl);
+            let tau = inverse_dynamics(&robot, &q, &qd, &qdd).unwrap();
+            let by_name = |v: &[f64]| -> Value {
+                (1..=nl)
+                    .filter(|&j| robot.frame(j).joint.is_movable())
+                    .map(|j| (robot.frame(j).name.clone(), json!(v[j - 1])))
+                    .collect::<serde_json::Map<_, _>>()
+                    .into()
+            };
+            states.push(json!({"q": by_name(&q), "qd": by_name(&qd), "qdd": by_name(&qdd)}));
+            ours.push(tau);
+        }
+        spec.push(json!({"urdf": path, "states": states}));
+        robots.push((n, robot, ours));
+    }
+    let tmp = std::env::temp_dir().join(format!("robodyn_pin_{}", std::process::id()));
+    std::fs::create_dir_all(&tmp).unwrap();
+    let (inp, outp) = (tmp.join("in.json"), tmp.join("out.json"));
+    std::fs::write(&inp, json!({ "robots": spec }).to_string()).unwrap();
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/pinocchio_rnea.py");
+    let st = Command::new(python())
+        .arg(&script)
+        .arg(&inp)
+        .arg(&outp)
+        .status()
+        .unwrap();
+    assert!(st.success(), "pinocchio script failed");
+    let res: Value = serde_json::from_str(&std::fs::read_to_string(&outp).unwrap()).unwrap();
+    let _ = std::fs::remove_dir_all(&tmp);
+    let mut worst: f64 = 0.0;
+    for (k, (n, robot, ours)) in robots.iter().enumerate() {
+        let r = &res["robots"][k];
+        let movable = robot.movable_joints();
+        assert_eq!(r["nv"].as_u64().unwrap() as usize, movable.len(), "{n}: nv");
+        for (s, tau) in ours.iter().enumerate() {
+            let pin_tau = &r["tau"][s];
+            let scale = movable
+                .iter()
+                .map(|&j| pin_tau[&robot.frame(j).name].as_f64().unwrap().abs())
+                .fold(0.0, f64::max);
+            assert!(
+                scale > 1e-3,
+                "{n}: torques vanish, the test would be vacuous"
+            );
+            for &j in &movable {
+                let name = &robot.frame(j).name;
+                let p = pin_tau[name]
+                    .as_f64()
+                    .unwrap_or_else(|| panic!("{n}: {name}"));
+                let rel = (tau[j - 1] - p).abs() / scale;
+                worst = worst.max(rel);
+                assert!(
+                    rel < 1e-9,
+                    "{n}, state {s}, joint {name}: robodyn {} vs pinocchio {p} (rel {rel:e})",
+                    tau[j - 1]
+                );
+            }
+        }
+    }
+    eprintln!("worst relative difference to pinocchio.rnea: {worst:e}");
+}
