@@ -31,9 +31,9 @@ pub enum Format {
     Json,
 }
 
-/// Solve q_p for q_a from `guess`. Without a guess: when the robot is assembled at q = 0 (the
-/// bundled closed robots are), by continuation from there, so the answer is on the reference
-/// assembly branch; otherwise by damped Newton from zeros.
+/// Solve q_p for q_a from `guess`. Without a guess: when the robot is assembled at its reference
+/// configuration (the file's `assembly`, else q = 0), by continuation from there, so the answer
+/// is on the reference assembly branch; otherwise by damped Newton from zeros.
 pub fn solve(
     cc: &ClosedChain,
     ws: &mut ClosedChainWorkspace,
@@ -45,16 +45,31 @@ pub fn solve(
     }
     let (n, p) = (cc.dof(), cc.passive_joints().len());
     let lc = cc.closure();
-    let zero_a = vec![0.0; n];
-    let zero_p = vec![0.0; p];
+    let reference = cc
+        .robot()
+        .description()
+        .assembly
+        .clone()
+        .unwrap_or_else(|| vec![0.0; cc.robot().nl()]);
+    let ref_a: Vec<f64> = cc
+        .actuated_joints()
+        .iter()
+        .map(|&j| reference[j - 1])
+        .collect();
+    let ref_p: Vec<f64> = cc
+        .passive_joints()
+        .iter()
+        .map(|&j| reference[j - 1])
+        .collect();
+    debug_assert_eq!(ref_p.len(), p);
     if q_a.len() == n {
-        if let Ok(s0) = lc.solve(&mut ws.closure, &zero_a, Some(&zero_p)) {
+        if let Ok(s0) = lc.solve(&mut ws.closure, &ref_a, Some(&ref_p)) {
             if s0.iterations == 0 {
-                return Ok(lc.solve_continuation(&mut ws.closure, q_a, &zero_a, &zero_p, 16)?);
+                return Ok(lc.solve_continuation(&mut ws.closure, q_a, &ref_a, &ref_p, 16)?);
             }
         }
     }
-    Ok(cc.solve_positions(ws, q_a, Some(&zero_p))?)
+    Ok(cc.solve_positions(ws, q_a, Some(&ref_p))?)
 }
 
 pub fn run(a: Args) -> CliResult {

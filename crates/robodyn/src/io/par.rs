@@ -273,6 +273,7 @@ struct Extras {
     link_names: BTreeMap<usize, String>,
     notes: Vec<String>,
     robot_name: Option<String>,
+    assembly: BTreeMap<usize, f64>,
 }
 
 /// Parse SYMORO's `Robotname = '...'` comment and the `robodyn ...:` blocks of our own comments.
@@ -300,7 +301,7 @@ fn parse_robodyn_comment(
     };
     let body_at = body_at + head.len() + 1;
     let h = head.trim();
-    let kind = ["values", "frame names", "link names", "note"]
+    let kind = ["values", "frame names", "link names", "note", "assembly"]
         .into_iter()
         .find(|k| h.starts_with(k));
     match kind {
@@ -326,7 +327,19 @@ fn parse_robodyn_comment(
                 let raw = &item[eq + 1..];
                 let v = raw.trim();
                 let v_at = item_at + eq + 1 + (raw.len() - raw.trim_start().len());
-                if kind == "values" {
+                if kind == "assembly" {
+                    let j: usize = k.parse().map_err(|_| {
+                        ctx.err(
+                            item_at,
+                            format!("robodyn assembly: `{k}` is not a joint number"),
+                        )
+                    })?;
+                    let x = ctx
+                        .expr(&format!("assembly value of q{k}"), v, v_at)?
+                        .eval(&|_| None)
+                        .map_err(|e| ctx.err(v_at, format!("assembly value of q{k}: {e}")))?;
+                    ex.assembly.insert(j, x);
+                } else if kind == "values" {
                     let e = ctx.expr(&format!("value of {k}"), v, v_at)?;
                     let x = e.eval(&|_| None).map_err(|e| {
                         ctx.err(
@@ -613,6 +626,20 @@ pub fn parse_description(text: &str, file: Option<&str>) -> Result<(RobotDescrip
                 desc.links[j - 1].wrench[k - 13] = e;
             }
         }
+    }
+    if !ex.assembly.is_empty() {
+        let mut q = vec![0.0; nl];
+        for (&j, &x) in &ex.assembly {
+            if !(1..=nl).contains(&j) {
+                return Err(Error::parse(
+                    file,
+                    1,
+                    format!("robodyn assembly: joint {j} is not a tree joint 1..{nl}"),
+                ));
+            }
+            q[j - 1] = x;
+        }
+        desc.assembly = Some(q);
     }
     for (j, n) in std::mem::take(&mut ex.link_names) {
         if (1..=nl).contains(&j) {
@@ -925,6 +952,17 @@ pub fn write_description(desc: &RobotDescription) -> String {
             .map(|(i, l)| format!("{} = {}", i + 1, clean_name(&l.name)))
             .collect();
         s.push_str(&format!("(* robodyn link names: {} *)\n", items.join("; ")));
+    }
+    if let Some(q) = &desc.assembly {
+        let items: Vec<String> = q
+            .iter()
+            .enumerate()
+            .map(|(i, x)| format!("{} = {x:?}", i + 1))
+            .collect();
+        s.push_str(&format!(
+            "\n(* robodyn assembly (joint values where the loops close): {} *)\n",
+            items.join("; ")
+        ));
     }
     if !desc.symbols.is_empty() {
         let items: Vec<String> = desc

@@ -38,6 +38,7 @@ struct FileTop {
     wp0: Option<Spanned<Vec<SV>>>,
     v0: Option<Spanned<Vec<SV>>>,
     vp0: Option<Spanned<Vec<SV>>>,
+    assembly: Option<Spanned<Vec<SV>>>,
     #[serde(default)]
     symbols: BTreeMap<String, Spanned<Value>>,
     #[serde(default)]
@@ -412,6 +413,22 @@ pub fn parse_description(text: &str, file: Option<&str>) -> Result<(RobotDescrip
             }
         }
     }
+    if let Some(v) = &top.assembly {
+        let line = line_of(text, v.span());
+        map.set_base("assembly", line);
+        let mut q = Vec::with_capacity(v.get_ref().len());
+        for e in v.get_ref() {
+            let x = to_expr(text, file, e)?.eval(&|_| None).map_err(|err| {
+                Error::parse(
+                    file,
+                    line,
+                    format!("assembly: {err} (joint values must be constants)"),
+                )
+            })?;
+            q.push(x);
+        }
+        desc.assembly = Some(q);
+    }
     validate_structure(&desc).map_err(|e| map.locate(e))?;
     Ok((desc, map))
 }
@@ -461,6 +478,10 @@ pub fn write_description(desc: &RobotDescription) -> String {
         if v.iter().any(|e| !e.is_zero()) {
             s.push_str(&format!("{name} = {}\n", arr(v)));
         }
+    }
+    if let Some(q) = &desc.assembly {
+        let v: Vec<String> = q.iter().map(|x| format!("{x:?}")).collect();
+        s.push_str(&format!("assembly = [{}]\n", v.join(", ")));
     }
     if !desc.symbols.is_empty() {
         s.push_str("\n[symbols]\n");

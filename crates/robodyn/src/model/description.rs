@@ -190,6 +190,9 @@ pub struct RobotDescription {
     pub mobile_base: bool,
     /// Numeric values of the symbols used in the expressions.
     pub symbols: BTreeMap<String, f64>,
+    /// Joint values of the tree joints 1..NL at an assembled configuration (closed loops
+    /// closed): the default starting point of loop closure, which picks the assembly branch.
+    pub assembly: Option<Vec<f64>>,
     /// Notes carried with the description (source of numbers, comments).
     pub notes: Vec<String>,
 }
@@ -226,6 +229,7 @@ impl RobotDescription {
             vp0: zero3(),
             mobile_base: false,
             symbols: BTreeMap::new(),
+            assembly: None,
             notes: Vec::new(),
         }
     }

@@ -110,6 +110,20 @@ pub fn validate_structure(desc: &RobotDescription) -> Result<Structure> {
         }
         ant[j] = f.ant;
     }
+    if let Some(a) = &desc.assembly {
+        if a.len() != nl {
+            return Err(Error::invalid(
+                Item::Base("assembly".into()),
+                format!("{} joint values given, NL = {nl} expected", a.len()),
+            ));
+        }
+        if let Some(k) = a.iter().position(|x| !x.is_finite()) {
+            return Err(Error::invalid(
+                Item::Base("assembly".into()),
+                format!("q{} = {} is not a finite number", k + 1, a[k]),
+            ));
+        }
+    }
     let b = nj - nl;
     for k in nl + 1..=nj {
         if ant[k] == ant[k + b] {
