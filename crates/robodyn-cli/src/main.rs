@@ -23,6 +23,12 @@ enum Command {
     Info(commands::info::Args),
     /// Inverse dynamic model: joint torques for given states (Newton-Euler).
     Idm(commands::idm::Args),
+    /// Inertia matrix A(q) by the composite-link method (csv or json).
+    Inertia(commands::inertia::Args),
+    /// Direct dynamic model: joint accelerations for given states and torques.
+    Ddm(commands::ddm::Args),
+    /// Simulate the direct dynamic model under a torque input; CSV trajectory and SVG plot.
+    Simulate(commands::simulate::Args),
 }
 
 fn main() {
@@ -30,6 +36,9 @@ fn main() {
     let result = match cli.command {
         Command::Info(a) => commands::info::run(a),
         Command::Idm(a) => commands::idm::run(a),
+        Command::Inertia(a) => commands::inertia::run(a),
+        Command::Ddm(a) => commands::ddm::run(a),
+        Command::Simulate(a) => commands::simulate::run(a),
     };
     if let Err(e) = result {
         eprintln!("robodyn: error: {e}");

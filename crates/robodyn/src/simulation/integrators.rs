@@ -107,6 +107,8 @@ const E: [f64; 7] = [
 #[derive(Clone, Debug)]
 pub struct Stepper {
     pub integrator: Integrator,
+    /// Stop with an error after this many steps (accepted + rejected) in total.
+    pub max_steps: Option<usize>,
     k: [Vec<f64>; 7],
     tmp: Vec<f64>,
     y1: Vec<f64>,
@@ -132,6 +134,7 @@ impl Stepper {
     pub fn new(integrator: Integrator, dim: usize) -> Self {
         Stepper {
             integrator,
+            max_steps: None,
             k: std::array::from_fn(|_| vec![0.0; dim]),
             tmp: vec![0.0; dim],
             y1: vec![0.0; dim],
@@ -153,6 +156,18 @@ impl Stepper {
         self.stats.evaluations += 1;
         let src = if y_is_tmp { &self.tmp[..] } else { y };
         ode.rhs(t, src, &mut self.k[s])
+    }
+
+    fn check_budget(&self) -> Result<()> {
+        match self.max_steps {
+            Some(m) if self.stats.accepted + self.stats.rejected >= m => {
+                Err(Error::Numerical(format!(
+                    "more than {m} integration steps: the motion is too stiff for the \
+                     tolerances (e.g. Coulomb friction sticking; smooth it or raise the limit)"
+                )))
+            }
+            _ => Ok(()),
+        }
     }
 
     /// One classical RK4 step of size h from (t, y), result in `y` (allocation-free).
@@ -233,6 +248,7 @@ impl Stepper {
                 let h = span / steps as f64;
                 let t0 = *t;
                 for s in 0..steps {
+                    self.check_budget()?;
                     self.rk4_step(ode, *t, y, h)?;
                     *t = if s + 1 == steps {
                         t_end
@@ -303,6 +319,7 @@ impl Stepper {
                      diverging motion)"
                 )));
             }
+            self.check_budget()?;
             self.dopri5_step(ode, *t, y, h)?;
             let mut sum = 0.0;
             for i in 0..n {

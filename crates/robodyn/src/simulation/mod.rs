@@ -17,6 +17,7 @@ pub use output::{plot_svg, CsvSink, Recorder, Tee, TrajectorySink};
 use crate::algorithms::direct_dynamics::{ddm, DirectWorkspace, Method};
 use crate::error::{Error, Result};
 use crate::model::Robot;
+use crate::scalar::DynScalar;
 use energy::{total_energy, EnergyWorkspace};
 
 /// A mechanical system with `dof` coordinates as the simulator sees it.
@@ -50,6 +51,7 @@ pub struct TreeDynamics<'a> {
     qd: Vec<f64>,
     tau: Vec<f64>,
     qdd: Vec<f64>,
+    coulomb_smoothing: Option<f64>,
 }
 
 impl<'a> TreeDynamics<'a> {
@@ -65,7 +67,17 @@ impl<'a> TreeDynamics<'a> {
             qd: vec![0.0; nl],
             tau: vec![0.0; nl],
             qdd: vec![0.0; nl],
+            coulomb_smoothing: None,
         }
+    }
+
+    /// Replace the Coulomb friction Fs sign(qd) by Fs tanh(qd / v) in the simulated motion
+    /// (v > 0, in rad/s or m/s). The exact sign makes the right-hand side discontinuous: a
+    /// sticking joint then chatters and the step size collapses. Done by adding
+    /// Fs (sign(qd) - tanh(qd / v)) to the torque given to the direct model.
+    pub fn with_coulomb_smoothing(mut self, v: Option<f64>) -> Self {
+        self.coulomb_smoothing = v.filter(|v| *v > 0.0);
+        self
     }
 
     /// The movable joints, in frame order: coordinate k is joint `joints()[k]`.
@@ -97,10 +109,14 @@ impl Dynamics for TreeDynamics<'_> {
         qdd: &mut [f64],
     ) -> Result<()> {
         self.scatter(q, qd);
+        let model = self.robot.numeric();
         for (k, &j) in self.joints.iter().enumerate() {
             self.tau[j - 1] = tau[k];
+            if let Some(v) = self.coulomb_smoothing {
+                let (fs, s) = (model.link(j).fs, qd[k]);
+                self.tau[j - 1] += fs * (s.sign() - (s / v).tanh());
+            }
         }
-        let model = self.robot.numeric();
         ddm(
             model,
             &mut self.ws,
@@ -134,6 +150,8 @@ pub struct SimOptions {
     pub integrator: Integrator,
     /// Time between output rows (the integrators land exactly on these times).
     pub output_dt: f64,
+    /// Stop with [`Error::Numerical`] after this many integration steps (None: no limit).
+    pub max_steps: Option<usize>,
 }
 
 /// What happened.
@@ -234,6 +252,7 @@ fn run(
     let mut y: Vec<f64> = q0.iter().chain(qd0).copied().collect();
     let mut row = vec![0.0; 1 + 4 * n + 1 + n_extra];
     let mut stepper = Stepper::new(opts.integrator, 2 * n);
+    stepper.max_steps = opts.max_steps;
     let mut ode = StateOde {
         dynamics,
         input,

@@ -15,7 +15,7 @@ pub trait TrajectorySink {
     }
 }
 
-/// CSV stream with a header line; numbers in shortest round-trip form.
+/// CSV stream with a header line; numbers in shortest round-trip form; flushed after each row.
 pub struct CsvSink<W: Write> {
     out: W,
     name: String,
@@ -71,7 +71,9 @@ impl<W: Write> TrajectorySink for CsvSink<W> {
             r.map_err(|e| self.io(e))?;
             first = false;
         }
-        writeln!(self.out).map_err(|e| self.io(e))
+        writeln!(self.out).map_err(|e| self.io(e))?;
+        // rows reach the file as they are computed (a long or stopped run keeps them)
+        self.out.flush().map_err(|e| self.io(e))
     }
     fn finish(&mut self) -> Result<()> {
         self.out.flush().map_err(|e| self.io(e))
