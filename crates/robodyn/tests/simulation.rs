@@ -609,12 +609,8 @@ fn plot_is_written() {
     plot_svg(&path, &rec).unwrap();
     let svg = std::fs::read_to_string(&path).unwrap();
     assert!(svg.starts_with("<svg"));
-    // one polyline per joint plus the energy curve
-    assert!(
-        svg.matches("<polyline").count() >= n + 1,
-        "{}",
-        svg.matches("<polyline").count()
-    );
+    // one 2-px curve per joint plus the energy curve (axes and legend lines are 1 px)
+    assert_eq!(svg.matches("stroke-width=\"2\"").count(), n + 1);
     assert!(svg.contains("total energy"));
     std::fs::remove_file(&path).ok();
     assert!(plot_svg(&path, &Recorder::default()).is_err());
