@@ -221,16 +221,48 @@ fn skew(v: &Vector3<f64>) -> Matrix3<f64> {
     Matrix3::new(0.0, -v.z, v.y, v.z, 0.0, -v.x, -v.y, v.x, 0.0)
 }
 
-/// kT_j, the 6x6 transformation of [linear; angular] motion vectors from R_j = R_a(k) to R_k,
-/// given R = jA_k, p = jP_k: kT_j = [[R', -R' skew(p)], [0, R']]. Wrenches go back with kT_j'.
+// Spatial transformations between R_i = R_a(k) and R_k, with R = iA_k, p = iP_k:
+// kT_i = [[R', -R' skew(p)], [0, R']] maps [linear; angular] motion from R_i to R_k; its
+// transpose maps wrenches back. Written with 3x3 blocks (no 6x6 products).
+
+/// kT_i V: the motion V of frame i seen at O_k in R_k: [R' (v + w x p); R' w].
 #[inline]
-fn motion_transform(r: &Matrix3<f64>, p: &Vector3<f64>) -> Matrix6<f64> {
-    let rt = r.transpose();
-    let mut x = Matrix6::zeros();
-    x.fixed_view_mut::<3, 3>(0, 0).copy_from(&rt);
-    x.fixed_view_mut::<3, 3>(0, 3).copy_from(&(-rt * skew(p)));
-    x.fixed_view_mut::<3, 3>(3, 3).copy_from(&rt);
-    x
+fn motion_to_child(r: &Matrix3<f64>, p: &Vector3<f64>, v: &Vector6<f64>) -> Vector6<f64> {
+    let lin = Vector3::new(v[0], v[1], v[2]);
+    let ang = Vector3::new(v[3], v[4], v[5]);
+    let l = r.tr_mul(&(lin + ang.cross(p)));
+    let a = r.tr_mul(&ang);
+    Vector6::new(l.x, l.y, l.z, a.x, a.y, a.z)
+}
+
+/// kT_i' F: the wrench F at O_k in R_k moved to O_i in R_i: [R f; p x R f + R m].
+#[inline]
+fn wrench_to_parent(r: &Matrix3<f64>, p: &Vector3<f64>, f: &Vector6<f64>) -> Vector6<f64> {
+    let fi = r * Vector3::new(f[0], f[1], f[2]);
+    let mi = r * Vector3::new(f[3], f[4], f[5]) + p.cross(&fi);
+    Vector6::new(fi.x, fi.y, fi.z, mi.x, mi.y, mi.z)
+}
+
+/// kT_i' K kT_i for a symmetric K (an inertia in R_k about O_k moved to R_i about O_i).
+/// With B = R K R' blockwise and S = skew(p):
+/// [[B11, B12 - B11 S], [sym, S (B12 - B11 S) + B22 - B12' S]].
+#[inline]
+fn inertia_to_parent(r: &Matrix3<f64>, p: &Vector3<f64>, k: &Matrix6<f64>) -> Matrix6<f64> {
+    let k11 = k.fixed_view::<3, 3>(0, 0);
+    let k12 = k.fixed_view::<3, 3>(0, 3);
+    let k22 = k.fixed_view::<3, 3>(3, 3);
+    let b11 = r * k11 * r.transpose();
+    let b12 = r * k12 * r.transpose();
+    let b22 = r * k22 * r.transpose();
+    let s = skew(p);
+    let c = b12 - b11 * s;
+    let d = s * c + b22 - b12.transpose() * s;
+    let mut out = Matrix6::zeros();
+    out.fixed_view_mut::<3, 3>(0, 0).copy_from(&b11);
+    out.fixed_view_mut::<3, 3>(0, 3).copy_from(&c);
+    out.fixed_view_mut::<3, 3>(3, 0).copy_from(&c.transpose());
+    out.fixed_view_mut::<3, 3>(3, 3).copy_from(&d);
+    out
 }
 
 /// Index of the joint axis a_j in a [linear; angular] spatial vector.
@@ -336,10 +368,8 @@ pub fn ddm_aba(
         };
         let i = fr.ant;
         if i != 0 {
-            let x = motion_transform(&b.rot[k], &b.pos[k]);
-            let xt = x.transpose();
-            b.ia[i] += xt * kk * x;
-            b.pa[i] += xt * alpha;
+            b.ia[i] += inertia_to_parent(&b.rot[k], &b.pos[k], &kk);
+            b.pa[i] += wrench_to_parent(&b.rot[k], &b.pos[k], &alpha);
         }
     }
     // Forward: accelerations.
@@ -347,8 +377,7 @@ pub fn ddm_aba(
     b.acc[0] = Vector6::new(g.x, g.y, g.z, model.wp0.x, model.wp0.y, model.wp0.z);
     for j in 1..=n {
         let fr = model.frame(j);
-        let x = motion_transform(&b.rot[j], &b.pos[j]);
-        let mut acc = x * b.acc[fr.ant] + b.gamma[j];
+        let mut acc = motion_to_child(&b.rot[j], &b.pos[j], &b.acc[fr.ant]) + b.gamma[j];
         match axis_index(fr.joint) {
             Some(ax) => {
                 let a = (b.tau[j] - b.u[j].dot(&acc) - b.pa[j][ax]) / b.d[j];
