@@ -31,6 +31,12 @@ enum Command {
     Regressor(commands::regressor::Args),
     /// Convert a robot file: TOML, SYMORO .par or URDF -> TOML or .par (by extension).
     Convert(commands::convert::Args),
+    /// Inertia matrix A(q) by the composite-link method (csv or json).
+    Inertia(commands::inertia::Args),
+    /// Direct dynamic model: joint accelerations for given states and torques.
+    Ddm(commands::ddm::Args),
+    /// Simulate the direct dynamic model under a torque input; CSV trajectory and SVG plot.
+    Simulate(commands::simulate::Args),
 }
 
 fn main() {
@@ -42,6 +48,9 @@ fn main() {
         Command::BaseParams(a) => commands::base_params::run(a),
         Command::Regressor(a) => commands::regressor::run(a),
         Command::Convert(a) => commands::convert::run(a),
+        Command::Inertia(a) => commands::inertia::run(a),
+        Command::Ddm(a) => commands::ddm::run(a),
+        Command::Simulate(a) => commands::simulate::run(a),
     };
     if let Err(e) = result {
         eprintln!("robodyn: error: {e}");

@@ -3,6 +3,9 @@
 pub mod base_params;
 pub mod closure;
 pub mod convert;
+pub mod ddm;
 pub mod idm;
+pub mod inertia;
 pub mod info;
 pub mod regressor;
+pub mod simulate;

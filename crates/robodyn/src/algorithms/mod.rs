@@ -2,7 +2,9 @@
 
 pub mod base_parameters;
 pub mod closed_chain;
+pub mod direct_dynamics;
 pub mod energy;
+pub mod inertia_matrix;
 pub mod inverse_dynamics;
 pub mod loop_closure;
 pub mod regressor;

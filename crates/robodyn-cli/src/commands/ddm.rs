@@ -1,0 +1,124 @@
+//! `robodyn ddm ROBOT`: direct dynamic model qdd = f(q, qd, tau) for states from a CSV file
+//! (columns q<j>, qd<j>, tau<j>) or from `--q/--qd/--tau`.
+
+use crate::common::{parse_list, write_table, CliResult, RobotArgs, Table, TableFormat};
+use robodyn::algorithms::direct_dynamics::{ddm, DirectWorkspace, Method};
+use robodyn::algorithms::inverse_dynamics::check_state;
+use std::path::PathBuf;
+
+/// Direct-dynamics algorithm.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MethodArg {
+    /// qdd = A^-1 (tau - H), A by composite links, tree L'DL factorization.
+    Composite,
+    /// O(n) recursive Newton-Euler direct model (articulated bodies).
+    Aba,
+}
+
+impl From<MethodArg> for Method {
+    fn from(m: MethodArg) -> Method {
+        match m {
+            MethodArg::Composite => Method::Composite,
+            MethodArg::Aba => Method::ArticulatedBody,
+        }
+    }
+}
+
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    #[command(flatten)]
+    pub robot: RobotArgs,
+    /// CSV of states with columns q<j>, qd<j>, tau<j> for the movable joints.
+    #[arg(long, conflicts_with_all = ["q", "qd", "tau"])]
+    pub input: Option<PathBuf>,
+    /// One state: joint positions, comma separated (movable joints in frame order).
+    #[arg(long, allow_hyphen_values = true)]
+    pub q: Option<String>,
+    /// Joint velocities (default zeros).
+    #[arg(long, allow_hyphen_values = true)]
+    pub qd: Option<String>,
+    /// Joint torques (default zeros).
+    #[arg(long, allow_hyphen_values = true)]
+    pub tau: Option<String>,
+    #[arg(long, value_enum, default_value = "composite")]
+    pub method: MethodArg,
+    /// Output file (default: standard output).
+    #[arg(long)]
+    pub output: Option<PathBuf>,
+    #[arg(long, value_enum, default_value = "csv")]
+    pub format: TableFormat,
+}
+
+pub fn run(a: Args) -> CliResult {
+    let robot = a.robot.load()?;
+    let joints = robot.movable_joints();
+    let nl = robot.nl();
+    let states: Vec<(String, [Vec<f64>; 3])> = if let Some(path) = &a.input {
+        let t = Table::read(path)?;
+        let cols: Vec<[usize; 3]> = joints
+            .iter()
+            .map(|j| {
+                Ok([
+                    t.column(&format!("q{j}"))?,
+                    t.column(&format!("qd{j}"))?,
+                    t.column(&format!("tau{j}"))?,
+                ])
+            })
+            .collect::<CliResult<_>>()?;
+        t.rows
+            .iter()
+            .enumerate()
+            .map(|(k, r)| {
+                let mut s = [vec![0.0; nl], vec![0.0; nl], vec![0.0; nl]];
+                for (j, c) in joints.iter().zip(&cols) {
+                    for i in 0..3 {
+                        s[i][j - 1] = r[c[i]];
+                    }
+                }
+                (format!("{}: data row {}", t.file, k + 1), s)
+            })
+            .collect()
+    } else {
+        let q =
+            a.q.as_deref()
+                .ok_or("give --input states.csv or --q (with --qd, --tau)")?;
+        let mut s = [vec![0.0; nl], vec![0.0; nl], vec![0.0; nl]];
+        for (k, (name, v)) in [
+            ("q", Some(q)),
+            ("qd", a.qd.as_deref()),
+            ("tau", a.tau.as_deref()),
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            if let Some(v) = v {
+                let vals = parse_list(name, v)?;
+                if vals.len() != joints.len() {
+                    return Err(format!(
+                        "--{name} has {} values, the robot has {} movable tree joints ({:?})",
+                        vals.len(),
+                        joints.len(),
+                        joints
+                    )
+                    .into());
+                }
+                for (j, x) in joints.iter().zip(vals) {
+                    s[k][j - 1] = x;
+                }
+            }
+        }
+        vec![("the given state".to_string(), s)]
+    };
+    let model = robot.numeric();
+    let mut ws = DirectWorkspace::new(model);
+    let mut qdd = vec![0.0; nl];
+    let mut rows = Vec::with_capacity(states.len());
+    for (what, [q, qd, tau]) in &states {
+        check_state(&robot, "q", q)?;
+        ddm(model, &mut ws, a.method.into(), q, qd, tau, &mut qdd)
+            .map_err(|e| format!("{what}: {e}"))?;
+        rows.push(joints.iter().map(|j| qdd[j - 1]).collect());
+    }
+    let headers: Vec<String> = joints.iter().map(|j| format!("qdd{j}")).collect();
+    write_table(a.output.as_deref(), a.format, &headers, &rows)
+}

@@ -1,0 +1,65 @@
+//! `robodyn inertia ROBOT --q ...`: the inertia matrix A(q) of the (equivalent) tree by the
+//! composite-link method, over the movable joints (rotor inertias on the diagonal).
+
+use crate::common::{parse_list, write_table, CliResult, RobotArgs, TableFormat};
+use robodyn::algorithms::inertia_matrix::inertia_matrix;
+use std::io::Write;
+use std::path::PathBuf;
+
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    #[command(flatten)]
+    pub robot: RobotArgs,
+    /// Joint positions, comma separated (movable joints in frame order; default zeros).
+    #[arg(long, allow_hyphen_values = true)]
+    pub q: Option<String>,
+    /// Output file (default: standard output).
+    #[arg(long)]
+    pub output: Option<PathBuf>,
+    /// csv: one column per movable joint (header = joint number), rows in the same order; json: {"joints": [...], "A": [[...]]}.
+    #[arg(long, value_enum, default_value = "csv")]
+    pub format: TableFormat,
+}
+
+pub fn run(a: Args) -> CliResult {
+    let robot = a.robot.load()?;
+    let joints = robot.movable_joints();
+    let mut q = vec![0.0; robot.nl()];
+    if let Some(s) = &a.q {
+        let vals = parse_list("q", s)?;
+        if vals.len() != joints.len() {
+            return Err(format!(
+                "--q has {} values, the robot has {} movable tree joints ({:?})",
+                vals.len(),
+                joints.len(),
+                joints
+            )
+            .into());
+        }
+        for (j, x) in joints.iter().zip(vals) {
+            q[j - 1] = x;
+        }
+    }
+    let m = inertia_matrix(&robot, &q)?;
+    let rows: Vec<Vec<f64>> = joints
+        .iter()
+        .map(|&i| joints.iter().map(|&j| m[(i - 1, j - 1)]).collect())
+        .collect();
+    match a.format {
+        TableFormat::Csv => {
+            let headers: Vec<String> = joints.iter().map(|j| j.to_string()).collect();
+            write_table(a.output.as_deref(), a.format, &headers, &rows)
+        }
+        TableFormat::Json => {
+            let v = serde_json::json!({ "joints": joints, "q": joints.iter().map(|j| q[j - 1]).collect::<Vec<_>>(), "A": rows });
+            let text = serde_json::to_string_pretty(&v)?;
+            match &a.output {
+                Some(p) => {
+                    std::fs::write(p, text + "\n").map_err(|e| format!("{}: {e}", p.display()))?
+                }
+                None => writeln!(std::io::stdout().lock(), "{text}")?,
+            }
+            Ok(())
+        }
+    }
+}

@@ -1,0 +1,427 @@
+//! Direct dynamic model of tree robots, qdd = f(q, qd, Gamma) (§10.2.3 with the two methods of
+//! the book's §9.7):
+//! - [`ddm_composite`]: qdd = A^-1 (Gamma - H), A by composite links, H by Newton–Euler with
+//!   qdd = 0, solved with the sparse L'DL factorization of the tree (A = L' D L with L_ij != 0
+//!   only when j is an ancestor of i; the antecedent order a(j) < j is a valid elimination
+//!   order, so there is no fill-in);
+//! - [`ddm_aba`]: the O(n) recursive Newton–Euler direct model (articulated bodies), written with
+//!   jA_i, jP_i and the 6x6 spatial inertia about O_j.
+//!
+//! Both are allocation-free with a [`DirectWorkspace`]. State vectors have NL entries (joint j
+//! at index j-1); fixed frames are ignored in Gamma and get qdd = 0. A singular or
+//! non-positive-definite model (e.g. a massless chain end) is an [`Error::Numerical`] naming the
+//! joint, never a NaN.
+
+use crate::algorithms::inertia_matrix::{h_vector_into, inertia_matrix_into, InertiaWorkspace};
+use crate::algorithms::inverse_dynamics::check_state;
+use crate::error::{Error, Result};
+use crate::model::{DynModel, JointType, Robot};
+use crate::scalar::DynScalar;
+use nalgebra::{DMatrix, DVector, Matrix3, Matrix6, Vector3, Vector6};
+
+/// Relative size under which a pivot or an articulated inertia counts as zero.
+const PIVOT_TOL: f64 = 1e-12;
+
+/// Which direct-dynamics algorithm to run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Method {
+    /// qdd = A^-1 (Gamma - H) with the tree L'DL factorization (§9.7, first method).
+    #[default]
+    Composite,
+    /// O(n) recursive Newton–Euler direct model / articulated bodies (§9.7, second method).
+    ArticulatedBody,
+}
+
+/// Buffers of the articulated-body algorithm (index j = link j; index 0 is the base).
+/// Spatial vectors are [linear; angular] in R_j about O_j: V = [V_j; w_j], F = [f_j; m_j].
+#[derive(Clone, Debug)]
+pub struct AbaWorkspace {
+    rot: Vec<Matrix3<f64>>,
+    pos: Vec<Vector3<f64>>,
+    w: Vec<Vector3<f64>>,
+    /// Velocity-dependent acceleration of O_j and link j (the gamma_j of Vd_j = jT_i Vd_i + gamma_j + a_j qdd_j).
+    gamma: Vec<Vector6<f64>>,
+    /// Articulated inertia J*_j about O_j.
+    ia: Vec<Matrix6<f64>>,
+    /// Articulated bias wrench beta*_j.
+    pa: Vec<Vector6<f64>>,
+    /// u_j = J*_j a_j.
+    u: Vec<Vector6<f64>>,
+    /// H_j = a_j' J*_j a_j + Ia_j.
+    d: Vec<f64>,
+    /// Gamma_j minus friction.
+    tau: Vec<f64>,
+    /// Classical accelerations [Vd_j; wd_j].
+    acc: Vec<Vector6<f64>>,
+}
+
+impl AbaWorkspace {
+    pub fn new(model: &DynModel<f64>) -> Self {
+        let n = model.nl + 1;
+        AbaWorkspace {
+            rot: vec![Matrix3::identity(); n],
+            pos: vec![Vector3::zeros(); n],
+            w: vec![Vector3::zeros(); n],
+            gamma: vec![Vector6::zeros(); n],
+            ia: vec![Matrix6::zeros(); n],
+            pa: vec![Vector6::zeros(); n],
+            u: vec![Vector6::zeros(); n],
+            d: vec![0.0; n],
+            tau: vec![0.0; n],
+            acc: vec![Vector6::zeros(); n],
+        }
+    }
+}
+
+/// Buffers of both direct-dynamics methods, sized once from the model.
+#[derive(Clone, Debug)]
+pub struct DirectWorkspace {
+    pub inertia: InertiaWorkspace<f64>,
+    /// A(q), then its L'DL factors.
+    pub a: DMatrix<f64>,
+    /// H(q, qd).
+    pub h: Vec<f64>,
+    pub aba: AbaWorkspace,
+}
+
+impl DirectWorkspace {
+    pub fn new(model: &DynModel<f64>) -> Self {
+        DirectWorkspace {
+            inertia: InertiaWorkspace::new(model),
+            a: DMatrix::zeros(model.nl, model.nl),
+            h: vec![0.0; model.nl],
+            aba: AbaWorkspace::new(model),
+        }
+    }
+}
+
+/// A usable pivot: finite and above the relative tolerance (false for NaN).
+#[inline]
+fn pivot_ok(d: f64, scale: f64) -> bool {
+    d.is_finite() && d > PIVOT_TOL * scale
+}
+
+fn singular(j: usize, what: &str, value: f64) -> Error {
+    Error::Numerical(format!(
+        "joint {j}: {what} is {value:.3e} (zero or negative): the direct dynamic model is \
+         singular; the links carried by joint {j} have no mass or inertia along its axis \
+         (e.g. a massless chain end) or the inertial parameters are not physical"
+    ))
+}
+
+/// In-place L'DL factorization of A exploiting the tree (Featherstone's LTDL): on return the
+/// diagonal holds D and entry (i, j), j an ancestor of i, holds L_ij. Only the lower triangle is
+/// read. Rows/columns of fixed frames are skipped. Zero or negative pivot -> error naming the joint.
+pub fn ltdl_factor(model: &DynModel<f64>, a: &mut DMatrix<f64>) -> Result<()> {
+    let n = model.nl;
+    let movable = |j: usize| model.frame(j).joint.is_movable();
+    let scale = (1..=n)
+        .filter(|&j| movable(j))
+        .map(|j| a[(j - 1, j - 1)].abs())
+        .fold(0.0, f64::max);
+    for k in (1..=n).rev() {
+        if !movable(k) {
+            continue;
+        }
+        let dk = a[(k - 1, k - 1)];
+        if !pivot_ok(dk, scale) {
+            return Err(singular(k, "the L'DL pivot of the inertia matrix", dk));
+        }
+        let mut i = model.frame(k).ant;
+        while i != 0 {
+            if movable(i) {
+                let f = a[(k - 1, i - 1)] / dk;
+                let mut j = i;
+                while j != 0 {
+                    if movable(j) {
+                        a[(i - 1, j - 1)] -= f * a[(k - 1, j - 1)];
+                    }
+                    j = model.frame(j).ant;
+                }
+                a[(k - 1, i - 1)] = f;
+            }
+            i = model.frame(i).ant;
+        }
+    }
+    Ok(())
+}
+
+/// Solve L'DL x = b in place after [`ltdl_factor`] (entries of fixed frames set to 0).
+pub fn ltdl_solve(model: &DynModel<f64>, a: &DMatrix<f64>, x: &mut [f64]) {
+    let n = model.nl;
+    let movable = |j: usize| model.frame(j).joint.is_movable();
+    for i in (1..=n).rev() {
+        if !movable(i) {
+            x[i - 1] = 0.0;
+            continue;
+        }
+        let xi = x[i - 1];
+        let mut j = model.frame(i).ant;
+        while j != 0 {
+            if movable(j) {
+                x[j - 1] -= a[(i - 1, j - 1)] * xi;
+            }
+            j = model.frame(j).ant;
+        }
+    }
+    for i in 1..=n {
+        if movable(i) {
+            x[i - 1] /= a[(i - 1, i - 1)];
+        }
+    }
+    for i in 1..=n {
+        if !movable(i) {
+            continue;
+        }
+        let mut j = model.frame(i).ant;
+        let mut s = x[i - 1];
+        while j != 0 {
+            if movable(j) {
+                s -= a[(i - 1, j - 1)] * x[j - 1];
+            }
+            j = model.frame(j).ant;
+        }
+        x[i - 1] = s;
+    }
+}
+
+fn check_finite(qdd: &[f64]) -> Result<()> {
+    match qdd.iter().position(|x| !x.is_finite()) {
+        Some(k) => Err(Error::Numerical(format!(
+            "joint {}: the direct dynamic model gives a non-finite acceleration ({})",
+            k + 1,
+            qdd[k]
+        ))),
+        None => Ok(()),
+    }
+}
+
+/// qdd = A^-1 (Gamma - H) (§9.7 first method) with the tree L'DL factorization.
+/// Allocation-free; all slices have NL entries.
+pub fn ddm_composite(
+    model: &DynModel<f64>,
+    ws: &mut DirectWorkspace,
+    q: &[f64],
+    qd: &[f64],
+    tau: &[f64],
+    qdd: &mut [f64],
+) -> Result<()> {
+    inertia_matrix_into(model, &mut ws.inertia, q, &mut ws.a);
+    h_vector_into(model, &mut ws.inertia, q, qd, &mut ws.h);
+    ltdl_factor(model, &mut ws.a)?;
+    for j in 0..model.nl {
+        qdd[j] = tau[j] - ws.h[j];
+    }
+    ltdl_solve(model, &ws.a, qdd);
+    check_finite(qdd)
+}
+
+#[inline]
+fn skew(v: &Vector3<f64>) -> Matrix3<f64> {
+    Matrix3::new(0.0, -v.z, v.y, v.z, 0.0, -v.x, -v.y, v.x, 0.0)
+}
+
+// Spatial transformations between R_i = R_a(k) and R_k, with R = iA_k, p = iP_k:
+// kT_i = [[R', -R' skew(p)], [0, R']] maps [linear; angular] motion from R_i to R_k; its
+// transpose maps wrenches back. Written with 3x3 blocks (no 6x6 products).
+
+/// kT_i V: the motion V of frame i seen at O_k in R_k: [R' (v + w x p); R' w].
+#[inline]
+fn motion_to_child(r: &Matrix3<f64>, p: &Vector3<f64>, v: &Vector6<f64>) -> Vector6<f64> {
+    let lin = Vector3::new(v[0], v[1], v[2]);
+    let ang = Vector3::new(v[3], v[4], v[5]);
+    let l = r.tr_mul(&(lin + ang.cross(p)));
+    let a = r.tr_mul(&ang);
+    Vector6::new(l.x, l.y, l.z, a.x, a.y, a.z)
+}
+
+/// kT_i' F: the wrench F at O_k in R_k moved to O_i in R_i: [R f; p x R f + R m].
+#[inline]
+fn wrench_to_parent(r: &Matrix3<f64>, p: &Vector3<f64>, f: &Vector6<f64>) -> Vector6<f64> {
+    let fi = r * Vector3::new(f[0], f[1], f[2]);
+    let mi = r * Vector3::new(f[3], f[4], f[5]) + p.cross(&fi);
+    Vector6::new(fi.x, fi.y, fi.z, mi.x, mi.y, mi.z)
+}
+
+/// kT_i' K kT_i for a symmetric K (an inertia in R_k about O_k moved to R_i about O_i).
+/// With B = R K R' blockwise and S = skew(p):
+/// [[B11, B12 - B11 S], [sym, S (B12 - B11 S) + B22 - B12' S]].
+#[inline]
+fn inertia_to_parent(r: &Matrix3<f64>, p: &Vector3<f64>, k: &Matrix6<f64>) -> Matrix6<f64> {
+    let k11 = k.fixed_view::<3, 3>(0, 0);
+    let k12 = k.fixed_view::<3, 3>(0, 3);
+    let k22 = k.fixed_view::<3, 3>(3, 3);
+    let b11 = r * k11 * r.transpose();
+    let b12 = r * k12 * r.transpose();
+    let b22 = r * k22 * r.transpose();
+    let s = skew(p);
+    let c = b12 - b11 * s;
+    let d = s * c + b22 - b12.transpose() * s;
+    let mut out = Matrix6::zeros();
+    out.fixed_view_mut::<3, 3>(0, 0).copy_from(&b11);
+    out.fixed_view_mut::<3, 3>(0, 3).copy_from(&c);
+    out.fixed_view_mut::<3, 3>(3, 0).copy_from(&c.transpose());
+    out.fixed_view_mut::<3, 3>(3, 3).copy_from(&d);
+    out
+}
+
+/// Index of the joint axis a_j in a [linear; angular] spatial vector.
+#[inline]
+fn axis_index(joint: JointType) -> Option<usize> {
+    match joint {
+        JointType::Revolute => Some(5),
+        JointType::Prismatic => Some(2),
+        JointType::Fixed => None,
+    }
+}
+
+/// The O(n) recursive Newton–Euler direct dynamic model (articulated bodies, §9.7 second method).
+///
+/// Link j's equation is F_j = J_j Vd_j + beta_j with the spatial inertia about O_j
+/// J_j = [[M_j I, -skew(MS_j)], [skew(MS_j), J_j]], the classical accelerations
+/// Vd_j = [jVd_j; jwd_j] = jT_i Vd_i + gamma_j + a_j qdd_j (eqs 10.4–10.6 split into the
+/// qdd-free part gamma_j and a_j = [sigma_j z; sigma_bar_j z]) and
+/// beta_j = [w x (w x MS) + fe; w x (J w) + me] (eqs 10.7–10.8). Backward, the articulated
+/// inertia J*_j and bias beta*_j with F_j = J*_j Vd_j + beta*_j collect the children through
+/// K_k = J*_k - u_k u_k' / H_k, u_k = J*_k a_k, H_k = a_k' u_k + Ia_k; forward,
+/// qdd_j = (Gamma_j - friction - u_j' (jT_i Vd_i + gamma_j) - a_j' beta*_j) / H_j (eq 10.12).
+pub fn ddm_aba(
+    model: &DynModel<f64>,
+    ws: &mut DirectWorkspace,
+    q: &[f64],
+    qd: &[f64],
+    tau: &[f64],
+    qdd: &mut [f64],
+) -> Result<()> {
+    let n = model.nl;
+    let b = &mut ws.aba;
+    let mut scale: f64 = 0.0;
+    // Forward: velocities, gamma_j, link inertias and biases.
+    b.w[0] = model.w0;
+    for j in 1..=n {
+        let fr = model.frame(j);
+        let i = fr.ant;
+        let (rot, pos) = fr.transform(&q[j - 1]);
+        let rt = rot.transpose();
+        let wi = rt * b.w[i];
+        let wpos = b.w[i].cross(&b.w[i].cross(&pos));
+        let mut lin = rt * wpos;
+        let mut ang = Vector3::zeros();
+        let mut w = wi;
+        let s = qd[j - 1];
+        match fr.joint {
+            JointType::Revolute => {
+                w.z += s;
+                ang = Vector3::new(wi.y * s, -wi.x * s, 0.0);
+            }
+            JointType::Prismatic => {
+                lin += Vector3::new(wi.y * s, -wi.x * s, 0.0) * 2.0;
+            }
+            JointType::Fixed => {}
+        }
+        b.gamma[j] = Vector6::new(lin.x, lin.y, lin.z, ang.x, ang.y, ang.z);
+        let l = model.link(j);
+        let mut ia = Matrix6::zeros();
+        ia.fixed_view_mut::<3, 3>(0, 0)
+            .copy_from(&(Matrix3::identity() * l.mass));
+        let sm = skew(&l.ms);
+        ia.fixed_view_mut::<3, 3>(0, 3).copy_from(&(-sm));
+        ia.fixed_view_mut::<3, 3>(3, 0).copy_from(&sm);
+        ia.fixed_view_mut::<3, 3>(3, 3).copy_from(&l.inertia);
+        let f = w.cross(&w.cross(&l.ms)) + l.fe;
+        let m = w.cross(&(l.inertia * w)) + l.me;
+        b.pa[j] = Vector6::new(f.x, f.y, f.z, m.x, m.y, m.z);
+        b.ia[j] = ia;
+        b.rot[j] = rot;
+        b.pos[j] = pos;
+        b.w[j] = w;
+        b.tau[j] = match fr.joint {
+            JointType::Fixed => 0.0,
+            _ => tau[j - 1] - l.fs * s.sign() - l.fv * s,
+        };
+        scale = scale
+            .max(l.mass.abs())
+            .max(l.inertia.trace().abs())
+            .max(l.ia.abs());
+    }
+    // Backward: articulated inertias.
+    for k in (1..=n).rev() {
+        let fr = model.frame(k);
+        let (kk, alpha) = match axis_index(fr.joint) {
+            Some(ax) => {
+                let u = b.ia[k].column(ax).into_owned();
+                let d = u[ax] + model.link(k).ia;
+                if !pivot_ok(d, scale) {
+                    return Err(singular(
+                        k,
+                        "the articulated inertia about the joint axis",
+                        d,
+                    ));
+                }
+                let kk = b.ia[k] - u * u.transpose() / d;
+                let alpha = kk * b.gamma[k] + b.pa[k] + u * ((b.tau[k] - b.pa[k][ax]) / d);
+                b.u[k] = u;
+                b.d[k] = d;
+                (kk, alpha)
+            }
+            None => (b.ia[k], b.ia[k] * b.gamma[k] + b.pa[k]),
+        };
+        let i = fr.ant;
+        if i != 0 {
+            b.ia[i] += inertia_to_parent(&b.rot[k], &b.pos[k], &kk);
+            b.pa[i] += wrench_to_parent(&b.rot[k], &b.pos[k], &alpha);
+        }
+    }
+    // Forward: accelerations.
+    let g = model.vp0 - model.gravity;
+    b.acc[0] = Vector6::new(g.x, g.y, g.z, model.wp0.x, model.wp0.y, model.wp0.z);
+    for j in 1..=n {
+        let fr = model.frame(j);
+        let mut acc = motion_to_child(&b.rot[j], &b.pos[j], &b.acc[fr.ant]) + b.gamma[j];
+        match axis_index(fr.joint) {
+            Some(ax) => {
+                let a = (b.tau[j] - b.u[j].dot(&acc) - b.pa[j][ax]) / b.d[j];
+                acc[ax] += a;
+                qdd[j - 1] = a;
+            }
+            None => qdd[j - 1] = 0.0,
+        }
+        b.acc[j] = acc;
+    }
+    check_finite(qdd)
+}
+
+/// Run one of the two methods.
+pub fn ddm(
+    model: &DynModel<f64>,
+    ws: &mut DirectWorkspace,
+    method: Method,
+    q: &[f64],
+    qd: &[f64],
+    tau: &[f64],
+    qdd: &mut [f64],
+) -> Result<()> {
+    match method {
+        Method::Composite => ddm_composite(model, ws, q, qd, tau, qdd),
+        Method::ArticulatedBody => ddm_aba(model, ws, q, qd, tau, qdd),
+    }
+}
+
+/// Direct dynamic model of the robot's (equivalent) tree: qdd for joints 1..NL.
+/// Convenience wrapper that checks its inputs and allocates; use [`ddm`] in loops.
+pub fn direct_dynamics(
+    robot: &Robot,
+    q: &[f64],
+    qd: &[f64],
+    tau: &[f64],
+    method: Method,
+) -> Result<DVector<f64>> {
+    check_state(robot, "q", q)?;
+    check_state(robot, "qd", qd)?;
+    check_state(robot, "tau", tau)?;
+    let model = robot.numeric();
+    let mut ws = DirectWorkspace::new(model);
+    let mut qdd = DVector::zeros(model.nl);
+    ddm(model, &mut ws, method, q, qd, tau, qdd.as_mut_slice())?;
+    Ok(qdd)
+}

@@ -1,0 +1,180 @@
+//! Inertia matrix A(q) of a tree robot by the composite-link method and the vector H(q, qd) by
+//! Newton–Euler with qdd = 0 (§10.2.3, which applies the two methods of the book's §9.7 to trees):
+//! Gamma = A(q) qdd + H(q, qd).
+//!
+//! Conventions: A has NL x NL entries indexed like the state vectors of
+//! [`rnea`](crate::algorithms::inverse_dynamics::rnea) (joint j at index j-1). The rows and
+//! columns of fixed frames (sigma = 2) are zero (they carry no variable) and are skipped by the
+//! solvers of [`crate::algorithms::direct_dynamics`]. A_ij = 0 whenever neither of i, j is an
+//! ancestor of the other, and the rotor inertia Ia_j is on the diagonal.
+//!
+//! Written once over [`DynScalar`]: the symbolic generator runs it on expressions.
+
+use crate::algorithms::inverse_dynamics::{check_state, rnea};
+use crate::error::Result;
+use crate::model::{DynModel, JointType, Robot};
+use crate::scalar::DynScalar;
+use crate::workspace::Workspace;
+use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
+
+/// Buffers of the composite-link method and of H (index j = link j; index 0 unused).
+#[derive(Clone, Debug)]
+pub struct InertiaWorkspace<T: DynScalar = f64> {
+    /// iA_j of the current q.
+    pub rot: Vec<Matrix3<T>>,
+    /// iP_j of the current q.
+    pub pos: Vec<Vector3<T>>,
+    /// jJ_j^c: inertia about O_j of the composite link j (link j and all its successors), in R_j.
+    pub jc: Vec<Matrix3<T>>,
+    /// jMS_j^c: first moments of the composite link j.
+    pub msc: Vec<Vector3<T>>,
+    /// M_j^c: mass of the composite link j.
+    pub mc: Vec<T>,
+    /// Newton–Euler buffers (for H).
+    pub ne: Workspace<T>,
+    zeros: Vec<T>,
+}
+
+impl<T: DynScalar> InertiaWorkspace<T> {
+    pub fn new(model: &DynModel<T>) -> Self {
+        let n = model.nl + 1;
+        InertiaWorkspace {
+            rot: vec![Matrix3::identity(); n],
+            pos: vec![Vector3::zeros(); n],
+            jc: vec![Matrix3::zeros(); n],
+            msc: vec![Vector3::zeros(); n],
+            mc: vec![T::zero(); n],
+            ne: Workspace::new(model),
+            zeros: vec![T::zero(); model.nl],
+        }
+    }
+}
+
+/// Composite links (backward recursion j = NL..1): jc, msc, mc of every link about its own
+/// origin, and iA_j, iP_j in `ws.rot`, `ws.pos`.
+///
+/// Moving the inertia (J, MS, M) of a body from R_k to R_i with R = iA_k, p = iP_k, m = R MS
+/// (parallel-axis theorem with J = integral of -skew(r)^2 dm, r = p + s):
+/// J' = R J R' + M (p'p I - p p') + 2 (p'm) I - m p' - p m',  MS' = m + M p,  M' = M.
+pub fn composite_links<T: DynScalar>(model: &DynModel<T>, ws: &mut InertiaWorkspace<T>, q: &[T]) {
+    for j in 1..=model.nl {
+        let (rot, pos) = model.frame(j).transform(&q[j - 1]);
+        ws.rot[j] = rot;
+        ws.pos[j] = pos;
+        let l = model.link(j);
+        ws.jc[j] = l.inertia.clone();
+        ws.msc[j] = l.ms.clone();
+        ws.mc[j] = l.mass.clone();
+    }
+    for k in (2..=model.nl).rev() {
+        let i = model.frame(k).ant;
+        if i == 0 {
+            continue;
+        }
+        let r = &ws.rot[k];
+        let p = &ws.pos[k];
+        let mk = ws.mc[k].clone();
+        let m = r * &ws.msc[k];
+        let pm = p.dot(&m);
+        let pp = p.dot(p);
+        let ident = Matrix3::<T>::identity();
+        let jk = r * &ws.jc[k] * r.transpose()
+            + (&ident * pp - p * p.transpose()) * mk.clone()
+            + &ident * (pm.clone() + pm)
+            - &m * p.transpose()
+            - p * m.transpose();
+        let ms = m + p * mk.clone();
+        ws.jc[i] += jk;
+        ws.msc[i] += ms;
+        ws.mc[i] += mk;
+    }
+}
+
+/// Inertia matrix A(q) (NL x NL) by the composite-link method, allocation-free.
+///
+/// Column j: the wrench on the composite link j for qdd = e_j (qd = 0, g = 0) is
+/// f = z x MS^c, m = J^c z (revolute) or f = M^c z, m = MS^c x z (prismatic); A_jj is its
+/// projection on the joint axis plus Ia_j, and A_ij (= A_ji) for every ancestor i of j is the
+/// projection after transporting the wrench to R_i (eqs 10.10–10.12 with the link terms zero).
+pub fn inertia_matrix_into<T: DynScalar>(
+    model: &DynModel<T>,
+    ws: &mut InertiaWorkspace<T>,
+    q: &[T],
+    a: &mut DMatrix<T>,
+) {
+    let n = model.nl;
+    assert_eq!(a.shape(), (n, n), "A must be NL x NL");
+    composite_links(model, ws, q);
+    a.fill(T::zero());
+    for j in 1..=n {
+        let fr = model.frame(j);
+        let ms = &ws.msc[j];
+        let (mut f, mut m) = match fr.joint {
+            JointType::Revolute => (
+                Vector3::new(-ms.y.clone(), ms.x.clone(), T::zero()),
+                ws.jc[j].column(2).into_owned(),
+            ),
+            JointType::Prismatic => (
+                Vector3::new(T::zero(), T::zero(), ws.mc[j].clone()),
+                Vector3::new(ms.y.clone(), -ms.x.clone(), T::zero()),
+            ),
+            JointType::Fixed => continue,
+        };
+        a[(j - 1, j - 1)] = project(fr.joint, &f, &m) + model.link(j).ia.clone();
+        let mut k = j;
+        while model.frame(k).ant != 0 {
+            let fi = &ws.rot[k] * &f;
+            m = &ws.rot[k] * &m + ws.pos[k].cross(&fi);
+            f = fi;
+            k = model.frame(k).ant;
+            let joint = model.frame(k).joint;
+            if joint.is_movable() {
+                let v = project(joint, &f, &m);
+                a[(k - 1, j - 1)] = v.clone();
+                a[(j - 1, k - 1)] = v;
+            }
+        }
+    }
+}
+
+#[inline]
+fn project<T: DynScalar>(joint: JointType, f: &Vector3<T>, m: &Vector3<T>) -> T {
+    match joint {
+        JointType::Revolute => m.z.clone(),
+        JointType::Prismatic => f.z.clone(),
+        JointType::Fixed => T::zero(),
+    }
+}
+
+/// H(q, qd): centrifugal, Coriolis, gravity, friction and external-wrench torques, i.e. the
+/// Newton–Euler torques with qdd = 0 (§9.7 method 1). Allocation-free; `h.len() == NL`.
+pub fn h_vector_into<T: DynScalar>(
+    model: &DynModel<T>,
+    ws: &mut InertiaWorkspace<T>,
+    q: &[T],
+    qd: &[T],
+    h: &mut [T],
+) {
+    rnea(model, &mut ws.ne, q, qd, &ws.zeros, h);
+}
+
+/// A(q) of a robot's (equivalent) tree; checks its input and allocates.
+pub fn inertia_matrix(robot: &Robot, q: &[f64]) -> Result<DMatrix<f64>> {
+    check_state(robot, "q", q)?;
+    let model = robot.numeric();
+    let mut ws = InertiaWorkspace::new(model);
+    let mut a = DMatrix::zeros(model.nl, model.nl);
+    inertia_matrix_into(model, &mut ws, q, &mut a);
+    Ok(a)
+}
+
+/// H(q, qd) of a robot's (equivalent) tree; checks its inputs and allocates.
+pub fn h_vector(robot: &Robot, q: &[f64], qd: &[f64]) -> Result<DVector<f64>> {
+    check_state(robot, "q", q)?;
+    check_state(robot, "qd", qd)?;
+    let model = robot.numeric();
+    let mut ws = InertiaWorkspace::new(model);
+    let mut h = DVector::zeros(model.nl);
+    h_vector_into(model, &mut ws, q, qd, h.as_mut_slice());
+    Ok(h)
+}

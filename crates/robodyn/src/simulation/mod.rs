@@ -1,0 +1,313 @@
+//! Simulation: integrate a direct dynamic model from an initial state under a torque input and
+//! stream the trajectory (t, q<j>, qd<j>, qdd<j>, tau<j>, energy, extra columns).
+//!
+//! The integrators only see a [`Dynamics`]: [`TreeDynamics`] for tree robots today; a
+//! closed-chain model (actuated coordinates, passive joints re-solved, a closure-residual extra
+//! column) plugs in by implementing the same trait.
+
+pub mod energy;
+pub mod input;
+pub mod integrators;
+pub mod output;
+
+pub use input::{TimeSeries, TorqueInput};
+pub use integrators::{Integrator, Ode, Stats, Stepper};
+pub use output::{plot_svg, CsvSink, Recorder, Tee, TrajectorySink};
+
+use crate::algorithms::direct_dynamics::{ddm, DirectWorkspace, Method};
+use crate::error::{Error, Result};
+use crate::model::Robot;
+use crate::scalar::DynScalar;
+use energy::{total_energy, EnergyWorkspace};
+
+/// A mechanical system with `dof` coordinates as the simulator sees it.
+pub trait Dynamics {
+    /// Number of simulated coordinates (length of q, qd, qdd, tau).
+    fn dof(&self) -> usize;
+    /// Label of each coordinate in the column names (`q<label>`); joint frame numbers.
+    fn labels(&self) -> Vec<String>;
+    /// qdd for the state (q, qd) under tau at time t (allocation-free in hot loops).
+    fn accel(&mut self, t: f64, q: &[f64], qd: &[f64], tau: &[f64], qdd: &mut [f64]) -> Result<()>;
+    /// Total (kinetic + potential) energy.
+    fn energy(&mut self, q: &[f64], qd: &[f64]) -> Result<f64>;
+    /// Names of extra output columns (e.g. a loop-closure residual).
+    fn extra_columns(&self) -> Vec<String> {
+        Vec::new()
+    }
+    /// Values of the extra columns at (q, qd).
+    fn extra_values(&mut self, _q: &[f64], _qd: &[f64], _out: &mut [f64]) -> Result<()> {
+        Ok(())
+    }
+}
+
+/// A tree robot: the coordinates are its movable joints (fixed frames carry no state).
+pub struct TreeDynamics<'a> {
+    robot: &'a Robot,
+    method: Method,
+    joints: Vec<usize>,
+    ws: DirectWorkspace,
+    energy_ws: EnergyWorkspace,
+    q: Vec<f64>,
+    qd: Vec<f64>,
+    tau: Vec<f64>,
+    qdd: Vec<f64>,
+    coulomb_smoothing: Option<f64>,
+}
+
+impl<'a> TreeDynamics<'a> {
+    pub fn new(robot: &'a Robot, method: Method) -> Self {
+        let nl = robot.nl();
+        TreeDynamics {
+            robot,
+            method,
+            joints: robot.movable_joints(),
+            ws: DirectWorkspace::new(robot.numeric()),
+            energy_ws: EnergyWorkspace::new(robot),
+            q: vec![0.0; nl],
+            qd: vec![0.0; nl],
+            tau: vec![0.0; nl],
+            qdd: vec![0.0; nl],
+            coulomb_smoothing: None,
+        }
+    }
+
+    /// Replace the Coulomb friction Fs sign(qd) by Fs tanh(qd / v) in the simulated motion
+    /// (v > 0, in rad/s or m/s). The exact sign makes the right-hand side discontinuous: a
+    /// sticking joint then chatters and the step size collapses. Done by adding
+    /// Fs (sign(qd) - tanh(qd / v)) to the torque given to the direct model.
+    pub fn with_coulomb_smoothing(mut self, v: Option<f64>) -> Self {
+        self.coulomb_smoothing = v.filter(|v| *v > 0.0);
+        self
+    }
+
+    /// The movable joints, in frame order: coordinate k is joint `joints()[k]`.
+    pub fn joints(&self) -> &[usize] {
+        &self.joints
+    }
+
+    fn scatter(&mut self, q: &[f64], qd: &[f64]) {
+        for (k, &j) in self.joints.iter().enumerate() {
+            self.q[j - 1] = q[k];
+            self.qd[j - 1] = qd[k];
+        }
+    }
+}
+
+impl Dynamics for TreeDynamics<'_> {
+    fn dof(&self) -> usize {
+        self.joints.len()
+    }
+    fn labels(&self) -> Vec<String> {
+        self.joints.iter().map(|j| j.to_string()).collect()
+    }
+    fn accel(
+        &mut self,
+        _t: f64,
+        q: &[f64],
+        qd: &[f64],
+        tau: &[f64],
+        qdd: &mut [f64],
+    ) -> Result<()> {
+        self.scatter(q, qd);
+        let model = self.robot.numeric();
+        for (k, &j) in self.joints.iter().enumerate() {
+            self.tau[j - 1] = tau[k];
+            if let Some(v) = self.coulomb_smoothing {
+                let (fs, s) = (model.link(j).fs, qd[k]);
+                self.tau[j - 1] += fs * (s.sign() - (s / v).tanh());
+            }
+        }
+        ddm(
+            model,
+            &mut self.ws,
+            self.method,
+            &self.q,
+            &self.qd,
+            &self.tau,
+            &mut self.qdd,
+        )?;
+        for (k, &j) in self.joints.iter().enumerate() {
+            qdd[k] = self.qdd[j - 1];
+        }
+        Ok(())
+    }
+    fn energy(&mut self, q: &[f64], qd: &[f64]) -> Result<f64> {
+        self.scatter(q, qd);
+        Ok(total_energy(
+            self.robot,
+            &mut self.energy_ws,
+            &self.q,
+            &self.qd,
+        ))
+    }
+}
+
+/// How to run a simulation.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SimOptions {
+    /// Simulated time span [0, duration].
+    pub duration: f64,
+    pub integrator: Integrator,
+    /// Time between output rows (the integrators land exactly on these times).
+    pub output_dt: f64,
+    /// Stop with [`Error::Numerical`] after this many integration steps (None: no limit).
+    pub max_steps: Option<usize>,
+}
+
+/// What happened.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SimSummary {
+    pub t_end: f64,
+    pub rows: usize,
+    pub stats: Stats,
+}
+
+/// y = [q; qd], y' = [qd; qdd(t, q, qd, tau(t, q, qd))].
+struct StateOde<'d, 'i> {
+    dynamics: &'d mut dyn Dynamics,
+    input: &'i TorqueInput,
+    tau: Vec<f64>,
+}
+
+impl Ode for StateOde<'_, '_> {
+    fn dim(&self) -> usize {
+        2 * self.dynamics.dof()
+    }
+    fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<()> {
+        let n = self.dynamics.dof();
+        let (q, qd) = y.split_at(n);
+        self.input.torque(t, q, qd, &mut self.tau);
+        let (dq, dqd) = dy.split_at_mut(n);
+        dq.copy_from_slice(qd);
+        self.dynamics.accel(t, q, qd, &self.tau, dqd)
+    }
+}
+
+/// Column names of the trajectory: t, q<l>, qd<l>, qdd<l>, tau<l>, energy, extras.
+pub fn trajectory_headers(dynamics: &dyn Dynamics) -> Vec<String> {
+    let labels = dynamics.labels();
+    let mut h = vec!["t".to_string()];
+    for p in ["q", "qd", "qdd", "tau"] {
+        h.extend(labels.iter().map(|l| format!("{p}{l}")));
+    }
+    h.push("energy".into());
+    h.extend(dynamics.extra_columns());
+    h
+}
+
+/// Integrate from (q0, qd0) at t = 0 to `duration`, writing a row at t = 0 and at every
+/// multiple of `output_dt` (and at `duration`). `progress(t)` is called after each row.
+///
+/// A non-finite state, a step-size underflow or a numerical error of the model stops the run
+/// with [`Error::Numerical`] saying when; the rows written so far stay in the sink (flushed).
+pub fn simulate(
+    dynamics: &mut dyn Dynamics,
+    input: &TorqueInput,
+    q0: &[f64],
+    qd0: &[f64],
+    opts: &SimOptions,
+    sink: &mut dyn TrajectorySink,
+    progress: &mut dyn FnMut(f64),
+) -> Result<SimSummary> {
+    let n = dynamics.dof();
+    for (name, v) in [("q0", q0), ("qd0", qd0)] {
+        if v.len() != n {
+            return Err(Error::Input(format!(
+                "{name} has {} values, the system has {n} coordinates",
+                v.len()
+            )));
+        }
+        if v.iter().any(|x| !x.is_finite()) {
+            return Err(Error::Input(format!("{name} has a non-finite value")));
+        }
+    }
+    for (name, v) in [("duration", opts.duration), ("output step", opts.output_dt)] {
+        if !(v.is_finite() && v > 0.0) {
+            return Err(Error::Input(format!(
+                "{name} = {v} must be a positive finite number"
+            )));
+        }
+    }
+    opts.integrator.validate()?;
+    input.validate(n)?;
+    sink.begin(&trajectory_headers(dynamics))?;
+    let result = run(dynamics, input, q0, qd0, opts, sink, progress);
+    let flushed = sink.finish();
+    let summary = result?;
+    flushed?;
+    Ok(summary)
+}
+
+fn run(
+    dynamics: &mut dyn Dynamics,
+    input: &TorqueInput,
+    q0: &[f64],
+    qd0: &[f64],
+    opts: &SimOptions,
+    sink: &mut dyn TrajectorySink,
+    progress: &mut dyn FnMut(f64),
+) -> Result<SimSummary> {
+    let n = dynamics.dof();
+    let n_extra = dynamics.extra_columns().len();
+    let mut y: Vec<f64> = q0.iter().chain(qd0).copied().collect();
+    let mut row = vec![0.0; 1 + 4 * n + 1 + n_extra];
+    let mut stepper = Stepper::new(opts.integrator, 2 * n);
+    stepper.max_steps = opts.max_steps;
+    let mut ode = StateOde {
+        dynamics,
+        input,
+        tau: vec![0.0; n],
+    };
+    let mut t = 0.0;
+    let mut k = 0usize;
+    let mut summary = SimSummary::default();
+    let stop = |t: f64, e: Error| -> Error {
+        match e {
+            Error::Numerical(m) => Error::Numerical(format!("simulation stopped at t = {t}: {m}")),
+            other => other,
+        }
+    };
+    loop {
+        // output row at (t, y)
+        let (q, qd) = y.split_at(n);
+        row[0] = t;
+        row[1..1 + n].copy_from_slice(q);
+        row[1 + n..1 + 2 * n].copy_from_slice(qd);
+        let (head, rest) = row.split_at_mut(1 + 3 * n);
+        let tau = &mut rest[..n];
+        ode.input.torque(t, q, qd, tau);
+        ode.dynamics
+            .accel(t, q, qd, tau, &mut head[1 + 2 * n..])
+            .map_err(|e| stop(t, e))?;
+        let e = ode.dynamics.energy(q, qd).map_err(|e| stop(t, e))?;
+        rest[n] = e;
+        ode.dynamics
+            .extra_values(q, qd, &mut rest[n + 1..])
+            .map_err(|e| stop(t, e))?;
+        if row.iter().any(|x| !x.is_finite()) {
+            return Err(stop(
+                t,
+                Error::Numerical("an output value is not finite".into()),
+            ));
+        }
+        sink.row(&row)?;
+        summary.rows += 1;
+        summary.t_end = t;
+        summary.stats = stepper.stats;
+        progress(t);
+        if t >= opts.duration {
+            break;
+        }
+        k += 1;
+        let t_next = (k as f64 * opts.output_dt).min(opts.duration);
+        let t_next = if opts.duration - t_next < 1e-9 * opts.output_dt {
+            opts.duration
+        } else {
+            t_next
+        };
+        stepper
+            .advance(&mut ode, &mut t, &mut y, t_next)
+            .map_err(|e| stop(t, e))?;
+    }
+    Ok(summary)
+}
