@@ -123,13 +123,14 @@ fn info_flags_mimic_joints() {
 
 #[test]
 fn convert_between_formats_keeps_the_torques() {
+    // the SR400 is a closed chain: idm takes the actuated joints 1, 2, 4, 5, 6, 7
     let args = [
         "--q",
-        "0.1,0.2,0.3,0.4,0.5,0.6,0.7,0.8",
+        "0.1,0.2,0.4,0.5,0.6,0.7",
         "--qd",
-        "1,-1,2,-2,1,1,0.5,0.3",
+        "1,-1,-2,1,1,0.5",
         "--qdd",
-        "1,2,3,4,5,6,7,8",
+        "1,2,4,5,6,7",
     ];
     let idm = |p: &str| {
         let mut a = vec!["idm", p];
