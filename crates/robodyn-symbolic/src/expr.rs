@@ -896,3 +896,34 @@ impl num_traits::One for Expr {
         Expr::one()
     }
 }
+
+/// Structural hash (floats by their bits), consistent with `PartialEq` for non-NaN values; used
+/// by the program builder for common-subexpression sharing.
+impl std::hash::Hash for Expr {
+    fn hash<H: std::hash::Hasher>(&self, h: &mut H) {
+        self.node().hash(h)
+    }
+}
+
+impl Eq for Expr {}
+
+impl std::hash::Hash for Node {
+    fn hash<H: std::hash::Hasher>(&self, h: &mut H) {
+        std::mem::discriminant(self).hash(h);
+        match self {
+            Node::Rational(r) => r.hash(h),
+            Node::Float(x) => x.to_bits().hash(h),
+            Node::Pi => {}
+            Node::Symbol(s) => s.hash(h),
+            Node::Add(v) | Node::Mul(v) => v.hash(h),
+            Node::Pow(b, n) => {
+                b.hash(h);
+                n.hash(h)
+            }
+            Node::Func(f, a) => {
+                f.hash(h);
+                a.hash(h)
+            }
+        }
+    }
+}

@@ -9,6 +9,7 @@
 //! - [`geometry`]: iT_j and 0T_j.
 
 pub mod algorithms;
+pub mod codegen;
 pub mod error;
 pub mod geometry;
 pub mod io;

@@ -1,0 +1,47 @@
+//! Operation counts of the customized inverse dynamic model of the Acma SR400 (Table 10.3).
+
+use robodyn::codegen::{generate, GenOptions, ModelKind};
+
+mod common_sr400 {
+    include!("codegen_sr400_base.rs");
+}
+
+fn sr400() -> robodyn::RobotDescription {
+    robodyn::io::load_description(std::path::Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../robots/sr400.toml"
+    )))
+    .unwrap()
+}
+
+#[test]
+fn sr400_table_10_3() {
+    let desc = sr400();
+    let mut rows = Vec::new();
+    for symmetric in [false, true] {
+        for base in [false, true] {
+            let opt = GenOptions {
+                model: ModelKind::Idm,
+                symmetric,
+                friction: false,
+                rotor: true,
+                base: base.then(common_sr400::table_10_2),
+                ..Default::default()
+            };
+            let p = generate(&desc, &opt).unwrap();
+            let c = p.count();
+            rows.push((symmetric, base, c));
+        }
+    }
+    println!("SR400 inverse dynamic model (Table 10.3): ours vs book");
+    let book = [(430, 420), (304, 326), (295, 245), (243, 118)];
+    for ((s, b, c), (bm, ba)) in rows.iter().zip(book) {
+        println!(
+            "  {:10} {:9}: {:4} mult {:4} add   (book {bm} / {ba})",
+            if *s { "symmetric" } else { "complete" },
+            if *b { "base" } else { "standard" },
+            c.mul,
+            c.add
+        );
+    }
+}
