@@ -258,7 +258,7 @@ fn code(e: &Expr, lang: Lang, prec: u8) -> String {
         Node::Float(x) => lit(*x),
         Node::Pi => match lang {
             Lang::Rust => "std::f64::consts::PI".into(),
-            Lang::C => "M_PI".into(),
+            Lang::C => "3.141592653589793".into(),
             Lang::Python => "np.pi".into(),
             _ => "pi".into(),
         },

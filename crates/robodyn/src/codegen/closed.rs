@@ -87,19 +87,9 @@ pub fn constant_g(robot: &Robot) -> Result<DMatrix<f64>> {
     let mut unk = robot.passive_joints();
     unk.extend(nl + 1..=nj);
     let mut rng = crate::testing::rng(7);
-    let mut gs: Vec<DMatrix<f64>> = Vec::new();
-    for _ in 0..3 {
-        let mut q = vec![0.0; nj];
-        for &a in &act {
-            q[a - 1] = rng.random_range(-1.0..1.0);
-        }
-        if !close_loops(robot, &mut q, &unk, &mut rng) {
-            return Err(Error::Numerical(
-                "loop closure did not converge while computing G".into(),
-            ));
-        }
-        let ja = jacobian(robot, &q, &act);
-        let jp = jacobian(robot, &q, &unk);
+    let g_at = |q: &[f64]| -> Result<DMatrix<f64>> {
+        let ja = jacobian(robot, q, &act);
+        let jp = jacobian(robot, q, &unk);
         let pinv = jp
             .pseudo_inverse(1e-9)
             .map_err(|e| Error::Numerical(format!("singular loop-closure Jacobian: {e}")))?;
@@ -115,18 +105,47 @@ pub fn constant_g(robot: &Robot) -> Result<DMatrix<f64>> {
                 }
             }
         }
-        gs.push(g);
+        Ok(g)
+    };
+    let mut qa0 = vec![0.0; nj];
+    for &a in &act {
+        qa0[a - 1] = rng.random_range(-1.0..1.0);
     }
-    let g0 = gs[0].clone();
-    for g in &gs[1..] {
-        if (g - &g0).amax() > 1e-6 {
-            return Err(Error::Input(
-                "general closed chains are not supported yet by the generator: G depends on the \
-                 configuration (only loops with a constant G, such as parallelograms, are)"
-                    .into(),
-            ));
+    // Several assembly modes may exist (a parallelogram and its crossed form): follow each
+    // solution found from a random start along a path of q_a (continuation keeps the mode) and
+    // accept the first mode whose G stays constant.
+    let mut found = None;
+    'starts: for _ in 0..8 {
+        let mut q = qa0.clone();
+        for &p in &unk {
+            q[p - 1] = rng.random_range(-3.0..3.0);
         }
+        if !close_loops(robot, &mut q, &unk, &mut rng) {
+            continue;
+        }
+        let g0 = g_at(&q)?;
+        let dir: Vec<f64> = act.iter().map(|_| rng.random_range(-0.2..0.2)).collect();
+        for _ in 0..4 {
+            for (c, &a) in act.iter().enumerate() {
+                q[a - 1] += dir[c];
+            }
+            if !close_loops(robot, &mut q, &unk, &mut rng) {
+                continue 'starts;
+            }
+            if (g_at(&q)? - &g0).amax() > 1e-6 {
+                continue 'starts;
+            }
+        }
+        found = Some(g0);
+        break;
     }
+    let Some(g0) = found else {
+        return Err(Error::Input(
+            "general closed chains are not supported yet by the generator: no assembly mode \
+             with a constant G was found (only loops such as parallelograms are supported)"
+                .into(),
+        ));
+    };
     // exact small rationals (0, +-1, +-1/2, ...)
     let mut out = g0.clone();
     for x in out.iter_mut() {
