@@ -23,6 +23,8 @@ enum Command {
     Info(commands::info::Args),
     /// Inverse dynamic model: joint torques for given states (Newton-Euler).
     Idm(commands::idm::Args),
+    /// Customized symbolic models (idm, inertia, h, ddm, closed) as text, LaTeX or code.
+    Generate(commands::generate::Args),
 }
 
 fn main() {
@@ -30,6 +32,7 @@ fn main() {
     let result = match cli.command {
         Command::Info(a) => commands::info::run(a),
         Command::Idm(a) => commands::idm::run(a),
+        Command::Generate(a) => commands::generate::run(a),
     };
     if let Err(e) = result {
         eprintln!("robodyn: error: {e}");

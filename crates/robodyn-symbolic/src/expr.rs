@@ -912,7 +912,8 @@ impl std::hash::Hash for Node {
         std::mem::discriminant(self).hash(h);
         match self {
             Node::Rational(r) => r.hash(h),
-            Node::Float(x) => x.to_bits().hash(h),
+            // -0.0 == 0.0: hash them alike
+            Node::Float(x) => (if *x == 0.0 { 0.0f64 } else { *x }).to_bits().hash(h),
             Node::Pi => {}
             Node::Symbol(s) => s.hash(h),
             Node::Add(v) | Node::Mul(v) => v.hash(h),

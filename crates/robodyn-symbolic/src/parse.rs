@@ -61,11 +61,11 @@ impl Parser<'_> {
             match c {
                 b'+' => {
                     self.pos += 1;
-                    acc = acc + self.product()?;
+                    acc += self.product()?;
                 }
                 b'-' => {
                     self.pos += 1;
-                    acc = acc - self.product()?;
+                    acc -= self.product()?;
                 }
                 _ => break,
             }
@@ -79,7 +79,7 @@ impl Parser<'_> {
             match self.peek() {
                 Some(b'*') if self.s.get(self.pos + 1) != Some(&b'*') => {
                     self.pos += 1;
-                    acc = acc * self.unary()?;
+                    acc *= self.unary()?;
                 }
                 Some(b'/') => {
                     self.pos += 1;
@@ -91,7 +91,7 @@ impl Parser<'_> {
                             message: "division by zero".into(),
                         });
                     }
-                    acc = acc / d;
+                    acc /= d;
                 }
                 _ => break,
             }

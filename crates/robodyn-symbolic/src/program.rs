@@ -561,7 +561,12 @@ impl Program {
                     (saving, e)
                 })
                 .filter(|(s, _)| *s > 0)
-                .max_by(|a, b| a.0.cmp(&b.0).then_with(|| crate::cmp_expr(&b.1, &a.1)));
+                .max_by(|a, b| {
+                    // deterministic choice among equal savings (never the hash order)
+                    a.0.cmp(&b.0)
+                        .then_with(|| crate::cmp_expr(&b.1, &a.1))
+                        .then_with(|| b.1.to_string().cmp(&a.1.to_string()))
+                });
             let Some((_, target)) = best else { break };
             let name = loop {
                 counter += 1;

@@ -26,41 +26,13 @@ mod sr400_base {
     include!("codegen_sr400_base.rs");
 }
 
-fn sr400() -> RobotDescription {
-    robodyn::io::load_description(Path::new(concat!(
+mod robots {
+    include!(concat!(
         env!("CARGO_MANIFEST_DIR"),
-        "/../../robots/sr400.toml"
-    )))
-    .unwrap()
+        "/benches/generated/robots.rs"
+    ));
 }
-
-/// Stäubli RX-90 (conventions.md): alpha = {0, pi/2, 0, -pi/2, pi/2, -pi/2}, d3 = D3, r4 = RL4,
-/// with the inertial parameters of a random physically consistent robot (fixed seed).
-fn rx90() -> RobotDescription {
-    let mut d = RobotDescription::new("RX-90", 6, 6);
-    let alpha = ["0", "pi/2", "0", "-pi/2", "pi/2", "-pi/2"];
-    for j in 1..=6 {
-        d.frame_mut(j).alpha = Expr::parse(alpha[j - 1]).unwrap();
-    }
-    d.frame_mut(3).d = Expr::symbol("D3");
-    d.frame_mut(4).r = Expr::symbol("RL4");
-    d.symbols.insert("D3".into(), 0.45);
-    d.symbols.insert("RL4".into(), 0.45);
-    d.symbols.insert("G3".into(), 9.81);
-    d.gravity = [Expr::zero(), Expr::zero(), Expr::parse("-G3").unwrap()];
-    let mut r = rng(90);
-    for j in 1..=6 {
-        let p = robodyn::testing::random_inertial(&mut r);
-        let l = d.link_mut(j);
-        for (k, v) in p.iter().enumerate() {
-            l.params[k] = Expr::num(*v);
-        }
-        l.params[10] = Expr::num(0.3);
-        l.params[11] = Expr::num(0.5);
-        l.params[12] = Expr::num(0.8);
-    }
-    d
-}
+use robots::{rx90_description as rx90, sr400_description as sr400};
 
 /// Value of any symbol of a generated program: robot symbols, standard parameters `XX<j>`.
 fn env_of(desc: &RobotDescription) -> impl Fn(&str) -> Option<f64> + '_ {

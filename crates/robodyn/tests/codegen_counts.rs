@@ -45,3 +45,24 @@ fn sr400_table_10_3() {
         );
     }
 }
+
+/// Generation is deterministic: the same text twice (no hash-order dependence).
+#[test]
+fn generation_is_deterministic() {
+    let desc = sr400();
+    for model in [ModelKind::Idm, ModelKind::Ddm] {
+        let opt = GenOptions {
+            model,
+            ..Default::default()
+        };
+        let a = robodyn_symbolic::emit(
+            &generate(&desc, &opt).unwrap(),
+            robodyn_symbolic::Lang::Text,
+        );
+        let b = robodyn_symbolic::emit(
+            &generate(&desc, &opt).unwrap(),
+            robodyn_symbolic::Lang::Text,
+        );
+        assert_eq!(a, b);
+    }
+}

@@ -125,7 +125,12 @@ fn ident(s: &str) -> String {
 /// The symbolic model: DynModel<Expr> with the options applied.
 fn symbolic_model(desc: &RobotDescription, opt: &GenOptions) -> Result<DynModel<Expr>> {
     let env = |s: &str| desc.symbols.get(s).copied();
+    // symbols replaced by their values, exact constants (pi/2) kept exact
     let numeric = |e: &Expr, item: &dyn Fn() -> Item| -> Result<Expr> {
+        let v = e.substitute(&|s| env(s).map(Expr::num));
+        if v.symbols().is_empty() {
+            return Ok(v);
+        }
         e.eval(&env).map(Expr::num).map_err(|err| {
             Error::invalid(
                 item(),
@@ -290,7 +295,7 @@ pub fn generate(desc: &RobotDescription, opt: &GenOptions) -> Result<Program> {
     for k in ["q", "QP", "QDP", "GAM"] {
         reserved.extend((1..=nl).map(|j| joint_symbol(k, j)));
     }
-    for (s, _) in &desc.symbols {
+    for s in desc.symbols.keys() {
         reserved.push(s.clone());
     }
     for l in 1..=nl {
@@ -564,4 +569,57 @@ fn describe(desc: &RobotDescription, opt: &GenOptions) -> Vec<String> {
     }
     v.push(format!("Options: {}", o.join(", ")));
     v
+}
+
+impl BaseParameters {
+    /// Read a grouping list: one `NAME = expr` per line, where NAME is a standard parameter
+    /// with `R` before the link number (`XXR2` replaces `XX2`, `MR3` replaces `M3`) and expr is
+    /// its value over standard parameters and geometry; `zero: XX1 XY1 ...` lines list the
+    /// parameters set to zero; `#` starts a comment. `file` names the source in errors.
+    pub fn parse(text: &str, file: &str) -> Result<BaseParameters> {
+        let mut out = BaseParameters::default();
+        for (i, raw) in text.lines().enumerate() {
+            let line = raw.split('#').next().unwrap_or("").trim();
+            if line.is_empty() {
+                continue;
+            }
+            let err = |reason: String| {
+                Error::Input(format!("{file}:{}: {reason} in `{}`", i + 1, raw.trim()))
+            };
+            if let Some(rest) = line.strip_prefix("zero:") {
+                for name in rest.split_whitespace() {
+                    if split_param(name)
+                        .filter(|(p, _)| STANDARD_PARAMETERS.contains(p))
+                        .is_none()
+                    {
+                        return Err(err(format!("`{name}` is not a standard parameter")));
+                    }
+                    out.zero.insert(name.to_string());
+                }
+                continue;
+            }
+            let (name, expr) = line
+                .split_once('=')
+                .ok_or_else(|| err("expected `NAME = expression` or `zero: ...`".into()))?;
+            let name = name.trim();
+            let replaces = split_param(name)
+                .and_then(|(p, j)| {
+                    let p = p.strip_suffix('R')?;
+                    STANDARD_PARAMETERS.contains(&p).then(|| format!("{p}{j}"))
+                })
+                .ok_or_else(|| {
+                    err(format!(
+                        "`{name}` is not a grouped parameter name (standard name with R \
+                         before the link number, e.g. XXR2)"
+                    ))
+                })?;
+            let expr = Expr::parse(expr.trim()).map_err(|e| err(e.to_string()))?;
+            out.grouped.push(GroupedParameter {
+                replaces,
+                name: name.to_string(),
+                expr,
+            });
+        }
+        Ok(out)
+    }
 }
