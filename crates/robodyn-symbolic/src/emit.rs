@@ -63,6 +63,7 @@ fn header(p: &Program, lang: Lang) -> String {
         "{c}Operations: {} multiplications, {} additions ({} function calls: sin, cos, sign)",
         k.mul, k.add, k.func
     );
+    let base = usize::from(lang == Lang::Julia);
     let _ = writeln!(s, "{c}Inputs:");
     for g in &p.inputs {
         let names: Vec<String> = g
@@ -70,8 +71,8 @@ fn header(p: &Program, lang: Lang) -> String {
             .iter()
             .enumerate()
             .map(|(i, s)| match s {
-                Some(s) => format!("{}[{i}]={s}", g.name),
-                None => format!("{}[{i}]=unused", g.name),
+                Some(s) => format!("{}[{}]={s}", g.name, i + base),
+                None => format!("{}[{}]=unused", g.name, i + base),
             })
             .collect();
         let _ = writeln!(s, "{c}  {} ({}): {}", g.name, g.doc, names.join(" "));
@@ -80,7 +81,7 @@ fn header(p: &Program, lang: Lang) -> String {
         .outputs
         .iter()
         .enumerate()
-        .map(|(i, o)| format!("out[{i}]={}", o.name))
+        .map(|(i, o)| format!("out[{}]={}", i + base, o.name))
         .collect();
     let _ = writeln!(s, "{c}Outputs: {}", outs.join(" "));
     s
