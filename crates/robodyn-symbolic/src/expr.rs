@@ -445,6 +445,31 @@ impl Expr {
                         _ => -Expr::func(f, pos),
                     };
                 }
+                if let (Func::Sin | Func::Cos, Node::Add(terms)) = (f, a.node()) {
+                    // sin/cos(x + k*pi/2) = +-sin/cos(x): shift the argument exactly
+                    if let Some((i, k)) = terms
+                        .iter()
+                        .enumerate()
+                        .find_map(|(i, t)| t.multiple_of_half_pi().map(|k| (i, k)))
+                    {
+                        let rest = Expr::sum(
+                            terms
+                                .iter()
+                                .enumerate()
+                                .filter(|(j, _)| *j != i)
+                                .map(|(_, t)| t.clone()),
+                        );
+                        let k = k.rem_euclid(4);
+                        let (g, neg) = match (f, k) {
+                            (Func::Sin, 0) | (Func::Cos, 3) => (Func::Sin, false),
+                            (Func::Sin, 1) | (Func::Cos, 0) => (Func::Cos, false),
+                            (Func::Sin, 2) | (Func::Cos, 1) => (Func::Sin, true),
+                            _ => (Func::Cos, true),
+                        };
+                        let v = Expr::func(g, rest);
+                        return if neg { -v } else { v };
+                    }
+                }
                 if let Some(k) = a.multiple_of_half_pi() {
                     // k * pi/2, exact values
                     let k = k.rem_euclid(4);
