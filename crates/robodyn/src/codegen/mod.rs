@@ -435,12 +435,29 @@ pub fn generate(desc: &RobotDescription, opt: &GenOptions) -> Result<Program> {
             inputs.push(group("gam", "GAM", "joint torques at index j-1"));
         }
     }
+    let mut description = describe(desc, opt);
+    if opt.model == ModelKind::Closed {
+        let act: Vec<usize> = (1..=nl).filter(|&j| desc.frame(j).actuated).collect();
+        description.push(format!(
+            "G = d q_tr / d q_a (constant; rows q1..q{nl}, columns q_a = {act:?}):"
+        ));
+        for r in 0..g_matrix.nrows() {
+            let row: Vec<String> = g_matrix.row(r).iter().map(|e| e.to_string()).collect();
+            description.push(format!("  q{}: [{}]", r + 1, row.join(", ")));
+        }
+    } else if desc.nj > desc.nl {
+        description.push(
+            "Closed robot: this is the model of the equivalent tree (loops cut); \
+             --model closed gives Gamma_cl"
+                .into(),
+        );
+    }
     let mut prog = Program {
         name: opt
             .name
             .clone()
             .unwrap_or_else(|| format!("{}_{}", ident(&desc.name), opt.model.name())),
-        description: describe(desc, opt),
+        description,
         inputs,
         assignments,
         outputs,
