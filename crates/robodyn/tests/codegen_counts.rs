@@ -43,7 +43,18 @@ fn sr400_table_10_3() {
             c.mul,
             c.add
         );
+        // within 15 % of the book's total operation count (a regression guard against the
+        // reference figures, not against our own output)
+        let (ours, book) = (c.mul + c.add, bm + ba);
+        assert!(
+            (ours as f64) <= 1.15 * book as f64,
+            "{ours} operations, book {book}"
+        );
     }
+    // simplifications lower the count: base < standard, symmetric < complete
+    let total = |k: usize| rows[k].2.mul + rows[k].2.add;
+    assert!(total(1) < total(0) && total(3) < total(2));
+    assert!(total(2) < total(0) && total(3) < total(1));
 }
 
 /// Generation is deterministic: the same text twice (no hash-order dependence).
