@@ -618,3 +618,69 @@ fn sr400_base_parameters_reproduce_the_closed_chain_torques() {
         );
     }
 }
+
+/// The options remove exactly what they say: the symmetric / no-friction / no-rotor models of the
+/// SR400 and of a random tree agree with `rnea` on the robot whose corresponding parameters were
+/// set to zero in the description.
+#[test]
+fn options_match_robots_with_those_parameters_zero() {
+    let mut r = rng(77);
+    let trees = [
+        sr400(),
+        random_tree_description(&mut r, 5, &TreeOptions::default()),
+    ];
+    for desc in trees {
+        for (symmetric, friction, rotor) in [
+            (true, true, true),
+            (false, false, true),
+            (true, false, false),
+        ] {
+            let mut zeroed = desc.clone();
+            for l in &mut zeroed.links {
+                for (k, name) in STANDARD_PARAMETERS.iter().enumerate() {
+                    let z = (symmetric && ["XY", "XZ", "YZ", "MX", "MY"].contains(name))
+                        || (!friction && ["FS", "FV"].contains(name))
+                        || (!rotor && *name == "IA");
+                    if z {
+                        l.params[k] = Expr::zero();
+                    }
+                }
+            }
+            let robot = Robot::new(zeroed).unwrap();
+            let opt = GenOptions {
+                symmetric,
+                friction,
+                rotor,
+                ..Default::default()
+            };
+            let prog = generate(&desc, &opt).unwrap();
+            let env = env_of(&desc);
+            let joints = movable(&desc);
+            let [q, qd, qdd] = random_state(&mut r, desc.nl);
+            let expected: Vec<f64> = numeric_rnea(&robot, &q, &qd, &qdd)
+                .iter()
+                .enumerate()
+                .filter(|(k, _)| joints.contains(&(k + 1)))
+                .map(|(_, x)| *x)
+                .collect();
+            let got = prog
+                .evaluate(&|s| {
+                    let i = s.trim_end_matches(|c: char| c.is_ascii_digit()).len();
+                    let j: Option<usize> = s[i..].parse().ok();
+                    match (&s[..i], j) {
+                        ("q", Some(j)) => Some(q[j - 1]),
+                        ("QP", Some(j)) => Some(qd[j - 1]),
+                        ("QDP", Some(j)) => Some(qdd[j - 1]),
+                        _ => env(s),
+                    }
+                })
+                .unwrap();
+            let e = rel_err(&got, &expected);
+            assert!(
+                e < 1e-10,
+                "{} {symmetric} {friction} {rotor}: {e:e}",
+                desc.name
+            );
+        }
+    }
+}
