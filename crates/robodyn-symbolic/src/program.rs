@@ -589,6 +589,9 @@ impl Program {
             .chain(self.input_symbols())
             .collect();
         let mut counter = 0;
+        // targets already extracted: never extracted twice (guards against a candidate whose
+        // occurrences do not all match as counted)
+        let mut done: HashSet<Expr> = HashSet::new();
         loop {
             let mut cands: HashMap<Expr, usize> = HashMap::new();
             for a in self.assignments.iter().chain(&self.outputs) {
@@ -600,7 +603,7 @@ impl Program {
             }
             let best = cands
                 .into_iter()
-                .filter(|(_, n)| *n >= 2)
+                .filter(|(e, n)| *n >= 2 && !done.contains(e))
                 .map(|(e, n)| {
                     let c = count_ops(&e);
                     let saving = (n - 1) * (c.mul + c.add + c.func);
@@ -614,6 +617,7 @@ impl Program {
                         .then_with(|| b.1.to_string().cmp(&a.1.to_string()))
                 });
             let Some((_, target)) = best else { break };
+            done.insert(target.clone());
             let name = loop {
                 counter += 1;
                 let n = format!("T{counter}");
