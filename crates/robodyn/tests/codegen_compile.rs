@@ -23,7 +23,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
 mod sr400_base {
-    include!("codegen_sr400_base.rs");
+    include!("codegen_data/sr400_base.rs");
 }
 
 mod robots {

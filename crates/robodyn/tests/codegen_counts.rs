@@ -3,7 +3,7 @@
 use robodyn::codegen::{generate, GenOptions, ModelKind};
 
 mod common_sr400 {
-    include!("codegen_sr400_base.rs");
+    include!("codegen_data/sr400_base.rs");
 }
 
 fn sr400() -> robodyn::RobotDescription {
