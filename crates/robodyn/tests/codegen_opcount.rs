@@ -47,10 +47,8 @@ fn count_tokens(expr: &str) -> (usize, usize) {
         match c {
             '*' | '/' => mul += 1,
             '+' => add += 1,
-            '-' => {
-                if prev.is_some_and(|p| p.is_ascii_alphanumeric() || p == '_' || p == ')') {
-                    add += 1;
-                }
+            '-' if prev.is_some_and(|p| p.is_ascii_alphanumeric() || p == '_' || p == ')') => {
+                add += 1
             }
             _ => {}
         }
