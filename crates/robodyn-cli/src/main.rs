@@ -37,6 +37,8 @@ enum Command {
     Ddm(commands::ddm::Args),
     /// Simulate the direct dynamic model under a torque input; CSV trajectory and SVG plot.
     Simulate(commands::simulate::Args),
+    /// Customized symbolic models (idm, inertia, h, ddm, closed) as text, LaTeX or code.
+    Generate(commands::generate::Args),
 }
 
 fn main() {
@@ -51,6 +53,7 @@ fn main() {
         Command::Inertia(a) => commands::inertia::run(a),
         Command::Ddm(a) => commands::ddm::run(a),
         Command::Simulate(a) => commands::simulate::run(a),
+        Command::Generate(a) => commands::generate::run(a),
     };
     if let Err(e) = result {
         eprintln!("robodyn: error: {e}");

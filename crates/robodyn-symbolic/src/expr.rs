@@ -445,6 +445,31 @@ impl Expr {
                         _ => -Expr::func(f, pos),
                     };
                 }
+                if let (Func::Sin | Func::Cos, Node::Add(terms)) = (f, a.node()) {
+                    // sin/cos(x + k*pi/2) = +-sin/cos(x): shift the argument exactly
+                    if let Some((i, k)) = terms
+                        .iter()
+                        .enumerate()
+                        .find_map(|(i, t)| t.multiple_of_half_pi().map(|k| (i, k)))
+                    {
+                        let rest = Expr::sum(
+                            terms
+                                .iter()
+                                .enumerate()
+                                .filter(|(j, _)| *j != i)
+                                .map(|(_, t)| t.clone()),
+                        );
+                        let k = k.rem_euclid(4);
+                        let (g, neg) = match (f, k) {
+                            (Func::Sin, 0) | (Func::Cos, 3) => (Func::Sin, false),
+                            (Func::Sin, 1) | (Func::Cos, 0) => (Func::Cos, false),
+                            (Func::Sin, 2) | (Func::Cos, 1) => (Func::Sin, true),
+                            _ => (Func::Cos, true),
+                        };
+                        let v = Expr::func(g, rest);
+                        return if neg { -v } else { v };
+                    }
+                }
                 if let Some(k) = a.multiple_of_half_pi() {
                     // k * pi/2, exact values
                     let k = k.rem_euclid(4);
@@ -894,5 +919,37 @@ impl num_traits::Zero for Expr {
 impl num_traits::One for Expr {
     fn one() -> Expr {
         Expr::one()
+    }
+}
+
+/// Structural hash (floats by their bits), consistent with `PartialEq` for non-NaN values; used
+/// by the program builder for common-subexpression sharing.
+impl std::hash::Hash for Expr {
+    fn hash<H: std::hash::Hasher>(&self, h: &mut H) {
+        self.node().hash(h)
+    }
+}
+
+impl Eq for Expr {}
+
+impl std::hash::Hash for Node {
+    fn hash<H: std::hash::Hasher>(&self, h: &mut H) {
+        std::mem::discriminant(self).hash(h);
+        match self {
+            Node::Rational(r) => r.hash(h),
+            // -0.0 == 0.0: hash them alike
+            Node::Float(x) => (if *x == 0.0 { 0.0f64 } else { *x }).to_bits().hash(h),
+            Node::Pi => {}
+            Node::Symbol(s) => s.hash(h),
+            Node::Add(v) | Node::Mul(v) => v.hash(h),
+            Node::Pow(b, n) => {
+                b.hash(h);
+                n.hash(h)
+            }
+            Node::Func(f, a) => {
+                f.hash(h);
+                a.hash(h)
+            }
+        }
     }
 }

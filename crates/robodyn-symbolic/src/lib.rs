@@ -4,12 +4,16 @@
 //! exact rational constants, `pi`, `sin`/`cos`, canonicalising constructors that fold trivial
 //! algebra on construction, expansion, substitution, numeric evaluation, parsing and printing.
 
+pub mod emit;
 mod expr;
 mod parse;
 mod print;
+pub mod program;
 
+pub use emit::{emit, Lang};
 pub use expr::{cmp_expr, EvalError, Expr, Func, Node};
 pub use parse::ParseError;
+pub use program::{count_ops, Assignment, InputGroup, OpCount, Program};
 
 #[cfg(test)]
 mod tests;

@@ -56,3 +56,23 @@ fn parse_errors_carry_offsets() {
 fn expand_distributes() {
     assert_eq!(p("(a + b)*(a - b)").expand().to_string(), "a^2 - b^2");
 }
+
+#[test]
+fn trig_of_shifted_arguments_folds() {
+    assert_eq!(p("sin(q + pi/2)"), p("cos(q)"));
+    assert_eq!(p("cos(q + pi/2)"), p("-sin(q)"));
+    assert_eq!(p("sin(q - pi/2)"), p("-cos(q)"));
+    assert_eq!(p("cos(q + pi)"), p("-cos(q)"));
+    assert_eq!(p("sin(q + 3*pi/2)"), p("-cos(q)"));
+    assert_eq!(p("cos(q + 0.3)").to_string(), "cos(3/10 + q)");
+    for x in [-2.0f64, 0.4, 1.7] {
+        for (a, b) in [
+            ("sin(q + pi/2)", x.cos()),
+            ("cos(q - pi/2)", x.sin()),
+            ("cos(q + pi)", -x.cos()),
+        ] {
+            let v = p(a).eval(&|_| Some(x)).unwrap();
+            assert!((v - b).abs() < 1e-15, "{a} at {x}");
+        }
+    }
+}

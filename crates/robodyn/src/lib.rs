@@ -13,6 +13,7 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod algorithms;
+pub mod codegen;
 pub mod error;
 pub mod geometry;
 pub mod io;

@@ -21,6 +21,15 @@ pub trait DynScalar:
     fn cos(&self) -> Self;
     /// sign(x) in {-1, 0, 1} (Coulomb friction).
     fn sign(&self) -> Self;
+    /// True for a scalar that records named intermediate values (the symbolic program builder):
+    /// the recursions skip their naming hooks entirely when false.
+    const NAMED: bool = false;
+    /// Name an intermediate value as SYMORO does (`WI12`, `VP32`, `E13`...): the symbolic scalar
+    /// turns a non-trivial value into an assignment and returns its symbol; numbers are unchanged.
+    #[inline(always)]
+    fn named(self, _name: impl FnOnce() -> String) -> Self {
+        self
+    }
 }
 
 impl DynScalar for f64 {
@@ -49,14 +58,20 @@ impl DynScalar for f64 {
 }
 
 impl DynScalar for Expr {
+    const NAMED: bool = true;
     fn from_f64(x: f64) -> Self {
         Expr::num(x)
     }
+    /// While a program is recorded, sin of a joint variable becomes the intermediate `S<j>`.
     fn sin(&self) -> Self {
-        Expr::sin(self)
+        robodyn_symbolic::program::name_trig(Expr::sin(self))
     }
+    /// While a program is recorded, cos of a joint variable becomes the intermediate `C<j>`.
     fn cos(&self) -> Self {
-        Expr::cos(self)
+        robodyn_symbolic::program::name_trig(Expr::cos(self))
+    }
+    fn named(self, name: impl FnOnce() -> String) -> Self {
+        robodyn_symbolic::program::name_value(self, name)
     }
     fn sign(&self) -> Self {
         Expr::func(robodyn_symbolic::Func::Sign, self.clone())

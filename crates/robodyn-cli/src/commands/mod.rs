@@ -4,6 +4,7 @@ pub mod base_params;
 pub mod closure;
 pub mod convert;
 pub mod ddm;
+pub mod generate;
 pub mod idm;
 pub mod inertia;
 pub mod info;

@@ -18,6 +18,21 @@ fn cross_z<T: DynScalar>(w: &Vector3<T>, s: &T) -> Vector3<T> {
     )
 }
 
+/// Naming hook of the customized symbolic model: component c of vector `v` of link j becomes
+/// `<prefix><c><j>` (SYMORO's `WI12`, `VP32`...). A no-op for `f64` (`T::NAMED` is false).
+#[inline(always)]
+fn name3<T: DynScalar>(v: Vector3<T>, prefix: &str, j: usize) -> Vector3<T> {
+    if !T::NAMED {
+        return v;
+    }
+    let [[x, y, z]] = v.data.0;
+    Vector3::new(
+        x.named(|| format!("{prefix}1{j}")),
+        y.named(|| format!("{prefix}2{j}")),
+        z.named(|| format!("{prefix}3{j}")),
+    )
+}
+
 /// Forward recursion (eqs 10.3–10.8): fills `ws.rot`, `ws.pos`, `ws.w`, `ws.wd`, `ws.vd` and the
 /// link wrenches `ws.f` = jF_j + jfe_j, `ws.m` = jM_j + jme_j for links 1..NL.
 pub fn forward_recursion<T: DynScalar>(
@@ -38,8 +53,9 @@ pub fn forward_recursion<T: DynScalar>(
         let jai = rot.transpose();
         // iU_i iP_j = wd_i x P + w_i x (w_i x P)
         let up = ws.wd[i].cross(&pos) + ws.w[i].cross(&ws.w[i].cross(&pos));
-        let wi = &jai * &ws.w[i]; // (10.3)
-        let mut vd = &jai * (&ws.vd[i] + up); // (10.6), first part
+        let wi = name3(&jai * &ws.w[i], "WI", j); // (10.3)
+        let vsp = name3(&ws.vd[i] + up, "VSP", j);
+        let mut vd = &jai * vsp; // (10.6), first part
         let mut wd = &jai * &ws.wd[i];
         let mut w = wi.clone();
         match fr.joint {
@@ -56,14 +72,17 @@ pub fn forward_recursion<T: DynScalar>(
             }
             JointType::Fixed => {}
         }
+        let w = name3(w, "W", j);
+        let wd = name3(wd, "WP", j);
+        let vd = name3(vd, "VP", j);
         let l = model.link(j);
         // (10.7): F = M vd + U MS, U MS = wd x MS + w x (w x MS)
         let f = &vd * l.mass.clone() + wd.cross(&l.ms) + w.cross(&w.cross(&l.ms));
         // (10.8): M = J wd + w x (J w) + MS x vd
-        let jw = &l.inertia * &w;
+        let jw = name3(&l.inertia * &w, "JW", j);
         let m = &l.inertia * &wd + w.cross(&jw) + l.ms.cross(&vd);
-        ws.f[j] = f + &l.fe;
-        ws.m[j] = m + &l.me;
+        ws.f[j] = name3(f + &l.fe, "F", j);
+        ws.m[j] = name3(m + &l.me, "No", j);
         ws.rot[j] = rot;
         ws.pos[j] = pos;
         ws.w[j] = w;
@@ -85,6 +104,11 @@ pub fn backward_recursion<T: DynScalar>(
     for j in (1..=model.nl).rev() {
         let fr = model.frame(j);
         let l = model.link(j);
+        if T::NAMED {
+            // total wrench on link j, complete once its children are processed
+            ws.f[j] = name3(ws.f[j].clone(), "E", j);
+            ws.m[j] = name3(ws.m[j].clone(), "N", j);
+        }
         tau[j - 1] = match fr.joint {
             JointType::Revolute | JointType::Prismatic => {
                 let proj = if fr.joint == JointType::Revolute {
@@ -102,8 +126,8 @@ pub fn backward_recursion<T: DynScalar>(
         let i = fr.ant;
         if i > 0 {
             // (10.10), (10.11)
-            let fi = &ws.rot[j] * &ws.f[j];
-            let mi = &ws.rot[j] * &ws.m[j] + ws.pos[j].cross(&fi);
+            let fi = name3(&ws.rot[j] * &ws.f[j], "FDI", j);
+            let mi = name3(&ws.rot[j] * &ws.m[j] + ws.pos[j].cross(&fi), "NDI", j);
             ws.f[i] += fi;
             ws.m[i] += mi;
         }

@@ -1,0 +1,131 @@
+//! `robodyn generate ROBOT`: customized symbolic models (Table 10.3) as SYMORO-style text, LaTeX
+//! or code (Rust, C, Python, Julia), with operation counts in the header.
+
+use crate::common::CliResult;
+use robodyn::codegen::{generate, BaseParameters, GenOptions, ModelKind};
+use robodyn_symbolic::{emit, Lang};
+use std::path::PathBuf;
+
+#[derive(clap::ValueEnum, Clone, Copy, Debug)]
+pub enum Model {
+    /// Inverse dynamic model Gamma(q, qd, qdd) of the (equivalent) tree.
+    Idm,
+    /// Inertia matrix A(q).
+    Inertia,
+    /// Vector H(q, qd).
+    H,
+    /// Direct dynamic model of a tree.
+    Ddm,
+    /// Closed chain: Gamma_cl = G^T Gamma_tr (constant G only).
+    Closed,
+}
+
+#[derive(clap::ValueEnum, Clone, Copy, Debug)]
+pub enum Params {
+    Standard,
+    Base,
+}
+
+#[derive(clap::ValueEnum, Clone, Copy, Debug)]
+pub enum Language {
+    Text,
+    Latex,
+    Rust,
+    C,
+    Python,
+    Julia,
+}
+
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    /// Robot file (.toml, .par or .urdf); symbols need no values unless --numeric or closed.
+    pub robot: PathBuf,
+    /// Give or override a symbol value, e.g. `--set d3=0.6` (repeatable).
+    #[arg(long = "set", value_name = "NAME=VALUE")]
+    pub set: Vec<String>,
+    #[arg(long, value_enum, default_value = "idm")]
+    pub model: Model,
+    #[arg(long, value_enum, default_value = "standard")]
+    pub params: Params,
+    /// Grouping list for --params base: lines `XXR2 = XX2 - YY2 + ...` and `zero: XX1 XY1 ...`.
+    #[arg(long, value_name = "FILE")]
+    pub base_file: Option<PathBuf>,
+    /// Symmetric links: XY = XZ = YZ = MX = MY = 0 (Table 10.3, simplified case).
+    #[arg(long)]
+    pub symmetric: bool,
+    /// Drop Coulomb and viscous friction.
+    #[arg(long)]
+    pub no_friction: bool,
+    /// Drop rotor inertias.
+    #[arg(long)]
+    pub no_rotor: bool,
+    /// Substitute the robot's numeric values for all symbols.
+    #[arg(long)]
+    pub numeric: bool,
+    #[arg(long, value_enum, default_value = "text")]
+    pub lang: Language,
+    /// Function name in the generated code.
+    #[arg(long)]
+    pub name: Option<String>,
+    /// Output file (default: standard output).
+    #[arg(long)]
+    pub output: Option<PathBuf>,
+}
+
+pub fn run(a: Args) -> CliResult {
+    let mut desc = robodyn::io::load_description(&a.robot)?;
+    let rargs = crate::common::RobotArgs {
+        robot: a.robot.clone(),
+        set: a.set.clone(),
+    };
+    desc.symbols.extend(rargs.overrides()?);
+    let base = match a.params {
+        Params::Standard => None,
+        Params::Base => {
+            let path = a.base_file.as_ref().ok_or(
+                "--params base needs --base-file FILE: lines `XXR2 = XX2 - YY2 + ...` and \
+                 `zero: XX1 XY1 ...` (the grouping of the base parameters)",
+            )?;
+            let text =
+                std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+            Some(BaseParameters::parse(&text, &path.display().to_string())?)
+        }
+    };
+    let opt = GenOptions {
+        model: match a.model {
+            Model::Idm => ModelKind::Idm,
+            Model::Inertia => ModelKind::Inertia,
+            Model::H => ModelKind::H,
+            Model::Ddm => ModelKind::Ddm,
+            Model::Closed => ModelKind::Closed,
+        },
+        numeric: a.numeric,
+        symmetric: a.symmetric,
+        friction: !a.no_friction,
+        rotor: !a.no_rotor,
+        base,
+        g: None,
+        name: a.name.clone(),
+        optimize: true,
+    };
+    let prog = generate(&desc, &opt)?;
+    let lang = match a.lang {
+        Language::Text => Lang::Text,
+        Language::Latex => Lang::Latex,
+        Language::Rust => Lang::Rust,
+        Language::C => Lang::C,
+        Language::Python => Lang::Python,
+        Language::Julia => Lang::Julia,
+    };
+    let text = emit(&prog, lang);
+    match &a.output {
+        Some(p) => std::fs::write(p, text).map_err(|e| format!("{}: {e}", p.display()))?,
+        None => print!("{text}"),
+    }
+    let c = prog.count();
+    eprintln!(
+        "{}: {} multiplications, {} additions",
+        prog.name, c.mul, c.add
+    );
+    Ok(())
+}

@@ -1,0 +1,431 @@
+//! Emitters of a [`Program`]: SYMORO-style text, LaTeX, Rust, C99, Python/NumPy and Julia.
+//!
+//! Output is deterministic (assignment order, no hash-map iteration) and documents the inputs and
+//! the operation counts in a header comment.
+
+use crate::expr::{Expr, Func, Node};
+use crate::print::{product_parts, term_is_negative};
+use crate::program::Program;
+use num_traits::Signed;
+use std::fmt::Write;
+
+/// Target language.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Lang {
+    Text,
+    Latex,
+    Rust,
+    C,
+    Python,
+    Julia,
+}
+
+impl Lang {
+    pub fn from_name(s: &str) -> Option<Lang> {
+        Some(match s {
+            "text" | "txt" => Lang::Text,
+            "latex" | "tex" => Lang::Latex,
+            "rust" | "rs" => Lang::Rust,
+            "c" => Lang::C,
+            "python" | "py" => Lang::Python,
+            "julia" | "jl" => Lang::Julia,
+            _ => return None,
+        })
+    }
+
+    fn comment(self) -> &'static str {
+        match self {
+            Lang::Text | Lang::Python | Lang::Julia => "# ",
+            Lang::Latex => "% ",
+            Lang::Rust | Lang::C => "// ",
+        }
+    }
+}
+
+/// Print a program in a language.
+pub fn emit(p: &Program, lang: Lang) -> String {
+    match lang {
+        Lang::Text => emit_text(p),
+        Lang::Latex => emit_latex(p),
+        _ => emit_code(p, lang),
+    }
+}
+
+fn header(p: &Program, lang: Lang) -> String {
+    let c = lang.comment();
+    let mut s = String::new();
+    for line in &p.description {
+        let _ = writeln!(s, "{c}{line}");
+    }
+    let k = p.count();
+    let _ = writeln!(
+        s,
+        "{c}Operations: {} multiplications, {} additions ({} function calls: sin, cos, sign)",
+        k.mul, k.add, k.func
+    );
+    let base = usize::from(lang == Lang::Julia);
+    let _ = writeln!(s, "{c}Inputs:");
+    for g in &p.inputs {
+        let names: Vec<String> = g
+            .symbols
+            .iter()
+            .enumerate()
+            .map(|(i, s)| match s {
+                Some(s) => format!("{}[{}]={s}", g.name, i + base),
+                None => format!("{}[{}]=unused", g.name, i + base),
+            })
+            .collect();
+        let _ = writeln!(s, "{c}  {} ({}): {}", g.name, g.doc, names.join(" "));
+    }
+    let outs: Vec<String> = p
+        .outputs
+        .iter()
+        .enumerate()
+        .map(|(i, o)| format!("out[{}]={}", i + base, o.name))
+        .collect();
+    let _ = writeln!(s, "{c}Outputs: {}", outs.join(" "));
+    s
+}
+
+fn emit_text(p: &Program) -> String {
+    let mut s = header(p, Lang::Text);
+    s.push('\n');
+    for a in p.assignments.iter().chain(&p.outputs) {
+        let _ = writeln!(s, "{} = {}", a.name, a.expr);
+    }
+    s
+}
+
+/// `WI12` -> `WI_{12}`, `XXR2` -> `XXR_{2}`, `T3` -> `T_{3}`.
+fn latex_name(n: &str) -> String {
+    let i = n.trim_end_matches(|c: char| c.is_ascii_digit()).len();
+    let (base, digits) = n.split_at(i);
+    let base = base.replace('_', "\\_");
+    let base = if base.len() > 1 {
+        format!("\\mathit{{{base}}}")
+    } else {
+        base
+    };
+    if digits.is_empty() {
+        base
+    } else {
+        format!("{base}_{{{digits}}}")
+    }
+}
+
+fn latex(e: &Expr, prec: u8) -> String {
+    match e.node() {
+        Node::Rational(r) => {
+            let body = if r.is_integer() {
+                r.numer().abs().to_string()
+            } else {
+                format!("\\frac{{{}}}{{{}}}", r.numer().abs(), r.denom())
+            };
+            if r.is_negative() {
+                if prec > 0 {
+                    format!("\\left(-{body}\\right)")
+                } else {
+                    format!("-{body}")
+                }
+            } else {
+                body
+            }
+        }
+        Node::Float(x) => {
+            if *x < 0.0 && prec > 0 {
+                format!("\\left({x:?}\\right)")
+            } else {
+                format!("{x:?}")
+            }
+        }
+        Node::Pi => "\\pi".into(),
+        Node::Symbol(s) => latex_name(s),
+        Node::Add(v) => {
+            let mut s = String::new();
+            for (i, t) in v.iter().enumerate() {
+                if i == 0 {
+                    s += &latex(t, 0);
+                } else if term_is_negative(t) {
+                    s += " - ";
+                    s += &latex(&-t.clone(), 0);
+                } else {
+                    s += " + ";
+                    s += &latex(t, 0);
+                }
+            }
+            if prec > 0 {
+                format!("\\left({s}\\right)")
+            } else {
+                s
+            }
+        }
+        Node::Pow(b, n) if *n > 0 => format!("{}^{{{n}}}", latex(b, 3)),
+        Node::Mul(_) | Node::Pow(..) => {
+            let (coef, num, den) = product_parts(e);
+            let mut neg = false;
+            let mut parts: Vec<String> = Vec::new();
+            let mut dens: Vec<String> = Vec::new();
+            if let Some(c) = coef {
+                let x = c.as_f64().unwrap_or(0.0);
+                neg = x < 0.0;
+                let a = if neg { -c } else { c };
+                if let Some(r) = a.as_rational() {
+                    if *r.numer() != 1 {
+                        parts.push(r.numer().to_string());
+                    }
+                    if *r.denom() != 1 {
+                        dens.push(r.denom().to_string());
+                    }
+                } else if !a.is_one() {
+                    parts.push(latex(&a, 2));
+                }
+            }
+            parts.extend(num.iter().map(|f| latex(f, 2)));
+            dens.extend(den.iter().map(|f| latex(f, 2)));
+            let n = if parts.is_empty() {
+                "1".to_string()
+            } else {
+                parts.join("\\,")
+            };
+            let body = if dens.is_empty() {
+                n
+            } else {
+                format!("\\frac{{{n}}}{{{}}}", dens.join("\\,"))
+            };
+            if neg {
+                if prec > 0 {
+                    format!("\\left(-{body}\\right)")
+                } else {
+                    format!("-{body}")
+                }
+            } else {
+                body
+            }
+        }
+        Node::Func(f, a) => {
+            let name = match f {
+                Func::Sin => "\\sin",
+                Func::Cos => "\\cos",
+                Func::Tan => "\\tan",
+                Func::Sqrt => return format!("\\sqrt{{{}}}", latex(a, 0)),
+                Func::Abs => return format!("\\left|{}\\right|", latex(a, 0)),
+                Func::Sign => "\\operatorname{sign}",
+            };
+            format!("{name}\\left({}\\right)", latex(a, 0))
+        }
+    }
+}
+
+fn emit_latex(p: &Program) -> String {
+    let mut s = header(p, Lang::Latex);
+    s.push_str("\\begin{align*}\n");
+    let all: Vec<_> = p.assignments.iter().chain(&p.outputs).collect();
+    for (i, a) in all.iter().enumerate() {
+        let end = if i + 1 < all.len() { " \\\\" } else { "" };
+        let _ = writeln!(s, "{} &= {}{end}", latex_name(&a.name), latex(&a.expr, 0));
+    }
+    s.push_str("\\end{align*}\n");
+    s
+}
+
+/// Infix code for C-like languages: powers written as products, rationals as float literals.
+fn code(e: &Expr, lang: Lang, prec: u8) -> String {
+    let lit = |x: f64| -> String {
+        let s = format!("{x:?}");
+        let s = if s.contains('.') || s.contains('e') || s.contains("inf") || s.contains("NaN") {
+            s
+        } else {
+            format!("{s}.0")
+        };
+        if x < 0.0 && prec > 0 {
+            format!("({s})")
+        } else {
+            s
+        }
+    };
+    match e.node() {
+        Node::Rational(r) => {
+            if r.is_integer() {
+                lit(*r.numer() as f64)
+            } else {
+                let s = format!("{}/{}", lit(r.numer().abs() as f64), lit(*r.denom() as f64));
+                if r.is_negative() {
+                    format!("(-{s})")
+                } else {
+                    format!("({s})")
+                }
+            }
+        }
+        Node::Float(x) => lit(*x),
+        Node::Pi => match lang {
+            Lang::Rust => "std::f64::consts::PI".into(),
+            Lang::C => "3.141592653589793".into(),
+            Lang::Python => "np.pi".into(),
+            _ => "pi".into(),
+        },
+        Node::Symbol(s) => s.clone(),
+        Node::Add(v) => {
+            let mut s = String::new();
+            for (i, t) in v.iter().enumerate() {
+                if i == 0 {
+                    s += &code(t, lang, 0);
+                } else if term_is_negative(t) {
+                    s += " - ";
+                    s += &code(&-t.clone(), lang, 1);
+                } else {
+                    s += " + ";
+                    s += &code(t, lang, 0);
+                }
+            }
+            if prec > 0 {
+                format!("({s})")
+            } else {
+                s
+            }
+        }
+        Node::Mul(_) | Node::Pow(..) => {
+            let (coef, num, den) = product_parts(e);
+            let mut neg = false;
+            let mut parts: Vec<String> = Vec::new();
+            if let Some(c) = coef {
+                neg = c.as_f64().unwrap_or(0.0) < 0.0;
+                let a = if neg { -c } else { c };
+                if !a.is_one() {
+                    parts.push(code(&a, lang, 2));
+                }
+            }
+            for f in &num {
+                push_power(f, lang, &mut parts);
+            }
+            let mut body = if parts.is_empty() {
+                "1.0".to_string()
+            } else {
+                parts.join("*")
+            };
+            for d in &den {
+                let mut dp = Vec::new();
+                push_power(d, lang, &mut dp);
+                for x in dp {
+                    body = format!("{body}/{x}");
+                }
+            }
+            if neg {
+                body = format!("-{body}");
+            }
+            if prec > 0 && (neg || prec > 1) {
+                format!("({body})")
+            } else {
+                body
+            }
+        }
+        Node::Func(f, a) => {
+            let arg = code(a, lang, 0);
+            match (lang, f) {
+                (Lang::Rust, Func::Sign) => format!("sgn({arg})"),
+                (Lang::Rust, _) => format!("({arg}).{}()", f.name()),
+                (Lang::C, Func::Sign) => format!("rd_sign({arg})"),
+                (Lang::C, Func::Abs) => format!("fabs({arg})"),
+                (Lang::C, _) => format!("{}({arg})", f.name()),
+                (Lang::Python, _) => format!("np.{}({arg})", f.name()),
+                (_, _) => format!("{}({arg})", f.name()),
+            }
+        }
+    }
+}
+
+/// x^n written as n factors so that the code performs the counted multiplications.
+fn push_power(f: &Expr, lang: Lang, parts: &mut Vec<String>) {
+    match f.node() {
+        Node::Pow(b, n) if *n > 0 => {
+            let s = code(b, lang, 2);
+            for _ in 0..*n {
+                parts.push(s.clone());
+            }
+        }
+        _ => parts.push(code(f, lang, 2)),
+    }
+}
+
+fn emit_code(p: &Program, lang: Lang) -> String {
+    let mut s = header(p, lang);
+    let name = &p.name;
+    let groups: Vec<&str> = p.inputs.iter().map(|g| g.name.as_str()).collect();
+    let base = if lang == Lang::Julia { 1 } else { 0 };
+    let ind = "    ";
+    match lang {
+        Lang::Rust => {
+            let args: Vec<String> = groups.iter().map(|g| format!("{g}: &[f64]")).collect();
+            let _ = writeln!(
+                s,
+                "#[allow(non_snake_case, unused_variables, unused_parens, clippy::all)]\n\
+                 pub fn {name}({}, out: &mut [f64]) {{",
+                args.join(", ")
+            );
+            let _ = writeln!(
+                s,
+                "{ind}#[allow(dead_code)]\n{ind}fn sgn(x: f64) -> f64 {{\n{ind}{ind}if x > 0.0 {{ 1.0 }} else if x < 0.0 {{ -1.0 }} else {{ 0.0 }}\n{ind}}}"
+            );
+        }
+        Lang::C => {
+            s.push_str("#include <math.h>\n\n");
+            s.push_str(
+                "static inline double rd_sign(double x) { return (x > 0.0) - (x < 0.0); }\n\n",
+            );
+            let args: Vec<String> = groups
+                .iter()
+                .map(|g| format!("const double *{g}"))
+                .collect();
+            let _ = writeln!(s, "void {name}({}, double *out) {{", args.join(", "));
+        }
+        Lang::Python => {
+            s.push_str("import numpy as np\n\n\n");
+            let _ = writeln!(s, "def {name}({}, out=None):", groups.join(", "));
+            let _ = writeln!(s, "{ind}if out is None:");
+            let _ = writeln!(s, "{ind}{ind}out = np.zeros({})", p.outputs.len());
+        }
+        Lang::Julia => {
+            let _ = writeln!(s, "function {name}!(out, {})", groups.join(", "));
+        }
+        _ => unreachable!(),
+    }
+    let decl = match lang {
+        Lang::Rust => "let ",
+        Lang::C => "const double ",
+        _ => "",
+    };
+    let end = match lang {
+        Lang::Rust | Lang::C => ";",
+        _ => "",
+    };
+    for g in &p.inputs {
+        for (i, sym) in g.symbols.iter().enumerate() {
+            if let Some(sym) = sym {
+                let _ = writeln!(s, "{ind}{decl}{sym} = {}[{}]{end}", g.name, i + base);
+            }
+        }
+    }
+    for a in &p.assignments {
+        let _ = writeln!(s, "{ind}{decl}{} = {}{end}", a.name, code(&a.expr, lang, 0));
+    }
+    for (i, o) in p.outputs.iter().enumerate() {
+        let _ = writeln!(
+            s,
+            "{ind}out[{}] = {}{end}  {}{}",
+            i + base,
+            code(&o.expr, lang, 0),
+            lang.comment(),
+            o.name
+        );
+    }
+    match lang {
+        Lang::Rust | Lang::C => s.push_str("}\n"),
+        Lang::Python => {
+            let _ = writeln!(s, "{ind}return out");
+        }
+        Lang::Julia => {
+            let _ = writeln!(s, "{ind}return out\nend");
+        }
+        _ => {}
+    }
+    s
+}

@@ -1,0 +1,786 @@
+//! Straight-line programs: named assignments `NAME = expr` and outputs, as SYMORO writes a
+//! customized model.
+//!
+//! A [`Program`] is recorded by running a numeric recursion on [`Expr`] while a thread-local
+//! recorder is active ([`record`]): every value the recursion names through [`name_value`]
+//! becomes an assignment unless it is trivial (a number, a symbol or a negated symbol), identical
+//! values share one name. [`Program::optimize`] then removes dead assignments, shares common
+//! subexpressions and inlines single-use intermediates when that lowers the operation count;
+//! [`Program::count`] counts operations as documented in `docs/models/generated-code.md`.
+
+use crate::expr::{Expr, Func, Node};
+use num_traits::{One, Signed};
+use std::cell::RefCell;
+use std::collections::{HashMap, HashSet};
+
+/// One assignment `name = expr`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Assignment {
+    pub name: String,
+    pub expr: Expr,
+}
+
+/// A group of input symbols passed to generated code as one array (`q`, `qd`, `p`...).
+#[derive(Clone, Debug, PartialEq)]
+pub struct InputGroup {
+    /// Array name in generated code.
+    pub name: String,
+    /// What the array holds (for the header comment).
+    pub doc: String,
+    /// Symbol at each index; `None` for an entry the program does not read.
+    pub symbols: Vec<Option<String>>,
+}
+
+/// A straight-line program: inputs, assignments in evaluation order, named outputs.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Program {
+    /// Function name for generated code.
+    pub name: String,
+    /// Header lines (what the model is, its options).
+    pub description: Vec<String>,
+    pub inputs: Vec<InputGroup>,
+    pub assignments: Vec<Assignment>,
+    /// Outputs, written to the output array in this order.
+    pub outputs: Vec<Assignment>,
+}
+
+/// Operation counts: multiplications (divisions included), additions (subtractions included),
+/// elementary function calls (sin, cos, sign, sqrt; not counted as multiplications).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct OpCount {
+    pub mul: usize,
+    pub add: usize,
+    pub func: usize,
+}
+
+impl std::ops::Add for OpCount {
+    type Output = OpCount;
+    fn add(self, o: OpCount) -> OpCount {
+        OpCount {
+            mul: self.mul + o.mul,
+            add: self.add + o.add,
+            func: self.func + o.func,
+        }
+    }
+}
+
+impl std::fmt::Display for OpCount {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} multiplications, {} additions, {} functions",
+            self.mul, self.add, self.func
+        )
+    }
+}
+
+/// Operations of one expression, counted as it is printed:
+/// - a sum of n terms: n - 1 additions (a term with coefficient -1 is a subtraction);
+/// - a product of k non-numeric factors: k - 1 multiplications (x^-n a division), plus one for a
+///   numeric coefficient other than +-1 (a factor -1 is a sign change, free);
+/// - x^n: n - 1 multiplications; x^-n alone: n - 1 multiplications and one division;
+/// - sin, cos, sign, sqrt...: one function call each.
+pub fn count_ops(e: &Expr) -> OpCount {
+    let mut c = OpCount::default();
+    count_into(e, &mut c);
+    c
+}
+
+fn count_into(e: &Expr, c: &mut OpCount) {
+    match e.node() {
+        Node::Rational(_) | Node::Float(_) | Node::Pi | Node::Symbol(_) => {}
+        Node::Add(v) => {
+            c.add += v.len() - 1;
+            v.iter().for_each(|t| count_into(t, c));
+        }
+        Node::Mul(v) => {
+            let mut k: usize = 0;
+            let mut positive = 0;
+            for f in v {
+                match f.node() {
+                    Node::Rational(r) => {
+                        if !r.abs().is_one() {
+                            c.mul += 1;
+                        }
+                    }
+                    Node::Float(x) => {
+                        if x.abs() != 1.0 {
+                            c.mul += 1;
+                        }
+                    }
+                    Node::Pow(b, n) if *n < 0 => {
+                        k += 1;
+                        c.mul += (n.unsigned_abs() - 1) as usize;
+                        count_into(b, c);
+                    }
+                    _ => {
+                        k += 1;
+                        positive += 1;
+                        count_into(f, c);
+                    }
+                }
+            }
+            let has_coef = v[0].is_number() && {
+                let x = v[0].as_f64().unwrap_or(0.0).abs();
+                x != 1.0
+            };
+            c.mul += k.saturating_sub(1);
+            if positive == 0 && !has_coef && k > 0 {
+                // 1/(x*y): one more division
+                c.mul += 1;
+            }
+        }
+        Node::Pow(b, n) => {
+            c.mul += (n.unsigned_abs() - 1) as usize + usize::from(*n < 0);
+            count_into(b, c);
+        }
+        Node::Func(_, a) => {
+            c.func += 1;
+            count_into(a, c);
+        }
+    }
+}
+
+/// True for values that stay inline rather than become an assignment: numbers, constants,
+/// symbols and negated symbols.
+pub fn is_trivial(e: &Expr) -> bool {
+    match e.node() {
+        Node::Rational(_) | Node::Float(_) | Node::Pi | Node::Symbol(_) => true,
+        Node::Mul(v) => {
+            v.len() == 2 && v[0].as_f64() == Some(-1.0) && matches!(v[1].node(), Node::Symbol(_))
+        }
+        _ => e.is_constant() && count_ops(e) == OpCount::default(),
+    }
+}
+
+struct Recorder {
+    assignments: Vec<Assignment>,
+    by_value: HashMap<Expr, Expr>,
+    names: HashSet<String>,
+    suffix: String,
+}
+
+impl Recorder {
+    fn unique(&mut self, base: String) -> String {
+        let base = format!("{base}{}", self.suffix);
+        if self.names.insert(base.clone()) {
+            return base;
+        }
+        for k in 2.. {
+            let n = format!("{base}_{k}");
+            if self.names.insert(n.clone()) {
+                return n;
+            }
+        }
+        unreachable!()
+    }
+
+    fn assign(&mut self, e: Expr, name: String) -> Expr {
+        if let Some(s) = self.by_value.get(&e) {
+            return s.clone();
+        }
+        let neg = match e.node() {
+            Node::Add(v) => Expr::sum(v.iter().map(|t| -t.clone())),
+            _ => -e.clone(),
+        };
+        if let Some(s) = self.by_value.get(&neg) {
+            return -s.clone();
+        }
+        let name = self.unique(name);
+        let sym = Expr::symbol(name.clone());
+        self.assignments.push(Assignment {
+            name,
+            expr: e.clone(),
+        });
+        self.by_value.insert(e, sym.clone());
+        sym
+    }
+}
+
+thread_local! {
+    static RECORDER: RefCell<Option<Recorder>> = const { RefCell::new(None) };
+}
+
+/// Run `f` with a fresh recorder on this thread and return its result with the recorded
+/// assignments. `reserved` names (the input symbols) are never used for intermediates.
+/// A recording already active on this thread is suspended and restored afterwards.
+pub fn record<R>(reserved: &[String], f: impl FnOnce() -> R) -> (R, Vec<Assignment>) {
+    let fresh = Recorder {
+        assignments: Vec::new(),
+        by_value: HashMap::new(),
+        names: reserved.iter().cloned().collect(),
+        suffix: String::new(),
+    };
+    let previous = RECORDER.with(|r| r.borrow_mut().replace(fresh));
+    let out = f();
+    let rec = RECORDER.with(|r| std::mem::replace(&mut *r.borrow_mut(), previous));
+    (out, rec.map(|r| r.assignments).unwrap_or_default())
+}
+
+/// Whether a recording is active on this thread.
+pub fn is_recording() -> bool {
+    RECORDER.with(|r| r.borrow().is_some())
+}
+
+/// Suffix appended to the names given from now on in the active recording (e.g. `_c2` for the
+/// second column of the inertia matrix); empty to stop.
+pub fn set_name_suffix(suffix: &str) {
+    RECORDER.with(|r| {
+        if let Some(rec) = r.borrow_mut().as_mut() {
+            rec.suffix = suffix.to_string();
+        }
+    })
+}
+
+/// Name a value in the active recording: a non-trivial value becomes `NAME = e` and its symbol
+/// is returned (identical or opposite values already named are shared); without a recording,
+/// or for a trivial value, `e` is returned unchanged.
+pub fn name_value(e: Expr, name: impl FnOnce() -> String) -> Expr {
+    if is_trivial(&e) {
+        return e;
+    }
+    RECORDER.with(|r| match r.borrow_mut().as_mut() {
+        Some(rec) => rec.assign(e, name()),
+        None => e,
+    })
+}
+
+/// Name the result of sin/cos (or its negation) of a non-constant argument: `sin(q2)` becomes
+/// `S2`, `cos(q2)` `C2`; other arguments get `S`/`C` with a counter.
+pub fn name_trig(e: Expr) -> Expr {
+    if !is_recording() {
+        return e;
+    }
+    let (negated, inner) = match e.node() {
+        Node::Mul(v) if v.len() == 2 && v[0].as_f64() == Some(-1.0) => (true, v[1].clone()),
+        _ => (false, e.clone()),
+    };
+    let Node::Func(f @ (Func::Sin | Func::Cos), arg) = inner.node() else {
+        return e;
+    };
+    if arg.is_constant() {
+        return e;
+    }
+    let letter = if *f == Func::Sin { "S" } else { "C" };
+    let suffix = match arg.as_symbol() {
+        Some(s) if s.starts_with('q') && s[1..].chars().all(|c| c.is_ascii_digit()) => {
+            s[1..].to_string()
+        }
+        _ => "T".to_string(),
+    };
+    let named = RECORDER.with(|r| {
+        let mut r = r.borrow_mut();
+        let rec = r.as_mut().expect("recording");
+        let saved = std::mem::take(&mut rec.suffix);
+        let s = rec.assign(inner.clone(), format!("{letter}{suffix}"));
+        rec.suffix = saved;
+        s
+    });
+    if negated {
+        -named
+    } else {
+        named
+    }
+}
+
+/// Replace every occurrence of `target` (as a whole node, as a sub-product of a product's
+/// factors or as a sub-sum of a sum's terms) by `by`.
+fn replace(e: &Expr, target: &Expr, by: &Expr) -> Expr {
+    if e == target {
+        return by.clone();
+    }
+    match e.node() {
+        Node::Add(v) => {
+            let mut terms: Vec<Expr> = v.iter().map(|t| replace(t, target, by)).collect();
+            if let Node::Add(tt) = target.node() {
+                if contains_all(&terms, tt) {
+                    remove_all(&mut terms, tt);
+                    terms.push(by.clone());
+                }
+            }
+            Expr::sum(terms)
+        }
+        Node::Mul(v) => {
+            let mut fs: Vec<Expr> = v.iter().map(|t| replace(t, target, by)).collect();
+            if let Node::Mul(tt) = target.node() {
+                if !tt[0].is_number() && contains_all(&fs, tt) {
+                    remove_all(&mut fs, tt);
+                    fs.push(by.clone());
+                }
+            }
+            Expr::product(fs)
+        }
+        Node::Pow(b, n) => replace(b, target, by).powi(*n),
+        Node::Func(f, a) => Expr::func(*f, replace(a, target, by)),
+        _ => e.clone(),
+    }
+}
+
+fn contains_all(hay: &[Expr], needles: &[Expr]) -> bool {
+    let mut used = vec![false; hay.len()];
+    needles.iter().all(
+        |n| match hay.iter().enumerate().position(|(i, h)| !used[i] && h == n) {
+            Some(i) => {
+                used[i] = true;
+                true
+            }
+            None => false,
+        },
+    )
+}
+
+fn remove_all(hay: &mut Vec<Expr>, needles: &[Expr]) {
+    for n in needles {
+        if let Some(i) = hay.iter().position(|h| h == n) {
+            hay.remove(i);
+        }
+    }
+}
+
+/// Does symbol `name` occur in `e`?
+fn uses(e: &Expr, name: &str) -> usize {
+    match e.node() {
+        Node::Symbol(s) => usize::from(s == name),
+        Node::Add(v) | Node::Mul(v) => v.iter().map(|t| uses(t, name)).sum(),
+        Node::Pow(b, _) => uses(b, name),
+        Node::Func(_, a) => uses(a, name),
+        _ => 0,
+    }
+}
+
+fn symbol_uses(e: &Expr, out: &mut HashMap<String, usize>) {
+    match e.node() {
+        Node::Symbol(s) => *out.entry(s.clone()).or_default() += 1,
+        Node::Add(v) | Node::Mul(v) => v.iter().for_each(|t| symbol_uses(t, out)),
+        Node::Pow(b, _) => symbol_uses(b, out),
+        Node::Func(_, a) => symbol_uses(a, out),
+        _ => {}
+    }
+}
+
+/// Candidate common subexpressions: whole sub-nodes and pairs of factors / terms.
+fn collect_candidates(e: &Expr, root: bool, out: &mut HashMap<Expr, usize>) {
+    match e.node() {
+        Node::Add(v) | Node::Mul(v) => {
+            if !root {
+                *out.entry(e.clone()).or_default() += 1;
+            }
+            let is_mul = matches!(e.node(), Node::Mul(_));
+            let items: Vec<&Expr> = v.iter().filter(|t| !(is_mul && t.is_number())).collect();
+            if items.len() > 2 {
+                for a in 0..items.len() {
+                    for b in a + 1..items.len() {
+                        let pair = if is_mul {
+                            Expr::product([items[a].clone(), items[b].clone()])
+                        } else {
+                            Expr::sum([items[a].clone(), items[b].clone()])
+                        };
+                        *out.entry(pair).or_default() += 1;
+                    }
+                }
+            }
+            v.iter().for_each(|t| collect_candidates(t, false, out));
+        }
+        Node::Pow(b, n) => {
+            if !root && *n > 1 {
+                *out.entry(e.clone()).or_default() += 1;
+            }
+            collect_candidates(b, false, out)
+        }
+        Node::Func(_, a) => {
+            if !root {
+                *out.entry(e.clone()).or_default() += 1;
+            }
+            collect_candidates(a, false, out)
+        }
+        _ => {}
+    }
+}
+
+/// Recursive greedy factoring of symbols common to terms of sums (see [`Program::factor_sums`]).
+fn factor(e: &Expr) -> Expr {
+    match e.node() {
+        Node::Add(v) => {
+            let terms: Vec<Expr> = v.iter().map(factor).collect();
+            // symbol factors of each term
+            let mut freq: HashMap<Expr, usize> = HashMap::new();
+            for t in &terms {
+                if let Node::Mul(fs) = t.node() {
+                    let mut seen: Vec<&Expr> = Vec::new();
+                    for f in fs {
+                        if matches!(f.node(), Node::Symbol(_)) && !seen.contains(&f) {
+                            seen.push(f);
+                            *freq.entry(f.clone()).or_default() += 1;
+                        }
+                    }
+                }
+            }
+            let best = freq
+                .into_iter()
+                .filter(|(_, n)| *n >= 2)
+                .max_by(|a, b| a.1.cmp(&b.1).then_with(|| crate::cmp_expr(&b.0, &a.0)));
+            let Some((f, _)) = best else {
+                return Expr::sum(terms);
+            };
+            let mut inner = Vec::new();
+            let mut rest = Vec::new();
+            for t in terms {
+                let has = matches!(t.node(), Node::Mul(fs) if fs.contains(&f));
+                if has {
+                    inner.push(t / f.clone());
+                } else {
+                    rest.push(t);
+                }
+            }
+            let factored = Expr::product([f, factor(&Expr::sum(inner))]);
+            rest.push(factored);
+            Expr::sum(rest)
+        }
+        Node::Mul(v) => Expr::product(v.iter().map(factor)),
+        Node::Pow(b, n) => factor(b).powi(*n),
+        Node::Func(f, a) => Expr::func(*f, factor(a)),
+        _ => e.clone(),
+    }
+}
+
+impl Program {
+    /// Total operations of the assignments and outputs.
+    pub fn count(&self) -> OpCount {
+        self.assignments
+            .iter()
+            .chain(&self.outputs)
+            .map(|a| count_ops(&a.expr))
+            .fold(OpCount::default(), |a, b| a + b)
+    }
+
+    /// Names of all input symbols.
+    pub fn input_symbols(&self) -> Vec<String> {
+        self.inputs
+            .iter()
+            .flat_map(|g| g.symbols.iter().flatten().cloned())
+            .collect()
+    }
+
+    /// Evaluate with input values from `env`; returns the outputs in order.
+    pub fn evaluate(
+        &self,
+        env: &dyn Fn(&str) -> Option<f64>,
+    ) -> Result<Vec<f64>, crate::EvalError> {
+        let mut vals: HashMap<String, f64> = HashMap::new();
+        for a in &self.assignments {
+            let v = a.expr.eval(&|s| vals.get(s).copied().or_else(|| env(s)))?;
+            vals.insert(a.name.clone(), v);
+        }
+        self.outputs
+            .iter()
+            .map(|o| o.expr.eval(&|s| vals.get(s).copied().or_else(|| env(s))))
+            .collect()
+    }
+
+    /// Remove assignments no output depends on.
+    pub fn remove_dead(&mut self) {
+        let mut live: HashSet<String> = HashSet::new();
+        let add = |e: &Expr, live: &mut HashSet<String>| {
+            for s in e.symbols() {
+                live.insert(s);
+            }
+        };
+        for o in &self.outputs {
+            add(&o.expr, &mut live);
+        }
+        let mut keep = vec![false; self.assignments.len()];
+        for (i, a) in self.assignments.iter().enumerate().rev() {
+            if live.contains(&a.name) {
+                keep[i] = true;
+                add(&a.expr, &mut live);
+            }
+        }
+        let mut k = keep.into_iter();
+        self.assignments.retain(|_| k.next().unwrap());
+    }
+
+    /// Replace assignments whose value is trivial (a symbol, a number, a negated symbol) by
+    /// their value where they are used.
+    pub fn remove_aliases(&mut self) {
+        let mut map: HashMap<String, Expr> = HashMap::new();
+        let mut out = Vec::with_capacity(self.assignments.len());
+        for a in self.assignments.drain(..) {
+            let e = if map.is_empty() {
+                a.expr
+            } else {
+                a.expr.substitute(&|s| map.get(s).cloned())
+            };
+            if is_trivial(&e) {
+                map.insert(a.name, e);
+            } else {
+                out.push(Assignment {
+                    name: a.name,
+                    expr: e,
+                });
+            }
+        }
+        self.assignments = out;
+        if !map.is_empty() {
+            for o in &mut self.outputs {
+                o.expr = o.expr.substitute(&|s| map.get(s).cloned());
+            }
+        }
+    }
+
+    /// Inline assignments used exactly once when that lowers the operation count (constants
+    /// fold, like terms merge).
+    pub fn inline_single_use(&mut self) {
+        let mut uses_count: HashMap<String, usize> = HashMap::new();
+        for a in self.assignments.iter().chain(&self.outputs) {
+            symbol_uses(&a.expr, &mut uses_count);
+        }
+        let mut i = 0;
+        while i < self.assignments.len() {
+            let name = self.assignments[i].name.clone();
+            if uses_count.get(&name) != Some(&1) {
+                i += 1;
+                continue;
+            }
+            let def = self.assignments[i].expr.clone();
+            let user = self
+                .assignments
+                .iter()
+                .position(|a| uses(&a.expr, &name) > 0)
+                .map(|k| (false, k))
+                .or_else(|| {
+                    self.outputs
+                        .iter()
+                        .position(|a| uses(&a.expr, &name) > 0)
+                        .map(|k| (true, k))
+                });
+            let Some((is_out, k)) = user else {
+                i += 1;
+                continue;
+            };
+            let slot = if is_out {
+                &mut self.outputs[k]
+            } else {
+                &mut self.assignments[k]
+            };
+            let before = count_ops(&slot.expr) + count_ops(&def);
+            let after_expr = slot.expr.substitute(&|s| (s == name).then(|| def.clone()));
+            let after = count_ops(&after_expr);
+            if after.mul + after.add < before.mul + before.add {
+                uses_count.clear();
+                slot.expr = after_expr;
+                self.assignments.remove(i);
+                for a in self.assignments.iter().chain(&self.outputs) {
+                    symbol_uses(&a.expr, &mut uses_count);
+                }
+            } else {
+                i += 1;
+            }
+        }
+    }
+
+    /// Share common subexpressions (whole sub-nodes, pairs of factors of products and pairs of
+    /// terms of sums) greedily, the largest saving first, as new assignments `T1, T2, ...`.
+    pub fn share_common_subexpressions(&mut self) {
+        let reserved: HashSet<String> = self
+            .assignments
+            .iter()
+            .chain(&self.outputs)
+            .map(|a| a.name.clone())
+            .chain(self.input_symbols())
+            .collect();
+        let mut counter = 0;
+        // targets already extracted: never extracted twice (guards against a candidate whose
+        // occurrences do not all match as counted)
+        let mut done: HashSet<Expr> = HashSet::new();
+        loop {
+            let mut cands: HashMap<Expr, usize> = HashMap::new();
+            for a in self.assignments.iter().chain(&self.outputs) {
+                collect_candidates(&a.expr, true, &mut cands);
+                // roots also count as occurrences
+                if !is_trivial(&a.expr) {
+                    *cands.entry(a.expr.clone()).or_default() += 1;
+                }
+            }
+            let best = cands
+                .into_iter()
+                .filter(|(e, n)| *n >= 2 && !done.contains(e))
+                .map(|(e, n)| {
+                    let c = count_ops(&e);
+                    let saving = (n - 1) * (c.mul + c.add + c.func);
+                    (saving, e)
+                })
+                .filter(|(s, _)| *s > 0)
+                .max_by(|a, b| {
+                    // deterministic choice among equal savings (never the hash order)
+                    a.0.cmp(&b.0)
+                        .then_with(|| crate::cmp_expr(&b.1, &a.1))
+                        .then_with(|| b.1.to_string().cmp(&a.1.to_string()))
+                });
+            let Some((_, target)) = best else { break };
+            done.insert(target.clone());
+            let name = loop {
+                counter += 1;
+                let n = format!("T{counter}");
+                if !reserved.contains(&n) {
+                    break n;
+                }
+            };
+            let sym = Expr::symbol(name.clone());
+            let mut first_use = None;
+            let mut changed = false;
+            for (k, a) in self.assignments.iter_mut().enumerate() {
+                let r = replace(&a.expr, &target, &sym);
+                if r != a.expr {
+                    changed = true;
+                    if first_use.is_none() {
+                        first_use = Some(k);
+                    }
+                    a.expr = r;
+                }
+            }
+            for o in &mut self.outputs {
+                let r = replace(&o.expr, &target, &sym);
+                if r != o.expr {
+                    changed = true;
+                    o.expr = r;
+                }
+            }
+            if !changed {
+                // the candidate did not match as counted (canonical re-ordering); stop here
+                break;
+            }
+            let at = first_use.unwrap_or(self.assignments.len());
+            self.assignments
+                .insert(at, Assignment { name, expr: target });
+            // an assignment whose value became exactly T: alias
+            self.remove_aliases();
+        }
+    }
+
+    /// Factor a symbol common to several terms of a sum: `a*x + b*x + c` -> `x*(a + b) + c`
+    /// (saves one multiplication per extra term), greedily, the most frequent factor first.
+    pub fn factor_sums(&mut self) {
+        for a in self.assignments.iter_mut().chain(self.outputs.iter_mut()) {
+            a.expr = factor(&a.expr);
+        }
+    }
+
+    /// All passes: dead assignments, aliases, single-use inlining, then the better (fewer
+    /// operations) of common-subexpression sharing alone or after factoring sums.
+    pub fn optimize(&mut self) {
+        self.remove_dead();
+        self.remove_aliases();
+        self.inline_single_use();
+        let mut factored = self.clone();
+        self.share_common_subexpressions();
+        self.inline_single_use();
+        self.remove_dead();
+        factored.factor_sums();
+        factored.share_common_subexpressions();
+        factored.inline_single_use();
+        factored.remove_dead();
+        let (a, b) = (self.count(), factored.count());
+        if b.mul + b.add < a.mul + a.add {
+            *self = factored;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn p(s: &str) -> Expr {
+        Expr::parse(s).unwrap()
+    }
+
+    #[test]
+    fn counts_follow_the_documented_rules() {
+        let c = |s: &str| {
+            let k = count_ops(&p(s));
+            (k.mul, k.add)
+        };
+        assert_eq!(c("a*b + c"), (1, 1));
+        assert_eq!(c("a - b"), (0, 1));
+        assert_eq!(c("-a*b"), (1, 0));
+        assert_eq!(c("2*a*b - c*d"), (3, 1));
+        assert_eq!(c("a/b"), (1, 0));
+        assert_eq!(c("1/(a*b)"), (2, 0));
+        assert_eq!(c("a^2"), (1, 0));
+        assert_eq!(c("1/a"), (1, 0));
+        assert_eq!(c("a*b*c - a"), (2, 1));
+        assert_eq!(count_ops(&p("sin(q1)*a")).func, 1);
+    }
+
+    #[test]
+    fn recording_names_and_shares() {
+        let reserved = vec!["a".to_string(), "b".to_string()];
+        let (out, asg) = record(&reserved, || {
+            let x = name_value(p("a*b + 1"), || "X".into());
+            let y = name_value(p("a*b + 1"), || "Y".into());
+            let z = name_value(p("-a*b - 1"), || "Z".into());
+            let t = name_value(p("-a"), || "T".into());
+            (x, y, z, t)
+        });
+        assert_eq!(asg.len(), 1);
+        assert_eq!(asg[0].name, "X");
+        assert_eq!(out.0, p("X"));
+        assert_eq!(out.1, p("X"));
+        assert_eq!(out.2, p("-X"));
+        assert_eq!(out.3, p("-a"));
+        assert!(!is_recording());
+        // without a recording nothing is named
+        assert_eq!(name_value(p("a*b"), || "X".into()), p("a*b"));
+    }
+
+    #[test]
+    fn optimisation_keeps_values_and_lowers_counts() {
+        let prog = Program {
+            name: "t".into(),
+            assignments: vec![
+                Assignment {
+                    name: "A".into(),
+                    expr: p("x*y*z + w"),
+                },
+                Assignment {
+                    name: "B".into(),
+                    expr: p("x*y*u - w"),
+                },
+                Assignment {
+                    name: "DEAD".into(),
+                    expr: p("x*x*x"),
+                },
+            ],
+            outputs: vec![
+                Assignment {
+                    name: "o1".into(),
+                    expr: p("A*B + x*y*z"),
+                },
+                Assignment {
+                    name: "o2".into(),
+                    expr: p("2*B"),
+                },
+            ],
+            ..Default::default()
+        };
+        let mut opt = prog.clone();
+        opt.optimize();
+        assert!(opt.assignments.iter().all(|a| a.name != "DEAD"));
+        let before = prog.count();
+        let after = opt.count();
+        assert!(after.mul + after.add < before.mul + before.add - 1);
+        let env = |s: &str| match s {
+            "x" => Some(0.3),
+            "y" => Some(-1.7),
+            "z" => Some(2.1),
+            "w" => Some(0.9),
+            "u" => Some(-0.4),
+            _ => None,
+        };
+        let a = prog.evaluate(&env).unwrap();
+        let b = opt.evaluate(&env).unwrap();
+        for (x, y) in a.iter().zip(&b) {
+            assert!((x - y).abs() < 1e-14 * (1.0 + x.abs()), "{x} vs {y}");
+        }
+    }
+}

@@ -1,0 +1,642 @@
+//! Customized symbolic models (§10.2, Table 10.3): the numeric recursions run on [`Expr`] while a
+//! [`program`](robodyn_symbolic::program) recorder is active, so that zeros, ones and constant
+//! trigonometric values vanish, every named intermediate (`WI12`, `VP32`, `E13`...) becomes one
+//! assignment, and the result is a straight-line [`Program`] with operation counts and emitters
+//! (text, LaTeX, Rust, C, Python, Julia).
+//!
+//! Models: the inverse dynamic model Gamma = f(q, qd, qdd) of the (equivalent) tree (eqs
+//! 10.3–10.12), the inertia matrix A(q), the vector H(q, qd), the direct dynamic model of trees
+//! (A qdd = Gamma - H solved by LDL' written out for the fixed size) and the closed-chain model
+//! Gamma_cl = G^T Gamma_tr (10.40) for a constant G.
+
+mod closed;
+
+pub use closed::constant_g;
+
+use crate::algorithms::inverse_dynamics::rnea;
+use crate::error::{Error, Item, Result};
+use crate::model::{DynModel, RobotDescription, STANDARD_PARAMETERS};
+use crate::workspace::Workspace;
+use nalgebra::{DMatrix, Vector3};
+use robodyn_symbolic::program::{name_value, record, set_name_suffix};
+use robodyn_symbolic::{cmp_expr, Assignment, Expr, InputGroup, Program};
+use std::collections::{BTreeSet, HashMap};
+
+/// Which model to generate.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ModelKind {
+    /// Inverse dynamic model of the (equivalent) tree: Gamma(q, qd, qdd).
+    Idm,
+    /// Inertia matrix A(q) (lower triangle).
+    Inertia,
+    /// Vector H(q, qd) = Gamma(q, qd, 0) (centrifugal, Coriolis, gravity, friction, wrenches).
+    H,
+    /// Direct dynamic model of a tree: qdd = A^-1 (Gamma - H).
+    Ddm,
+    /// Closed chain: Gamma_cl = G^T Gamma_tr (10.40) with a constant G.
+    Closed,
+}
+
+impl ModelKind {
+    pub fn name(self) -> &'static str {
+        match self {
+            ModelKind::Idm => "idm",
+            ModelKind::Inertia => "inertia",
+            ModelKind::H => "h",
+            ModelKind::Ddm => "ddm",
+            ModelKind::Closed => "closed",
+        }
+    }
+}
+
+/// One grouped base parameter: `name` (e.g. `XXR2`) takes the place of the standard parameter
+/// `replaces` (e.g. `XX2`); `expr` is its value over the standard parameters and the geometry.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GroupedParameter {
+    pub replaces: String,
+    pub name: String,
+    pub expr: Expr,
+}
+
+/// A set of base parameters (§10.3): grouped parameters, and the standard parameters set to
+/// zero (no effect, or grouped into others). Standard parameters in neither list stay.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct BaseParameters {
+    pub grouped: Vec<GroupedParameter>,
+    pub zero: BTreeSet<String>,
+}
+
+/// Options of the generator.
+#[derive(Clone, Debug)]
+pub struct GenOptions {
+    pub model: ModelKind,
+    /// Substitute the robot's numeric values for every symbol (geometry and parameters).
+    pub numeric: bool,
+    /// Symmetric links (Table 10.3, simplified case): XY = XZ = YZ = MX = MY = 0 for every link.
+    pub symmetric: bool,
+    /// Keep Coulomb and viscous friction (FS, FV).
+    pub friction: bool,
+    /// Keep rotor inertias (IA).
+    pub rotor: bool,
+    /// Base parameters instead of standard ones.
+    pub base: Option<BaseParameters>,
+    /// G (NL rows, one column per actuated joint) for [`ModelKind::Closed`]; computed by
+    /// [`constant_g`] when `None`.
+    pub g: Option<DMatrix<Expr>>,
+    /// Function name in generated code (default `<robot>_<model>`).
+    pub name: Option<String>,
+    /// Run the program optimisations (common subexpressions, dead code).
+    pub optimize: bool,
+}
+
+impl Default for GenOptions {
+    fn default() -> Self {
+        GenOptions {
+            model: ModelKind::Idm,
+            numeric: false,
+            symmetric: false,
+            friction: true,
+            rotor: true,
+            base: None,
+            g: None,
+            name: None,
+            optimize: true,
+        }
+    }
+}
+
+/// Names of the joint variables: `q<j>`, velocities `QP<j>`, accelerations `QDP<j>`, torques
+/// `GAM<j>` (SYMORO's names).
+pub fn joint_symbol(kind: &str, j: usize) -> String {
+    format!("{kind}{j}")
+}
+
+fn ident(s: &str) -> String {
+    let mut out: String = s
+        .chars()
+        .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
+        .collect();
+    if out.is_empty() || out.starts_with(|c: char| c.is_ascii_digit()) {
+        out.insert(0, 'r');
+    }
+    out.to_lowercase()
+}
+
+/// The symbolic model: DynModel<Expr> with the options applied.
+fn symbolic_model(desc: &RobotDescription, opt: &GenOptions) -> Result<DynModel<Expr>> {
+    let env = |s: &str| desc.symbols.get(s).copied();
+    // symbols replaced by their values, exact constants (pi/2) kept exact
+    let numeric = |e: &Expr, item: &dyn Fn() -> Item| -> Result<Expr> {
+        let v = e.substitute(&|s| env(s).map(Expr::num));
+        if v.symbols().is_empty() {
+            return Ok(v);
+        }
+        e.eval(&env).map(Expr::num).map_err(|err| {
+            Error::invalid(
+                item(),
+                format!("`{e}` has no numeric value for --numeric: {err}"),
+            )
+        })
+    };
+    let base_map: HashMap<&str, &GroupedParameter> = opt
+        .base
+        .iter()
+        .flat_map(|b| b.grouped.iter().map(|g| (g.replaces.as_str(), g)))
+        .collect();
+    // Check the geometry first so that errors are values.
+    let mut errors = Vec::new();
+    let mut geo = |e: &Expr| -> Expr {
+        if opt.numeric {
+            numeric(e, &|| Item::Robot).unwrap_or_else(|err| {
+                errors.push(err);
+                Expr::zero()
+            })
+        } else {
+            e.clone()
+        }
+    };
+    let mut link_errors = Vec::new();
+    let link = |j: usize, k: usize, e: &Expr| -> Expr {
+        if k >= 13 {
+            // external wrench as given in the description
+            return if opt.numeric {
+                numeric(e, &|| Item::Link(j, None)).unwrap_or_else(|err| {
+                    link_errors.push(err);
+                    Expr::zero()
+                })
+            } else {
+                e.clone()
+            };
+        }
+        let pname = STANDARD_PARAMETERS[k];
+        let full = format!("{pname}{j}");
+        let grouped = base_map.get(full.as_str());
+        let symmetric_zero = match grouped {
+            // a grouped parameter vanishes when its expression does on symmetric links
+            Some(g) => opt.symmetric && g.expr.substitute(&symmetric_zeros).expand().is_zero(),
+            None => opt.symmetric && matches!(pname, "XY" | "XZ" | "YZ" | "MX" | "MY"),
+        };
+        let zero = symmetric_zero
+            || (!opt.friction && matches!(pname, "FS" | "FV"))
+            || (!opt.rotor && pname == "IA")
+            || opt.base.as_ref().is_some_and(|b| b.zero.contains(&full));
+        if zero {
+            return Expr::zero();
+        }
+        let standard = |name: &str| -> Option<Expr> {
+            // value of standard parameter NAME<j> from the description
+            let (p, idx) = split_param(name)?;
+            let kk = STANDARD_PARAMETERS.iter().position(|&x| x == p)?;
+            desc.links
+                .get(idx.checked_sub(1)?)
+                .map(|l| l.params[kk].clone())
+        };
+        if let Some(g) = grouped {
+            if opt.numeric {
+                let ex = g.expr.substitute(&standard);
+                return numeric(&ex, &|| Item::Link(j, Some(g.name.clone()))).unwrap_or_else(
+                    |err| {
+                        link_errors.push(err);
+                        Expr::zero()
+                    },
+                );
+            }
+            return Expr::symbol(g.name.clone());
+        }
+        if opt.numeric {
+            numeric(e, &|| Item::Link(j, Some(pname.into()))).unwrap_or_else(|err| {
+                link_errors.push(err);
+                Expr::zero()
+            })
+        } else {
+            Expr::symbol(full)
+        }
+    };
+    let model = DynModel::build(desc, &mut geo, link);
+    if let Some(e) = errors.into_iter().chain(link_errors).next() {
+        return Err(e);
+    }
+    Ok(model)
+}
+
+/// Symmetric links (Table 10.3, simplified case): XY, XZ, YZ, MX, MY of every link are zero.
+fn symmetric_zeros(name: &str) -> Option<Expr> {
+    let (p, _) = split_param(name)?;
+    matches!(p, "XY" | "XZ" | "YZ" | "MX" | "MY").then(Expr::zero)
+}
+
+/// `XX12` -> ("XX", 12).
+fn split_param(name: &str) -> Option<(&str, usize)> {
+    let i = name.trim_end_matches(|c: char| c.is_ascii_digit()).len();
+    Some((&name[..i], name[i..].parse().ok()?))
+}
+
+/// Columns c of the inertia matrix A(q) for the given joints, each from Newton–Euler with
+/// qd = 0, g = 0, no wrench and qdd = e_c (A's column c is Gamma(q, 0, e_c) without friction).
+/// One function so that a composite-link algorithm can replace it.
+pub fn inertia_columns(model: &DynModel<Expr>, joints: &[usize], q: &[Expr]) -> Vec<Vec<Expr>> {
+    let nl = model.nl;
+    let mut m = model.clone();
+    let z = Vector3::<Expr>::zeros;
+    m.gravity = z();
+    m.w0 = z();
+    m.wp0 = z();
+    m.vp0 = z();
+    for l in &mut m.links {
+        l.fe = z();
+        l.me = z();
+        l.fs = Expr::zero();
+        l.fv = Expr::zero();
+    }
+    let mut ws = Workspace::new(&m);
+    let qd = vec![Expr::zero(); nl];
+    let mut cols = Vec::with_capacity(joints.len());
+    for &c in joints {
+        set_name_suffix(&format!("_c{c}"));
+        let mut qdd = vec![Expr::zero(); nl];
+        qdd[c - 1] = Expr::one();
+        let mut tau = vec![Expr::zero(); nl];
+        rnea(&m, &mut ws, q, &qd, &qdd, &mut tau);
+        cols.push(joints.iter().map(|&r| tau[r - 1].clone()).collect());
+    }
+    set_name_suffix("");
+    cols
+}
+
+fn pair_name(prefix: &str, i: usize, j: usize) -> String {
+    if i < 10 && j < 10 {
+        format!("{prefix}{i}{j}")
+    } else {
+        format!("{prefix}{i}_{j}")
+    }
+}
+
+/// Generate a customized model of a robot description.
+pub fn generate(desc: &RobotDescription, opt: &GenOptions) -> Result<Program> {
+    crate::model::validate_structure(desc)?;
+    let model = symbolic_model(desc, opt)?;
+    let nl = desc.nl;
+    let joints: Vec<usize> = (1..=nl)
+        .filter(|&j| desc.frame(j).joint.is_movable())
+        .collect();
+    let sym = |k: &str, j: usize| Expr::symbol(joint_symbol(k, j));
+    let q: Vec<Expr> = (1..=nl).map(|j| sym("q", j)).collect();
+    let qd: Vec<Expr> = (1..=nl).map(|j| sym("QP", j)).collect();
+    let qdd: Vec<Expr> = (1..=nl).map(|j| sym("QDP", j)).collect();
+    let group = |name: &str, kind: &str, doc: &str| InputGroup {
+        name: name.into(),
+        doc: doc.into(),
+        symbols: (1..=nl)
+            .map(|j| joints.contains(&j).then(|| joint_symbol(kind, j)))
+            .collect(),
+    };
+    let mut inputs = vec![group("q", "q", "joint positions q_j at index j-1")];
+    let mut reserved: Vec<String> = Vec::new();
+    for k in ["q", "QP", "QDP", "GAM"] {
+        reserved.extend((1..=nl).map(|j| joint_symbol(k, j)));
+    }
+    for s in desc.symbols.keys() {
+        reserved.push(s.clone());
+    }
+    for l in 1..=nl {
+        for p in STANDARD_PARAMETERS {
+            reserved.push(format!("{p}{l}"));
+        }
+    }
+    if let Some(b) = &opt.base {
+        reserved.extend(b.grouped.iter().map(|g| g.name.clone()));
+    }
+    let g_matrix = if opt.model == ModelKind::Closed {
+        if desc.nj == desc.nl {
+            return Err(Error::invalid(
+                Item::Robot,
+                "the closed-chain model needs a robot with closed loops (NJ > NL)",
+            ));
+        }
+        match &opt.g {
+            Some(g) => {
+                if g.nrows() != nl {
+                    return Err(Error::Input(format!(
+                        "G has {} rows, NL = {nl} expected",
+                        g.nrows()
+                    )));
+                }
+                g.clone()
+            }
+            None => {
+                let robot = crate::Robot::new(desc.clone())?;
+                constant_g(&robot)?.map(Expr::num)
+            }
+        }
+    } else {
+        DMatrix::zeros(0, 0)
+    };
+    let (outputs, assignments) = record(&reserved, || -> Vec<Assignment> {
+        let mut ws = Workspace::new(&model);
+        let mut tau = vec![Expr::zero(); nl];
+        match opt.model {
+            ModelKind::Idm | ModelKind::Closed => {
+                rnea(&model, &mut ws, &q, &qd, &qdd, &mut tau);
+                if opt.model == ModelKind::Idm {
+                    joints
+                        .iter()
+                        .map(|&j| Assignment {
+                            name: joint_symbol("GAM", j),
+                            expr: tau[j - 1].clone(),
+                        })
+                        .collect()
+                } else {
+                    let gam: Vec<Expr> =
+                        (1..=nl).map(|j| tau[j - 1].clone().named_gam(j)).collect();
+                    let actuated: Vec<usize> =
+                        (1..=nl).filter(|&j| desc.frame(j).actuated).collect();
+                    (0..g_matrix.ncols())
+                        .map(|c| {
+                            let e = Expr::sum(
+                                (0..nl).map(|r| g_matrix[(r, c)].clone() * gam[r].clone()),
+                            );
+                            Assignment {
+                                name: format!("GAMCL{}", actuated.get(c).copied().unwrap_or(c + 1)),
+                                expr: e,
+                            }
+                        })
+                        .collect()
+                }
+            }
+            ModelKind::H => {
+                let zero = vec![Expr::zero(); nl];
+                rnea(&model, &mut ws, &q, &qd, &zero, &mut tau);
+                joints
+                    .iter()
+                    .map(|&j| Assignment {
+                        name: joint_symbol("H", j),
+                        expr: tau[j - 1].clone(),
+                    })
+                    .collect()
+            }
+            ModelKind::Inertia => {
+                let cols = inertia_columns(&model, &joints, &q);
+                let mut out = Vec::new();
+                for (a, &i) in joints.iter().enumerate() {
+                    for (b, &j) in joints.iter().enumerate().take(a + 1) {
+                        out.push(Assignment {
+                            name: pair_name("A", i, j),
+                            expr: cols[b][a].clone(),
+                        });
+                    }
+                }
+                out
+            }
+            ModelKind::Ddm => {
+                let zero = vec![Expr::zero(); nl];
+                rnea(&model, &mut ws, &q, &qd, &zero, &mut tau);
+                let n = joints.len();
+                // right-hand side Gamma - H
+                let rhs: Vec<Expr> = joints
+                    .iter()
+                    .map(|&j| {
+                        let h = tau[j - 1].clone().named(|| joint_symbol("H", j));
+                        (sym("GAM", j) - h).named(|| format!("BB{j}"))
+                    })
+                    .collect();
+                let cols = inertia_columns(&model, &joints, &q);
+                let a: Vec<Vec<Expr>> = (0..n)
+                    .map(|r| {
+                        (0..n)
+                            .map(|c| {
+                                let (r2, c2) = if r >= c { (r, c) } else { (c, r) };
+                                cols[c2][r2]
+                                    .clone()
+                                    .named(|| pair_name("A", joints[r2], joints[c2]))
+                            })
+                            .collect()
+                    })
+                    .collect();
+                ldl_solve(&a, &rhs, &joints)
+                    .into_iter()
+                    .zip(&joints)
+                    .map(|(x, &j)| Assignment {
+                        name: joint_symbol("QDP", j),
+                        expr: x,
+                    })
+                    .collect()
+            }
+        }
+    });
+    match opt.model {
+        ModelKind::Idm | ModelKind::Closed => {
+            inputs.push(group("qd", "QP", "joint velocities at index j-1"));
+            inputs.push(group("qdd", "QDP", "joint accelerations at index j-1"));
+        }
+        ModelKind::H => inputs.push(group("qd", "QP", "joint velocities at index j-1")),
+        ModelKind::Inertia => {}
+        ModelKind::Ddm => {
+            inputs.push(group("qd", "QP", "joint velocities at index j-1"));
+            inputs.push(group("gam", "GAM", "joint torques at index j-1"));
+        }
+    }
+    let mut description = describe(desc, opt);
+    if opt.model == ModelKind::Closed {
+        let act: Vec<usize> = (1..=nl).filter(|&j| desc.frame(j).actuated).collect();
+        description.push(format!(
+            "G = d q_tr / d q_a (constant; rows q1..q{nl}, columns q_a = {act:?}):"
+        ));
+        for r in 0..g_matrix.nrows() {
+            let row: Vec<String> = g_matrix.row(r).iter().map(|e| e.to_string()).collect();
+            description.push(format!("  q{}: [{}]", r + 1, row.join(", ")));
+        }
+    } else if desc.nj > desc.nl {
+        description.push(
+            "Closed robot: this is the model of the equivalent tree (loops cut); \
+             --model closed gives Gamma_cl"
+                .into(),
+        );
+    }
+    let mut prog = Program {
+        name: opt
+            .name
+            .clone()
+            .unwrap_or_else(|| format!("{}_{}", ident(&desc.name), opt.model.name())),
+        description,
+        inputs,
+        assignments,
+        outputs,
+    };
+    if opt.optimize {
+        prog.optimize();
+    } else {
+        prog.remove_dead();
+    }
+    // every other symbol is a parameter
+    let known: BTreeSet<String> = prog
+        .input_symbols()
+        .into_iter()
+        .chain(prog.assignments.iter().map(|a| a.name.clone()))
+        .collect();
+    let mut params: Vec<Expr> = prog
+        .assignments
+        .iter()
+        .chain(&prog.outputs)
+        .flat_map(|a| a.expr.symbols())
+        .collect::<BTreeSet<String>>()
+        .into_iter()
+        .filter(|s| !known.contains(s))
+        .map(Expr::symbol)
+        .collect();
+    params.sort_by(cmp_expr);
+    prog.inputs.push(InputGroup {
+        name: "p".into(),
+        doc: "parameters (geometry, inertial, drive, gravity)".into(),
+        symbols: params
+            .iter()
+            .map(|e| e.as_symbol().map(str::to_string))
+            .collect(),
+    });
+    Ok(prog)
+}
+
+/// Helper so that the closed-chain model names the tree torques GAM<j>.
+trait NamedGam {
+    fn named_gam(self, j: usize) -> Expr;
+}
+impl NamedGam for Expr {
+    fn named_gam(self, j: usize) -> Expr {
+        name_value(self, || format!("GAM{j}"))
+    }
+}
+
+use crate::scalar::DynScalar as _;
+
+/// Solve A x = b by A = L D L' written out for the fixed size (A symmetric positive definite):
+/// D_i = A_ii - sum_k L_ik^2 D_k, L_ij = (A_ij - sum_k L_ik L_jk D_k) / D_j, then forward,
+/// diagonal and backward substitution. Intermediates are named L<i><j>, D<i>, Y<i>, X<i>.
+fn ldl_solve(a: &[Vec<Expr>], b: &[Expr], joints: &[usize]) -> Vec<Expr> {
+    let n = a.len();
+    let mut l = vec![vec![Expr::zero(); n]; n];
+    let mut d = vec![Expr::zero(); n];
+    let mut ld = vec![vec![Expr::zero(); n]; n]; // L_ik D_k
+    for i in 0..n {
+        for j in 0..i {
+            let mut s = a[i][j].clone();
+            for k in 0..j {
+                s -= ld[i][k].clone() * l[j][k].clone();
+            }
+            let s = s.named(|| pair_name("U", joints[i], joints[j]));
+            ld[i][j] = s.clone();
+            l[i][j] = (s / d[j].clone()).named(|| pair_name("L", joints[i], joints[j]));
+        }
+        let mut s = a[i][i].clone();
+        for k in 0..i {
+            s -= ld[i][k].clone() * l[i][k].clone();
+        }
+        d[i] = s.named(|| format!("D{}", joints[i]));
+    }
+    let mut y = vec![Expr::zero(); n];
+    for i in 0..n {
+        let mut s = b[i].clone();
+        for k in 0..i {
+            s -= l[i][k].clone() * y[k].clone();
+        }
+        y[i] = s.named(|| format!("Y{}", joints[i]));
+    }
+    let mut x = vec![Expr::zero(); n];
+    for i in (0..n).rev() {
+        let mut s = y[i].clone() / d[i].clone();
+        for k in i + 1..n {
+            s -= l[k][i].clone() * x[k].clone();
+        }
+        x[i] = if i == 0 {
+            s
+        } else {
+            s.named(|| format!("X{}", joints[i]))
+        };
+    }
+    x
+}
+
+fn describe(desc: &RobotDescription, opt: &GenOptions) -> Vec<String> {
+    let model = match opt.model {
+        ModelKind::Idm => "customized inverse dynamic model Gamma = f(q, qd, qdd) (Newton-Euler, eqs 10.3-10.12)",
+        ModelKind::Inertia => "inertia matrix A(q), lower triangle (Newton-Euler columns)",
+        ModelKind::H => "vector H(q, qd) = Gamma(q, qd, 0)",
+        ModelKind::Ddm => "direct dynamic model qdd = A^-1 (Gamma - H), LDL' solution written out",
+        ModelKind::Closed => "closed-chain inverse dynamic model Gamma_cl = G^T Gamma_tr (eq 10.40), inputs are the tree state",
+    };
+    let mut v = vec![
+        format!("{} -- {model}", desc.name),
+        "Generated by robodyn (robodyn generate); do not edit.".to_string(),
+    ];
+    let mut o = Vec::new();
+    o.push(if opt.base.is_some() {
+        "base parameters"
+    } else {
+        "standard parameters"
+    });
+    if opt.numeric {
+        o.push("numeric values substituted");
+    }
+    if opt.symmetric {
+        o.push("symmetric links (XY = XZ = YZ = MX = MY = 0)");
+    }
+    if !opt.friction {
+        o.push("no friction");
+    }
+    if !opt.rotor {
+        o.push("no rotor inertia");
+    }
+    v.push(format!("Options: {}", o.join(", ")));
+    v
+}
+
+impl BaseParameters {
+    /// Read a grouping list: one `NAME = expr` per line, where NAME is a standard parameter
+    /// with `R` before the link number (`XXR2` replaces `XX2`, `MR3` replaces `M3`) and expr is
+    /// its value over standard parameters and geometry; `zero: XX1 XY1 ...` lines list the
+    /// parameters set to zero; `#` starts a comment. `file` names the source in errors.
+    pub fn parse(text: &str, file: &str) -> Result<BaseParameters> {
+        let mut out = BaseParameters::default();
+        for (i, raw) in text.lines().enumerate() {
+            let line = raw.split('#').next().unwrap_or("").trim();
+            if line.is_empty() {
+                continue;
+            }
+            let err = |reason: String| {
+                Error::Input(format!("{file}:{}: {reason} in `{}`", i + 1, raw.trim()))
+            };
+            if let Some(rest) = line.strip_prefix("zero:") {
+                for name in rest.split_whitespace() {
+                    if split_param(name)
+                        .filter(|(p, _)| STANDARD_PARAMETERS.contains(p))
+                        .is_none()
+                    {
+                        return Err(err(format!("`{name}` is not a standard parameter")));
+                    }
+                    out.zero.insert(name.to_string());
+                }
+                continue;
+            }
+            let (name, expr) = line
+                .split_once('=')
+                .ok_or_else(|| err("expected `NAME = expression` or `zero: ...`".into()))?;
+            let name = name.trim();
+            let replaces = split_param(name)
+                .and_then(|(p, j)| {
+                    let p = p.strip_suffix('R')?;
+                    STANDARD_PARAMETERS.contains(&p).then(|| format!("{p}{j}"))
+                })
+                .ok_or_else(|| {
+                    err(format!(
+                        "`{name}` is not a grouped parameter name (standard name with R \
+                         before the link number, e.g. XXR2)"
+                    ))
+                })?;
+            let expr = Expr::parse(expr.trim()).map_err(|e| err(e.to_string()))?;
+            out.grouped.push(GroupedParameter {
+                replaces,
+                name: name.to_string(),
+                expr,
+            });
+        }
+        Ok(out)
+    }
+}
