@@ -47,7 +47,8 @@ pub struct Args {
     pub model: Model,
     #[arg(long, value_enum, default_value = "standard")]
     pub params: Params,
-    /// Grouping list for --params base: lines `XXR2 = XX2 - YY2 + ...` and `zero: XX1 XY1 ...`.
+    /// Grouping list for --params base: lines `XXR2 = XX2 - YY2 + ...` and `zero: XX1 XY1 ...`
+    /// (default: the grouping of the symbolic method, as `robodyn base-params` prints it).
     #[arg(long, value_name = "FILE")]
     pub base_file: Option<PathBuf>,
     /// Symmetric links: XY = XZ = YZ = MX = MY = 0 (Table 10.3, simplified case).
@@ -81,15 +82,15 @@ pub fn run(a: Args) -> CliResult {
     desc.symbols.extend(rargs.overrides()?);
     let base = match a.params {
         Params::Standard => None,
-        Params::Base => {
-            let path = a.base_file.as_ref().ok_or(
-                "--params base needs --base-file FILE: lines `XXR2 = XX2 - YY2 + ...` and \
-                 `zero: XX1 XY1 ...` (the grouping of the base parameters)",
-            )?;
-            let text =
-                std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
-            Some(BaseParameters::parse(&text, &path.display().to_string())?)
-        }
+        Params::Base => match &a.base_file {
+            Some(path) => {
+                let text = std::fs::read_to_string(path)
+                    .map_err(|e| format!("{}: {e}", path.display()))?;
+                Some(BaseParameters::parse(&text, &path.display().to_string())?)
+            }
+            // the grouping of the symbolic method (Table 10.2 for the SR400)
+            None => Some(BaseParameters::symbolic(&desc, !a.no_rotor, !a.no_friction)?),
+        },
     };
     let opt = GenOptions {
         model: match a.model {

@@ -589,6 +589,51 @@ fn describe(desc: &RobotDescription, opt: &GenOptions) -> Vec<String> {
 }
 
 impl BaseParameters {
+    /// The base parameters found by the symbolic method (§10.2.4, §10.3.4–10.3.6) for the drive
+    /// parameters the generator keeps: rotor inertias (`rotor`) and friction (`friction`) of the
+    /// actuated joints. Drive parameters outside that selection, grouped parameters and
+    /// parameters with no effect are set to zero. Fails when the symbolic method is incomplete
+    /// for the robot (closed loops other than parallelograms): use a grouping file then.
+    pub fn symbolic(desc: &RobotDescription, rotor: bool, friction: bool) -> Result<BaseParameters> {
+        use crate::algorithms::base_parameters::symbolic::symbolic_base_parameters;
+        use crate::algorithms::regressor::{parameter_name, ParameterSelection, RotorMode};
+        let mode = if rotor {
+            RotorMode::Actuated
+        } else {
+            RotorMode::None
+        };
+        let sel = ParameterSelection::from_description(desc, mode, friction);
+        let sb = symbolic_base_parameters(desc, &sel)?;
+        if !sb.unhandled_loops.is_empty() {
+            return Err(Error::Input(format!(
+                "the symbolic grouping rules do not cover the loops cut at joints {:?} (not \
+                 parallelograms): compute the base parameters with `robodyn base-params \
+                 --method numeric` and pass them with --base-file",
+                sb.unhandled_loops
+            )));
+        }
+        let selected: BTreeSet<usize> = sel.columns().into_iter().collect();
+        let mut out = BaseParameters::default();
+        for idx in 0..STANDARD_PARAMETERS.len() * desc.nl {
+            if !selected.contains(&idx) || sb.grouped.contains(&idx) || sb.no_effect.contains(&idx)
+            {
+                out.zero.insert(parameter_name(idx));
+            }
+        }
+        for (r, &idx) in sb.base.iter().enumerate() {
+            if sb.is_regrouped(r) {
+                let std = parameter_name(idx);
+                let (p, j) = split_param(&std).expect("standard parameter names end in digits");
+                out.grouped.push(GroupedParameter {
+                    replaces: std.clone(),
+                    name: format!("{p}R{j}"),
+                    expr: sb.equations[r].clone(),
+                });
+            }
+        }
+        Ok(out)
+    }
+
     /// Read a grouping list: one `NAME = expr` per line, where NAME is a standard parameter
     /// with `R` before the link number (`XXR2` replaces `XX2`, `MR3` replaces `M3`) and expr is
     /// its value over standard parameters and geometry; `zero: XX1 XY1 ...` lines list the
