@@ -13,12 +13,13 @@ mod closed;
 
 pub use closed::constant_g;
 
+use crate::algorithms::inertia_matrix::{inertia_matrix_into, InertiaWorkspace};
 use crate::algorithms::inverse_dynamics::rnea;
 use crate::error::{Error, Item, Result};
 use crate::model::{DynModel, RobotDescription, STANDARD_PARAMETERS};
 use crate::workspace::Workspace;
-use nalgebra::{DMatrix, Vector3};
-use robodyn_symbolic::program::{name_value, record, set_name_suffix};
+use nalgebra::DMatrix;
+use robodyn_symbolic::program::{name_value, record};
 use robodyn_symbolic::{cmp_expr, Assignment, Expr, InputGroup, Program};
 use std::collections::{BTreeSet, HashMap};
 
@@ -231,36 +232,17 @@ fn split_param(name: &str) -> Option<(&str, usize)> {
     Some((&name[..i], name[i..].parse().ok()?))
 }
 
-/// Columns c of the inertia matrix A(q) for the given joints, each from Newton–Euler with
-/// qd = 0, g = 0, no wrench and qdd = e_c (A's column c is Gamma(q, 0, e_c) without friction).
-/// One function so that a composite-link algorithm can replace it.
+/// Columns c of the inertia matrix A(q) for the given joints, by the composite-link method
+/// (`algorithms::inertia_matrix`, generic over the scalar), rotor inertias on the diagonal.
 pub fn inertia_columns(model: &DynModel<Expr>, joints: &[usize], q: &[Expr]) -> Vec<Vec<Expr>> {
-    let nl = model.nl;
-    let mut m = model.clone();
-    let z = Vector3::<Expr>::zeros;
-    m.gravity = z();
-    m.w0 = z();
-    m.wp0 = z();
-    m.vp0 = z();
-    for l in &mut m.links {
-        l.fe = z();
-        l.me = z();
-        l.fs = Expr::zero();
-        l.fv = Expr::zero();
-    }
-    let mut ws = Workspace::new(&m);
-    let qd = vec![Expr::zero(); nl];
-    let mut cols = Vec::with_capacity(joints.len());
-    for &c in joints {
-        set_name_suffix(&format!("_c{c}"));
-        let mut qdd = vec![Expr::zero(); nl];
-        qdd[c - 1] = Expr::one();
-        let mut tau = vec![Expr::zero(); nl];
-        rnea(&m, &mut ws, q, &qd, &qdd, &mut tau);
-        cols.push(joints.iter().map(|&r| tau[r - 1].clone()).collect());
-    }
-    set_name_suffix("");
-    cols
+    let n = model.nl;
+    let mut ws = InertiaWorkspace::new(model);
+    let mut a = DMatrix::from_element(n, n, Expr::zero());
+    inertia_matrix_into(model, &mut ws, q, &mut a);
+    joints
+        .iter()
+        .map(|&c| joints.iter().map(|&r| a[(r - 1, c - 1)].clone()).collect())
+        .collect()
 }
 
 fn pair_name(prefix: &str, i: usize, j: usize) -> String {
