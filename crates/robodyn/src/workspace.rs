@@ -19,6 +19,8 @@ pub struct Workspace<T: DynScalar = f64> {
     pub wd: Vec<Vector3<T>>,
     /// jVd_j, linear acceleration of O_j (gravity included as a base acceleration).
     pub vd: Vec<Vector3<T>>,
+    /// jU_j = skew(jwd_j) + skew(jw_j)^2 (eq 10.6–10.7).
+    pub u: Vec<Matrix3<T>>,
     /// jf_j, force exerted on link j by link a(j).
     pub f: Vec<Vector3<T>>,
     /// jm_j, moment about O_j exerted on link j by link a(j).
@@ -37,6 +39,7 @@ impl<T: DynScalar> Workspace<T> {
             w: v(),
             wd: v(),
             vd: v(),
+            u: vec![Matrix3::zeros(); nl + 1],
             f: v(),
             m: v(),
         }

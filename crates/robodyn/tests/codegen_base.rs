@@ -26,7 +26,13 @@ fn sr400_symbolic_grouping_is_table_10_2() {
         let a = auto.grouped.iter().find(|g| g.name == h.name).unwrap();
         assert_eq!(a.replaces, h.replaces, "{}", h.name);
         let diff = (a.expr.clone() - h.expr.clone()).expand();
-        assert!(diff.is_zero(), "{}: {} vs {} (difference {diff})", h.name, a.expr, h.expr);
+        assert!(
+            diff.is_zero(),
+            "{}: {} vs {} (difference {diff})",
+            h.name,
+            a.expr,
+            h.expr
+        );
     }
     // every parameter the hand list sets to zero is zero here too; the automatic list also zeroes
     // the drive parameters that are not in the model (friction, rotors of passive joints)
@@ -35,10 +41,16 @@ fn sr400_symbolic_grouping_is_table_10_2() {
     }
     for z in &auto.zero {
         assert!(
-            hand.zero.contains(z) || z.starts_with("FS") || z.starts_with("FV") || z.starts_with("IA"),
+            hand.zero.contains(z)
+                || z.starts_with("FS")
+                || z.starts_with("FV")
+                || z.starts_with("IA"),
             "{z} is zero only in the automatic list"
         );
     }
     // sanity: a grouped expression is not its own symbol
-    assert!(auto.grouped.iter().all(|g| g.expr != Expr::symbol(&g.replaces)));
+    assert!(auto
+        .grouped
+        .iter()
+        .all(|g| g.expr != Expr::symbol(&g.replaces)));
 }

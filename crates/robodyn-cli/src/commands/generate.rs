@@ -89,7 +89,11 @@ pub fn run(a: Args) -> CliResult {
                 Some(BaseParameters::parse(&text, &path.display().to_string())?)
             }
             // the grouping of the symbolic method (Table 10.2 for the SR400)
-            None => Some(BaseParameters::symbolic(&desc, !a.no_rotor, !a.no_friction)?),
+            None => Some(BaseParameters::symbolic(
+                &desc,
+                !a.no_rotor,
+                !a.no_friction,
+            )?),
         },
     };
     let opt = GenOptions {

@@ -6,7 +6,7 @@ use crate::error::{Error, Result};
 use crate::model::{DynModel, JointType, Robot};
 use crate::scalar::DynScalar;
 use crate::workspace::Workspace;
-use nalgebra::{DVector, Vector3};
+use nalgebra::{DVector, Matrix3, Vector3};
 
 /// `z x (s v)` is needed as `w x (qd * z)`: returns `w x [0, 0, s]`.
 #[inline]
@@ -33,6 +33,39 @@ fn name3<T: DynScalar>(v: Vector3<T>, prefix: &str, j: usize) -> Vector3<T> {
     )
 }
 
+/// jU_j = skew(wd) + skew(w) skew(w) (below eq 10.8), computed once per link and used both for
+/// the acceleration of its successors' origins (10.6) and for its own force (10.7); entries are
+/// named `U<r><c><j>` in the customized model.
+#[inline]
+fn u_matrix<T: DynScalar>(w: &Vector3<T>, wd: &Vector3<T>, j: usize) -> Matrix3<T> {
+    let (x, y, z) = (w.x.clone(), w.y.clone(), w.z.clone());
+    let (xx, yy, zz) = (
+        x.clone() * x.clone(),
+        y.clone() * y.clone(),
+        z.clone() * z.clone(),
+    );
+    let (xy, xz, yz) = (x.clone() * y.clone(), x * z.clone(), y * z);
+    let u = Matrix3::new(
+        -(yy.clone() + zz.clone()),
+        xy.clone() - wd.z.clone(),
+        xz.clone() + wd.y.clone(),
+        xy + wd.z.clone(),
+        -(xx.clone() + zz),
+        yz.clone() - wd.x.clone(),
+        xz - wd.y.clone(),
+        yz + wd.x.clone(),
+        -(xx + yy),
+    );
+    if !T::NAMED {
+        return u;
+    }
+    Matrix3::from_fn(|r, c| {
+        u[(r, c)]
+            .clone()
+            .named(|| format!("U{}{}{j}", r + 1, c + 1))
+    })
+}
+
 /// Forward recursion (eqs 10.3–10.8): fills `ws.rot`, `ws.pos`, `ws.w`, `ws.wd`, `ws.vd` and the
 /// link wrenches `ws.f` = jF_j + jfe_j, `ws.m` = jM_j + jme_j for links 1..NL.
 pub fn forward_recursion<T: DynScalar>(
@@ -45,14 +78,15 @@ pub fn forward_recursion<T: DynScalar>(
     ws.w[0] = model.w0.clone();
     ws.wd[0] = model.wp0.clone();
     ws.vd[0] = &model.vp0 - &model.gravity;
+    ws.u[0] = u_matrix(&ws.w[0], &ws.wd[0], 0);
     for j in 1..=model.nl {
         let fr = model.frame(j);
         let i = fr.ant;
         let (rot, pos) = fr.transform(&q[j - 1]);
         // jA_i = (iA_j)^T
         let jai = rot.transpose();
-        // iU_i iP_j = wd_i x P + w_i x (w_i x P)
-        let up = ws.wd[i].cross(&pos) + ws.w[i].cross(&ws.w[i].cross(&pos));
+        // iU_i iP_j (10.6)
+        let up = &ws.u[i] * &pos;
         let wi = name3(&jai * &ws.w[i], "WI", j); // (10.3)
         let vsp = name3(&ws.vd[i] + up, "VSP", j);
         let mut vd = &jai * vsp; // (10.6), first part
@@ -76,8 +110,10 @@ pub fn forward_recursion<T: DynScalar>(
         let wd = name3(wd, "WP", j);
         let vd = name3(vd, "VP", j);
         let l = model.link(j);
-        // (10.7): F = M vd + U MS, U MS = wd x MS + w x (w x MS)
-        let f = &vd * l.mass.clone() + wd.cross(&l.ms) + w.cross(&w.cross(&l.ms));
+        // (10.7): F = M vd + U MS
+        let u = u_matrix(&w, &wd, j);
+        let f = &vd * l.mass.clone() + &u * &l.ms;
+        ws.u[j] = u;
         // (10.8): M = J wd + w x (J w) + MS x vd
         let jw = name3(&l.inertia * &w, "JW", j);
         let m = &l.inertia * &wd + w.cross(&jw) + l.ms.cross(&vd);

@@ -576,7 +576,11 @@ impl BaseParameters {
     /// actuated joints. Drive parameters outside that selection, grouped parameters and
     /// parameters with no effect are set to zero. Fails when the symbolic method is incomplete
     /// for the robot (closed loops other than parallelograms): use a grouping file then.
-    pub fn symbolic(desc: &RobotDescription, rotor: bool, friction: bool) -> Result<BaseParameters> {
+    pub fn symbolic(
+        desc: &RobotDescription,
+        rotor: bool,
+        friction: bool,
+    ) -> Result<BaseParameters> {
         use crate::algorithms::base_parameters::symbolic::symbolic_base_parameters;
         use crate::algorithms::regressor::{parameter_name, ParameterSelection, RotorMode};
         let mode = if rotor {
