@@ -166,6 +166,18 @@ pub fn run(a: Args) -> CliResult {
             let d = ClosedChainDynamics::new(&robot)?.with_coulomb_smoothing(smoothing);
             let joints = d.actuated_joints().to_vec();
             let q0 = d.model().reference_actuated();
+            if a.q0.is_none() {
+                let (m, z) = (d.model(), vec![0.0; q0.len()]);
+                let mut ws = m.workspace();
+                m.solve_from_reference(&mut ws, &q0, None)
+                    .and_then(|s| m.state(&mut ws, &q0, &z, &z, Some(&s.q_p)))
+                    .map_err(|e| {
+                        format!(
+                            "the default initial state (the actuated values {q0:?} of the \
+                             assembly configuration) cannot be simulated: {e}\n  give --q0"
+                        )
+                    })?;
+            }
             (
                 Box::new(d),
                 joints,
