@@ -280,3 +280,43 @@ fn reference_start_is_the_assembly_branch() {
         assert!(wrap(out[1 + k] - s.q_tr[j - 1]).abs() < 1e-9, "q{j}");
     }
 }
+
+#[test]
+fn falling_into_a_singularity_is_a_clear_error() {
+    // The five-bar under the file's gravity (-y0) falls until its distal links align (a parallel
+    // singularity, Wp singular): the run stops with an error value that says so, and the rows
+    // written before it are closed loops.
+    let r = load("fivebar.toml");
+    let mut sys = ClosedChainDynamics::new(&r).unwrap();
+    let mut rec = Recorder::default();
+    let opts = SimOptions {
+        duration: 2.0,
+        integrator: dopri(1e-9, 1e-11),
+        output_dt: 0.01,
+        max_steps: Some(200_000),
+    };
+    let e = simulate(
+        &mut sys,
+        &TorqueInput::Constant(vec![0.0; 2]),
+        &[0.1, -0.1],
+        &[0.0, 0.0],
+        &opts,
+        &mut rec,
+        &mut |_| {},
+    )
+    .unwrap_err();
+    let m = e.to_string();
+    println!("{m}");
+    assert!(matches!(e, robodyn::Error::Numerical(_)), "{m}");
+    assert!(m.contains("simulation stopped at t = "), "{m}");
+    assert!(m.contains("singular configuration"), "{m}");
+    assert!(rec.rows.len() > 10);
+    let (cr, gap) = (
+        col(&rec, "closure_residual"),
+        rec.rows
+            .iter()
+            .map(|row| placement_gap(&r, &tree_q(&r, &rec, row)))
+            .fold(0.0, f64::max),
+    );
+    assert!(rec.rows.iter().all(|row| row[cr] < 1e-9) && gap < 1e-9);
+}

@@ -8,7 +8,7 @@
 use super::energy::{total_energy, EnergyWorkspace};
 use super::Dynamics;
 use crate::algorithms::closed_chain::{ClosedChain, ClosedDynamics};
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::model::Robot;
 
 /// A closed-chain robot as the simulator sees it (actuated coordinates).
@@ -18,6 +18,8 @@ pub struct ClosedChainDynamics {
     energy_ws: EnergyWorkspace,
     zeros: Vec<f64>,
     coulomb_smoothing: Option<f64>,
+    /// q_tr of the last successful evaluation (for the diagnosis of a failure).
+    last_q_tr: Option<Vec<f64>>,
 }
 
 impl ClosedChainDynamics {
@@ -30,6 +32,7 @@ impl ClosedChainDynamics {
             sys,
             zeros: vec![0.0; n],
             coulomb_smoothing: None,
+            last_q_tr: None,
         })
     }
 
@@ -58,6 +61,34 @@ impl ClosedChainDynamics {
     pub fn passive_joints(&self) -> &[usize] {
         self.sys.model.passive_joints()
     }
+
+    /// A failed loop closure during a simulation is most often the approach of a singular
+    /// configuration (Wp singular: the passive joints are no longer determined by the actuated
+    /// ones); say so when Wp was already ill-conditioned at the last closed configuration.
+    fn diagnose(&mut self, e: Error) -> Error {
+        let Error::Numerical(m) = e else {
+            return e;
+        };
+        let Some(q) = self.last_q_tr.clone() else {
+            return Error::Numerical(m);
+        };
+        let ratio = match self.sys.model.constraints(&mut self.sys.ws, &q) {
+            Ok(c) => {
+                let sv = c.wp.svd(false, false).singular_values;
+                sv.min() / sv.max()
+            }
+            Err(_) => 0.0,
+        };
+        if ratio < 1e-2 {
+            Error::Numerical(format!(
+                "{m}\n  at the last closed configuration q_tr = {q:.6?} Wp was ill-conditioned \
+                 (smallest / largest singular value {ratio:.1e}): the motion reached a singular \
+                 configuration of the mechanism"
+            ))
+        } else {
+            Error::Numerical(m)
+        }
+    }
 }
 
 impl Dynamics for ClosedChainDynamics {
@@ -78,11 +109,26 @@ impl Dynamics for ClosedChainDynamics {
         tau: &[f64],
         qdd: &mut [f64],
     ) -> Result<()> {
-        let a = self
-            .sys
-            .accel_smoothed(q, qd, tau, self.coulomb_smoothing)?;
-        qdd.copy_from_slice(a.as_slice());
-        Ok(())
+        if self.sys.ws.closure.last_qp.is_none() {
+            self.sys.solve(q)?;
+        }
+        // guess None: the previous solution (drift control)
+        let d = self.sys.model.direct_dynamics_smoothed(
+            &mut self.sys.ws,
+            q,
+            qd,
+            tau,
+            None,
+            self.coulomb_smoothing,
+        );
+        match d {
+            Ok(d) => {
+                qdd.copy_from_slice(d.qdd_a.as_slice());
+                self.last_q_tr = Some(d.state.q);
+                Ok(())
+            }
+            Err(e) => Err(self.diagnose(e)),
+        }
     }
     fn energy(&mut self, q: &[f64], qd: &[f64]) -> Result<f64> {
         let sol = self.sys.solve(q)?;
