@@ -70,7 +70,11 @@ fn sr400_simulation(c: &mut Criterion) {
             b.iter(|| {
                 // back and forth along a short path so that every call moves q_a by 1 ms x qd
                 k += 1;
-                let s = if (k / 50).is_multiple_of(2) { 1e-3 } else { -1e-3 };
+                let s = if (k / 50).is_multiple_of(2) {
+                    1e-3
+                } else {
+                    -1e-3
+                };
                 for (x, v) in q.iter_mut().zip(&qd) {
                     *x += s * v;
                 }
