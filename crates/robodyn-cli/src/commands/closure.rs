@@ -15,7 +15,8 @@ pub struct Args {
     #[arg(long, allow_hyphen_values = true)]
     pub qa: String,
     /// Initial guess of q_p (passive tree joints in joint order); default: continuation from
-    /// q = 0 when the robot is assembled there, else zeros.
+    /// the robot's `assembly` configuration (else q = 0) when the loops close there, else
+    /// damped Newton from its q_p.
     #[arg(long, allow_hyphen_values = true)]
     pub guess: Option<String>,
     /// Also print W = d q_p / d q_a.
@@ -31,45 +32,15 @@ pub enum Format {
     Json,
 }
 
-/// Solve q_p for q_a from `guess`. Without a guess: when the robot is assembled at its reference
-/// configuration (the file's `assembly`, else q = 0), by continuation from there, so the answer
-/// is on the reference assembly branch; otherwise by damped Newton from zeros.
+/// Solve q_p for q_a from `guess`, else from the reference assembly
+/// ([`ClosedChain::solve_from_reference`]).
 pub fn solve(
     cc: &ClosedChain,
     ws: &mut ClosedChainWorkspace,
     q_a: &[f64],
     guess: Option<&[f64]>,
 ) -> CliResult<ClosureSolution> {
-    if guess.is_some() {
-        return Ok(cc.solve_positions(ws, q_a, guess)?);
-    }
-    let (n, p) = (cc.dof(), cc.passive_joints().len());
-    let lc = cc.closure();
-    let reference = cc
-        .robot()
-        .description()
-        .assembly
-        .clone()
-        .unwrap_or_else(|| vec![0.0; cc.robot().nl()]);
-    let ref_a: Vec<f64> = cc
-        .actuated_joints()
-        .iter()
-        .map(|&j| reference[j - 1])
-        .collect();
-    let ref_p: Vec<f64> = cc
-        .passive_joints()
-        .iter()
-        .map(|&j| reference[j - 1])
-        .collect();
-    debug_assert_eq!(ref_p.len(), p);
-    if q_a.len() == n {
-        if let Ok(s0) = lc.solve(&mut ws.closure, &ref_a, Some(&ref_p)) {
-            if s0.iterations == 0 {
-                return Ok(lc.solve_continuation(&mut ws.closure, q_a, &ref_a, &ref_p, 16)?);
-            }
-        }
-    }
-    Ok(cc.solve_positions(ws, q_a, Some(&ref_p))?)
+    Ok(cc.solve_from_reference(ws, q_a, guess)?)
 }
 
 pub fn run(a: Args) -> CliResult {

@@ -1,5 +1,10 @@
 //! `robodyn ddm ROBOT`: direct dynamic model qdd = f(q, qd, tau) for states from a CSV file
 //! (columns q<j>, qd<j>, tau<j>) or from `--q/--qd/--tau`.
+//!
+//! For a closed-chain robot the states, torques and accelerations are those of the actuated
+//! joints only: qdd_a = A_cl^-1 (Γ_cl - H_cl) (10.46–10.48) at the consistent tree state (q_p by
+//! loop closure, each row starting from the previous row's solution, the first from `--guess`,
+//! else from the robot's assembly configuration as `closure` does).
 
 use crate::common::{parse_list, write_table, CliResult, RobotArgs, Table, TableFormat};
 use robodyn::algorithms::direct_dynamics::{ddm, DirectWorkspace, Method};
@@ -28,10 +33,12 @@ impl From<MethodArg> for Method {
 pub struct Args {
     #[command(flatten)]
     pub robot: RobotArgs,
-    /// CSV of states with columns q<j>, qd<j>, tau<j> for the movable joints.
+    /// CSV of states with columns q<j>, qd<j>, tau<j> for the movable joints (closed chains:
+    /// the actuated joints).
     #[arg(long, conflicts_with_all = ["q", "qd", "tau"])]
     pub input: Option<PathBuf>,
-    /// One state: joint positions, comma separated (movable joints in frame order).
+    /// One state: joint positions, comma separated (movable joints in frame order; closed
+    /// chains: the actuated joints).
     #[arg(long, allow_hyphen_values = true)]
     pub q: Option<String>,
     /// Joint velocities (default zeros).
@@ -47,10 +54,16 @@ pub struct Args {
     pub output: Option<PathBuf>,
     #[arg(long, value_enum, default_value = "csv")]
     pub format: TableFormat,
+    /// Closed chains: initial guess of q_p for the first state (passive tree joints in order).
+    #[arg(long, allow_hyphen_values = true)]
+    pub guess: Option<String>,
 }
 
 pub fn run(a: Args) -> CliResult {
     let robot = a.robot.load()?;
+    if !robot.is_tree() {
+        return run_closed(a, robot);
+    }
     let joints = robot.movable_joints();
     let nl = robot.nl();
     let states: Vec<(String, [Vec<f64>; 3])> = if let Some(path) = &a.input {
@@ -118,6 +131,82 @@ pub fn run(a: Args) -> CliResult {
         ddm(model, &mut ws, a.method.into(), q, qd, tau, &mut qdd)
             .map_err(|e| format!("{what}: {e}"))?;
         rows.push(joints.iter().map(|j| qdd[j - 1]).collect());
+    }
+    let headers: Vec<String> = joints.iter().map(|j| format!("qdd{j}")).collect();
+    write_table(a.output.as_deref(), a.format, &headers, &rows)
+}
+
+/// Closed chains: columns q<j>, qd<j>, tau<j> of the actuated joints in, qdd<j> of the actuated
+/// joints out (the `--method` is the closed-chain model's A_cl, H_cl).
+fn run_closed(a: Args, robot: robodyn::Robot) -> CliResult {
+    use robodyn::algorithms::closed_chain::ClosedChain;
+    let cc = ClosedChain::new(&robot)?;
+    let joints = cc.actuated_joints().to_vec();
+    let n = joints.len();
+    let what = "actuated joints (closed chain)";
+    let states: Vec<(String, [Vec<f64>; 3])> = if let Some(path) = &a.input {
+        let t = Table::read(path)?;
+        let cols: Vec<[usize; 3]> = joints
+            .iter()
+            .map(|j| {
+                Ok([
+                    t.column(&format!("q{j}"))?,
+                    t.column(&format!("qd{j}"))?,
+                    t.column(&format!("tau{j}"))?,
+                ])
+            })
+            .collect::<CliResult<_>>()?;
+        t.rows
+            .iter()
+            .enumerate()
+            .map(|(k, r)| {
+                let s = std::array::from_fn(|i| cols.iter().map(|c| r[c[i]]).collect());
+                (format!("{}: data row {}", t.file, k + 1), s)
+            })
+            .collect()
+    } else {
+        let q =
+            a.q.as_deref()
+                .ok_or("give --input states.csv or --q (with --qd, --tau)")?;
+        let mut s = [vec![0.0; n], vec![0.0; n], vec![0.0; n]];
+        for (k, (name, v)) in [
+            ("q", Some(q)),
+            ("qd", a.qd.as_deref()),
+            ("tau", a.tau.as_deref()),
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            if let Some(v) = v {
+                let vals = parse_list(name, v)?;
+                if vals.len() != n {
+                    return Err(format!(
+                        "--{name} has {} values, the robot has {n} {what} ({joints:?})",
+                        vals.len()
+                    )
+                    .into());
+                }
+                s[k] = vals;
+            }
+        }
+        vec![("the given state".to_string(), s)]
+    };
+    let mut guess = a
+        .guess
+        .as_deref()
+        .map(|g| parse_list("guess", g))
+        .transpose()?;
+    let mut ws = cc.workspace();
+    let mut rows = Vec::with_capacity(states.len());
+    for (what, [q, qd, tau]) in &states {
+        let s = cc
+            .solve_from_reference(&mut ws, q, guess.as_deref())
+            .map_err(|e| format!("{what}: {e}"))?;
+        let r = cc
+            .direct_dynamics(&mut ws, q, qd, tau, Some(&s.q_p))
+            .map_err(|e| format!("{what}: {e}"))?;
+        rows.push(r.qdd_a.iter().copied().collect());
+        guess = Some(s.q_p);
     }
     let headers: Vec<String> = joints.iter().map(|j| format!("qdd{j}")).collect();
     write_table(a.output.as_deref(), a.format, &headers, &rows)

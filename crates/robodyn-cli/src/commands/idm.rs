@@ -175,7 +175,8 @@ fn run_closed(a: Args, robot: robodyn::Robot) -> CliResult {
     let mut ws = cc.workspace();
     let mut rows = Vec::with_capacity(states.len());
     for (i, [q, qd, qdd]) in states.iter().enumerate() {
-        let s = crate::commands::closure::solve(&cc, &mut ws, q, guess.as_deref())
+        let s = cc
+            .solve_from_reference(&mut ws, q, guess.as_deref())
             .map_err(|e| format!("state {}: {e}", i + 1))?;
         let r = cc
             .inverse_dynamics(&mut ws, q, qd, qdd, Some(&s.q_p))

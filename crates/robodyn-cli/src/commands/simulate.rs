@@ -1,13 +1,17 @@
 //! `robodyn simulate ROBOT --duration T --output traj.csv`: integrate the direct dynamic model
 //! of a tree robot under constant torques, a torque time series or a joint PD controller; stream
 //! the trajectory to CSV (kept when the run stops early) and optionally plot it as SVG.
+//!
+//! A closed-chain robot is simulated in its actuated coordinates (columns q<j>, qd<j>, qdd<j>,
+//! tau<j> of the actuated joints; q_p re-solved at every evaluation so the loops stay closed),
+//! with the extra columns `closure_residual` and the passive joints' q<j>.
 
 use crate::commands::ddm::MethodArg;
 use crate::common::{parse_list, CliResult, RobotArgs, Table};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use robodyn::simulation::{
-    plot_svg, simulate, CsvSink, Integrator, Recorder, SimOptions, Tee, TimeSeries, TorqueInput,
-    TreeDynamics,
+    plot_svg, simulate, ClosedChainDynamics, CsvSink, Dynamics, Integrator, Recorder, SimOptions,
+    Tee, TimeSeries, TorqueInput, TreeDynamics,
 };
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -31,7 +35,8 @@ pub struct Args {
     /// Time between output rows [s] (default: --dt, or 0.01).
     #[arg(long)]
     pub output_step: Option<f64>,
-    /// Initial joint positions, comma separated (movable joints in frame order; default zeros).
+    /// Initial joint positions, comma separated (movable joints in frame order; default zeros;
+    /// closed chains: the actuated joints, default their values in the `assembly`).
     #[arg(long, allow_hyphen_values = true)]
     pub q0: Option<String>,
     /// Initial joint velocities (default zeros).
@@ -53,6 +58,7 @@ pub struct Args {
     /// Derivative gains: one value for all joints or one per joint.
     #[arg(long, allow_hyphen_values = true)]
     pub kd: Option<String>,
+    /// Direct model of a tree robot (closed chains always use A_cl, H_cl of 10.46–10.48).
     #[arg(long, value_enum, default_value = "aba")]
     pub method: MethodArg,
     /// Simulate the Coulomb friction as Fs tanh(qd / V) instead of Fs sign(qd) (V in rad/s or
@@ -62,7 +68,8 @@ pub struct Args {
     /// Stop after this many integration steps.
     #[arg(long, default_value_t = 5_000_000)]
     pub max_steps: usize,
-    /// Trajectory CSV: t, q<j>, qd<j>, qdd<j>, tau<j>, energy.
+    /// Trajectory CSV: t, q<j>, qd<j>, qdd<j>, tau<j>, energy (closed chains: then
+    /// closure_residual and the passive q<j>).
     #[arg(long)]
     pub output: PathBuf,
     /// SVG plot of the joint positions and the total energy.
@@ -70,14 +77,20 @@ pub struct Args {
     pub plot: Option<PathBuf>,
 }
 
-fn joint_values(name: &str, s: Option<&str>, joints: &[usize]) -> CliResult<Vec<f64>> {
+fn joint_values(
+    name: &str,
+    s: Option<&str>,
+    joints: &[usize],
+    what: &str,
+    default: Option<&[f64]>,
+) -> CliResult<Vec<f64>> {
     let Some(s) = s else {
-        return Ok(vec![0.0; joints.len()]);
+        return Ok(default.map_or_else(|| vec![0.0; joints.len()], <[f64]>::to_vec));
     };
     let v = parse_list(name, s)?;
     if v.len() != joints.len() {
         return Err(format!(
-            "--{name} has {} values, the robot has {} movable tree joints ({joints:?})",
+            "--{name} has {} values, the robot has {} {what} ({joints:?})",
             v.len(),
             joints.len()
         )
@@ -140,28 +153,44 @@ fn read_series(
 
 pub fn run(a: Args) -> CliResult {
     let robot = a.robot.load()?;
-    if !robot.is_tree() {
-        return Err(format!(
-            "{} has {} closed loop(s): `simulate` integrates tree robots only (simulating the \
-             equivalent tree would ignore the loop closure); the closed-chain direct model \
-             plugs into the same simulator later",
-            robot.name(),
-            robot.n_loops()
-        )
-        .into());
-    }
     if !(a.coulomb_smoothing.is_finite() && a.coulomb_smoothing >= 0.0) {
         return Err("--coulomb-smoothing must be a finite number >= 0".into());
     }
-    let mut dynamics = TreeDynamics::new(&robot, a.method.into())
-        .with_coulomb_smoothing(Some(a.coulomb_smoothing));
-    let joints = dynamics.joints().to_vec();
+    let smoothing = Some(a.coulomb_smoothing);
+    let (mut dynamics, joints, what, q0_default): (Box<dyn Dynamics + '_>, _, _, _) =
+        if robot.is_tree() {
+            let d = TreeDynamics::new(&robot, a.method.into()).with_coulomb_smoothing(smoothing);
+            let joints = d.joints().to_vec();
+            (Box::new(d), joints, "movable tree joints", None)
+        } else {
+            let d = ClosedChainDynamics::new(&robot)?.with_coulomb_smoothing(smoothing);
+            let joints = d.actuated_joints().to_vec();
+            let q0 = d.model().reference_actuated();
+            if a.q0.is_none() {
+                let (m, z) = (d.model(), vec![0.0; q0.len()]);
+                let mut ws = m.workspace();
+                m.solve_from_reference(&mut ws, &q0, None)
+                    .and_then(|s| m.state(&mut ws, &q0, &z, &z, Some(&s.q_p)))
+                    .map_err(|e| {
+                        format!(
+                            "the default initial state (the actuated values {q0:?} of the \
+                             assembly configuration) cannot be simulated: {e}\n  give --q0"
+                        )
+                    })?;
+            }
+            (
+                Box::new(d),
+                joints,
+                "actuated joints (closed chain)",
+                Some(q0),
+            )
+        };
     let n = joints.len();
     if n == 0 {
         return Err("the robot has no movable joint: nothing to simulate".into());
     }
-    let q0 = joint_values("q0", a.q0.as_deref(), &joints)?;
-    let qd0 = joint_values("qd0", a.qd0.as_deref(), &joints)?;
+    let q0 = joint_values("q0", a.q0.as_deref(), &joints, what, q0_default.as_deref())?;
+    let qd0 = joint_values("qd0", a.qd0.as_deref(), &joints, what, None)?;
     let input = if let Some(p) = &a.torque_csv {
         TorqueInput::Series(read_series(p, &[("tau", false)], &joints)?.0)
     } else if let Some(p) = &a.track {
@@ -173,7 +202,13 @@ pub fn run(a: Args) -> CliResult {
             kd: gains("kd", a.kd.as_deref().unwrap_or_default(), n)?,
         }
     } else {
-        TorqueInput::Constant(joint_values("torque", a.torque.as_deref(), &joints)?)
+        TorqueInput::Constant(joint_values(
+            "torque",
+            a.torque.as_deref(),
+            &joints,
+            what,
+            None,
+        )?)
     };
     let integrator = match a.dt {
         Some(dt) => Integrator::Rk4 { dt },
@@ -210,7 +245,7 @@ pub fn run(a: Args) -> CliResult {
     };
     let result = if a.plot.is_some() {
         simulate(
-            &mut dynamics,
+            dynamics.as_mut(),
             &input,
             &q0,
             &qd0,
@@ -220,7 +255,7 @@ pub fn run(a: Args) -> CliResult {
         )
     } else {
         simulate(
-            &mut dynamics,
+            dynamics.as_mut(),
             &input,
             &q0,
             &qd0,

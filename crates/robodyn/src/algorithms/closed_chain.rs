@@ -10,20 +10,18 @@
 //! [`ClosedChain`] is the immutable model (built once from a [`Robot`]); [`ClosedChainWorkspace`]
 //! holds the buffers and the previous closure solution (the next solve's guess).
 
+use crate::algorithms::inertia_matrix::{inertia_matrix_into, InertiaWorkspace};
 use crate::algorithms::inverse_dynamics::rnea;
 use crate::algorithms::loop_closure::{ClosureSolution, LoopClosure, LoopWorkspace};
 use crate::error::{Error, Result};
-use crate::model::{DynModel, Robot};
+use crate::model::Robot;
 use crate::workspace::Workspace;
-use nalgebra::{DMatrix, DVector, Vector3};
+use nalgebra::{DMatrix, DVector};
 
 /// Closed-chain dynamic model: loop closure plus the equivalent tree.
 #[derive(Clone, Debug)]
 pub struct ClosedChain {
     closure: LoopClosure,
-    /// The tree model without gravity, base motion and external wrenches: its Newton–Euler
-    /// torques at qd = 0 are A_tr qdd.
-    inertia_model: DynModel<f64>,
 }
 
 /// Buffers of the closed-chain models.
@@ -33,7 +31,8 @@ pub struct ClosedChainWorkspace {
     pub tree: Workspace<f64>,
     tau: Vec<f64>,
     zeros: Vec<f64>,
-    unit: Vec<f64>,
+    inertia: InertiaWorkspace<f64>,
+    a_tr: DMatrix<f64>,
 }
 
 /// Constraint matrices at a closed configuration (eqs 10.27–10.30, 10.40).
@@ -101,21 +100,7 @@ impl ClosedChain {
     /// Build the model of a closed-chain robot (see [`LoopClosure::new`] for the checks).
     pub fn new(robot: &Robot) -> Result<ClosedChain> {
         let closure = LoopClosure::new(robot)?;
-        let mut inertia_model = robot.numeric().clone();
-        let z = Vector3::zeros();
-        inertia_model.gravity = z;
-        inertia_model.w0 = z;
-        inertia_model.wp0 = z;
-        inertia_model.v0 = z;
-        inertia_model.vp0 = z;
-        for l in inertia_model.links.iter_mut() {
-            l.fe = z;
-            l.me = z;
-        }
-        Ok(ClosedChain {
-            closure,
-            inertia_model,
-        })
+        Ok(ClosedChain { closure })
     }
 
     pub fn closure(&self) -> &LoopClosure {
@@ -146,7 +131,8 @@ impl ClosedChain {
             tree: Workspace::new(self.robot().numeric()),
             tau: vec![0.0; nl],
             zeros: vec![0.0; nl],
-            unit: vec![0.0; nl],
+            inertia: InertiaWorkspace::new(self.robot().numeric()),
+            a_tr: DMatrix::zeros(nl, nl),
         }
     }
 
@@ -158,6 +144,53 @@ impl ClosedChain {
         guess: Option<&[f64]>,
     ) -> Result<ClosureSolution> {
         self.closure.solve(&mut ws.closure, q_a, guess)
+    }
+
+    /// The reference configuration q_tr (NL entries): the description's `assembly`, else zeros.
+    pub fn reference(&self) -> Vec<f64> {
+        self.robot()
+            .description()
+            .assembly
+            .clone()
+            .unwrap_or_else(|| vec![0.0; self.robot().nl()])
+    }
+
+    /// The actuated values (q_a) of the reference configuration [`ClosedChain::reference`].
+    pub fn reference_actuated(&self) -> Vec<f64> {
+        let r = self.reference();
+        self.actuated_joints().iter().map(|&j| r[j - 1]).collect()
+    }
+
+    /// q_p for q_a on the reference assembly branch (the default start of loop closure). With
+    /// a `guess`, damped Newton from it. Without: when the loops close at the reference
+    /// configuration (the file's `assembly`, else q = 0), by continuation (16 steps) from there,
+    /// so that the answer lies on the reference branch; otherwise damped Newton from the
+    /// reference q_p.
+    pub fn solve_from_reference(
+        &self,
+        ws: &mut ClosedChainWorkspace,
+        q_a: &[f64],
+        guess: Option<&[f64]>,
+    ) -> Result<ClosureSolution> {
+        if guess.is_some() {
+            return self.solve_positions(ws, q_a, guess);
+        }
+        let reference = self.reference();
+        let ref_a = self.reference_actuated();
+        let ref_p: Vec<f64> = self
+            .passive_joints()
+            .iter()
+            .map(|&j| reference[j - 1])
+            .collect();
+        let lc = &self.closure;
+        if q_a.len() == self.dof() {
+            if let Ok(s0) = lc.solve(&mut ws.closure, &ref_a, Some(&ref_p)) {
+                if s0.iterations == 0 {
+                    return lc.solve_continuation(&mut ws.closure, q_a, &ref_a, &ref_p, 16);
+                }
+            }
+        }
+        self.solve_positions(ws, q_a, Some(&ref_p))
     }
 
     /// Wa, Wp, W and G at a closed configuration q_tr (error if Wp is singular).
@@ -298,30 +331,6 @@ impl ClosedChain {
         })
     }
 
-    /// A_tr (NL x NL, by joint number) of the equivalent tree by Newton–Euler columns:
-    /// column i = Γ_tr(q, 0, e_i) on the model without gravity, base motion and wrenches (friction
-    /// vanishes at qd = 0). To be replaced by the composite-link algorithm.
-    fn tree_inertia_matrix(&self, ws: &mut ClosedChainWorkspace, q: &[f64]) -> DMatrix<f64> {
-        let nl = self.robot().nl();
-        let mut a = DMatrix::zeros(nl, nl);
-        for j in self.robot().movable_joints() {
-            ws.unit.iter_mut().for_each(|x| *x = 0.0);
-            ws.unit[j - 1] = 1.0;
-            rnea(
-                &self.inertia_model,
-                &mut ws.tree,
-                q,
-                &ws.zeros,
-                &ws.unit,
-                &mut ws.tau,
-            );
-            for (r, &t) in ws.tau.iter().enumerate() {
-                a[(r, j - 1)] = t;
-            }
-        }
-        a
-    }
-
     /// Direct dynamic model: qdd_a = A_cl^-1 (Γ_cl - H_cl) (10.46–10.48) and qdd_p (10.42).
     pub fn direct_dynamics(
         &self,
@@ -331,12 +340,35 @@ impl ClosedChain {
         tau_a: &[f64],
         guess: Option<&[f64]>,
     ) -> Result<ClosedDdm> {
+        self.direct_dynamics_smoothed(ws, q_a, qd_a, tau_a, guess, None)
+    }
+
+    /// [`ClosedChain::direct_dynamics`] with the Coulomb friction of every tree joint (actuated
+    /// and passive) taken as Fs tanh(qd / v) instead of Fs sign(qd) when `coulomb_smoothing` is
+    /// `Some(v)`, v > 0 (for simulation: the exact sign makes the right-hand side discontinuous).
+    pub fn direct_dynamics_smoothed(
+        &self,
+        ws: &mut ClosedChainWorkspace,
+        q_a: &[f64],
+        qd_a: &[f64],
+        tau_a: &[f64],
+        guess: Option<&[f64]>,
+        coulomb_smoothing: Option<f64>,
+    ) -> Result<ClosedDdm> {
+        use crate::scalar::DynScalar;
         self.check("tau", tau_a)?;
         let n = self.dof();
         let zero_a = vec![0.0; n];
         // state with qdd_a = 0: qdd_tr = [0; -Wp^-1 Ψ]
         let mut state = self.state(ws, q_a, qd_a, &zero_a, guess)?;
-        let a_tr = self.tree_inertia_matrix(ws, &state.q);
+        // A_tr by composite links (rows/columns of fixed frames zero, Ia_j on the diagonal)
+        inertia_matrix_into(
+            self.robot().numeric(),
+            &mut ws.inertia,
+            &state.q,
+            &mut ws.a_tr,
+        );
+        let a_tr = &ws.a_tr;
         // H_tr = Γ_tr(q, qd, 0) (10.32)
         rnea(
             self.robot().numeric(),
@@ -346,13 +378,20 @@ impl ClosedChain {
             &ws.zeros,
             &mut ws.tau,
         );
-        let h_tr = DVector::from_column_slice(&ws.tau);
+        let mut h_tr = DVector::from_column_slice(&ws.tau);
+        if let Some(v) = coulomb_smoothing.filter(|v| *v > 0.0) {
+            let model = self.robot().numeric();
+            for j in self.robot().movable_joints() {
+                let s = state.qd[j - 1];
+                h_tr[j - 1] -= model.link(j).fs * (s.sign() - (s / v).tanh());
+            }
+        }
         let g = &state.constraints.g;
         // (10.46): A_cl = A_aa + A_ap W + W^T A_pa + W^T A_pp W = G^T A_tr G
-        let a_cl = g.transpose() * &a_tr * g;
+        let a_cl = g.transpose() * a_tr * g;
         // (10.47): H_cl = H_a + W^T H_p - (A_ap + W^T A_pp) Wp^-1 Ψ = G^T (H_tr + A_tr qdd0)
         let qdd0 = DVector::from_column_slice(&state.qdd);
-        let h_cl = g.transpose() * (h_tr + &a_tr * &qdd0);
+        let h_cl = g.transpose() * (h_tr + a_tr * &qdd0);
         let chol = a_cl.clone().cholesky().ok_or_else(|| {
             Error::Numerical(format!(
                 "the closed-chain inertia matrix A_cl is not positive definite at q_a = {q_a:?} \
@@ -378,8 +417,11 @@ impl ClosedChain {
     }
 }
 
-/// A closed-chain robot seen as a system in the actuated coordinates (for simulation): the
-/// loops are re-solved at every call with the previous solution as guess, so they never drift.
+/// A closed-chain robot seen as a system in the actuated coordinates: the loops are re-solved
+/// at every call with the previous solution as guess, so they never drift. The first call
+/// starts from the reference assembly ([`ClosedChain::solve_from_reference`]) unless a guess
+/// was set. The simulator's [`crate::simulation::Dynamics`] implementation is
+/// [`crate::simulation::ClosedChainDynamics`].
 #[derive(Clone, Debug)]
 pub struct ClosedDynamics {
     pub model: ClosedChain,
@@ -398,20 +440,41 @@ impl ClosedDynamics {
         self.model.dof()
     }
 
+    /// q_p for q_a: from the previous solution, or the reference assembly at the first call.
+    pub fn solve(&mut self, q_a: &[f64]) -> Result<ClosureSolution> {
+        if self.ws.closure.last_qp.is_some() {
+            self.model.solve_positions(&mut self.ws, q_a, None)
+        } else {
+            self.model.solve_from_reference(&mut self.ws, q_a, None)
+        }
+    }
+
     /// qdd_a for (q_a, qd_a, Γ_cl).
     pub fn accel(&mut self, q_a: &[f64], qd_a: &[f64], tau: &[f64]) -> Result<DVector<f64>> {
+        self.accel_smoothed(q_a, qd_a, tau, None)
+    }
+
+    /// qdd_a with the Coulomb friction smoothed ([`ClosedChain::direct_dynamics_smoothed`]).
+    pub fn accel_smoothed(
+        &mut self,
+        q_a: &[f64],
+        qd_a: &[f64],
+        tau: &[f64],
+        coulomb_smoothing: Option<f64>,
+    ) -> Result<DVector<f64>> {
+        if self.ws.closure.last_qp.is_none() {
+            self.model.solve_from_reference(&mut self.ws, q_a, None)?;
+        }
+        // guess None: the previous solution
         Ok(self
             .model
-            .direct_dynamics(&mut self.ws, q_a, qd_a, tau, None)?
+            .direct_dynamics_smoothed(&mut self.ws, q_a, qd_a, tau, None, coulomb_smoothing)?
             .qdd_a)
     }
 
-    /// Largest closure residual of the last solved configuration.
+    /// Largest closure residual (over the loops) of q_a's solution.
     pub fn closure_residual(&mut self, q_a: &[f64]) -> Result<f64> {
-        Ok(self
-            .model
-            .solve_positions(&mut self.ws, q_a, None)?
-            .residual)
+        Ok(self.solve(q_a)?.residual)
     }
 
     /// Set the guess of q_p for the next solve (e.g. the initial assembly).

@@ -1,15 +1,17 @@
 //! Simulation: integrate a direct dynamic model from an initial state under a torque input and
 //! stream the trajectory (t, q<j>, qd<j>, qdd<j>, tau<j>, energy, extra columns).
 //!
-//! The integrators only see a [`Dynamics`]: [`TreeDynamics`] for tree robots today; a
-//! closed-chain model (actuated coordinates, passive joints re-solved, a closure-residual extra
-//! column) plugs in by implementing the same trait.
+//! The integrators only see a [`Dynamics`]: [`TreeDynamics`] for tree robots and
+//! [`ClosedChainDynamics`] for closed chains (actuated coordinates, passive joints re-solved at
+//! every evaluation, extra columns `closure_residual` and the passive q<j>).
 
+pub mod closed;
 pub mod energy;
 pub mod input;
 pub mod integrators;
 pub mod output;
 
+pub use closed::ClosedChainDynamics;
 pub use input::{TimeSeries, TorqueInput};
 pub use integrators::{Integrator, Ode, Stats, Stepper};
 pub use output::{plot_svg, CsvSink, Recorder, Tee, TrajectorySink};
