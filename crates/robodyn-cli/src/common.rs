@@ -168,3 +168,74 @@ pub fn write_table(
     }
     Ok(())
 }
+
+/// One state per row: three per-joint columns (e.g. `q qd qdd` or `q qd tau`), for `joints` in
+/// that order, with a label naming its origin for error messages.
+pub type LabelledStates = Vec<(String, [Vec<f64>; 3])>;
+
+/// Read states of `joints` from a CSV file (`input`, columns `<name><j>`) or from the comma lists
+/// of the command line (`lists`, the first one required, the others default to zeros). `what`
+/// names the joints in messages ("movable tree joints", "actuated joints (closed chain)").
+pub fn read_joint_states(
+    input: Option<&Path>,
+    names: [&str; 3],
+    lists: [Option<&str>; 3],
+    joints: &[usize],
+    what: &str,
+) -> CliResult<LabelledStates> {
+    let n = joints.len();
+    if let Some(path) = input {
+        let t = Table::read(path)?;
+        let cols: Vec<[usize; 3]> = joints
+            .iter()
+            .map(|j| {
+                Ok([
+                    t.column(&format!("{}{j}", names[0]))?,
+                    t.column(&format!("{}{j}", names[1]))?,
+                    t.column(&format!("{}{j}", names[2]))?,
+                ])
+            })
+            .collect::<CliResult<_>>()?;
+        return Ok(t
+            .rows
+            .iter()
+            .enumerate()
+            .map(|(k, r)| {
+                let s = std::array::from_fn(|i| cols.iter().map(|c| r[c[i]]).collect());
+                (format!("{}: data row {}", t.file, k + 1), s)
+            })
+            .collect());
+    }
+    if lists[0].is_none() {
+        return Err(format!(
+            "give --input states.csv or --{} (with --{}, --{})",
+            names[0], names[1], names[2]
+        )
+        .into());
+    }
+    let mut s = [vec![0.0; n], vec![0.0; n], vec![0.0; n]];
+    for k in 0..3 {
+        if let Some(v) = lists[k] {
+            let vals = parse_list(names[k], v)?;
+            if vals.len() != n {
+                return Err(format!(
+                    "--{} has {} values, the robot has {n} {what} ({joints:?})",
+                    names[k],
+                    vals.len()
+                )
+                .into());
+            }
+            s[k] = vals;
+        }
+    }
+    Ok(vec![("the given state".to_string(), s)])
+}
+
+/// Spread values of `joints` into a vector of NL entries (index j-1), zeros elsewhere.
+pub fn scatter(joints: &[usize], nl: usize, values: &[f64]) -> Vec<f64> {
+    let mut v = vec![0.0; nl];
+    for (j, x) in joints.iter().zip(values) {
+        v[j - 1] = *x;
+    }
+    v
+}

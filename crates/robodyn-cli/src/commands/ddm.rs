@@ -6,7 +6,9 @@
 //! loop closure, each row starting from the previous row's solution, the first from `--guess`,
 //! else from the robot's assembly configuration as `closure` does).
 
-use crate::common::{parse_list, write_table, CliResult, RobotArgs, Table, TableFormat};
+use crate::common::{
+    parse_list, read_joint_states, scatter, write_table, CliResult, RobotArgs, TableFormat,
+};
 use robodyn::algorithms::direct_dynamics::{ddm, DirectWorkspace, Method};
 use robodyn::algorithms::inverse_dynamics::check_state;
 use std::path::PathBuf;
@@ -66,69 +68,21 @@ pub fn run(a: Args) -> CliResult {
     }
     let joints = robot.movable_joints();
     let nl = robot.nl();
-    let states: Vec<(String, [Vec<f64>; 3])> = if let Some(path) = &a.input {
-        let t = Table::read(path)?;
-        let cols: Vec<[usize; 3]> = joints
-            .iter()
-            .map(|j| {
-                Ok([
-                    t.column(&format!("q{j}"))?,
-                    t.column(&format!("qd{j}"))?,
-                    t.column(&format!("tau{j}"))?,
-                ])
-            })
-            .collect::<CliResult<_>>()?;
-        t.rows
-            .iter()
-            .enumerate()
-            .map(|(k, r)| {
-                let mut s = [vec![0.0; nl], vec![0.0; nl], vec![0.0; nl]];
-                for (j, c) in joints.iter().zip(&cols) {
-                    for i in 0..3 {
-                        s[i][j - 1] = r[c[i]];
-                    }
-                }
-                (format!("{}: data row {}", t.file, k + 1), s)
-            })
-            .collect()
-    } else {
-        let q =
-            a.q.as_deref()
-                .ok_or("give --input states.csv or --q (with --qd, --tau)")?;
-        let mut s = [vec![0.0; nl], vec![0.0; nl], vec![0.0; nl]];
-        for (k, (name, v)) in [
-            ("q", Some(q)),
-            ("qd", a.qd.as_deref()),
-            ("tau", a.tau.as_deref()),
-        ]
-        .into_iter()
-        .enumerate()
-        {
-            if let Some(v) = v {
-                let vals = parse_list(name, v)?;
-                if vals.len() != joints.len() {
-                    return Err(format!(
-                        "--{name} has {} values, the robot has {} movable tree joints ({:?})",
-                        vals.len(),
-                        joints.len(),
-                        joints
-                    )
-                    .into());
-                }
-                for (j, x) in joints.iter().zip(vals) {
-                    s[k][j - 1] = x;
-                }
-            }
-        }
-        vec![("the given state".to_string(), s)]
-    };
+    let states = read_joint_states(
+        a.input.as_deref(),
+        ["q", "qd", "tau"],
+        [a.q.as_deref(), a.qd.as_deref(), a.tau.as_deref()],
+        &joints,
+        "movable tree joints",
+    )?;
     let model = robot.numeric();
     let mut ws = DirectWorkspace::new(model);
     let mut qdd = vec![0.0; nl];
     let mut rows = Vec::with_capacity(states.len());
     for (what, [q, qd, tau]) in &states {
-        check_state(&robot, "q", q)?;
-        ddm(model, &mut ws, a.method.into(), q, qd, tau, &mut qdd)
+        let [q, qd, tau] = [q, qd, tau].map(|v| scatter(&joints, nl, v));
+        check_state(&robot, "q", &q)?;
+        ddm(model, &mut ws, a.method.into(), &q, &qd, &tau, &mut qdd)
             .map_err(|e| format!("{what}: {e}"))?;
         rows.push(joints.iter().map(|j| qdd[j - 1]).collect());
     }
@@ -142,55 +96,13 @@ fn run_closed(a: Args, robot: robodyn::Robot) -> CliResult {
     use robodyn::algorithms::closed_chain::ClosedChain;
     let cc = ClosedChain::new(&robot)?;
     let joints = cc.actuated_joints().to_vec();
-    let n = joints.len();
-    let what = "actuated joints (closed chain)";
-    let states: Vec<(String, [Vec<f64>; 3])> = if let Some(path) = &a.input {
-        let t = Table::read(path)?;
-        let cols: Vec<[usize; 3]> = joints
-            .iter()
-            .map(|j| {
-                Ok([
-                    t.column(&format!("q{j}"))?,
-                    t.column(&format!("qd{j}"))?,
-                    t.column(&format!("tau{j}"))?,
-                ])
-            })
-            .collect::<CliResult<_>>()?;
-        t.rows
-            .iter()
-            .enumerate()
-            .map(|(k, r)| {
-                let s = std::array::from_fn(|i| cols.iter().map(|c| r[c[i]]).collect());
-                (format!("{}: data row {}", t.file, k + 1), s)
-            })
-            .collect()
-    } else {
-        let q =
-            a.q.as_deref()
-                .ok_or("give --input states.csv or --q (with --qd, --tau)")?;
-        let mut s = [vec![0.0; n], vec![0.0; n], vec![0.0; n]];
-        for (k, (name, v)) in [
-            ("q", Some(q)),
-            ("qd", a.qd.as_deref()),
-            ("tau", a.tau.as_deref()),
-        ]
-        .into_iter()
-        .enumerate()
-        {
-            if let Some(v) = v {
-                let vals = parse_list(name, v)?;
-                if vals.len() != n {
-                    return Err(format!(
-                        "--{name} has {} values, the robot has {n} {what} ({joints:?})",
-                        vals.len()
-                    )
-                    .into());
-                }
-                s[k] = vals;
-            }
-        }
-        vec![("the given state".to_string(), s)]
-    };
+    let states = read_joint_states(
+        a.input.as_deref(),
+        ["q", "qd", "tau"],
+        [a.q.as_deref(), a.qd.as_deref(), a.tau.as_deref()],
+        &joints,
+        "actuated joints (closed chain)",
+    )?;
     let mut guess = a
         .guess
         .as_deref()
