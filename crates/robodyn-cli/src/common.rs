@@ -239,3 +239,31 @@ pub fn scatter(joints: &[usize], nl: usize, values: &[f64]) -> Vec<f64> {
     }
     v
 }
+
+/// Closed chains: evaluate a model row after row, each row's loop closure starting from the
+/// previous row's q_p (the first from `guess`, else from the robot's assembly configuration).
+/// `eval(ws, q_a, x, y, q_p)` gets the row's three columns and the solved q_p.
+pub fn closed_chain_rows(
+    cc: &robodyn::algorithms::closed_chain::ClosedChain,
+    states: &LabelledStates,
+    guess: Option<&str>,
+    mut eval: impl FnMut(
+        &mut robodyn::algorithms::closed_chain::ClosedChainWorkspace,
+        &[f64],
+        &[f64],
+        &[f64],
+        &[f64],
+    ) -> robodyn::Result<Vec<f64>>,
+) -> CliResult<Vec<Vec<f64>>> {
+    let mut guess = guess.map(|g| parse_list("guess", g)).transpose()?;
+    let mut ws = cc.workspace();
+    let mut rows = Vec::with_capacity(states.len());
+    for (what, [q, x, y]) in states {
+        let s = cc
+            .solve_from_reference(&mut ws, q, guess.as_deref())
+            .map_err(|e| format!("{what}: {e}"))?;
+        rows.push(eval(&mut ws, q, x, y, &s.q_p).map_err(|e| format!("{what}: {e}"))?);
+        guess = Some(s.q_p);
+    }
+    Ok(rows)
+}

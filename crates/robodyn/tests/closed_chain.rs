@@ -35,71 +35,7 @@ const ROBOTS: &[(&str, &[f64], &[f64], f64)] = &[
 /// Slider-crank with a PRISMATIC cut joint: crank 1 (0.1 m, actuated) and rod 2 (0.3 m) in the
 /// plane z0 = 0, slider link 3 pinned to the rod; cut joint 4 is the slider's prismatic joint along
 /// x0, its twin frame 5 fixed on the base. Assembled at q = 0 (crank along y0, sin beta = -1/3).
-const SLIDER_CRANK: &str = r#"
-name = "slider-crank (prismatic cut)"
-nl = 3
-nj = 4
-gravity = [0, -9.81, 0]
-[[frame]]
-j = 1
-ant = 0
-sigma = 0
-mu = 1
-theta = "pi/2"
-[[frame]]
-j = 2
-ant = 1
-sigma = 0
-mu = 0
-d = 0.1
-theta = "-pi/2 - 0.3398369094541219"
-[[frame]]
-j = 3
-ant = 2
-sigma = 0
-mu = 0
-d = 0.3
-theta = 0.3398369094541219
-[[frame]]
-j = 4
-ant = 3
-sigma = 1
-mu = 0
-gamma = "pi/2"
-alpha = "pi/2"
-[[frame]]
-j = 5
-ant = 0
-sigma = 2
-mu = 0
-gamma = "pi/2"
-alpha = "pi/2"
-[[link]]
-j = 1
-XX = 0.0002
-YY = 0.0034
-ZZ = 0.0034
-MX = 0.05
-M = 1.0
-IA = 0.01
-FV = 0.1
-[[link]]
-j = 2
-XX = 0.0003
-YY = 0.045
-ZZ = 0.045
-XY = 0.001
-MX = 0.225
-MY = 0.01
-M = 1.5
-[[link]]
-j = 3
-XX = 0.002
-YY = 0.003
-ZZ = 0.002
-MZ = 0.02
-M = 2.0
-"#;
+const SLIDER_CRANK: &str = include_str!("data/slider_crank.toml");
 
 fn slider_crank() -> Robot {
     robodyn::io::toml_format::parse_robot(SLIDER_CRANK, None).unwrap()

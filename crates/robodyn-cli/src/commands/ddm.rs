@@ -7,7 +7,7 @@
 //! else from the robot's assembly configuration as `closure` does).
 
 use crate::common::{
-    parse_list, read_joint_states, scatter, write_table, CliResult, RobotArgs, TableFormat,
+    closed_chain_rows, read_joint_states, scatter, write_table, CliResult, RobotArgs, TableFormat,
 };
 use robodyn::algorithms::direct_dynamics::{ddm, DirectWorkspace, Method};
 use robodyn::algorithms::inverse_dynamics::check_state;
@@ -103,23 +103,10 @@ fn run_closed(a: Args, robot: robodyn::Robot) -> CliResult {
         &joints,
         "actuated joints (closed chain)",
     )?;
-    let mut guess = a
-        .guess
-        .as_deref()
-        .map(|g| parse_list("guess", g))
-        .transpose()?;
-    let mut ws = cc.workspace();
-    let mut rows = Vec::with_capacity(states.len());
-    for (what, [q, qd, tau]) in &states {
-        let s = cc
-            .solve_from_reference(&mut ws, q, guess.as_deref())
-            .map_err(|e| format!("{what}: {e}"))?;
-        let r = cc
-            .direct_dynamics(&mut ws, q, qd, tau, Some(&s.q_p))
-            .map_err(|e| format!("{what}: {e}"))?;
-        rows.push(r.qdd_a.iter().copied().collect());
-        guess = Some(s.q_p);
-    }
+    let rows = closed_chain_rows(&cc, &states, a.guess.as_deref(), |ws, q, x, y, q_p| {
+        let r = cc.direct_dynamics(ws, q, x, y, Some(q_p))?;
+        Ok(r.qdd_a.iter().copied().collect())
+    })?;
     let headers: Vec<String> = joints.iter().map(|j| format!("qdd{j}")).collect();
     write_table(a.output.as_deref(), a.format, &headers, &rows)
 }
