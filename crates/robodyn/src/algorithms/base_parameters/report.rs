@@ -361,3 +361,90 @@ pub fn base_robot(
     );
     Ok(d)
 }
+
+/// How the symbolic rules and the numerical method compare on one robot (§10.3.4: for loops
+/// that are not parallelograms the rules do not use the cut-joint relations (10.51), so their
+/// set can be larger; the numerical method is then the arbiter).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct MethodComparison {
+    pub symbolic_count: usize,
+    pub numeric_count: usize,
+    /// Base by the symbolic rules but grouped or without effect numerically.
+    pub symbolic_only: Vec<String>,
+    /// Base numerically but grouped or without effect by the symbolic rules.
+    pub numeric_only: Vec<String>,
+    /// Cut joints of the loops the symbolic rules did not fully handle.
+    pub unhandled_loops: Vec<usize>,
+}
+
+/// Compare the base sets of the two methods.
+pub fn compare_methods(sb: &SymbolicBase, nb: &NumericBase) -> MethodComparison {
+    let only = |a: &[usize], b: &[usize]| -> Vec<String> {
+        a.iter()
+            .filter(|i| !b.contains(i))
+            .map(|&i| parameter_name(i))
+            .collect()
+    };
+    MethodComparison {
+        symbolic_count: sb.count(),
+        numeric_count: nb.count(),
+        symbolic_only: only(&sb.base, &nb.base),
+        numeric_only: only(&nb.base, &sb.base),
+        unhandled_loops: sb.unhandled_loops.clone(),
+    }
+}
+
+impl MethodComparison {
+    /// Same base set.
+    pub fn same(&self) -> bool {
+        self.symbolic_only.is_empty() && self.numeric_only.is_empty()
+    }
+
+    /// One note for the report: agreement, or which method is the arbiter and which
+    /// parameters differ.
+    pub fn note(&self) -> String {
+        if self.same() {
+            return format!(
+                "numerical method: {} base parameters, the same set as the symbolic rules",
+                self.numeric_count
+            );
+        }
+        let list = |v: &[String]| {
+            if v.is_empty() {
+                "none".to_string()
+            } else {
+                v.join(", ")
+            }
+        };
+        let why = if self.unhandled_loops.is_empty() {
+            String::new()
+        } else {
+            format!(
+                " (the rules do not use the cut-joint relations (10.51) of the loop(s) cut at \
+                 joint(s) {:?})",
+                self.unhandled_loops
+            )
+        };
+        format!(
+            "METHODS DIFFER: the symbolic rules give {} base parameters, the numerical method {}. \
+             The NUMERICAL method is the arbiter (its set is minimal){why}. Base by the rules \
+             only (grouped or without effect numerically): {}. Base numerically only: {}. The \
+             symbolic equations above remain valid groupings but are not minimal; use \
+             `--method numeric` for the minimal set.",
+            self.symbolic_count,
+            self.numeric_count,
+            list(&self.symbolic_only),
+            list(&self.numeric_only)
+        )
+    }
+}
+
+impl Report {
+    /// Add the comparison note (first, so it is seen) and mark the method.
+    pub fn add_comparison(&mut self, c: &MethodComparison) {
+        if !c.same() {
+            self.method = "symbolic; numerical method is the arbiter and differs";
+        }
+        self.notes.insert(0, c.note());
+    }
+}
