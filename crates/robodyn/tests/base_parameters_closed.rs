@@ -377,10 +377,21 @@ fn every_bundled_robot_counts_bounds_and_reproduces_the_full_model() {
                     let mut rep = Report::from_symbolic(robot.description(), &sb);
                     rep.add_comparison(&cmp);
                     let text = rep.to_text();
-                    assert!(text.contains("NUMERICAL method is the arbiter"), "{label}");
-                    for p in &cmp.symbolic_only {
-                        assert!(text.contains(p.as_str()), "{label}: {p} not named");
+                    // the block under the title names the arbiter and the differing parameters
+                    let head: String = text.lines().take(4).collect::<Vec<_>>().join("\n");
+                    assert!(
+                        head.contains("THE NUMERICAL METHOD IS THE ARBITER"),
+                        "{label}: {head}"
+                    );
+                    assert!(!cmp.symbolic_only.is_empty() || !cmp.numeric_only.is_empty());
+                    for p in cmp.symbolic_only.iter().chain(&cmp.numeric_only) {
+                        assert!(head.contains(p.as_str()), "{label}: {p} not named: {head}");
                     }
+                    let j = rep.to_json();
+                    assert_eq!(j["comparison"]["arbiter"], "numeric");
+                    assert_eq!(j["comparison"]["numeric_count"], nb.count());
+                    assert_eq!(j["comparison"]["symbolic_count"], sb.count());
+                    assert!(rep.to_latex().contains("% THE METHODS DIFFER"), "{label}");
                 }
             }
             eprintln!(
