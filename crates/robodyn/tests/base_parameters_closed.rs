@@ -440,6 +440,58 @@ fn closed_sampler_rejects_a_tree_and_reports_unclosable_assemblies() {
     let four = load("fourbar.toml");
     let mut s = ClosedChainSampler::new(&four).unwrap();
     assert!(s.sample(&sr, &mut rng(1)).is_err());
+    // a four-bar whose ground link (5 m) is longer than the three others together never closes:
+    // an error naming the robot, no panic
+    let mut d = four.description().clone();
+    d.frame_mut(3).d = robodyn::Expr::num(5.0);
+    match Robot::new(d) {
+        Err(e) => eprintln!("rejected at load: {e}"),
+        Ok(bad) => {
+            let e = ClosedChainSampler::new(&bad).unwrap_err().to_string();
+            assert!(
+                e.contains("planar four-bar") && e.contains("assembly"),
+                "{e}"
+            );
+        }
+    }
+}
+
+/// The diagnostic of a mismatch names the parameter: a grouping with one coefficient corrupted
+/// (M2 in ZZR1 of the four-bar) is caught by the torque check and M2 is the worst column.
+#[test]
+fn a_wrong_grouping_is_named() {
+    let robot = load("fourbar.toml");
+    let sel = ParameterSelection::new(&robot, RotorMode::Actuated, false);
+    let nb = numeric(&robot, &sel, 3);
+    let mut g = Grouping::numeric(&nb);
+    let zz1 = nb
+        .base
+        .iter()
+        .position(|&b| parameter_name(b) == "ZZ1")
+        .unwrap();
+    let m2 = nb
+        .columns
+        .iter()
+        .position(|&c| parameter_name(c) == "M2")
+        .unwrap();
+    assert!(g.coef[(zz1, m2)].abs() > 1e-3, "M2 groups into ZZR1");
+    g.coef[(zz1, m2)] *= 1.01;
+    let k = random_parameters(&robot, &sel, 9);
+    let values: Vec<f64> = (0..g.base.len())
+        .map(|r| {
+            g.columns
+                .iter()
+                .enumerate()
+                .map(|(c, &col)| g.coef[(r, c)] * k[col])
+                .sum()
+        })
+        .collect();
+    let out = std::panic::catch_unwind(|| {
+        check_against_idm("corrupted", &robot, &k, &g, &values, 4);
+    });
+    let msg = out.expect_err("the corrupted grouping must fail");
+    let msg = msg.downcast_ref::<String>().cloned().unwrap_or_default();
+    assert!(msg.contains("worst grouped parameter M2"), "{msg}");
 }
 
 /// The numerical result does not depend on the samples: for every closed robot, 8 seeds give the
