@@ -1,8 +1,10 @@
-//! Numerical method for the base parameters on 30-joint random trees, and the symbolic rules.
+//! Numerical method for the base parameters on 30-joint random trees and on the SR400 closed
+//! chain (loop-closure sampler), and the symbolic rules.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use robodyn::algorithms::base_parameters::{
-    numeric_base_parameters, symbolic_base_parameters, NumericOptions, TreeSampler,
+    numeric_base_parameters, symbolic_base_parameters, ClosedChainSampler, NumericOptions,
+    TreeSampler,
 };
 use robodyn::algorithms::regressor::{regressor, ParameterSelection, RotorMode, PARAMS_PER_LINK};
 use robodyn::testing::{random_state, random_tree, rng, TreeOptions};
@@ -24,6 +26,24 @@ fn bench(c: &mut Criterion) {
     });
     g.bench_function("symbolic_30_joint_tree", |b| {
         b.iter(|| symbolic_base_parameters(robot.description(), &sel).unwrap())
+    });
+    // SR400 closed chain (Table 10.2 selection): loop-closure sampler built once per run, as the
+    // CLI does
+    let sr400 = robodyn::io::load(std::path::Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../robots/sr400.toml"
+    )))
+    .unwrap();
+    let sr_opt = NumericOptions {
+        selection: ParameterSelection::new(&sr400, RotorMode::Actuated, false),
+        samples: None,
+        seed: 1,
+    };
+    g.bench_function("numeric_sr400_closed_chain", |b| {
+        b.iter(|| {
+            let mut s = ClosedChainSampler::new(&sr400).unwrap();
+            numeric_base_parameters(&sr400, &mut s, &sr_opt).unwrap()
+        })
     });
     g.finish();
     let [q, qd, qdd] = random_state(&mut r, 30);

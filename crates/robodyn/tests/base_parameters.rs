@@ -35,8 +35,8 @@ fn rx90(seed: u64) -> Robot {
     d.symbols.insert("RL4".into(), 0.45);
     for j in 1..=6 {
         let v = random_inertial(&mut r);
-        for k in 0..10 {
-            d.link_mut(j).params[k] = Expr::num(v[k]);
+        for (k, x) in v.iter().enumerate() {
+            d.link_mut(j).params[k] = Expr::num(*x);
         }
         d.link_mut(j).params[10] = Expr::num(r.random_range(0.1..1.0));
         d.link_mut(j).params[11] = Expr::zero();

@@ -4,8 +4,8 @@
 
 use crate::common::{CliResult, RobotArgs};
 use robodyn::algorithms::base_parameters::{
-    base_robot, numeric_base_parameters, symbolic_base_parameters, NumericOptions, Report,
-    TreeSampler,
+    base_robot, compare_methods, numeric_base_parameters, symbolic_base_parameters,
+    ClosedChainSampler, NumericOptions, Report, TreeSampler,
 };
 use robodyn::algorithms::regressor::{ParameterSelection, RotorMode};
 use std::path::PathBuf;
@@ -71,28 +71,23 @@ pub fn run(a: Args) -> CliResult {
         Method::Symbolic | Method::Both => Some(symbolic_base_parameters(&desc, &sel)?),
         Method::Numeric => None,
     };
-    let mut notes = Vec::new();
     let numeric = match a.method {
         Method::Numeric | Method::Both => {
-            if desc.nj != desc.nl {
-                let msg = "the numerical method of a closed chain needs consistent samples from \
-                           the loop-closure solver, which this build does not provide yet";
-                if a.method == Method::Numeric {
-                    return Err(msg.into());
-                }
-                notes.push(format!("numeric check skipped: {msg}"));
-                None
+            let robot = robodyn::Robot::new(desc.clone())
+                .map_err(|e| format!("the numerical method needs every symbol's value: {e}"))?;
+            let opt = NumericOptions {
+                selection: sel.clone(),
+                samples: None,
+                seed: a.seed,
+            };
+            let nb = if robot.is_tree() {
+                numeric_base_parameters(&robot, &mut TreeSampler, &opt)?
             } else {
-                let robot = robodyn::Robot::new(desc.clone())
-                    .map_err(|e| format!("the numerical method needs every symbol's value: {e}"))?;
-                let opt = NumericOptions {
-                    selection: sel.clone(),
-                    samples: None,
-                    seed: a.seed,
-                };
-                let nb = numeric_base_parameters(&robot, &mut TreeSampler, &opt)?;
-                Some((robot, nb))
-            }
+                // consistent samples by loop closure from the assembly configuration
+                let mut sampler = ClosedChainSampler::new(&robot)?;
+                numeric_base_parameters(&robot, &mut sampler, &opt)?
+            };
+            Some((robot, nb))
         }
         Method::Symbolic => None,
     };
@@ -102,22 +97,8 @@ pub fn run(a: Args) -> CliResult {
         _ => unreachable!(),
     };
     if let (Some(sb), Some((_, nb))) = (&symbolic, &numeric) {
-        let same = sb.base == nb.base;
-        report.notes.push(format!(
-            "numerical method: {} base parameters, {}",
-            nb.count(),
-            if same {
-                "the same set".to_string()
-            } else {
-                format!(
-                    "a DIFFERENT set from the symbolic rules ({}); the numerical method is the \
-                     arbiter",
-                    sb.count()
-                )
-            }
-        ));
+        report.add_comparison(&compare_methods(sb, nb));
     }
-    report.notes.extend(notes);
     match a.format {
         Format::Text => print!("{}", report.to_text()),
         Format::Latex => print!("{}", report.to_latex()),

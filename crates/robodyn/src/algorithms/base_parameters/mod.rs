@@ -13,4 +13,8 @@ pub mod symbolic;
 pub use symbolic::{collect_by_coefficient, symbolic_base_parameters, SymbolicBase};
 pub mod report;
 
-pub use report::{base_robot, Report};
+pub mod closed;
+
+pub use closed::ClosedChainSampler;
+
+pub use report::{base_robot, compare_methods, MethodComparison, Report};

@@ -35,6 +35,8 @@ pub struct Report {
     pub no_effect: Vec<String>,
     pub grouped: Vec<String>,
     pub notes: Vec<String>,
+    /// Comparison with the other method (`--method both`).
+    pub comparison: Option<MethodComparison>,
 }
 
 /// Name with the R suffix of grouped parameters: `XXR2`.
@@ -101,6 +103,7 @@ impl Report {
             no_effect: sb.no_effect.iter().map(|&i| parameter_name(i)).collect(),
             grouped: sb.grouped.iter().map(|&i| parameter_name(i)).collect(),
             notes,
+            comparison: None,
         }
     }
 
@@ -138,6 +141,7 @@ impl Report {
                  numbers for the robot's geometry (rounded for display only)",
                 nb.rows, nb.tolerance
             )],
+            comparison: None,
         }
     }
 
@@ -182,6 +186,9 @@ impl Report {
             self.count(),
             self.method
         );
+        if let Some(b) = self.comparison_block() {
+            s.push_str(&b);
+        }
         let t = self.table();
         let w: Vec<usize> = (0..t[0].len())
             .map(|c| t.iter().map(|r| r[c].len()).max().unwrap_or(1))
@@ -239,6 +246,13 @@ impl Report {
             self.method,
             "c".repeat(t[0].len())
         );
+        if let Some(b) = self.comparison_block() {
+            let lines: Vec<String> = b.lines().map(|l| format!("% {l}")).collect();
+            s.insert_str(
+                s.find('\n').map_or(0, |i| i + 1),
+                &format!("{}\n", lines.join("\n")),
+            );
+        }
         for (k, r) in t.iter().enumerate() {
             let cells: Vec<String> = r.iter().map(|x| latex_name(x)).collect();
             s.push_str(&format!("{} \\\\\n", cells.join(" & ")));
@@ -260,9 +274,11 @@ impl Report {
         s
     }
 
-    /// JSON: `count`, `base` [{name, equation, value}], `no_effect`, `grouped`.
+    /// JSON: `count`, `base` [{name, equation, value}], `no_effect`, `grouped`, and with both
+    /// methods `comparison` {arbiter, same, symbolic_count, numeric_count, symbolic_only,
+    /// numeric_only}.
     pub fn to_json(&self) -> serde_json::Value {
-        json!({
+        let mut o = json!({
             "robot": self.robot,
             "method": self.method,
             "count": self.count(),
@@ -274,7 +290,18 @@ impl Report {
             "no_effect": self.no_effect,
             "grouped": self.grouped,
             "notes": self.notes,
-        })
+        });
+        if let Some(c) = &self.comparison {
+            o["comparison"] = json!({
+                "arbiter": "numeric",
+                "same": c.same(),
+                "symbolic_count": c.symbolic_count,
+                "numeric_count": c.numeric_count,
+                "symbolic_only": c.symbolic_only,
+                "numeric_only": c.numeric_only,
+            });
+        }
+        o
     }
 }
 
@@ -360,4 +387,121 @@ pub fn base_robot(
             .into(),
     );
     Ok(d)
+}
+
+/// How the symbolic rules and the numerical method compare on one robot (§10.3.4: for loops
+/// that are not parallelograms the rules do not use the cut-joint relations (10.51), so their
+/// set can be larger; the numerical method is then the arbiter).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct MethodComparison {
+    pub symbolic_count: usize,
+    pub numeric_count: usize,
+    /// Base by the symbolic rules but grouped or without effect numerically.
+    pub symbolic_only: Vec<String>,
+    /// Base numerically but grouped or without effect by the symbolic rules.
+    pub numeric_only: Vec<String>,
+    /// Cut joints of the loops the symbolic rules did not fully handle.
+    pub unhandled_loops: Vec<usize>,
+}
+
+/// Compare the base sets of the two methods.
+pub fn compare_methods(sb: &SymbolicBase, nb: &NumericBase) -> MethodComparison {
+    let only = |a: &[usize], b: &[usize]| -> Vec<String> {
+        a.iter()
+            .filter(|i| !b.contains(i))
+            .map(|&i| parameter_name(i))
+            .collect()
+    };
+    MethodComparison {
+        symbolic_count: sb.count(),
+        numeric_count: nb.count(),
+        symbolic_only: only(&sb.base, &nb.base),
+        numeric_only: only(&nb.base, &sb.base),
+        unhandled_loops: sb.unhandled_loops.clone(),
+    }
+}
+
+impl MethodComparison {
+    /// Same base set.
+    pub fn same(&self) -> bool {
+        self.symbolic_only.is_empty() && self.numeric_only.is_empty()
+    }
+
+    /// One note for the report: agreement, or which method is the arbiter and which
+    /// parameters differ.
+    pub fn note(&self) -> String {
+        if self.same() {
+            return format!(
+                "numerical method: {} base parameters, the same set as the symbolic rules",
+                self.numeric_count
+            );
+        }
+        let list = |v: &[String]| {
+            if v.is_empty() {
+                "none".to_string()
+            } else {
+                v.join(", ")
+            }
+        };
+        let why = if self.unhandled_loops.is_empty() {
+            String::new()
+        } else {
+            format!(
+                " (the rules do not use the cut-joint relations (10.51) of the loop(s) cut at \
+                 joint(s) {:?})",
+                self.unhandled_loops
+            )
+        };
+        format!(
+            "METHODS DIFFER: the symbolic rules give {} base parameters, the numerical method {}. \
+             The NUMERICAL method is the arbiter (its set is minimal){why}. Base by the rules \
+             only (grouped or without effect numerically): {}. Base numerically only: {}. The \
+             symbolic equations above remain valid groupings but are not minimal; use \
+             `--method numeric` for the minimal set.",
+            self.symbolic_count,
+            self.numeric_count,
+            list(&self.symbolic_only),
+            list(&self.numeric_only)
+        )
+    }
+}
+
+impl Report {
+    /// Record the comparison with the other method: a note, and when the sets differ a block
+    /// right under the title of the text report (and `comparison` in JSON).
+    pub fn add_comparison(&mut self, c: &MethodComparison) {
+        self.notes.insert(0, c.note());
+        self.comparison = Some(c.clone());
+    }
+
+    /// The block printed under the title when the methods differ.
+    fn comparison_block(&self) -> Option<String> {
+        let c = self.comparison.as_ref().filter(|c| !c.same())?;
+        let list = |v: &[String]| {
+            if v.is_empty() {
+                "none".to_string()
+            } else {
+                v.join(", ")
+            }
+        };
+        Some(format!(
+            "THE METHODS DIFFER; THE NUMERICAL METHOD IS THE ARBITER: it finds {} base parameters, \
+             the symbolic rules {}{}.\n  base by the rules only: {}\n  base numerically only: {}\n\
+             The table and equations below are the symbolic ones (valid, not minimal); \
+             `--method numeric` gives the minimal set.\n\n",
+            c.numeric_count,
+            c.symbolic_count,
+            if c.unhandled_loops.is_empty() {
+                String::new()
+            } else {
+                format!(
+                    " (the loop(s) cut at joint(s) {:?} are not parallelograms: their cut-joint \
+                     relations 10.51 are not used by the rules)",
+                    c.unhandled_loops
+                )
+            },
+            list(&c.symbolic_only),
+            list(&c.numeric_only)
+        ))
+    }
 }
