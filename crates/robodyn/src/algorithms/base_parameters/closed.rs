@@ -6,8 +6,9 @@
 //! random walk continuing from the previous sample was tried first: on the SR400, whose assembly
 //! is a flattened parallelogram, the walk crosses the bifurcation set q7 = q2 and mixes the
 //! parallelogram and crossed branches, giving 50 base parameters instead of 42.) A sample is
-//! rejected (another drawn) when the closure fails or Wp is ill-conditioned (near a singular
-//! configuration, where G = [I; W] is inaccurate). Velocities and accelerations come from
+//! rejected (another drawn) when the closure fails or Wp is ill-conditioned at the sample or
+//! anywhere on the continuation path (a path through a singular configuration may switch
+//! assembly branch; near one, G = [I; W] is inaccurate). Velocities and accelerations come from
 //! [`ClosedChain::state`]: qd_p = W qd_a (10.29), qdd_p = W qdd_a - Wp^-1 Psi (10.42);
 //! G = d q_tr / d q_a (10.40).
 
@@ -99,7 +100,7 @@ impl ClosedChainSampler {
             range,
             chain,
             ws,
-            continuation: 12,
+            continuation: 24,
             min_wp_ratio: 1e-2,
             max_attempts: 200,
             qd_max: 2.0,
@@ -119,18 +120,60 @@ impl ClosedChainSampler {
         let target: Vec<f64> = (0..n)
             .map(|k| self.qa0[k] + rng.random_range(-self.range[k]..self.range[k]))
             .collect();
-        let sol = self
-            .chain
-            .closure()
-            .solve_continuation(
-                &mut self.ws.closure,
-                &target,
-                &self.qa0,
-                &self.qp0,
-                self.continuation,
-            )
-            .ok()?;
-        let qp = self.polish(&target, sol.q_p);
+        // Continuation from the assembly, staying in its regular region: a path through a
+        // singular configuration (Wp rank-deficient) may switch assembly branch (the SR400's
+        // parallelogram flattens at q7 = q2 and q7 = q2 + pi), so such a path is rejected.
+        // Predictor-corrector: the guess of each step is q_p + W dq_a (eq 10.29); a corrected
+        // q_p far from the prediction means Newton jumped to another branch: rejected.
+        let steps = self.continuation.max(1);
+        let zeros = vec![0.0; n];
+        let mut q_p = self.qp0.clone();
+        let mut w: Option<nalgebra::DMatrix<f64>> = None;
+        let dqa: Vec<f64> = (0..n)
+            .map(|k| (target[k] - self.qa0[k]) / steps as f64)
+            .collect();
+        for s in 1..=steps {
+            let t = s as f64 / steps as f64;
+            let qa: Vec<f64> = (0..n)
+                .map(|k| self.qa0[k] + t * (target[k] - self.qa0[k]))
+                .collect();
+            let predicted: Vec<f64> = match &w {
+                Some(w) => {
+                    let d = w * nalgebra::DVector::from_column_slice(&dqa);
+                    q_p.iter().zip(d.iter()).map(|(a, b)| a + b).collect()
+                }
+                None => q_p.clone(),
+            };
+            let step_norm = predicted
+                .iter()
+                .zip(&q_p)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max);
+            q_p = self
+                .chain
+                .closure()
+                .solve(&mut self.ws.closure, &qa, Some(&predicted))
+                .ok()?
+                .q_p;
+            let jump = q_p
+                .iter()
+                .zip(&predicted)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max);
+            if w.is_some() && jump > 0.05 + 0.5 * step_norm {
+                return None;
+            }
+            let on_path = self
+                .chain
+                .state(&mut self.ws, &qa, &zeros, &zeros, Some(&q_p))
+                .ok()?;
+            if ratio(&on_path) < self.min_wp_ratio {
+                return None;
+            }
+            w = Some(on_path.constraints.w.clone());
+        }
+        let sol_q_p = q_p;
+        let qp = self.polish(&target, sol_q_p);
         let mut v = |s: f64| -> Vec<f64> { (0..n).map(|_| rng.random_range(-s..s)).collect() };
         let (qd, qdd) = (v(self.qd_max), v(self.qdd_max));
         let state = self
