@@ -240,8 +240,11 @@ pub fn scatter(joints: &[usize], nl: usize, values: &[f64]) -> Vec<f64> {
     v
 }
 
-/// Closed chains: evaluate a model row after row, each row's loop closure starting from the
-/// previous row's q_p (the first from `guess`, else from the robot's assembly configuration).
+/// Continuation steps between consecutive rows of a closed-chain table.
+const CONTINUATION_STEPS: usize = 8;
+
+/// Closed chains: evaluate a model row after row, each row's loop closure continued from the
+/// previous row's solution (the first from `guess`, else from the robot's assembly configuration).
 /// `eval(ws, q_a, x, y, q_p)` gets the row's three columns and the solved q_p.
 pub fn closed_chain_rows(
     cc: &robodyn::algorithms::closed_chain::ClosedChain,
@@ -255,15 +258,23 @@ pub fn closed_chain_rows(
         &[f64],
     ) -> robodyn::Result<Vec<f64>>,
 ) -> CliResult<Vec<Vec<f64>>> {
-    let mut guess = guess.map(|g| parse_list("guess", g)).transpose()?;
+    let guess = guess.map(|g| parse_list("guess", g)).transpose()?;
     let mut ws = cc.workspace();
     let mut rows = Vec::with_capacity(states.len());
+    let mut previous: Option<(Vec<f64>, Vec<f64>)> = None;
     for (what, [q, x, y]) in states {
-        let s = cc
-            .solve_from_reference(&mut ws, q, guess.as_deref())
-            .map_err(|e| format!("{what}: {e}"))?;
+        // continuation from the previous row keeps the assembly branch even when consecutive
+        // rows are far apart (a plain Newton solve from the previous q_p may jump branches)
+        let s = match &previous {
+            None => cc.solve_from_reference(&mut ws, q, guess.as_deref()),
+            Some((qa0, qp0)) => {
+                cc.closure()
+                    .solve_continuation(&mut ws.closure, q, qa0, qp0, CONTINUATION_STEPS)
+            }
+        }
+        .map_err(|e| format!("{what}: {e}"))?;
         rows.push(eval(&mut ws, q, x, y, &s.q_p).map_err(|e| format!("{what}: {e}"))?);
-        guess = Some(s.q_p);
+        previous = Some((q.clone(), s.q_p));
     }
     Ok(rows)
 }

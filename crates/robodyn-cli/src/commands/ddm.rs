@@ -3,7 +3,7 @@
 //!
 //! For a closed-chain robot the states, torques and accelerations are those of the actuated
 //! joints only: qdd_a = A_cl^-1 (Γ_cl - H_cl) (10.46–10.48) at the consistent tree state (q_p by
-//! loop closure, each row starting from the previous row's solution, the first from `--guess`,
+//! loop closure, each row continued from the previous row's solution, the first from `--guess`,
 //! else from the robot's assembly configuration as `closure` does).
 
 use crate::common::{

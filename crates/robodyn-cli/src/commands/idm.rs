@@ -3,7 +3,7 @@
 //!
 //! For a closed-chain robot the states and torques are those of the actuated joints only:
 //! Γ_cl = G^T Γ_tr (10.40) at the consistent tree state (q_p solved by loop closure, each row
-//! starting from the previous row's solution; the first from `--guess`, else as `closure` does).
+//! continued from the previous row's solution; the first from `--guess`, else as `closure` does).
 
 use crate::common::{
     closed_chain_rows, read_joint_states, scatter, write_table, CliResult, RobotArgs, TableFormat,
