@@ -3,13 +3,13 @@
 
 use nalgebra::DMatrix;
 use rand::{Rng, RngCore};
+use robodyn::algorithms::base_parameters::inertial_bound;
 use robodyn::algorithms::base_parameters::{
     numeric_base_parameters, ConsistentSample, NumericBase, NumericOptions, Sampler, TreeSampler,
 };
 use robodyn::algorithms::regressor::{
     parameter_name, regressor, ParameterSelection, RotorMode, PARAMS_PER_LINK,
 };
-use robodyn::model::JointType;
 use robodyn::testing::{random_inertial, random_tree, rng, TreeOptions};
 use robodyn::{Expr, Robot, RobotDescription, Workspace};
 use std::f64::consts::FRAC_PI_2;
@@ -385,41 +385,6 @@ fn rx90_symbolic_has_40_base_parameters() {
     assert!(err < 1e-9, "RX-90 symbolic base model error {err:e}");
 }
 
-/// Bound b_m of eq 10.24 (10.57 without parallelograms) for the inertial parameters of a tree.
-fn bound_bm(robot: &Robot) -> usize {
-    let d = robot.description();
-    let (mut nr, mut np, mut nr0, mut np0, mut ng0) = (0i64, 0, 0, 0, 0);
-    let g = nalgebra::Vector3::new(
-        robot.value(&d.gravity[0]).unwrap(),
-        robot.value(&d.gravity[1]).unwrap(),
-        robot.value(&d.gravity[2]).unwrap(),
-    );
-    for j in 1..=robot.nl() {
-        let f = robot.frame(j);
-        let at_base = f.ant == 0;
-        match f.joint {
-            JointType::Revolute => {
-                nr += 1;
-                if at_base {
-                    nr0 += 1;
-                    let (rot, _) = robot.numeric().frame(j).transform(&0.0);
-                    if rot.column(2).cross(&g).norm() < 1e-9 * g.norm().max(1.0) {
-                        ng0 += 1;
-                    }
-                }
-            }
-            JointType::Prismatic => {
-                np += 1;
-                if at_base {
-                    np0 += 1;
-                }
-            }
-            JointType::Fixed => {}
-        }
-    }
-    (7 * nr + 4 * np - 4 * nr0 - 3 * np0 - 2 * ng0).max(0) as usize
-}
-
 #[test]
 fn random_trees_symbolic_agrees_with_numeric() {
     let mut worst: f64 = 0.0;
@@ -488,7 +453,7 @@ fn random_trees_symbolic_agrees_with_numeric() {
             .filter(|&&c| c % PARAMS_PER_LINK < 10)
             .count();
         assert!(
-            inertial <= bound_bm(&robot),
+            inertial <= inertial_bound(&robot, 0),
             "seed {seed}: {inertial} > b_m"
         );
         let err = check_symbolic_reproduces(&robot, &sb, &mut TreeSampler, seed + 11);

@@ -6,6 +6,7 @@
 
 use nalgebra::{DMatrix, DVector};
 use rand::Rng;
+use robodyn::algorithms::base_parameters::inertial_bound;
 use robodyn::algorithms::base_parameters::{
     compare_methods, numeric_base_parameters, symbolic_base_parameters, ClosedChainSampler,
     NumericBase, NumericOptions, Report, Sampler, SymbolicBase, TreeSampler,
@@ -15,7 +16,6 @@ use robodyn::algorithms::inverse_dynamics::inverse_dynamics;
 use robodyn::algorithms::regressor::{
     parameter_name, regressor, wrench_torques, ParameterSelection, RotorMode, PARAMS_PER_LINK,
 };
-use robodyn::model::JointType;
 use robodyn::testing::{random_inertial, rng};
 use robodyn::{Robot, Workspace};
 
@@ -202,41 +202,6 @@ fn check_against_idm(
     worst
 }
 
-/// Inertial bound b_m: 10.24 for a tree, 10.57 for a closed chain (n_par parallelogram loops).
-fn bound_bm(robot: &Robot, n_par: usize) -> usize {
-    let d = robot.description();
-    let (mut nr, mut np, mut nr0, mut np0, mut ng0) = (0i64, 0, 0, 0, 0);
-    let g = nalgebra::Vector3::new(
-        robot.value(&d.gravity[0]).unwrap(),
-        robot.value(&d.gravity[1]).unwrap(),
-        robot.value(&d.gravity[2]).unwrap(),
-    );
-    for j in 1..=robot.nl() {
-        let f = robot.frame(j);
-        let at_base = f.ant == 0;
-        match f.joint {
-            JointType::Revolute => {
-                nr += 1;
-                if at_base {
-                    nr0 += 1;
-                    let (rot, _) = robot.numeric().frame(j).transform(&0.0);
-                    if rot.column(2).cross(&g).norm() < 1e-9 * g.norm().max(1.0) {
-                        ng0 += 1;
-                    }
-                }
-            }
-            JointType::Prismatic => {
-                np += 1;
-                if at_base {
-                    np0 += 1;
-                }
-            }
-            JointType::Fixed => {}
-        }
-    }
-    (7 * nr + 4 * np - 4 * nr0 - 3 * np0 - 11 * n_par as i64 - 2 * ng0).max(0) as usize
-}
-
 fn numeric(robot: &Robot, sel: &ParameterSelection, seed: u64) -> NumericBase {
     let opt = NumericOptions {
         selection: sel.clone(),
@@ -360,7 +325,7 @@ fn every_bundled_robot_counts_bounds_and_reproduces_the_full_model() {
             let sb = symbolic_base_parameters(robot.description(), &sel).unwrap();
             // bound: inertial parameters <= b_m; drive parameters <= those selected
             let inertial = |b: &[usize]| b.iter().filter(|&&c| c % PARAMS_PER_LINK < 10).count();
-            let bm = bound_bm(&robot, sb.parallelograms.len());
+            let bm = inertial_bound(&robot, sb.parallelograms.len());
             assert!(
                 inertial(&nb.base) <= bm,
                 "{label}: numeric {} > b_m {bm}",
