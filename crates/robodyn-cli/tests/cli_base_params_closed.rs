@@ -5,44 +5,12 @@
 
 use serde_json::Value;
 use std::path::PathBuf;
-use std::process::Command;
+mod common;
 
-fn run(args: &[&str]) -> String {
-    let out = Command::new(env!("CARGO_BIN_EXE_robodyn"))
-        .args(args)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8(out.stdout).unwrap()
-}
+use common::{csv, robot, run};
 
-fn robot(name: &str) -> String {
-    format!("{}/../../robots/{name}", env!("CARGO_MANIFEST_DIR"))
-}
-
-fn tmp(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("robodyn_cli_bpc_{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
-}
-
-/// CSV text -> header and rows of numbers.
-fn csv(text: &str) -> (Vec<String>, Vec<Vec<f64>>) {
-    let mut lines = text.lines().filter(|l| !l.trim().is_empty());
-    let head: Vec<String> = lines
-        .next()
-        .unwrap()
-        .split(',')
-        .map(|s| s.trim().to_string())
-        .collect();
-    let rows = lines
-        .map(|l| l.split(',').map(|x| x.trim().parse().unwrap()).collect())
-        .collect();
-    (head, rows)
+fn tmp_(name: &str) -> PathBuf {
+    common::tmp("bpc", name)
 }
 
 #[test]
@@ -126,7 +94,7 @@ fn closed_base_regressor_times_base_values_gives_idm_torques() {
             .iter()
             .flat_map(|j| [format!("q{j}"), format!("qd{j}"), format!("qdd{j}")])
             .collect();
-        let input = tmp(&format!("{file}.csv"));
+        let input = tmp_(&format!("{file}.csv"));
         std::fs::write(
             &input,
             format!("{}\n{}\n", header.join(","), states.join("\n")),
@@ -165,7 +133,7 @@ fn closed_base_regressor_times_base_values_gives_idm_torques() {
         assert_eq!(values.len() + 3, head.len(), "{file}: {head:?}");
         for (s, state) in states.iter().enumerate() {
             // idm one state at a time: each solved from the assembly like the regressor
-            let one = tmp(&format!("{file}-{s}.csv"));
+            let one = tmp_(&format!("{file}-{s}.csv"));
             std::fs::write(&one, format!("{}\n{state}\n", header.join(","))).unwrap();
             let (ih, irows) = csv(&run(&["idm", &r, "--input", one.to_str().unwrap()]));
             for row in rows.iter().filter(|x| x[0] as usize == s + 1) {

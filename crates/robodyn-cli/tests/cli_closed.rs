@@ -3,16 +3,13 @@
 //! values, a closed loop along the trajectory, and `ddm` / `idm` agreeing with the simulation.
 
 use std::path::PathBuf;
+mod common;
+
+use common::{csv as parse_csv, run};
 use std::process::Command;
 
-fn robodyn(args: &[&str]) -> String {
-    let out = Command::new(env!("CARGO_BIN_EXE_robodyn"))
-        .args(args)
-        .output()
-        .unwrap();
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "robodyn {args:?}: {err}");
-    String::from_utf8(out.stdout).unwrap()
+fn tmp_(name: &str) -> PathBuf {
+    common::tmp("closed", name)
 }
 
 fn fourbar() -> String {
@@ -23,32 +20,11 @@ fn fourbar() -> String {
         .to_string()
 }
 
-fn tmp(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("robodyn_cli_closed_{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
-}
-
-fn parse_csv(text: &str) -> (Vec<String>, Vec<Vec<f64>>) {
-    let mut lines = text.lines();
-    let headers = lines
-        .next()
-        .unwrap()
-        .split(',')
-        .map(str::to_string)
-        .collect();
-    let rows = lines
-        .filter(|l| !l.trim().is_empty())
-        .map(|l| l.split(',').map(|x| x.trim().parse().unwrap()).collect())
-        .collect();
-    (headers, rows)
-}
-
 #[test]
 fn simulate_and_ddm_on_the_fourbar() {
     let robot = fourbar();
-    let traj = tmp("fourbar.csv");
-    robodyn(&[
+    let traj = tmp_("fourbar.csv");
+    run(&[
         "simulate",
         &robot,
         "--duration",
@@ -91,7 +67,7 @@ fn simulate_and_ddm_on_the_fourbar() {
     assert!((rows[50][1] - 0.3).abs() > 0.1, "the crank should turn");
     // ddm on the simulated states: the same qdd1 where the Coulomb smoothing tanh(qd/0.01) is
     // exactly sign(qd) (|qd| > 0.5)
-    let states = tmp("states.csv");
+    let states = tmp_("states.csv");
     let mut csv = String::from("q1,qd1,tau1\n");
     let picked: Vec<&Vec<f64>> = rows.iter().filter(|r| r[2].abs() > 0.5).collect();
     assert!(picked.len() > 10);
@@ -99,12 +75,7 @@ fn simulate_and_ddm_on_the_fourbar() {
         csv.push_str(&format!("{},{},{}\n", r[1], r[2], r[4]));
     }
     std::fs::write(&states, csv).unwrap();
-    let (hd, qdd) = parse_csv(&robodyn(&[
-        "ddm",
-        &robot,
-        "--input",
-        states.to_str().unwrap(),
-    ]));
+    let (hd, qdd) = parse_csv(&run(&["ddm", &robot, "--input", states.to_str().unwrap()]));
     assert_eq!(hd, ["qdd1"]);
     assert_eq!(qdd.len(), picked.len());
     for (r, a) in picked.iter().zip(&qdd) {
@@ -117,7 +88,7 @@ fn simulate_and_ddm_on_the_fourbar() {
     }
     // idm of that acceleration gives back the torque
     let r = picked[picked.len() / 2];
-    let (ht, tau) = parse_csv(&robodyn(&[
+    let (ht, tau) = parse_csv(&run(&[
         "idm",
         &robot,
         "--q",

@@ -2,11 +2,10 @@
 //! row far from its predecessor stays on the assembly branch and gets the same torques as when
 //! it is evaluated alone (from the robot's assembly configuration).
 
-use std::process::Command;
+mod common;
 
-fn robot(name: &str) -> String {
-    format!("{}/../../robots/{name}", env!("CARGO_MANIFEST_DIR"))
-}
+use common::robot;
+use std::process::Command;
 
 fn idm_csv(robot: &str, rows: &[f64]) -> Vec<f64> {
     let dir = std::env::temp_dir().join(format!("robodyn-cli-rows-{}", std::process::id()));

@@ -2,32 +2,15 @@
 //! parameters) and every link (its 13 standard parameters); `robodyn convert` between formats
 //! keeps the torques; mimic joints are flagged by `info`.
 
+mod common;
+
+use common::{robot, run};
+
+fn tmp_(name: &str) -> std::path::PathBuf {
+    common::tmp("info", name)
+}
 use serde_json::Value;
-use std::path::PathBuf;
 use std::process::Command;
-
-fn run(args: &[&str]) -> String {
-    let out = Command::new(env!("CARGO_BIN_EXE_robodyn"))
-        .args(args)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8(out.stdout).unwrap()
-}
-
-fn robot(name: &str) -> String {
-    format!("{}/../../robots/{name}", env!("CARGO_MANIFEST_DIR"))
-}
-
-fn tmp(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("robodyn_cli_info_{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
-}
 
 fn info_json(path: &str) -> Value {
     serde_json::from_str(&run(&["info", path, "--format", "json"])).unwrap()
@@ -100,7 +83,7 @@ fn json_keeps_urdf_joint_names_and_toml_names() {
 
 #[test]
 fn info_flags_mimic_joints() {
-    let f = tmp("mimic.urdf");
+    let f = tmp_("mimic.urdf");
     std::fs::write(
         &f,
         r#"<robot name="gripper">
@@ -138,13 +121,13 @@ fn convert_between_formats_keeps_the_torques() {
         run(&a)
     };
     let reference = idm(&robot("sr400.toml"));
-    let (toml, par) = (tmp("sr400_conv.toml"), tmp("sr400_conv.par"));
+    let (toml, par) = (tmp_("sr400_conv.toml"), tmp_("sr400_conv.par"));
     run(&["convert", &robot("sr400.par"), toml.to_str().unwrap()]);
     run(&["convert", toml.to_str().unwrap(), par.to_str().unwrap()]);
     assert_eq!(idm(toml.to_str().unwrap()), reference);
     assert_eq!(idm(par.to_str().unwrap()), reference);
     // URDF -> .par keeps the joint names
-    let p = tmp("rx90_conv.par");
+    let p = tmp_("rx90_conv.par");
     run(&["convert", &robot("rx90.urdf"), p.to_str().unwrap()]);
     let v = info_json(p.to_str().unwrap());
     assert_eq!(v["frames"][2]["name"], "elbow");
@@ -153,7 +136,7 @@ fn convert_between_formats_keeps_the_torques() {
         .args([
             "convert",
             &robot("rx90.toml"),
-            tmp("x.urdf").to_str().unwrap(),
+            tmp_("x.urdf").to_str().unwrap(),
         ])
         .output()
         .unwrap();

@@ -1,0 +1,46 @@
+//! Helpers shared by the CLI tests: run the binary, locate bundled robots, temporary files, CSV.
+#![allow(dead_code)]
+
+use std::path::PathBuf;
+use std::process::Command;
+
+/// Run `robodyn ARGS`, assert success, return standard output.
+pub fn run(args: &[&str]) -> String {
+    let out = Command::new(env!("CARGO_BIN_EXE_robodyn"))
+        .args(args)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "robodyn {args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).unwrap()
+}
+
+/// Path of a bundled robot file.
+pub fn robot(name: &str) -> String {
+    format!("{}/../../robots/{name}", env!("CARGO_MANIFEST_DIR"))
+}
+
+/// A path in a temporary directory of this test binary (`tag` keeps test files apart).
+pub fn tmp(tag: &str, name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("robodyn_cli_{tag}_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+/// CSV text -> header and rows of numbers.
+pub fn csv(text: &str) -> (Vec<String>, Vec<Vec<f64>>) {
+    let mut lines = text.lines().filter(|l| !l.trim().is_empty());
+    let head: Vec<String> = lines
+        .next()
+        .unwrap()
+        .split(',')
+        .map(|s| s.trim().to_string())
+        .collect();
+    let rows = lines
+        .map(|l| l.split(',').map(|x| x.trim().parse().unwrap()).collect())
+        .collect();
+    (head, rows)
+}
