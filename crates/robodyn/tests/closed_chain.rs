@@ -2,6 +2,9 @@
 //! the Lagrange-multiplier form against the G^T projection, kinetic energy against A_cl, the
 //! power balance against Γ_cl (independent of Newton–Euler), and idm(ddm(tau)) = tau.
 
+mod common;
+
+use common::{cases, robot, ROBOTS};
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 use rand::Rng;
 use robodyn::algorithms::closed_chain::{ClosedChain, ClosedDynamics, ClosedState};
@@ -9,49 +12,6 @@ use robodyn::algorithms::inverse_dynamics::rnea;
 use robodyn::algorithms::loop_closure::LoopClosure;
 use robodyn::{Error, Robot};
 use std::f64::consts::{FRAC_PI_2, PI};
-use std::path::PathBuf;
-
-fn robot(name: &str) -> Robot {
-    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../robots")
-        .join(name);
-    robodyn::io::load(&p).unwrap_or_else(|e| panic!("{name}: {e}"))
-}
-
-/// File, reference (q_a, q_p) where the loops close, random range of q_a around it.
-const ROBOTS: &[(&str, &[f64], &[f64], f64)] = &[
-    (
-        "sr400.toml",
-        &[0.0, 0.0, 0.0, 0.0, 0.0, FRAC_PI_2],
-        &[PI, -FRAC_PI_2],
-        0.5,
-    ),
-    ("fourbar.toml", &[0.0], &[0.0, 0.0], 1.0),
-    ("fivebar.toml", &[0.0, 0.0], &[0.0, 0.0], 0.3),
-    ("spatial_loop.toml", &[0.0], &[0.0; 5], 0.3),
-    ("twoloops.toml", &[0.0], &[0.0; 4], 1.0),
-];
-
-/// Slider-crank with a PRISMATIC cut joint: crank 1 (0.1 m, actuated) and rod 2 (0.3 m) in the
-/// plane z0 = 0, slider link 3 pinned to the rod; cut joint 4 is the slider's prismatic joint along
-/// x0, its twin frame 5 fixed on the base. Assembled at q = 0 (crank along y0, sin beta = -1/3).
-const SLIDER_CRANK: &str = include_str!("data/slider_crank.toml");
-
-fn slider_crank() -> Robot {
-    robodyn::io::toml_format::parse_robot(SLIDER_CRANK, None).unwrap()
-}
-
-/// The bundled robots and the slider-crank: (label, robot, q_a0, q_p0, range).
-type Loaded = (&'static str, Robot, &'static [f64], &'static [f64], f64);
-
-fn cases() -> Vec<Loaded> {
-    let mut v: Vec<_> = ROBOTS
-        .iter()
-        .map(|c| (c.0, robot(c.0), c.1, c.2, c.3))
-        .collect();
-    v.push(("slider-crank", slider_crank(), &[0.0], &[0.0, 0.0], 1.0));
-    v
-}
 
 fn uniform(rng: &mut impl Rng, n: usize, s: f64) -> Vec<f64> {
     (0..n).map(|_| rng.random_range(-s..s)).collect()

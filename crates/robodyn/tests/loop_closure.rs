@@ -2,65 +2,23 @@
 //! against central finite differences of the solved q_p, Ψ against the second derivative of the
 //! solved q_p along random smooth paths q_a(t), and the errors (unreachable, singular Wp).
 
+mod common;
+
+use common::{cases, robot, slider_crank, ROBOTS};
 use rand::Rng;
 use robodyn::algorithms::closed_chain::ClosedChain;
 use robodyn::algorithms::loop_closure::LoopClosure;
 use robodyn::{Error, Robot};
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_6, PI};
-use std::path::PathBuf;
 
-fn robot(name: &str) -> Robot {
-    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../robots")
-        .join(name);
-    robodyn::io::load(&p).unwrap_or_else(|e| panic!("{name}: {e}"))
-}
-
-/// Bundled closed robots: file, reference q_a, q_p where the loops are closed, random range of q_a
-/// around it, and the number of kept equations per loop.
-/// (file, q_a0, q_p0, range, rows per loop)
-type Case = (
-    &'static str,
-    &'static [f64],
-    &'static [f64],
-    f64,
-    &'static [usize],
-);
-
-const ROBOTS: &[Case] = &[
-    (
-        "sr400.toml",
-        &[0.0, 0.0, 0.0, 0.0, 0.0, FRAC_PI_2],
-        &[PI, -FRAC_PI_2],
-        0.5,
-        &[2],
-    ),
-    ("fourbar.toml", &[0.0], &[0.0, 0.0], 1.0, &[2]),
-    ("fivebar.toml", &[0.0, 0.0], &[0.0, 0.0], 0.3, &[2]),
-    ("spatial_loop.toml", &[0.0], &[0.0; 5], 0.3, &[5]),
-    ("twoloops.toml", &[0.0], &[0.0; 4], 1.0, &[2, 2]),
+/// Independent closure equations kept per loop (by rank), for each bundled closed robot.
+const ROWS_PER_LOOP: &[(&str, &[usize])] = &[
+    ("sr400.toml", &[2]),
+    ("fourbar.toml", &[2]),
+    ("fivebar.toml", &[2]),
+    ("spatial_loop.toml", &[5]),
+    ("twoloops.toml", &[2, 2]),
 ];
-
-/// Slider-crank with a PRISMATIC cut joint: crank 1 (0.1 m, actuated) and rod 2 (0.3 m) in the
-/// plane z0 = 0, slider link 3 pinned to the rod; cut joint 4 is the slider's prismatic joint along
-/// x0, its twin frame 5 fixed on the base. Assembled at q = 0 (crank along y0, sin beta = -1/3).
-const SLIDER_CRANK: &str = include_str!("data/slider_crank.toml");
-
-fn slider_crank() -> Robot {
-    robodyn::io::toml_format::parse_robot(SLIDER_CRANK, None).unwrap()
-}
-
-/// The bundled robots and the slider-crank: (label, robot, q_a0, q_p0, range).
-type Loaded = (&'static str, Robot, &'static [f64], &'static [f64], f64);
-
-fn cases() -> Vec<Loaded> {
-    let mut v: Vec<_> = ROBOTS
-        .iter()
-        .map(|c| (c.0, robot(c.0), c.1, c.2, c.3))
-        .collect();
-    v.push(("slider-crank", slider_crank(), &[0.0], &[0.0, 0.0], 1.0));
-    v
-}
 
 /// A random reachable q_a near the reference and its q_p (by continuation from the reference).
 fn random_config(
@@ -113,7 +71,8 @@ fn sr400_example_10_1() {
 
 #[test]
 fn bundled_robots_close_at_reference_with_rank_chosen_rows() {
-    for (name, qa0, qp0, _, rows) in ROBOTS {
+    for ((name, qa0, qp0, _), (rows_name, rows)) in ROBOTS.iter().zip(ROWS_PER_LOOP) {
+        assert_eq!(name, rows_name);
         let r = robot(name);
         let lc = LoopClosure::new(&r).unwrap();
         let kept: Vec<usize> = lc.loops().iter().map(|l| l.rows.len()).collect();
