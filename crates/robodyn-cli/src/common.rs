@@ -130,6 +130,23 @@ pub enum TableFormat {
     Json,
 }
 
+/// Where and how a command writes its table (`--output`, `--format`).
+#[derive(Args, Debug, Clone)]
+pub struct TableOutput {
+    /// Output file (default: standard output).
+    #[arg(long)]
+    pub output: Option<PathBuf>,
+    #[arg(long, value_enum, default_value = "csv")]
+    pub format: TableFormat,
+}
+
+impl TableOutput {
+    /// Write rows of named columns.
+    pub fn write(&self, headers: &[String], rows: &[Vec<f64>]) -> CliResult {
+        write_table(self.output.as_deref(), self.format, headers, rows)
+    }
+}
+
 /// Write rows of named columns as CSV or JSON (a list of objects) to a file or stdout.
 pub fn write_table(
     path: Option<&Path>,

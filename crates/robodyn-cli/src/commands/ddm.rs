@@ -7,7 +7,7 @@
 //! else from the robot's assembly configuration as `closure` does).
 
 use crate::common::{
-    closed_chain_rows, read_joint_states, scatter, write_table, CliResult, RobotArgs, TableFormat,
+    closed_chain_rows, read_joint_states, scatter, CliResult, RobotArgs, TableOutput,
 };
 use robodyn::algorithms::direct_dynamics::{ddm, DirectWorkspace, Method};
 use robodyn::algorithms::inverse_dynamics::check_state;
@@ -51,11 +51,8 @@ pub struct Args {
     pub tau: Option<String>,
     #[arg(long, value_enum, default_value = "composite")]
     pub method: MethodArg,
-    /// Output file (default: standard output).
-    #[arg(long)]
-    pub output: Option<PathBuf>,
-    #[arg(long, value_enum, default_value = "csv")]
-    pub format: TableFormat,
+    #[command(flatten)]
+    pub out: TableOutput,
     /// Closed chains: initial guess of q_p for the first state (passive tree joints in order).
     #[arg(long, allow_hyphen_values = true)]
     pub guess: Option<String>,
@@ -87,7 +84,7 @@ pub fn run(a: Args) -> CliResult {
         rows.push(joints.iter().map(|j| qdd[j - 1]).collect());
     }
     let headers: Vec<String> = joints.iter().map(|j| format!("qdd{j}")).collect();
-    write_table(a.output.as_deref(), a.format, &headers, &rows)
+    a.out.write(&headers, &rows)
 }
 
 /// Closed chains: columns q<j>, qd<j>, tau<j> of the actuated joints in, qdd<j> of the actuated
@@ -108,5 +105,5 @@ fn run_closed(a: Args, robot: robodyn::Robot) -> CliResult {
         Ok(r.qdd_a.iter().copied().collect())
     })?;
     let headers: Vec<String> = joints.iter().map(|j| format!("qdd{j}")).collect();
-    write_table(a.output.as_deref(), a.format, &headers, &rows)
+    a.out.write(&headers, &rows)
 }

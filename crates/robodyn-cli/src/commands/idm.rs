@@ -6,7 +6,7 @@
 //! continued from the previous row's solution; the first from `--guess`, else as `closure` does).
 
 use crate::common::{
-    closed_chain_rows, read_joint_states, scatter, write_table, CliResult, RobotArgs, TableFormat,
+    closed_chain_rows, read_joint_states, scatter, CliResult, RobotArgs, TableOutput,
 };
 use robodyn::algorithms::inverse_dynamics::{check_state, rnea};
 use robodyn::Workspace;
@@ -30,11 +30,8 @@ pub struct Args {
     /// Joint accelerations (default zeros).
     #[arg(long, allow_hyphen_values = true)]
     pub qdd: Option<String>,
-    /// Output file (default: standard output).
-    #[arg(long)]
-    pub output: Option<PathBuf>,
-    #[arg(long, value_enum, default_value = "csv")]
-    pub format: TableFormat,
+    #[command(flatten)]
+    pub out: TableOutput,
     /// Closed chains: initial guess of q_p for the first state (passive tree joints in order).
     #[arg(long, allow_hyphen_values = true)]
     pub guess: Option<String>,
@@ -65,7 +62,7 @@ pub fn run(a: Args) -> CliResult {
         rows.push(joints.iter().map(|j| tau[j - 1]).collect());
     }
     let headers: Vec<String> = joints.iter().map(|j| format!("tau{j}")).collect();
-    write_table(a.output.as_deref(), a.format, &headers, &rows)
+    a.out.write(&headers, &rows)
 }
 
 /// Closed chains: columns of the actuated joints in, tau<j> of the actuated joints out.
@@ -85,5 +82,5 @@ fn run_closed(a: Args, robot: robodyn::Robot) -> CliResult {
         Ok(r.gamma_cl.iter().copied().collect())
     })?;
     let headers: Vec<String> = joints.iter().map(|j| format!("tau{j}")).collect();
-    write_table(a.output.as_deref(), a.format, &headers, &rows)
+    a.out.write(&headers, &rows)
 }

@@ -7,7 +7,7 @@
 //! `--base` a closed chain uses the numerical base set when the symbolic rules do not handle
 //! every loop (the numerical method is then the arbiter).
 
-use crate::common::{write_table, CliResult, RobotArgs, Table, TableFormat};
+use crate::common::{CliResult, RobotArgs, Table, TableOutput};
 use robodyn::algorithms::base_parameters::report::grouped_name;
 use robodyn::algorithms::base_parameters::{
     numeric_base_parameters, symbolic_base_parameters, ClosedChainSampler, NumericOptions,
@@ -37,11 +37,8 @@ pub struct Args {
     /// Seed of the numerical method's samples (closed chain with `--base`).
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Output file (default: standard output).
-    #[arg(long)]
-    pub output: Option<PathBuf>,
-    #[arg(long, value_enum, default_value = "csv")]
-    pub format: TableFormat,
+    #[command(flatten)]
+    pub out: TableOutput,
 }
 
 pub fn run(a: Args) -> CliResult {
@@ -173,5 +170,5 @@ pub fn run(a: Args) -> CliResult {
         .map(|s| s.to_string())
         .chain(names)
         .collect();
-    write_table(a.output.as_deref(), a.format, &headers, &rows)
+    a.out.write(&headers, &rows)
 }
