@@ -528,7 +528,7 @@ impl Program {
     }
 
     /// Inline assignments used exactly once when that lowers the operation count (constants
-    /// fold, like terms merge).
+    /// fold, like terms merge), or when the single user is a plain copy of it (`GAMCL4 = GAM4`).
     pub fn inline_single_use(&mut self) {
         let mut uses_count: HashMap<String, usize> = HashMap::new();
         for a in self.assignments.iter().chain(&self.outputs) {
@@ -565,7 +565,8 @@ impl Program {
             let before = count_ops(&slot.expr) + count_ops(&def);
             let after_expr = slot.expr.substitute(&|s| (s == name).then(|| def.clone()));
             let after = count_ops(&after_expr);
-            if after.mul + after.add < before.mul + before.add {
+            let copy = slot.expr.as_symbol() == Some(name.as_str());
+            if copy || after.mul + after.add < before.mul + before.add {
                 uses_count.clear();
                 slot.expr = after_expr;
                 self.assignments.remove(i);

@@ -159,6 +159,7 @@ pub fn convert_model<T: DynScalar>(m: &DynModel<f64>) -> DynModel<T> {
             .iter()
             .map(|l| LinkConstants {
                 inertia: l.inertia.map(f),
+                inertia_diff: map3(&l.inertia_diff),
                 ms: map3(&l.ms),
                 mass: f(l.mass),
                 ia: f(l.ia),

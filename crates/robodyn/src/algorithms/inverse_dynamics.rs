@@ -33,18 +33,33 @@ fn name3<T: DynScalar>(v: Vector3<T>, prefix: &str, j: usize) -> Vector3<T> {
     )
 }
 
+/// Products of the components of w: (w_y w_z, w_x w_z, w_x w_y) and (w_x^2, w_y^2, w_z^2).
+/// Shared by jU_j and the Euler moment; the customized model names them `T<k>` when shared.
+#[inline]
+fn w_products<T: DynScalar>(w: &Vector3<T>) -> (Vector3<T>, Vector3<T>) {
+    let (x, y, z) = (w.x.clone(), w.y.clone(), w.z.clone());
+    (
+        Vector3::new(
+            y.clone() * z.clone(),
+            x.clone() * z.clone(),
+            x.clone() * y.clone(),
+        ),
+        Vector3::new(x.clone() * x, y.clone() * y, z.clone() * z),
+    )
+}
+
 /// jU_j = skew(wd) + skew(w) skew(w) (below eq 10.8), computed once per link and used both for
 /// the acceleration of its successors' origins (10.6) and for its own force (10.7); entries are
-/// named `U<r><c><j>` in the customized model.
+/// named `U<r><c><j>` in the customized model. `p` and `sq` come from [`w_products`].
 #[inline]
-fn u_matrix<T: DynScalar>(w: &Vector3<T>, wd: &Vector3<T>, j: usize) -> Matrix3<T> {
-    let (x, y, z) = (w.x.clone(), w.y.clone(), w.z.clone());
-    let (xx, yy, zz) = (
-        x.clone() * x.clone(),
-        y.clone() * y.clone(),
-        z.clone() * z.clone(),
-    );
-    let (xy, xz, yz) = (x.clone() * y.clone(), x * z.clone(), y * z);
+fn u_matrix<T: DynScalar>(
+    p: &Vector3<T>,
+    sq: &Vector3<T>,
+    wd: &Vector3<T>,
+    j: usize,
+) -> Matrix3<T> {
+    let (yz, xz, xy) = (p.x.clone(), p.y.clone(), p.z.clone());
+    let (xx, yy, zz) = (sq.x.clone(), sq.y.clone(), sq.z.clone());
     let u = Matrix3::new(
         -(yy.clone() + zz.clone()),
         xy.clone() - wd.z.clone(),
@@ -66,6 +81,43 @@ fn u_matrix<T: DynScalar>(w: &Vector3<T>, wd: &Vector3<T>, j: usize) -> Matrix3<
     })
 }
 
+/// Euler moment J wd + w x (J w) of eq 10.8 in product form, with the products of w shared with
+/// jU_j (derived from first principles; the spec writes the vector form):
+///
+/// n_x = XX wd_x + XY (wd_y - w_x w_z) + XZ (wd_z + w_x w_y) + YZ (w_y^2 - w_z^2)
+///       + (ZZ - YY) w_y w_z,
+///
+/// and cyclically for y and z. Here wd_y - w_x w_z = -U31, wd_z + w_x w_y = U21 and
+/// w_y^2 - w_z^2 is a difference of the squares `sq`. Fifteen multiplications instead of the 24
+/// of J wd + w x (J w); with base parameters (YY = 0) the differences of moments mostly vanish.
+#[inline]
+fn euler_moment<T: DynScalar>(
+    inertia: &Matrix3<T>,
+    diff: &Vector3<T>,
+    wd: &Vector3<T>,
+    p: &Vector3<T>,
+    sq: &Vector3<T>,
+    u: &Matrix3<T>,
+) -> Vector3<T> {
+    let jj = |r: usize, c: usize| inertia[(r, c)].clone();
+    let uu = |r: usize, c: usize| u[(r, c)].clone();
+    let (xy, xz, yz) = (jj(0, 1), jj(0, 2), jj(1, 2));
+    Vector3::new(
+        jj(0, 0) * wd.x.clone() - xy.clone() * uu(2, 0)
+            + xz.clone() * uu(1, 0)
+            + yz.clone() * (sq.y.clone() - sq.z.clone())
+            + diff.x.clone() * p.x.clone(),
+        jj(1, 1) * wd.y.clone() - yz.clone() * uu(0, 1)
+            + xy.clone() * uu(2, 1)
+            + xz.clone() * (sq.z.clone() - sq.x.clone())
+            + diff.y.clone() * p.y.clone(),
+        jj(2, 2) * wd.z.clone() - xz * uu(1, 2)
+            + yz * uu(0, 2)
+            + xy * (sq.x.clone() - sq.y.clone())
+            + diff.z.clone() * p.z.clone(),
+    )
+}
+
 /// Forward recursion (eqs 10.3–10.8): fills `ws.rot`, `ws.pos`, `ws.w`, `ws.wd`, `ws.vd` and the
 /// link wrenches `ws.f` = jF_j + jfe_j, `ws.m` = jM_j + jme_j for links 1..NL.
 pub fn forward_recursion<T: DynScalar>(
@@ -75,10 +127,36 @@ pub fn forward_recursion<T: DynScalar>(
     qd: &[T],
     qdd: &[T],
 ) {
+    forward_recursion_sharing(model, ws, q, qd, qdd, &[]);
+}
+
+/// Orientation of link k taken from an earlier link m on a closed chain: 0R_k = 0R_m C with C
+/// constant on the closure manifold (the parallel links of a parallelogram, §10.3.5).
+#[derive(Clone, Debug, PartialEq)]
+pub struct SharedOrientation<T: DynScalar> {
+    /// The earlier link m (m < k).
+    pub link: usize,
+    /// C = mR_k, constant.
+    pub rot: Matrix3<T>,
+}
+
+/// [`forward_recursion`] for a closed chain whose tree state satisfies the loop constraints:
+/// for link k with `shared[k - 1] = Some(m, C)`, w_k = C^T w_m, wd_k = C^T wd_m and
+/// jU_k = C^T jU_m C replace eqs 10.3–10.5 (a signed permutation C costs nothing in the
+/// customized model). Entries beyond `shared.len()` are computed as usual.
+pub fn forward_recursion_sharing<T: DynScalar>(
+    model: &DynModel<T>,
+    ws: &mut Workspace<T>,
+    q: &[T],
+    qd: &[T],
+    qdd: &[T],
+    shared: &[Option<SharedOrientation<T>>],
+) {
     ws.w[0] = model.w0.clone();
     ws.wd[0] = model.wp0.clone();
     ws.vd[0] = &model.vp0 - &model.gravity;
-    ws.u[0] = u_matrix(&ws.w[0], &ws.wd[0], 0);
+    let (p0, sq0) = w_products(&ws.w[0]);
+    ws.u[0] = u_matrix(&p0, &sq0, &ws.wd[0], 0);
     for j in 1..=model.nl {
         let fr = model.frame(j);
         let i = fr.ant;
@@ -90,33 +168,38 @@ pub fn forward_recursion<T: DynScalar>(
         let wi = name3(&jai * &ws.w[i], "WI", j); // (10.3)
         let vsp = name3(&ws.vd[i] + up, "VSP", j);
         let mut vd = &jai * vsp; // (10.6), first part
-        let mut wd = &jai * &ws.wd[i];
-        let mut w = wi.clone();
-        match fr.joint {
-            JointType::Revolute => {
-                // (10.4), (10.5)
-                w.z += qd[j - 1].clone();
-                wd += cross_z(&wi, &qd[j - 1]);
-                wd.z += qdd[j - 1].clone();
+        let share = shared.get(j - 1).and_then(Option::as_ref);
+        let (w, wd) = match share {
+            Some(s) => (s.rot.tr_mul(&ws.w[s.link]), s.rot.tr_mul(&ws.wd[s.link])),
+            None => {
+                let mut wd = &jai * &ws.wd[i];
+                let mut w = wi.clone();
+                if fr.joint == JointType::Revolute {
+                    // (10.4), (10.5)
+                    w.z += qd[j - 1].clone();
+                    wd += cross_z(&wi, &qd[j - 1]);
+                    wd.z += qdd[j - 1].clone();
+                }
+                (name3(w, "W", j), name3(wd, "WP", j))
             }
-            JointType::Prismatic => {
-                // (10.6), second part: qdd a + 2 w_i x qd a
-                vd += cross_z(&wi, &(qd[j - 1].clone() + qd[j - 1].clone()));
-                vd.z += qdd[j - 1].clone();
-            }
-            JointType::Fixed => {}
+        };
+        if fr.joint == JointType::Prismatic {
+            // (10.6), second part: qdd a + 2 w_i x qd a
+            vd += cross_z(&wi, &(qd[j - 1].clone() + qd[j - 1].clone()));
+            vd.z += qdd[j - 1].clone();
         }
-        let w = name3(w, "W", j);
-        let wd = name3(wd, "WP", j);
         let vd = name3(vd, "VP", j);
         let l = model.link(j);
         // (10.7): F = M vd + U MS
-        let u = u_matrix(&w, &wd, j);
+        let (p, sq) = w_products(&w);
+        let u = match share {
+            Some(s) => s.rot.tr_mul(&ws.u[s.link]) * &s.rot,
+            None => u_matrix(&p, &sq, &wd, j),
+        };
         let f = &vd * l.mass.clone() + &u * &l.ms;
-        ws.u[j] = u;
         // (10.8): M = J wd + w x (J w) + MS x vd
-        let jw = name3(&l.inertia * &w, "JW", j);
-        let m = &l.inertia * &wd + w.cross(&jw) + l.ms.cross(&vd);
+        let m = euler_moment(&l.inertia, &l.inertia_diff, &wd, &p, &sq, &u) + l.ms.cross(&vd);
+        ws.u[j] = u;
         ws.f[j] = name3(f + &l.fe, "F", j);
         ws.m[j] = name3(m + &l.me, "No", j);
         ws.rot[j] = rot;

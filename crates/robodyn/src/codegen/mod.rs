@@ -10,11 +10,15 @@
 //! Gamma_cl = G^T Gamma_tr (10.40) for a constant G.
 
 mod closed;
+mod parallel_links;
 
 pub use closed::constant_g;
+pub use parallel_links::parallel_links;
 
 use crate::algorithms::inertia_matrix::{inertia_matrix_into, InertiaWorkspace};
-use crate::algorithms::inverse_dynamics::rnea;
+use crate::algorithms::inverse_dynamics::{
+    backward_recursion, forward_recursion_sharing, rnea, SharedOrientation,
+};
 use crate::error::{Error, Item, Result};
 use crate::model::{DynModel, RobotDescription, STANDARD_PARAMETERS};
 use crate::workspace::Workspace;
@@ -313,12 +317,29 @@ pub fn generate(desc: &RobotDescription, opt: &GenOptions) -> Result<Program> {
     } else {
         DMatrix::zeros(0, 0)
     };
+    // Closed chains: links kept parallel by the loops take their orientation from their partner.
+    let shared: Vec<Option<SharedOrientation<Expr>>> = if opt.model == ModelKind::Closed {
+        crate::Robot::new(desc.clone())
+            .and_then(|r| parallel_links(&r))
+            .unwrap_or_else(|_| vec![None; nl])
+            .into_iter()
+            .map(|s| {
+                s.map(|s| SharedOrientation {
+                    link: s.link,
+                    rot: s.rot.map(Expr::num),
+                })
+            })
+            .collect()
+    } else {
+        Vec::new()
+    };
     let (outputs, assignments) = record(&reserved, || -> Vec<Assignment> {
         let mut ws = Workspace::new(&model);
         let mut tau = vec![Expr::zero(); nl];
         match opt.model {
             ModelKind::Idm | ModelKind::Closed => {
-                rnea(&model, &mut ws, &q, &qd, &qdd, &mut tau);
+                forward_recursion_sharing(&model, &mut ws, &q, &qd, &qdd, &shared);
+                backward_recursion(&model, &mut ws, &qd, &qdd, &mut tau);
                 if opt.model == ModelKind::Idm {
                     joints
                         .iter()

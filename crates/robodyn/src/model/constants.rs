@@ -73,6 +73,9 @@ impl<T: DynScalar> FrameConstants<T> {
 pub struct LinkConstants<T: DynScalar> {
     /// jJ_j about O_j.
     pub inertia: Matrix3<T>,
+    /// (ZZ - YY, XX - ZZ, YY - XX): the differences of principal moments the Euler moment
+    /// takes in its product form (see `inverse_dynamics::euler_moment`, eq 10.8).
+    pub inertia_diff: Vector3<T>,
     /// jMS_j.
     pub ms: Vector3<T>,
     pub mass: T,
@@ -90,6 +93,11 @@ impl<T: DynScalar> LinkConstants<T> {
         let [xx, xy, xz, yy, yz, zz, mx, my, mz, m, ia, fs, fv] = p;
         let [fx, fy, fz, cx, cy, cz] = w;
         LinkConstants {
+            inertia_diff: Vector3::new(
+                zz.clone() - yy.clone(),
+                xx.clone() - zz.clone(),
+                yy.clone() - xx.clone(),
+            ),
             inertia: Matrix3::new(xx, xy.clone(), xz.clone(), xy, yy, yz.clone(), xz, yz, zz),
             ms: Vector3::new(mx, my, mz),
             mass: m,
