@@ -1,0 +1,64 @@
+//! Links kept parallel by a loop (§10.3.5): detection and the Newton–Euler recursion that takes
+//! their orientation from the partner link (used by the customized closed-chain model).
+
+mod common;
+
+use robodyn::algorithms::base_parameters::closed::ClosedChainSampler;
+use robodyn::algorithms::inverse_dynamics::{backward_recursion, forward_recursion_sharing, rnea};
+use robodyn::codegen::parallel_links;
+use robodyn::testing::rng;
+use robodyn::Workspace;
+
+/// Example 10.1: theta3 = theta7 + pi/2 - theta2 and theta8 = theta2 - theta7, so link 7 keeps
+/// the orientation of link 3 (up to a quarter turn) and link 8 that of link 2.
+#[test]
+fn sr400_parallelogram_links_are_found() {
+    let robot = common::robot("sr400.toml");
+    let shared = parallel_links(&robot).unwrap();
+    let pairs: Vec<(usize, usize)> = shared
+        .iter()
+        .enumerate()
+        .filter_map(|(k, s)| s.as_ref().map(|s| (k + 1, s.link)))
+        .collect();
+    assert_eq!(pairs, vec![(7, 3), (8, 2)]);
+    for s in shared.iter().flatten() {
+        // signed permutation: orthogonal with entries in {-1, 0, 1}
+        assert!((s.rot.transpose() * s.rot - nalgebra::Matrix3::identity()).amax() < 1e-15);
+        assert!(s.rot.iter().all(|x| [-1.0, 0.0, 1.0].contains(x)));
+    }
+}
+
+/// On consistent closed states (sampled independently of the detection), the recursion with
+/// shared orientations gives the torques of the plain tree recursion, for every bundled closed
+/// robot; tree robots have no shared link.
+#[test]
+fn sharing_recursion_equals_tree_recursion_on_closed_states() {
+    let mut found = 0;
+    for (name, robot, ..) in common::cases() {
+        let shared = parallel_links(&robot).unwrap();
+        found += shared.iter().flatten().count();
+        let model = robot.numeric();
+        let mut sampler = ClosedChainSampler::new(&robot).unwrap();
+        let mut r = rng(1056);
+        let mut ws = Workspace::new(model);
+        let nl = robot.nl();
+        for _ in 0..5 {
+            let s = sampler.next_state(&mut r).unwrap();
+            let mut plain = vec![0.0; nl];
+            rnea(model, &mut ws, &s.q, &s.qd, &s.qdd, &mut plain);
+            let mut tau = vec![0.0; nl];
+            forward_recursion_sharing(model, &mut ws, &s.q, &s.qd, &s.qdd, &shared);
+            backward_recursion(model, &mut ws, &s.qd, &s.qdd, &mut tau);
+            let scale = plain.iter().fold(1.0f64, |m, x| m.max(x.abs()));
+            for (a, b) in tau.iter().zip(&plain) {
+                assert!(
+                    (a - b).abs() < 1e-11 * scale,
+                    "{name}: {tau:?} vs {plain:?}"
+                );
+            }
+        }
+    }
+    assert!(found >= 2, "the SR400's two parallel links at least");
+    let tree = common::robot("rx90.toml");
+    assert!(parallel_links(&tree).unwrap().iter().all(Option::is_none));
+}
