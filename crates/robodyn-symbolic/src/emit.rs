@@ -322,6 +322,8 @@ fn code(e: &Expr, lang: Lang, prec: u8) -> String {
             let arg = code(a, lang, 0);
             match (lang, f) {
                 (Lang::Rust, Func::Sign) => format!("sgn({arg})"),
+                // a literal argument has no type of its own: name the method's type
+                (Lang::Rust, _) if a.is_number() => format!("f64::{}({arg})", f.name()),
                 (Lang::Rust, _) => format!("({arg}).{}()", f.name()),
                 (Lang::C, Func::Sign) => format!("rd_sign({arg})"),
                 (Lang::C, Func::Abs) => format!("fabs({arg})"),

@@ -7,6 +7,9 @@
 //! - ddm: generated qdd from (q, qd, Gamma = rnea(q, qd, qdd*)) vs the random qdd*;
 //! - closed: generated Gamma_cl vs G^T rnea with G written by hand from Example 10.1.
 //!
+//! Robots: the SR400 (symbolic and numeric), the RX-90, every other bundled robot (closed ones as
+//! their equivalent trees) and three random trees.
+//!
 //! Every program is compiled (rustc, cc) into a harness that reads inputs on stdin and prints the
 //! outputs; tolerance 1e-10 relative (norm-wise over each output vector).
 
@@ -218,6 +221,24 @@ fn all_cases() -> Vec<Case> {
     cases.push(closed_case(&sr, false));
     cases.push(closed_case(&sr, true));
     cases.extend(tree_cases(&rx90(), false, 3, "rx90"));
+    // every other bundled robot (the closed ones as their equivalent trees)
+    for (k, name) in [
+        "torso2arms",
+        "scara",
+        "fourbar",
+        "fivebar",
+        "spatial_loop",
+        "twoloops",
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../robots")
+            .join(format!("{name}.toml"));
+        let d = robodyn::io::load_description(&path).unwrap();
+        cases.extend(tree_cases(&d, false, 20 + k as u64, name));
+    }
     let opts = TreeOptions::default();
     for (k, seed) in [11u64, 12, 13].into_iter().enumerate() {
         let mut r = rng(seed);
