@@ -5,15 +5,21 @@
 //! - inertia + h: generated A qdd + H vs numeric `rnea(q, qd, qdd)` (A and H never computed
 //!   numerically);
 //! - ddm: generated qdd from (q, qd, Gamma = rnea(q, qd, qdd*)) vs the random qdd*;
-//! - closed: generated Gamma_cl vs G^T rnea with G written by hand from Example 10.1.
+//! - closed: generated Gamma_cl vs G^T rnea with G written by hand from Example 10.1 (SR400,
+//!   constant G); for the other closed robots (G depending on q, loop-closure Jacobian written
+//!   out, multiplier form 10.36-10.37) vs the numeric closed-chain model G^T Gamma_tr (10.40);
+//! - w: generated W = d q_p / d q_a vs the numeric W of the closed-chain model (both checked
+//!   against finite differences of the loop closure in `generated_w_is_the_derivative_of_loop_closure`).
 //!
-//! Robots: the SR400 (symbolic and numeric), the RX-90, every other bundled robot (closed ones as
-//! their equivalent trees) and three random trees.
+//! Robots: the SR400 (symbolic and numeric), the RX-90, every other bundled robot (the closed
+//! ones as their equivalent trees, and as closed chains), a slider-crank with a prismatic cut
+//! joint and three random trees.
 //!
 //! Every program is compiled (rustc, cc) into a harness that reads inputs on stdin and prints the
 //! outputs; tolerance 1e-10 relative (norm-wise over each output vector).
 
 use nalgebra::{DMatrix, DVector};
+use robodyn::algorithms::closed_chain::ClosedChain;
 use robodyn::algorithms::inverse_dynamics::rnea;
 use robodyn::codegen::{constant_g, generate, GenOptions, ModelKind};
 use robodyn::model::STANDARD_PARAMETERS;
@@ -24,6 +30,8 @@ use std::collections::HashMap;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
+
+mod common;
 
 mod sr400_base {
     include!("codegen_data/sr400_base.rs");
@@ -213,6 +221,88 @@ fn closed_case(desc: &RobotDescription, numeric: bool) -> Case {
     }
 }
 
+/// Closed states of a closed robot near its reference: q_a within `range` of q_a0, q_p by
+/// continuation from (q_a0, q_p0) (so the assembly branch is kept), qd_a and qdd_a random.
+fn closed_states(
+    cc: &ClosedChain,
+    qa0: &[f64],
+    qp0: &[f64],
+    range: f64,
+    seed: u64,
+) -> Vec<robodyn::algorithms::closed_chain::ClosedIdm> {
+    let mut r = rng(seed);
+    let mut ws = cc.workspace();
+    let n = qa0.len();
+    (0..3)
+        .map(|_| {
+            use rand::Rng;
+            let qa: Vec<f64> = qa0
+                .iter()
+                .map(|x| x + r.random_range(-range..range))
+                .collect();
+            let [_, qda, qdda] = random_state(&mut r, n);
+            let sol = cc
+                .closure()
+                .solve_continuation(&mut ws.closure, &qa, qa0, qp0, 16)
+                .unwrap();
+            cc.inverse_dynamics(&mut ws, &qa, &qda, &qdda, Some(&sol.q_p))
+                .unwrap()
+        })
+        .collect()
+}
+
+/// The closed and w models of every closed robot whose G depends on q (all but the SR400).
+fn general_closed_cases() -> Vec<Case> {
+    let mut cases = Vec::new();
+    for (k, (label, robot, qa0, qp0, range)) in common::cases().into_iter().enumerate() {
+        if label == "sr400.toml" {
+            continue;
+        }
+        let desc = robot.description().clone();
+        let tag = label.trim_end_matches(".toml").replace('-', "_");
+        let cc = ClosedChain::new(&robot).unwrap();
+        let states = closed_states(&cc, qa0, qp0, range, 600 + k as u64);
+        for model in [ModelKind::Closed, ModelKind::W] {
+            let opt = GenOptions {
+                model,
+                name: Some(format!("{tag}_{}", model.name())),
+                ..Default::default()
+            };
+            let prog = generate(&desc, &opt).unwrap();
+            let p = parameter_values(&prog, &env_of(&desc));
+            let inputs = states
+                .iter()
+                .map(|s| {
+                    let st = &s.state;
+                    if model == ModelKind::W {
+                        vec![st.q.clone(), p.clone()]
+                    } else {
+                        vec![st.q.clone(), st.qd.clone(), st.qdd.clone(), p.clone()]
+                    }
+                })
+                .collect();
+            let expected = states
+                .iter()
+                .map(|s| {
+                    if model == ModelKind::W {
+                        // row by row: passive joint, then actuated joint
+                        s.state.constraints.w.transpose().as_slice().to_vec()
+                    } else {
+                        s.gamma_cl.as_slice().to_vec()
+                    }
+                })
+                .collect();
+            cases.push(Case {
+                prog,
+                inputs,
+                expected,
+                what: format!("{tag} {}", model.name()),
+            });
+        }
+    }
+    cases
+}
+
 fn all_cases() -> Vec<Case> {
     let mut cases = Vec::new();
     let sr = sr400();
@@ -239,6 +329,7 @@ fn all_cases() -> Vec<Case> {
         let d = robodyn::io::load_description(&path).unwrap();
         cases.extend(tree_cases(&d, false, 20 + k as u64, name));
     }
+    cases.extend(general_closed_cases());
     let opts = TreeOptions::default();
     for (k, seed) in [11u64, 12, 13].into_iter().enumerate() {
         let mut r = rng(seed);
@@ -304,6 +395,7 @@ fn rel_err(a: &[f64], b: &[f64]) -> f64 {
 /// are checked together as A qdd + H = Gamma.
 fn check(cases: &[Case], outputs: &[Vec<Vec<f64>>], lang: &str) -> f64 {
     let mut worst = 0.0f64;
+    let mut worst_case = String::new();
     for (i, c) in cases.iter().enumerate() {
         if c.what.ends_with(" inertia") {
             let h = &outputs[i + 1];
@@ -340,10 +432,14 @@ fn check(cases: &[Case], outputs: &[Vec<Vec<f64>>], lang: &str) -> f64 {
         for (got, exp) in outputs[i].iter().zip(&c.expected) {
             let e = rel_err(got, exp);
             assert!(e < 1e-10, "{lang} {}: off by {e:e}", c.what);
+            if e > worst {
+                worst_case = c.what.clone();
+            }
             worst = worst.max(e);
         }
         assert_eq!(outputs[i].len(), c.expected.len());
     }
+    println!("{lang}: worst relative error {worst:e} ({worst_case})");
     worst
 }
 
@@ -702,6 +798,75 @@ fn options_match_robots_with_those_parameters_zero() {
                 "{} {symmetric} {friction} {rotor}: {e:e}",
                 desc.name
             );
+        }
+    }
+}
+
+/// Closed chains whose G depends on q: the generated W is the derivative of the loop closure
+/// (central differences of q_p solved at q_a +- h, h = 1e-5: truncation ~1e-10, closure
+/// tolerance 1e-12 / h ~1e-7, so 1e-6 relative), and the generated Gamma_cl satisfies the
+/// virtual power balance Gamma_cl . qd_a = Gamma_tr . qd_tr with Gamma_tr the numeric tree
+/// torques (10.40 read as power).
+#[test]
+fn generated_w_is_the_derivative_of_loop_closure() {
+    for (k, (label, robot, qa0, qp0, range)) in common::cases().into_iter().enumerate() {
+        let desc = robot.description().clone();
+        let cc = ClosedChain::new(&robot).unwrap();
+        let lc = cc.closure();
+        let mut ws = cc.workspace();
+        let gen = |model| {
+            let opt = GenOptions {
+                model,
+                ..Default::default()
+            };
+            generate(&desc, &opt).unwrap()
+        };
+        let (wprog, cprog) = (gen(ModelKind::W), gen(ModelKind::Closed));
+        let env = env_of(&desc);
+        for s in closed_states(&cc, qa0, qp0, range, 900 + k as u64) {
+            let st = &s.state;
+            let value = |name: &str| -> Option<f64> {
+                let i = name.trim_end_matches(|c: char| c.is_ascii_digit()).len();
+                let j: Option<usize> = name[i..].parse().ok();
+                match (&name[..i], j) {
+                    ("q", Some(j)) => Some(st.q[j - 1]),
+                    ("QP", Some(j)) => Some(st.qd[j - 1]),
+                    ("QDP", Some(j)) => Some(st.qdd[j - 1]),
+                    _ => env(name),
+                }
+            };
+            let w = wprog.evaluate(&value).unwrap();
+            let (pj, aj) = (lc.passive_joints(), lc.actuated_joints());
+            let qa: Vec<f64> = aj.iter().map(|&j| st.q[j - 1]).collect();
+            let qp: Vec<f64> = pj.iter().map(|&j| st.q[j - 1]).collect();
+            let h = 1e-5;
+            let mut worst = 0.0f64;
+            for (c, _) in aj.iter().enumerate() {
+                let mut solve = |d: f64| {
+                    let mut x = qa.clone();
+                    x[c] += d;
+                    lc.solve(&mut ws.closure, &x, Some(&qp)).unwrap().q_p
+                };
+                let (plus, minus) = (solve(h), solve(-h));
+                for r in 0..pj.len() {
+                    let fd = (plus[r] - minus[r]) / (2.0 * h);
+                    let got = w[r * aj.len() + c];
+                    worst = worst.max((got - fd).abs() / fd.abs().max(1.0));
+                }
+            }
+            assert!(
+                worst < 1e-6,
+                "{label}: generated W off the finite differences by {worst:e}"
+            );
+            // virtual power
+            let gcl = cprog.evaluate(&value).unwrap();
+            let qda: Vec<f64> = aj.iter().map(|&j| st.qd[j - 1]).collect();
+            let p_cl: f64 = gcl.iter().zip(&qda).map(|(g, v)| g * v).sum();
+            let p_tr: f64 = s.gamma_tr.iter().zip(&st.qd).map(|(g, v)| g * v).sum();
+            let scale = s.gamma_tr.amax() * st.qd.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            let power_err = (p_cl - p_tr).abs() / scale.max(1.0);
+            assert!(power_err < 1e-10, "{label}: power {p_cl} vs {p_tr}");
+            println!("{label}: W vs finite differences {worst:.1e}, virtual power {power_err:.1e}");
         }
     }
 }

@@ -31,26 +31,49 @@ fn four_bar() -> RobotDescription {
     d
 }
 
+/// G depending on q: constant_g says so; the general closed model needs the loops closed at the
+/// reference configuration (the file's `assembly`, else q = 0) and is generated once they are.
 #[test]
-fn general_closed_chain_is_not_supported() {
-    let d = four_bar();
+fn general_closed_chain_needs_a_closed_reference() {
+    let mut d = four_bar();
     let robot = Robot::new(d.clone()).unwrap();
     let e = constant_g(&robot).unwrap_err().to_string();
-    assert!(e.contains("not supported"), "{e}");
+    assert!(e.contains("not constant"), "{e}");
     let opt = GenOptions {
         model: ModelKind::Closed,
         ..Default::default()
     };
+    // the four-bar does not close at q = 0 (no assembly given)
     let e = generate(&d, &opt).unwrap_err().to_string();
-    assert!(e.contains("not supported"), "{e}");
+    assert!(
+        e.contains("four-bar") && e.contains("do not close at the reference configuration"),
+        "{e}"
+    );
+    // with a closed assembly configuration the model is generated
+    let cc = robodyn::algorithms::closed_chain::ClosedChain::new(&robot).unwrap();
+    let mut ws = cc.workspace();
+    let sol = [[1.0, 1.0], [-1.0, 1.0], [1.0, -1.0], [2.0, 2.0]]
+        .iter()
+        .find_map(|g| cc.solve_positions(&mut ws, &[0.3], Some(g)).ok())
+        .expect("the four-bar closes at q1 = 0.3");
+    d.assembly = Some(sol.q_tr.clone());
+    let prog = generate(&d, &opt).unwrap();
+    assert_eq!(prog.outputs.len(), 1);
+    assert_eq!(prog.outputs[0].name, "GAMCL1");
     // the closed model of a tree is refused
     let t = robodyn::testing::random_tree_description(
         &mut robodyn::testing::rng(1),
         3,
         &Default::default(),
     );
-    let e = generate(&t, &opt).unwrap_err().to_string();
-    assert!(e.contains("closed loops"), "{e}");
+    for model in [ModelKind::Closed, ModelKind::W] {
+        let opt = GenOptions {
+            model,
+            ..Default::default()
+        };
+        let e = generate(&t, &opt).unwrap_err().to_string();
+        assert!(e.contains("closed loops"), "{e}");
+    }
 }
 
 #[test]

@@ -16,8 +16,10 @@ pub enum Model {
     H,
     /// Direct dynamic model of a tree.
     Ddm,
-    /// Closed chain: Gamma_cl = G^T Gamma_tr (constant G only).
+    /// Closed chain: Gamma_cl = G^T Gamma_tr (10.40), inputs the closed tree state.
     Closed,
+    /// Closed chain: W = d q_p / d q_a (10.30), inputs the closed tree positions.
+    W,
 }
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug)]
@@ -103,6 +105,7 @@ pub fn run(a: Args) -> CliResult {
             Model::H => ModelKind::H,
             Model::Ddm => ModelKind::Ddm,
             Model::Closed => ModelKind::Closed,
+            Model::W => ModelKind::W,
         },
         numeric: a.numeric,
         symmetric: a.symmetric,

@@ -10,9 +10,11 @@
 //! Gamma_cl = G^T Gamma_tr (10.40) for a constant G.
 
 mod closed;
+mod linear;
 mod parallel_links;
 
 pub use closed::constant_g;
+use closed::{closed_form, closed_torques, closed_w, ClosedForm};
 pub use parallel_links::parallel_links;
 
 use crate::algorithms::inertia_matrix::{inertia_matrix_into, InertiaWorkspace};
@@ -21,6 +23,7 @@ use crate::algorithms::inverse_dynamics::{
 };
 use crate::error::{Error, Item, Result};
 use crate::model::{DynModel, RobotDescription, STANDARD_PARAMETERS};
+use crate::scalar::DynScalar as _;
 use crate::workspace::Workspace;
 use nalgebra::DMatrix;
 use robodyn_symbolic::program::{name_value, record};
@@ -38,8 +41,12 @@ pub enum ModelKind {
     H,
     /// Direct dynamic model of a tree: qdd = A^-1 (Gamma - H).
     Ddm,
-    /// Closed chain: Gamma_cl = G^T Gamma_tr (10.40) with a constant G.
+    /// Closed chain: Gamma_cl = G^T Gamma_tr (10.40): with G constant when the loops make it so
+    /// (parallelograms), else Gamma_cl = Gamma_a + Wa^T lambda, Wp^T lambda = -Gamma_p (10.36–10.37)
+    /// with the loop-closure Jacobian written out.
     Closed,
+    /// Closed chain: W = d q_p / d q_a = -Wp^-1 Wa (10.30) at a closed configuration.
+    W,
 }
 
 impl ModelKind {
@@ -50,6 +57,7 @@ impl ModelKind {
             ModelKind::H => "h",
             ModelKind::Ddm => "ddm",
             ModelKind::Closed => "closed",
+            ModelKind::W => "w",
         }
     }
 }
@@ -85,8 +93,9 @@ pub struct GenOptions {
     pub rotor: bool,
     /// Base parameters instead of standard ones.
     pub base: Option<BaseParameters>,
-    /// G (NL rows, one column per actuated joint) for [`ModelKind::Closed`]; computed by
-    /// [`constant_g`] when `None`.
+    /// A constant G (NL rows, one column per actuated joint) for [`ModelKind::Closed`] and
+    /// [`ModelKind::W`]; when `None`, [`constant_g`] looks for one and the general form (G
+    /// depending on q) is generated when there is none.
     pub g: Option<DMatrix<Expr>>,
     /// Function name in generated code (default `<robot>_<model>`).
     pub name: Option<String>,
@@ -249,7 +258,7 @@ pub fn inertia_columns(model: &DynModel<Expr>, joints: &[usize], q: &[Expr]) -> 
         .collect()
 }
 
-fn pair_name(prefix: &str, i: usize, j: usize) -> String {
+pub(crate) fn pair_name(prefix: &str, i: usize, j: usize) -> String {
     if i < 10 && j < 10 {
         format!("{prefix}{i}{j}")
     } else {
@@ -278,7 +287,13 @@ pub fn generate(desc: &RobotDescription, opt: &GenOptions) -> Result<Program> {
     };
     let mut inputs = vec![group("q", "q", "joint positions q_j at index j-1")];
     let mut reserved: Vec<String> = Vec::new();
-    for k in ["q", "QP", "QDP", "GAM"] {
+    // GAM<j> are inputs of the direct model only; elsewhere they name the tree torques
+    let kinds: &[&str] = if opt.model == ModelKind::Ddm {
+        &["q", "QP", "QDP", "GAM"]
+    } else {
+        &["q", "QP", "QDP"]
+    };
+    for k in kinds {
         reserved.extend((1..=nl).map(|j| joint_symbol(k, j)));
     }
     for s in desc.symbols.keys() {
@@ -292,30 +307,11 @@ pub fn generate(desc: &RobotDescription, opt: &GenOptions) -> Result<Program> {
     if let Some(b) = &opt.base {
         reserved.extend(b.grouped.iter().map(|g| g.name.clone()));
     }
-    let g_matrix = if opt.model == ModelKind::Closed {
-        if desc.nj == desc.nl {
-            return Err(Error::invalid(
-                Item::Robot,
-                "the closed-chain model needs a robot with closed loops (NJ > NL)",
-            ));
-        }
-        match &opt.g {
-            Some(g) => {
-                if g.nrows() != nl {
-                    return Err(Error::Input(format!(
-                        "G has {} rows, NL = {nl} expected",
-                        g.nrows()
-                    )));
-                }
-                g.clone()
-            }
-            None => {
-                let robot = crate::Robot::new(desc.clone())?;
-                constant_g(&robot)?.map(Expr::num)
-            }
-        }
+    let closed = matches!(opt.model, ModelKind::Closed | ModelKind::W);
+    let form = if closed {
+        closed_form(desc, opt)?
     } else {
-        DMatrix::zeros(0, 0)
+        ClosedForm::Tree
     };
     // Closed chains: links kept parallel by the loops take their orientation from their partner.
     let shared: Vec<Option<SharedOrientation<Expr>>> = if opt.model == ModelKind::Closed {
@@ -333,7 +329,7 @@ pub fn generate(desc: &RobotDescription, opt: &GenOptions) -> Result<Program> {
     } else {
         Vec::new()
     };
-    let (outputs, assignments) = record(&reserved, || -> Vec<Assignment> {
+    let (outputs, assignments) = record(&reserved, || -> Result<Vec<Assignment>> {
         let mut ws = Workspace::new(&model);
         let mut tau = vec![Expr::zero(); nl];
         match opt.model {
@@ -341,41 +337,30 @@ pub fn generate(desc: &RobotDescription, opt: &GenOptions) -> Result<Program> {
                 forward_recursion_sharing(&model, &mut ws, &q, &qd, &qdd, &shared);
                 backward_recursion(&model, &mut ws, &qd, &qdd, &mut tau);
                 if opt.model == ModelKind::Idm {
-                    joints
+                    Ok(joints
                         .iter()
                         .map(|&j| Assignment {
                             name: joint_symbol("GAM", j),
                             expr: tau[j - 1].clone(),
                         })
-                        .collect()
+                        .collect())
                 } else {
                     let gam: Vec<Expr> =
                         (1..=nl).map(|j| tau[j - 1].clone().named_gam(j)).collect();
-                    let actuated: Vec<usize> =
-                        (1..=nl).filter(|&j| desc.frame(j).actuated).collect();
-                    (0..g_matrix.ncols())
-                        .map(|c| {
-                            let e = Expr::sum(
-                                (0..nl).map(|r| g_matrix[(r, c)].clone() * gam[r].clone()),
-                            );
-                            Assignment {
-                                name: format!("GAMCL{}", actuated.get(c).copied().unwrap_or(c + 1)),
-                                expr: e,
-                            }
-                        })
-                        .collect()
+                    closed_torques(&model, &form, &q, &gam)
                 }
             }
+            ModelKind::W => closed_w(&model, &form, &q),
             ModelKind::H => {
                 let zero = vec![Expr::zero(); nl];
                 rnea(&model, &mut ws, &q, &qd, &zero, &mut tau);
-                joints
+                Ok(joints
                     .iter()
                     .map(|&j| Assignment {
                         name: joint_symbol("H", j),
                         expr: tau[j - 1].clone(),
                     })
-                    .collect()
+                    .collect())
             }
             ModelKind::Inertia => {
                 let cols = inertia_columns(&model, &joints, &q);
@@ -388,7 +373,7 @@ pub fn generate(desc: &RobotDescription, opt: &GenOptions) -> Result<Program> {
                         });
                     }
                 }
-                out
+                Ok(out)
             }
             ModelKind::Ddm => {
                 let zero = vec![Expr::zero(); nl];
@@ -415,39 +400,33 @@ pub fn generate(desc: &RobotDescription, opt: &GenOptions) -> Result<Program> {
                             .collect()
                     })
                     .collect();
-                ldl_solve(&a, &rhs, &joints)
+                Ok(linear::ldl_solve(&a, &rhs, &joints)
                     .into_iter()
                     .zip(&joints)
                     .map(|(x, &j)| Assignment {
                         name: joint_symbol("QDP", j),
                         expr: x,
                     })
-                    .collect()
+                    .collect())
             }
         }
     });
+    let outputs = outputs?;
     match opt.model {
         ModelKind::Idm | ModelKind::Closed => {
             inputs.push(group("qd", "QP", "joint velocities at index j-1"));
             inputs.push(group("qdd", "QDP", "joint accelerations at index j-1"));
         }
         ModelKind::H => inputs.push(group("qd", "QP", "joint velocities at index j-1")),
-        ModelKind::Inertia => {}
+        ModelKind::Inertia | ModelKind::W => {}
         ModelKind::Ddm => {
             inputs.push(group("qd", "QP", "joint velocities at index j-1"));
             inputs.push(group("gam", "GAM", "joint torques at index j-1"));
         }
     }
     let mut description = describe(desc, opt);
-    if opt.model == ModelKind::Closed {
-        let act: Vec<usize> = (1..=nl).filter(|&j| desc.frame(j).actuated).collect();
-        description.push(format!(
-            "G = d q_tr / d q_a (constant; rows q1..q{nl}, columns q_a = {act:?}):"
-        ));
-        for r in 0..g_matrix.nrows() {
-            let row: Vec<String> = g_matrix.row(r).iter().map(|e| e.to_string()).collect();
-            description.push(format!("  q{}: [{}]", r + 1, row.join(", ")));
-        }
+    if closed {
+        description.extend(form.describe(nl));
     } else if desc.nj > desc.nl {
         description.push(
             "Closed robot: this is the model of the equivalent tree (loops cut); \
@@ -508,55 +487,6 @@ impl NamedGam for Expr {
     }
 }
 
-use crate::scalar::DynScalar as _;
-
-/// Solve A x = b by A = L D L' written out for the fixed size (A symmetric positive definite):
-/// D_i = A_ii - sum_k L_ik^2 D_k, L_ij = (A_ij - sum_k L_ik L_jk D_k) / D_j, then forward,
-/// diagonal and backward substitution. Intermediates are named L<i><j>, D<i>, Y<i>, X<i>.
-fn ldl_solve(a: &[Vec<Expr>], b: &[Expr], joints: &[usize]) -> Vec<Expr> {
-    let n = a.len();
-    let mut l = vec![vec![Expr::zero(); n]; n];
-    let mut d = vec![Expr::zero(); n];
-    let mut ld = vec![vec![Expr::zero(); n]; n]; // L_ik D_k
-    for i in 0..n {
-        for j in 0..i {
-            let mut s = a[i][j].clone();
-            for k in 0..j {
-                s -= ld[i][k].clone() * l[j][k].clone();
-            }
-            let s = s.named(|| pair_name("U", joints[i], joints[j]));
-            ld[i][j] = s.clone();
-            l[i][j] = (s / d[j].clone()).named(|| pair_name("L", joints[i], joints[j]));
-        }
-        let mut s = a[i][i].clone();
-        for k in 0..i {
-            s -= ld[i][k].clone() * l[i][k].clone();
-        }
-        d[i] = s.named(|| format!("D{}", joints[i]));
-    }
-    let mut y = vec![Expr::zero(); n];
-    for i in 0..n {
-        let mut s = b[i].clone();
-        for k in 0..i {
-            s -= l[i][k].clone() * y[k].clone();
-        }
-        y[i] = s.named(|| format!("Y{}", joints[i]));
-    }
-    let mut x = vec![Expr::zero(); n];
-    for i in (0..n).rev() {
-        let mut s = y[i].clone() / d[i].clone();
-        for k in i + 1..n {
-            s -= l[k][i].clone() * x[k].clone();
-        }
-        x[i] = if i == 0 {
-            s
-        } else {
-            s.named(|| format!("X{}", joints[i]))
-        };
-    }
-    x
-}
-
 fn describe(desc: &RobotDescription, opt: &GenOptions) -> Vec<String> {
     let model = match opt.model {
         ModelKind::Idm => "customized inverse dynamic model Gamma = f(q, qd, qdd) (Newton-Euler, eqs 10.3-10.12)",
@@ -564,6 +494,7 @@ fn describe(desc: &RobotDescription, opt: &GenOptions) -> Vec<String> {
         ModelKind::H => "vector H(q, qd) = Gamma(q, qd, 0)",
         ModelKind::Ddm => "direct dynamic model qdd = A^-1 (Gamma - H), LDL' solution written out",
         ModelKind::Closed => "closed-chain inverse dynamic model Gamma_cl = G^T Gamma_tr (eq 10.40), inputs are the tree state",
+        ModelKind::W => "closed-chain kinematic constraint W = d q_p / d q_a = -Wp^-1 Wa (eq 10.30), inputs are the tree positions",
     };
     let mut v = vec![
         format!("{} -- {model}", desc.name),
