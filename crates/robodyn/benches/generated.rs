@@ -1,7 +1,10 @@
 //! Generated customized inverse dynamic model (Rust, numeric values substituted) against the
-//! numeric Newton–Euler `rnea` on the SR400 (equivalent tree) and the RX-90.
+//! numeric Newton–Euler `rnea` on the SR400 (equivalent tree) and the RX-90; and the generated
+//! closed-chain model of the five-bar (G depending on q) against the numeric route on the same
+//! closed state: `rnea`, constraint Jacobian and W (`ClosedChain::constraints`), G^T Gamma_tr.
 
 use criterion::{criterion_group, criterion_main, Criterion};
+use robodyn::algorithms::closed_chain::ClosedChain;
 use robodyn::algorithms::inverse_dynamics::rnea;
 use robodyn::testing::{random_state, rng};
 use robodyn::{Robot, Workspace};
@@ -15,6 +18,9 @@ mod gen_sr400 {
 }
 mod gen_rx90 {
     include!("generated/rx90_idm.rs");
+}
+mod gen_fivebar {
+    include!("generated/fivebar_closed.rs");
 }
 
 type GenFn = fn(&[f64], &[f64], &[f64], &[f64], &mut [f64]);
@@ -79,5 +85,57 @@ fn benches(c: &mut Criterion) {
     );
 }
 
-criterion_group!(generated, benches);
+/// Five-bar closed-chain model on a closed state near the assembly.
+fn bench_closed(c: &mut Criterion) {
+    let robot = Robot::new(robots::fivebar_description()).unwrap();
+    let cc = ClosedChain::new(&robot).unwrap();
+    let mut ws = cc.workspace();
+    let qa = cc.reference_actuated();
+    let qa: Vec<f64> = qa.iter().map(|x| x + 0.1).collect();
+    let sol = cc.solve_from_reference(&mut ws, &qa, None).unwrap();
+    let idm = cc
+        .inverse_dynamics(&mut ws, &qa, &[0.7, -0.4], &[1.5, 2.0], Some(&sol.q_p))
+        .unwrap();
+    let st = &idm.state;
+    let (q, qd, qdd) = (st.q.clone(), st.qd.clone(), st.qdd.clone());
+    let mut out = vec![0.0; cc.dof()];
+    gen_fivebar::fivebar_closed(&q, &qd, &qdd, &[], &mut out);
+    for (a, b) in idm.gamma_cl.iter().zip(&out) {
+        assert!((a - b).abs() <= 1e-9 * (1.0 + a.abs()), "{a} vs {b}");
+    }
+    let model = robot.numeric();
+    let mut tws = Workspace::new(model);
+    let mut tau = vec![0.0; robot.nl()];
+    let mut g = c.benchmark_group("closed_fivebar");
+    g.bench_function("numeric", |b| {
+        b.iter(|| {
+            rnea(
+                model,
+                &mut tws,
+                black_box(&q),
+                black_box(&qd),
+                black_box(&qdd),
+                &mut tau,
+            );
+            let cons = cc.constraints(&mut ws, black_box(&q)).unwrap();
+            let gamma = cons.g.tr_mul(&nalgebra::DVector::from_column_slice(&tau));
+            black_box(gamma);
+        })
+    });
+    g.bench_function("generated", |b| {
+        b.iter(|| {
+            gen_fivebar::fivebar_closed(
+                black_box(&q),
+                black_box(&qd),
+                black_box(&qdd),
+                black_box(&[]),
+                &mut out,
+            );
+            black_box(&out);
+        })
+    });
+    g.finish();
+}
+
+criterion_group!(generated, benches, bench_closed);
 criterion_main!(generated);

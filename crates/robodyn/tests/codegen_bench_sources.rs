@@ -11,11 +11,28 @@ mod robots {
 #[test]
 fn bench_sources_are_current() {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("benches/generated");
-    for (file, desc, name) in [
-        ("sr400_idm.rs", robots::sr400_description(), "sr400_idm"),
-        ("rx90_idm.rs", robots::rx90_description(), "rx90_idm"),
+    use robodyn::codegen::ModelKind;
+    for (file, desc, name, model) in [
+        (
+            "sr400_idm.rs",
+            robots::sr400_description(),
+            "sr400_idm",
+            ModelKind::Idm,
+        ),
+        (
+            "rx90_idm.rs",
+            robots::rx90_description(),
+            "rx90_idm",
+            ModelKind::Idm,
+        ),
+        (
+            "fivebar_closed.rs",
+            robots::fivebar_description(),
+            "fivebar_closed",
+            ModelKind::Closed,
+        ),
     ] {
-        let fresh = robots::bench_source(&desc, name);
+        let fresh = robots::bench_source(&desc, name, model);
         let path = dir.join(file);
         if std::env::var_os("ROBODYN_BLESS").is_some() {
             std::fs::write(&path, &fresh).unwrap();

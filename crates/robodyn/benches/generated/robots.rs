@@ -41,10 +41,25 @@ pub fn rx90_description() -> robodyn::RobotDescription {
     d
 }
 
+/// The planar five-bar bundled in `robots/fivebar.toml` (closed, G depending on q).
+#[allow(dead_code)]
+pub fn fivebar_description() -> robodyn::RobotDescription {
+    robodyn::io::load_description(std::path::Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../robots/fivebar.toml"
+    )))
+    .expect("robots/fivebar.toml loads")
+}
+
 /// The generated source of the bench: numeric values substituted, all options default.
 #[allow(dead_code)]
-pub fn bench_source(desc: &robodyn::RobotDescription, name: &str) -> String {
+pub fn bench_source(
+    desc: &robodyn::RobotDescription,
+    name: &str,
+    model: robodyn::codegen::ModelKind,
+) -> String {
     let opt = robodyn::codegen::GenOptions {
+        model,
         numeric: true,
         name: Some(name.to_string()),
         ..Default::default()
