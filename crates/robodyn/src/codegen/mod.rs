@@ -6,8 +6,9 @@
 //!
 //! Models: the inverse dynamic model Gamma = f(q, qd, qdd) of the (equivalent) tree (eqs
 //! 10.3–10.12), the inertia matrix A(q), the vector H(q, qd), the direct dynamic model of trees
-//! (A qdd = Gamma - H solved by LDL' written out for the fixed size) and the closed-chain model
-//! Gamma_cl = G^T Gamma_tr (10.40) for a constant G.
+//! (A qdd = Gamma - H solved by LDL' written out for the fixed size) and the closed-chain models
+//! Gamma_cl = G^T Gamma_tr (10.40) and W = d q_p / d q_a (10.30), with a constant G where the
+//! loops have one and the loop-closure Jacobian written out otherwise (`closed.rs`).
 
 mod closed;
 mod linear;
