@@ -573,9 +573,57 @@ impl Program {
                 for a in self.assignments.iter().chain(&self.outputs) {
                     symbol_uses(&a.expr, &mut uses_count);
                 }
-            } else {
-                i += 1;
+                continue;
             }
+            // one step further: the user is itself used once; inlining both into its user may
+            // pay (terms cancel: N32 = NDI33 + No32, GAMCL2 = N32 - N33, NDI33 = N33 + ...)
+            if !is_out {
+                let uname = self.assignments[k].name.clone();
+                if uses_count.get(&uname) == Some(&1) {
+                    let user2 = self
+                        .assignments
+                        .iter()
+                        .position(|a| uses(&a.expr, &uname) > 0)
+                        .map(|k2| (false, k2))
+                        .or_else(|| {
+                            self.outputs
+                                .iter()
+                                .position(|a| uses(&a.expr, &uname) > 0)
+                                .map(|k2| (true, k2))
+                        });
+                    if let Some((is_out2, k2)) = user2 {
+                        let uexpr = after_expr.clone();
+                        let slot2 = if is_out2 {
+                            &self.outputs[k2]
+                        } else {
+                            &self.assignments[k2]
+                        };
+                        let before2 = before + count_ops(&slot2.expr);
+                        let after2_expr = slot2
+                            .expr
+                            .substitute(&|s| (s == uname).then(|| uexpr.clone()));
+                        let after2 = count_ops(&after2_expr);
+                        if after2.mul + after2.add < before2.mul + before2.add {
+                            if is_out2 {
+                                self.outputs[k2].expr = after2_expr;
+                            } else {
+                                self.assignments[k2].expr = after2_expr;
+                            }
+                            // remove the user (k) and the definition (i)
+                            let (hi, lo) = if k > i { (k, i) } else { (i, k) };
+                            self.assignments.remove(hi);
+                            self.assignments.remove(lo);
+                            uses_count.clear();
+                            for a in self.assignments.iter().chain(&self.outputs) {
+                                symbol_uses(&a.expr, &mut uses_count);
+                            }
+                            i = i.min(k);
+                            continue;
+                        }
+                    }
+                }
+            }
+            i += 1;
         }
     }
 

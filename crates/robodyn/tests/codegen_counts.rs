@@ -16,8 +16,9 @@ fn sr400() -> robodyn::RobotDescription {
 
 /// Table 10.3 counts the inverse dynamic model of the SR400, a closed chain: Gamma_cl = G^T
 /// Gamma_tr (10.40), where the customized model also takes the orientation of the links kept
-/// parallel by the parallelogram from their partners. Book figures from the chapter; the
-/// additions of the base/symmetric case (118) are not reached (see docs/models/generated-code.md).
+/// parallel by the parallelogram from their partners and moves their pure moments onto them.
+/// Book figures from the chapter; the additions of the base/symmetric case (118) are not reached
+/// (see docs/models/generated-code.md).
 #[test]
 fn sr400_table_10_3() {
     let desc = sr400();

@@ -3,7 +3,7 @@
 // Options: standard parameters, numeric values substituted
 // G = [I; W(q)], W = -Wp^-1 Wa (eq 10.30), q_a = [1, 3], q_p = [2, 4]: the Jacobian of the kept loop-closure equations (JC, eq 10.27) is written in the cut frames (KR, KP) and is valid on closed configurations only
 // Gamma_cl = Gamma_a + Wa^T LAM with Wp^T LAM = -Gamma_p (eqs 10.36-10.37); Gaussian elimination with the row order of partial pivoting at the robot's reference configuration (valid while those pivots stay away from zero)
-// Operations: 71 multiplications, 48 additions (10 function calls: sin, cos, sign)
+// Operations: 69 multiplications, 46 additions (10 function calls: sin, cos, sign)
 // Inputs:
 //   q (joint positions q_j at index j-1): q[0]=q1 q[1]=q2 q[2]=q3 q[3]=q4
 //   qd (joint velocities at index j-1): qd[0]=QP1 qd[1]=QP2 qd[2]=QP3 qd[3]=QP4
@@ -33,7 +33,6 @@ pub fn fivebar_closed(q: &[f64], qd: &[f64], qdd: &[f64], p: &[f64], out: &mut [
     let VP11 = (981.0/100.0)*C1;
     let VP21 = -(981.0/100.0)*S1;
     let U111 = -QP1*QP1;
-    let No31 = 0.010666666666667*QDP1 + (2.0/25.0)*VP21;
     let T1 = -(1.0/6.0)*std::f64::consts::PI + q2;
     let CT = (T1).cos();
     let ST = (T1).sin();
@@ -52,7 +51,6 @@ pub fn fivebar_closed(q: &[f64], qd: &[f64], qdd: &[f64], p: &[f64], out: &mut [
     let VP13 = (981.0/100.0)*C3;
     let VP23 = -(981.0/100.0)*S3;
     let U113 = -QP3*QP3;
-    let No33 = 0.010666666666667*QDP3 + (2.0/25.0)*VP23;
     let T2 = (1.0/6.0)*std::f64::consts::PI + q4;
     let CT_2 = (T2).cos();
     let ST_2 = (T2).sin();
@@ -68,12 +66,10 @@ pub fn fivebar_closed(q: &[f64], qd: &[f64], qdd: &[f64], p: &[f64], out: &mut [
     let No34 = (1.0/20.0)*VP24 + 0.006666666666667*WP34;
     let FDI24 = CT_2*F24 + F14*ST_2;
     let NDI34 = (1.0/5.0)*FDI24 + No34;
-    let N33 = NDI34 + No33;
     let FDI22 = CT*F22 + F12*ST;
     let NDI32 = (1.0/5.0)*FDI22 + No32;
-    let N31 = NDI32 + No31;
-    let GAM1 = N31 + (1.0/50.0)*QDP1 + (1.0/2.0)*QP1 + (3.0/10.0)*sgn(QP1);
-    let GAM3 = N33 + (1.0/50.0)*QDP3 + (1.0/2.0)*QP3 + (3.0/10.0)*sgn(QP3);
+    let GAM1 = NDI32 + 0.030666666666667*QDP1 + (1.0/2.0)*QP1 + (2.0/25.0)*VP21 + (3.0/10.0)*sgn(QP1);
+    let GAM3 = NDI34 + 0.030666666666667*QDP3 + (1.0/2.0)*QP3 + (2.0/25.0)*VP23 + (3.0/10.0)*sgn(QP3);
     let KP5_1_1 = (-1.0/5.0) - (1.0/5.0)*CT;
     let KP5_1_2 = (1.0/5.0)*ST;
     let KR5_0_11 = -C1*ST - CT*S1;
@@ -83,9 +79,8 @@ pub fn fivebar_closed(q: &[f64], qd: &[f64], qdd: &[f64], p: &[f64], out: &mut [
     let KP5_3_1 = KP5_1_1 + (1.0/5.0)*KR5_0_11;
     let KP5_3_2 = KP5_1_2 + (1.0/5.0)*KR5_0_21;
     let KP5_4_1 = KP5_3_1 + (1.0/5.0)*KR5_3_11;
-    let KP5_4_2 = KP5_3_2 + (1.0/5.0)*KR5_3_21;
     let LAM2 = 5.0*No32;
-    let LAM1 = (KP5_4_1*LAM2 - No34)/KP5_4_2;
+    let LAM1 = (KP5_4_1*LAM2 - No34)/(KP5_3_2 + (1.0/5.0)*KR5_3_21);
     out[0] = GAM1 + KP5_1_1*LAM2 - KP5_1_2*LAM1;  // GAMCL1
     out[1] = GAM3 - KP5_3_1*LAM2 + KP5_3_2*LAM1;  // GAMCL3
 }

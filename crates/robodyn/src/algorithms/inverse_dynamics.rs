@@ -134,16 +134,53 @@ pub fn forward_recursion<T: DynScalar>(
 /// constant on the closure manifold (the parallel links of a parallelogram, §10.3.5).
 #[derive(Clone, Debug, PartialEq)]
 pub struct SharedOrientation<T: DynScalar> {
-    /// The earlier link m (m < k).
+    /// The link m (computed before k by the recursion, see `sharing_order`).
     pub link: usize,
     /// C = mR_k, constant.
     pub rot: Matrix3<T>,
 }
 
+/// Order of the forward recursion: every link after its antecedent and after the link whose
+/// orientation it shares (which may carry a higher number), otherwise by increasing number;
+/// None for 1..NL (no shared link).
+fn sharing_order<T: DynScalar>(
+    model: &DynModel<T>,
+    shared: &[Option<SharedOrientation<T>>],
+) -> Option<Vec<usize>> {
+    let nl = model.nl;
+    if shared.iter().all(Option::is_none) {
+        return None;
+    }
+    let mut done = vec![false; nl + 1];
+    done[0] = true;
+    let mut order = Vec::with_capacity(nl);
+    while order.len() < nl {
+        let j = (1..=nl)
+            .find(|&j| {
+                !done[j]
+                    && done[model.frame(j).ant]
+                    && shared
+                        .get(j - 1)
+                        .and_then(Option::as_ref)
+                        .is_none_or(|s| done[s.link])
+            })
+            .expect("shared orientations form no cycle");
+        done[j] = true;
+        order.push(j);
+    }
+    Some(order)
+}
+
 /// [`forward_recursion`] for a closed chain whose tree state satisfies the loop constraints:
 /// for link k with `shared[k - 1] = Some(m, C)`, w_k = C^T w_m, wd_k = C^T wd_m and
 /// jU_k = C^T jU_m C replace eqs 10.3–10.5 (a signed permutation C costs nothing in the
-/// customized model). Entries beyond `shared.len()` are computed as usual.
+/// customized model). Entries beyond `shared.len()` are computed as usual. Links run in
+/// dependency order (a source may carry a higher number than the link that follows it).
+///
+/// # Panics
+/// If the sharing is cyclic (a link would need itself before it), which
+/// [`crate::codegen::parallel_links`] never produces: its source of a class is the member closest
+/// to the base, never a descendant of another member.
 pub fn forward_recursion_sharing<T: DynScalar>(
     model: &DynModel<T>,
     ws: &mut Workspace<T>,
@@ -157,7 +194,10 @@ pub fn forward_recursion_sharing<T: DynScalar>(
     ws.vd[0] = &model.vp0 - &model.gravity;
     let (p0, sq0) = w_products(&ws.w[0]);
     ws.u[0] = u_matrix(&p0, &sq0, &ws.wd[0], 0);
-    for j in 1..=model.nl {
+    // no allocation without shared links (the numeric rnea)
+    let order = sharing_order(model, shared);
+    for idx in 0..model.nl {
+        let j = order.as_ref().map_or(idx + 1, |o| o[idx]);
         let fr = model.frame(j);
         let i = fr.ant;
         let (rot, pos) = fr.transform(&q[j - 1]);
@@ -220,13 +260,39 @@ pub fn backward_recursion<T: DynScalar>(
     qdd: &[T],
     tau: &mut [T],
 ) {
-    for j in (1..=model.nl).rev() {
+    backward_recursion_sharing(model, ws, qd, qdd, tau, &[]);
+}
+
+/// [`backward_recursion`] after [`forward_recursion_sharing`], for the closed-chain torques
+/// G^T Gamma_tr only: the pure moment jm_j accumulated on a link k that shares the orientation
+/// of link m (w_k = C^T w_m on the closure manifold) is moved, as C jm_k, onto link m instead of
+/// being transmitted through joint k to a(k); the force and its moment P x f still go to a(k).
+/// A pure moment on a body does the virtual power m . w, and m . w_k = (C m) . w_m for every
+/// motion that keeps the loops closed, so G^T Gamma_tr is unchanged while the individual tree
+/// torques of the joints between the two links are not those of the tree.
+pub fn backward_recursion_sharing<T: DynScalar>(
+    model: &DynModel<T>,
+    ws: &mut Workspace<T>,
+    qd: &[T],
+    qdd: &[T],
+    tau: &mut [T],
+    shared: &[Option<SharedOrientation<T>>],
+) {
+    let order = sharing_order(model, shared);
+    for idx in (0..model.nl).rev() {
+        let j = order.as_ref().map_or(idx + 1, |o| o[idx]);
         let fr = model.frame(j);
         let l = model.link(j);
         if T::NAMED {
             // total wrench on link j, complete once its children are processed
             ws.f[j] = name3(ws.f[j].clone(), "E", j);
             ws.m[j] = name3(ws.m[j].clone(), "N", j);
+        }
+        let share = shared.get(j - 1).and_then(Option::as_ref).cloned();
+        if let Some(s) = &share {
+            let moved = &s.rot * &ws.m[j];
+            ws.m[s.link] += moved;
+            ws.m[j] = Vector3::zeros();
         }
         tau[j - 1] = match fr.joint {
             JointType::Revolute | JointType::Prismatic => {

@@ -20,7 +20,7 @@ pub use parallel_links::parallel_links;
 
 use crate::algorithms::inertia_matrix::{inertia_matrix_into, InertiaWorkspace};
 use crate::algorithms::inverse_dynamics::{
-    backward_recursion, forward_recursion_sharing, rnea, SharedOrientation,
+    backward_recursion_sharing, forward_recursion_sharing, rnea, SharedOrientation,
 };
 use crate::error::{Error, Item, Result};
 use crate::model::{DynModel, RobotDescription, STANDARD_PARAMETERS};
@@ -336,7 +336,8 @@ pub fn generate(desc: &RobotDescription, opt: &GenOptions) -> Result<Program> {
         match opt.model {
             ModelKind::Idm | ModelKind::Closed => {
                 forward_recursion_sharing(&model, &mut ws, &q, &qd, &qdd, &shared);
-                backward_recursion(&model, &mut ws, &qd, &qdd, &mut tau);
+                // the closed model only needs G^T Gamma_tr: moments of shared links move too
+                backward_recursion_sharing(&model, &mut ws, &qd, &qdd, &mut tau, &shared);
                 if opt.model == ModelKind::Idm {
                     Ok(joints
                         .iter()

@@ -18,8 +18,9 @@ use nalgebra::Matrix3;
 /// Number of closed configurations on which mR_k is compared.
 const SAMPLES: usize = 5;
 
-/// Entry k - 1: the earliest link m < k with 0R_k = 0R_m C on the closure manifold, C a signed
-/// permutation (None for trees and links without such a partner).
+/// Entry k - 1: the link m whose orientation link k takes, 0R_k = 0R_m C on the closure
+/// manifold with C a signed permutation (None for trees, for links without such a partner and
+/// for the source of each class, the link of the class closest to the base; m may be > k).
 pub fn parallel_links(robot: &Robot) -> Result<Vec<Option<SharedOrientation<f64>>>> {
     let nl = robot.nl();
     if robot.is_tree() {
@@ -39,16 +40,55 @@ pub fn parallel_links(robot: &Robot) -> Result<Vec<Option<SharedOrientation<f64>
             && (0..3).all(|i| r.row(i).abs().sum() == 1.0 && r.column(i).abs().sum() == 1.0);
         ok.then_some(r)
     };
-    Ok((1..=nl)
-        .map(|k| {
-            (1..k).find_map(|m| {
-                let c0 = rotations[0][m - 1].tr_mul(&rotations[0][k - 1]);
-                let c = signed_permutation(&c0)?;
-                rotations[1..]
-                    .iter()
-                    .all(|r| (r[m - 1].tr_mul(&r[k - 1]) - c).amax() < 1e-9)
-                    .then_some(SharedOrientation { link: m, rot: c })
-            })
-        })
-        .collect())
+    // revolute joints between link j and the base: the cost of propagating w, wd to link j
+    let depth = |mut j: usize| {
+        let mut d = 0;
+        while j > 0 {
+            if robot.frame(j).joint == crate::model::JointType::Revolute {
+                d += 1;
+            }
+            j = robot.ant(j);
+        }
+        d
+    };
+    let relative = |m: usize, k: usize| -> Option<Matrix3<f64>> {
+        let c0 = rotations[0][m - 1].tr_mul(&rotations[0][k - 1]);
+        let c = signed_permutation(&c0)?;
+        rotations[1..]
+            .iter()
+            .all(|r| (r[m - 1].tr_mul(&r[k - 1]) - c).amax() < 1e-9)
+            .then_some(c)
+    };
+    // classes of links with a constant relative orientation; the source of each class is its
+    // link closest to the base (fewest revolute joints, then lowest index), so that the
+    // recursion propagates w and wd along the shortest path
+    let mut out: Vec<Option<SharedOrientation<f64>>> = vec![None; nl];
+    let mut done = vec![false; nl + 1];
+    for k in 1..=nl {
+        if done[k] {
+            continue;
+        }
+        let class: Vec<(usize, Matrix3<f64>)> = std::iter::once((k, Matrix3::identity()))
+            .chain(
+                (k + 1..=nl)
+                    .filter(|&m| !done[m])
+                    .filter_map(|m| relative(k, m).map(|c| (m, c))),
+            )
+            .collect();
+        let &(src, ref c_src) = class
+            .iter()
+            .min_by_key(|(m, _)| (depth(*m), *m))
+            .expect("non-empty");
+        for (m, c_m) in &class {
+            done[*m] = true;
+            if *m != src {
+                // 0R_m = 0R_k C_m and 0R_src = 0R_k C_src: srcR_m = C_src^T C_m
+                out[*m - 1] = Some(SharedOrientation {
+                    link: src,
+                    rot: c_src.tr_mul(c_m),
+                });
+            }
+        }
+    }
+    Ok(out)
 }
