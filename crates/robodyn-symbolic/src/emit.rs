@@ -91,15 +91,30 @@ fn emit_text(p: &Program) -> String {
     let mut s = header(p, Lang::Text);
     s.push('\n');
     for a in p.assignments.iter().chain(&p.outputs) {
-        let _ = writeln!(s, "{} = {}", a.name, a.expr);
+        if !p.output_is_named(a) {
+            let _ = writeln!(s, "{} = {}", a.name, a.expr);
+        }
     }
     s
 }
 
-/// `WI12` -> `WI_{12}`, `XXR2` -> `XXR_{2}`, `T3` -> `T_{3}`.
+/// `WI12` -> `WI_{12}`, `XXR2` -> `XXR_{2}`, `T3` -> `T_{3}`; indices joined by underscores
+/// become a list: `KP4_1_2` -> `KP_{4,1,2}`, `W3_1` -> `W_{3,1}`.
 fn latex_name(n: &str) -> String {
-    let i = n.trim_end_matches(|c: char| c.is_ascii_digit()).len();
-    let (base, digits) = n.split_at(i);
+    let i = n
+        .trim_end_matches(|c: char| c.is_ascii_digit() || c == '_')
+        .len();
+    let (base, rest) = n.split_at(i);
+    let (base, digits) = if !base.is_empty()
+        && rest.starts_with(|c: char| c.is_ascii_digit())
+        && rest.ends_with(|c: char| c.is_ascii_digit())
+        && !rest.contains("__")
+    {
+        (base, rest.replace('_', ","))
+    } else {
+        let i = n.trim_end_matches(|c: char| c.is_ascii_digit()).len();
+        (&n[..i], n[i..].to_string())
+    };
     let base = base.replace('_', "\\_");
     let base = if base.len() > 1 {
         format!("\\mathit{{{base}}}")
@@ -219,7 +234,12 @@ fn latex(e: &Expr, prec: u8) -> String {
 fn emit_latex(p: &Program) -> String {
     let mut s = header(p, Lang::Latex);
     s.push_str("\\begin{align*}\n");
-    let all: Vec<_> = p.assignments.iter().chain(&p.outputs).collect();
+    let all: Vec<_> = p
+        .assignments
+        .iter()
+        .chain(&p.outputs)
+        .filter(|a| !p.output_is_named(a))
+        .collect();
     for (i, a) in all.iter().enumerate() {
         let end = if i + 1 < all.len() { " \\\\" } else { "" };
         let _ = writeln!(s, "{} &= {}{end}", latex_name(&a.name), latex(&a.expr, 0));

@@ -732,6 +732,46 @@ impl Program {
         if b.mul + b.add < a.mul + a.add {
             *self = factored;
         }
+        self.name_outputs();
+    }
+
+    /// An output that is a copy of an intermediate (`W3_1 = X2_1`, `QDP2 = X2`) gives that
+    /// intermediate its own name, so that the equations read `W3_1 = ...` once. Inputs, and
+    /// intermediates copied by several outputs beyond the first, keep theirs. No operation changes.
+    pub fn name_outputs(&mut self) {
+        let taken: HashSet<String> = self
+            .input_symbols()
+            .into_iter()
+            .chain(self.assignments.iter().map(|a| a.name.clone()))
+            .collect();
+        let mut map: HashMap<String, Expr> = HashMap::new();
+        for o in &self.outputs {
+            let Some(s) = o.expr.as_symbol() else {
+                continue;
+            };
+            let is_assignment = self.assignments.iter().any(|a| a.name == s);
+            if is_assignment && !map.contains_key(s) && !taken.contains(&o.name) {
+                map.insert(s.to_string(), Expr::symbol(o.name.clone()));
+            }
+        }
+        if map.is_empty() {
+            return;
+        }
+        let rename = |e: &Expr| e.substitute(&|s| map.get(s).cloned());
+        for a in &mut self.assignments {
+            if let Some(n) = map.get(&a.name).and_then(Expr::as_symbol) {
+                a.name = n.to_string();
+            }
+            a.expr = rename(&a.expr);
+        }
+        for o in &mut self.outputs {
+            o.expr = rename(&o.expr);
+        }
+    }
+
+    /// True when output `o` is just the intermediate of the same name (see [`Self::name_outputs`]).
+    pub fn output_is_named(&self, o: &Assignment) -> bool {
+        o.expr.as_symbol() == Some(o.name.as_str())
     }
 }
 
@@ -831,5 +871,39 @@ mod tests {
         for (x, y) in a.iter().zip(&b) {
             assert!((x - y).abs() < 1e-14 * (1.0 + x.abs()), "{x} vs {y}");
         }
+    }
+
+    #[test]
+    fn outputs_copying_an_intermediate_take_its_place() {
+        let a = |n: &str, e: &str| Assignment {
+            name: n.into(),
+            expr: p(e),
+        };
+        let mut prog = Program {
+            name: "t".into(),
+            assignments: vec![a("X1", "x*y + z"), a("X2", "X1*w - u")],
+            outputs: vec![a("W1", "X1"), a("W2", "X2*x"), a("W3", "X1")],
+            ..Default::default()
+        };
+        let env = |s: &str| match s {
+            "x" => Some(0.3),
+            "y" => Some(-1.7),
+            "z" => Some(2.1),
+            "w" => Some(0.9),
+            "u" => Some(-0.4),
+            _ => None,
+        };
+        let (before, values) = (prog.count(), prog.evaluate(&env).unwrap());
+        prog.name_outputs();
+        assert_eq!(prog.assignments[0].name, "W1");
+        assert_eq!(prog.assignments[1].expr, p("W1*w - u"));
+        assert!(prog.output_is_named(&prog.outputs[0]));
+        // a second copy of the same intermediate keeps copying it
+        assert_eq!(prog.outputs[2].expr, p("W1"));
+        assert_eq!(prog.count(), before);
+        assert_eq!(prog.evaluate(&env).unwrap(), values);
+        // the text form writes W1 once
+        let text = crate::emit(&prog, crate::Lang::Text);
+        assert_eq!(text.matches("W1 = ").count(), 1, "{text}");
     }
 }
