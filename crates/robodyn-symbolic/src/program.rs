@@ -527,99 +527,79 @@ impl Program {
         }
     }
 
-    /// Inline assignments used exactly once when that lowers the operation count (constants
-    /// fold, like terms merge), or when the single user is a plain copy of it (`GAMCL4 = GAM4`).
-    pub fn inline_single_use(&mut self) {
-        let mut uses_count: HashMap<String, usize> = HashMap::new();
+    /// Where `name` is used: the first assignment using it, else the first output (`true`).
+    fn user_of(&self, name: &str) -> Option<(bool, usize)> {
+        let find = |v: &[Assignment]| v.iter().position(|a| uses(&a.expr, name) > 0);
+        find(&self.assignments)
+            .map(|k| (false, k))
+            .or_else(|| find(&self.outputs).map(|k| (true, k)))
+    }
+
+    fn slot_mut(&mut self, (is_out, k): (bool, usize)) -> &mut Assignment {
+        if is_out {
+            &mut self.outputs[k]
+        } else {
+            &mut self.assignments[k]
+        }
+    }
+
+    fn count_uses(&self) -> HashMap<String, usize> {
+        let mut uses_count = HashMap::new();
         for a in self.assignments.iter().chain(&self.outputs) {
             symbol_uses(&a.expr, &mut uses_count);
         }
+        uses_count
+    }
+
+    /// Inline assignments used exactly once when that lowers the operation count (constants
+    /// fold, like terms merge), or when the single user is a plain copy of it (`GAMCL4 = GAM4`).
+    /// One step further too: when the user is itself an assignment used once, inlining both into
+    /// its user may pay (terms cancel: `GAMCL2 = N32 - N33`, `N32 = NDI33 + No32`,
+    /// `NDI33 = N33 + ...`).
+    pub fn inline_single_use(&mut self) {
+        let mut uses_count = self.count_uses();
         let mut i = 0;
         while i < self.assignments.len() {
             let name = self.assignments[i].name.clone();
-            if uses_count.get(&name) != Some(&1) {
+            let user = (uses_count.get(&name) == Some(&1))
+                .then(|| self.user_of(&name))
+                .flatten();
+            let Some(user) = user else {
                 i += 1;
                 continue;
-            }
+            };
             let def = self.assignments[i].expr.clone();
-            let user = self
-                .assignments
-                .iter()
-                .position(|a| uses(&a.expr, &name) > 0)
-                .map(|k| (false, k))
-                .or_else(|| {
-                    self.outputs
-                        .iter()
-                        .position(|a| uses(&a.expr, &name) > 0)
-                        .map(|k| (true, k))
-                });
-            let Some((is_out, k)) = user else {
-                i += 1;
-                continue;
-            };
-            let slot = if is_out {
-                &mut self.outputs[k]
-            } else {
-                &mut self.assignments[k]
-            };
+            let slot = self.slot_mut(user);
             let before = count_ops(&slot.expr) + count_ops(&def);
             let after_expr = slot.expr.substitute(&|s| (s == name).then(|| def.clone()));
             let after = count_ops(&after_expr);
             let copy = slot.expr.as_symbol() == Some(name.as_str());
             if copy || after.mul + after.add < before.mul + before.add {
-                uses_count.clear();
                 slot.expr = after_expr;
                 self.assignments.remove(i);
-                for a in self.assignments.iter().chain(&self.outputs) {
-                    symbol_uses(&a.expr, &mut uses_count);
-                }
+                uses_count = self.count_uses();
                 continue;
             }
-            // one step further: the user is itself used once; inlining both into its user may
-            // pay (terms cancel: N32 = NDI33 + No32, GAMCL2 = N32 - N33, NDI33 = N33 + ...)
-            if !is_out {
+            if let (false, k) = user {
                 let uname = self.assignments[k].name.clone();
-                if uses_count.get(&uname) == Some(&1) {
-                    let user2 = self
-                        .assignments
-                        .iter()
-                        .position(|a| uses(&a.expr, &uname) > 0)
-                        .map(|k2| (false, k2))
-                        .or_else(|| {
-                            self.outputs
-                                .iter()
-                                .position(|a| uses(&a.expr, &uname) > 0)
-                                .map(|k2| (true, k2))
-                        });
-                    if let Some((is_out2, k2)) = user2 {
-                        let uexpr = after_expr.clone();
-                        let slot2 = if is_out2 {
-                            &self.outputs[k2]
-                        } else {
-                            &self.assignments[k2]
-                        };
-                        let before2 = before + count_ops(&slot2.expr);
-                        let after2_expr = slot2
-                            .expr
-                            .substitute(&|s| (s == uname).then(|| uexpr.clone()));
-                        let after2 = count_ops(&after2_expr);
-                        if after2.mul + after2.add < before2.mul + before2.add {
-                            if is_out2 {
-                                self.outputs[k2].expr = after2_expr;
-                            } else {
-                                self.assignments[k2].expr = after2_expr;
-                            }
-                            // remove the user (k) and the definition (i)
-                            let (hi, lo) = if k > i { (k, i) } else { (i, k) };
-                            self.assignments.remove(hi);
-                            self.assignments.remove(lo);
-                            uses_count.clear();
-                            for a in self.assignments.iter().chain(&self.outputs) {
-                                symbol_uses(&a.expr, &mut uses_count);
-                            }
-                            i = i.min(k);
-                            continue;
-                        }
+                let user2 = (uses_count.get(&uname) == Some(&1))
+                    .then(|| self.user_of(&uname))
+                    .flatten();
+                if let Some(user2) = user2 {
+                    let slot2 = self.slot_mut(user2);
+                    let before2 = before + count_ops(&slot2.expr);
+                    let after2_expr = slot2
+                        .expr
+                        .substitute(&|s| (s == uname).then(|| after_expr.clone()));
+                    let after2 = count_ops(&after2_expr);
+                    if after2.mul + after2.add < before2.mul + before2.add {
+                        slot2.expr = after2_expr;
+                        // remove the user (k) and the definition (i)
+                        self.assignments.remove(i.max(k));
+                        self.assignments.remove(i.min(k));
+                        uses_count = self.count_uses();
+                        i = i.min(k);
+                        continue;
                     }
                 }
             }

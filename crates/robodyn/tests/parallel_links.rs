@@ -31,36 +31,51 @@ fn sr400_parallelogram_links_are_found() {
     }
 }
 
-/// On consistent closed states (sampled independently of the detection), the recursion with
-/// shared orientations gives the torques of the plain tree recursion, for every bundled closed
-/// robot; tree robots have no shared link.
-#[test]
-fn sharing_recursion_equals_tree_recursion_on_closed_states() {
+/// Torques on 5 consistent closed states (sampled independently of the detection) of every
+/// bundled closed robot: `f(name, state, plain rnea, sharing forward + plain backward, sharing
+/// forward + moved moments)`. Returns the number of shared links found.
+fn on_closed_states(
+    seed: u64,
+    mut f: impl FnMut(&str, &robodyn::algorithms::closed_chain::ClosedState, &[f64], &[f64], &[f64]),
+) -> usize {
     let mut found = 0;
     for (name, robot, ..) in common::cases() {
         let shared = parallel_links(&robot).unwrap();
         found += shared.iter().flatten().count();
         let model = robot.numeric();
         let mut sampler = ClosedChainSampler::new(&robot).unwrap();
-        let mut r = rng(1056);
+        let mut r = rng(seed);
         let mut ws = Workspace::new(model);
         let nl = robot.nl();
         for _ in 0..5 {
             let s = sampler.next_state(&mut r).unwrap();
             let mut plain = vec![0.0; nl];
             rnea(model, &mut ws, &s.q, &s.qd, &s.qdd, &mut plain);
-            let mut tau = vec![0.0; nl];
+            let mut sharing = vec![0.0; nl];
             forward_recursion_sharing(model, &mut ws, &s.q, &s.qd, &s.qdd, &shared);
-            backward_recursion(model, &mut ws, &s.qd, &s.qdd, &mut tau);
-            let scale = plain.iter().fold(1.0f64, |m, x| m.max(x.abs()));
-            for (a, b) in tau.iter().zip(&plain) {
-                assert!(
-                    (a - b).abs() < 1e-11 * scale,
-                    "{name}: {tau:?} vs {plain:?}"
-                );
-            }
+            backward_recursion(model, &mut ws, &s.qd, &s.qdd, &mut sharing);
+            let mut moved = vec![0.0; nl];
+            forward_recursion_sharing(model, &mut ws, &s.q, &s.qd, &s.qdd, &shared);
+            backward_recursion_sharing(model, &mut ws, &s.qd, &s.qdd, &mut moved, &shared);
+            f(name, &s, &plain, &sharing, &moved);
         }
     }
+    found
+}
+
+/// On consistent closed states the recursion with shared orientations gives the torques of the
+/// plain tree recursion, for every bundled closed robot; tree robots have no shared link.
+#[test]
+fn sharing_recursion_equals_tree_recursion_on_closed_states() {
+    let found = on_closed_states(1056, |name, _, plain, tau, _| {
+        let scale = plain.iter().fold(1.0f64, |m, x| m.max(x.abs()));
+        for (a, b) in tau.iter().zip(plain) {
+            assert!(
+                (a - b).abs() < 1e-11 * scale,
+                "{name}: {tau:?} vs {plain:?}"
+            );
+        }
+    });
     assert!(found >= 2, "the SR400's two parallel links at least");
     let tree = common::robot("rx90.toml");
     assert!(parallel_links(&tree).unwrap().iter().all(Option::is_none));
@@ -73,35 +88,21 @@ fn sharing_recursion_equals_tree_recursion_on_closed_states() {
 #[test]
 fn moved_moments_keep_the_closed_chain_torques() {
     let mut changed = 0.0f64;
-    for (name, robot, ..) in common::cases() {
-        let shared = parallel_links(&robot).unwrap();
-        let model = robot.numeric();
-        let mut sampler = ClosedChainSampler::new(&robot).unwrap();
-        let mut r = rng(1057);
-        let mut ws = Workspace::new(model);
-        let nl = robot.nl();
-        for _ in 0..5 {
-            let s = sampler.next_state(&mut r).unwrap();
-            let mut plain = vec![0.0; nl];
-            rnea(model, &mut ws, &s.q, &s.qd, &s.qdd, &mut plain);
-            let mut tau = vec![0.0; nl];
-            forward_recursion_sharing(model, &mut ws, &s.q, &s.qd, &s.qdd, &shared);
-            backward_recursion_sharing(model, &mut ws, &s.qd, &s.qdd, &mut tau, &shared);
-            let g = &s.constraints.g;
-            let a = g.tr_mul(&nalgebra::DVector::from_column_slice(&plain));
-            let b = g.tr_mul(&nalgebra::DVector::from_column_slice(&tau));
-            let scale = a.amax().max(1.0);
-            assert!(
-                (&a - &b).amax() < 1e-11 * scale,
-                "{name}: G^T tau {b} vs {a}"
-            );
-            let diff = plain
-                .iter()
-                .zip(&tau)
-                .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
-            changed = changed.max(diff / scale);
-        }
-    }
+    on_closed_states(1057, |name, s, plain, _, tau| {
+        let g = &s.constraints.g;
+        let a = g.tr_mul(&nalgebra::DVector::from_column_slice(plain));
+        let b = g.tr_mul(&nalgebra::DVector::from_column_slice(tau));
+        let scale = a.amax().max(1.0);
+        assert!(
+            (&a - &b).amax() < 1e-11 * scale,
+            "{name}: G^T tau {b} vs {a}"
+        );
+        let diff = plain
+            .iter()
+            .zip(tau)
+            .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+        changed = changed.max(diff / scale);
+    });
     assert!(
         changed > 1e-3,
         "the moved moments change some tree torques ({changed:e})"
