@@ -763,6 +763,18 @@ mod tests {
         Expr::parse(s).unwrap()
     }
 
+    /// Values of the test programs' symbols.
+    fn env(s: &str) -> Option<f64> {
+        match s {
+            "x" => Some(0.3),
+            "y" => Some(-1.7),
+            "z" => Some(2.1),
+            "w" => Some(0.9),
+            "u" => Some(-0.4),
+            _ => None,
+        }
+    }
+
     #[test]
     fn counts_follow_the_documented_rules() {
         let c = |s: &str| {
@@ -838,14 +850,6 @@ mod tests {
         let before = prog.count();
         let after = opt.count();
         assert!(after.mul + after.add < before.mul + before.add - 1);
-        let env = |s: &str| match s {
-            "x" => Some(0.3),
-            "y" => Some(-1.7),
-            "z" => Some(2.1),
-            "w" => Some(0.9),
-            "u" => Some(-0.4),
-            _ => None,
-        };
         let a = prog.evaluate(&env).unwrap();
         let b = opt.evaluate(&env).unwrap();
         for (x, y) in a.iter().zip(&b) {
@@ -864,14 +868,6 @@ mod tests {
             assignments: vec![a("X1", "x*y + z"), a("X2", "X1*w - u")],
             outputs: vec![a("W1", "X1"), a("W2", "X2*x"), a("W3", "X1")],
             ..Default::default()
-        };
-        let env = |s: &str| match s {
-            "x" => Some(0.3),
-            "y" => Some(-1.7),
-            "z" => Some(2.1),
-            "w" => Some(0.9),
-            "u" => Some(-0.4),
-            _ => None,
         };
         let (before, values) = (prog.count(), prog.evaluate(&env).unwrap());
         prog.name_outputs();

@@ -55,19 +55,29 @@ fn bench_robot(c: &mut Criterion, label: &str, robot: Robot, f: GenFn) {
             black_box(&tau);
         })
     });
+    bench_generated(&mut g, f, [&q, &qd, &qdd], &mut out);
+    g.finish();
+}
+
+/// The "generated" member of a group: `f(q, qd, qdd, [], out)` (numeric values baked in).
+fn bench_generated(
+    g: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
+    f: GenFn,
+    [q, qd, qdd]: [&[f64]; 3],
+    out: &mut [f64],
+) {
     g.bench_function("generated", |b| {
         b.iter(|| {
             f(
-                black_box(&q),
-                black_box(&qd),
-                black_box(&qdd),
+                black_box(q),
+                black_box(qd),
+                black_box(qdd),
                 black_box(&[]),
-                &mut out,
+                out,
             );
-            black_box(&out);
+            black_box(&*out);
         })
     });
-    g.finish();
 }
 
 fn benches(c: &mut Criterion) {
@@ -122,18 +132,12 @@ fn bench_closed(c: &mut Criterion) {
             black_box(gamma);
         })
     });
-    g.bench_function("generated", |b| {
-        b.iter(|| {
-            gen_fivebar::fivebar_closed(
-                black_box(&q),
-                black_box(&qd),
-                black_box(&qdd),
-                black_box(&[]),
-                &mut out,
-            );
-            black_box(&out);
-        })
-    });
+    bench_generated(
+        &mut g,
+        gen_fivebar::fivebar_closed,
+        [&q, &qd, &qdd],
+        &mut out,
+    );
     g.finish();
 }
 

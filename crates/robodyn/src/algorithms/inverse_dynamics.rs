@@ -288,8 +288,7 @@ pub fn backward_recursion_sharing<T: DynScalar>(
             ws.f[j] = name3(ws.f[j].clone(), "E", j);
             ws.m[j] = name3(ws.m[j].clone(), "N", j);
         }
-        let share = shared.get(j - 1).and_then(Option::as_ref).cloned();
-        if let Some(s) = &share {
+        if let Some(s) = shared.get(j - 1).and_then(Option::as_ref) {
             let moved = &s.rot * &ws.m[j];
             ws.m[s.link] += moved;
             ws.m[j] = Vector3::zeros();

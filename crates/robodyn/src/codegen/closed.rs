@@ -294,18 +294,25 @@ pub(crate) fn constraint_jacobian(
 pub(crate) enum ClosedForm {
     /// Not a closed-chain model.
     Tree,
-    /// G constant (rows q_1..q_NL, columns the actuated joints in increasing order).
+    /// G constant (rows q_1..q_NL, columns the actuated joints in increasing order); the
+    /// passive joints are the movable tree joints that are not actuated.
     Constant {
         g: DMatrix<Expr>,
         actuated: Vec<usize>,
+        passive: Vec<usize>,
     },
     /// G = [I; W(q)] with the loop-closure Jacobian written out.
     General(Box<ClosureReference>),
 }
 
 /// The closed-chain form of a robot: the given G, else a constant G when the loops have one,
-/// else the general form.
-pub(crate) fn closed_form(desc: &RobotDescription, opt: &GenOptions) -> Result<ClosedForm> {
+/// else the general form. `robot` is the description validated as a numeric robot (needed
+/// unless G is given).
+pub(crate) fn closed_form(
+    desc: &RobotDescription,
+    opt: &GenOptions,
+    robot: std::result::Result<&Robot, &Error>,
+) -> Result<ClosedForm> {
     let nl = desc.nl;
     if desc.nj == nl {
         return Err(Error::invalid(
@@ -317,6 +324,9 @@ pub(crate) fn closed_form(desc: &RobotDescription, opt: &GenOptions) -> Result<C
         ));
     }
     let actuated: Vec<usize> = (1..=nl).filter(|&j| desc.frame(j).actuated).collect();
+    let passive: Vec<usize> = (1..=nl)
+        .filter(|&j| !desc.frame(j).actuated && desc.frame(j).joint.is_movable())
+        .collect();
     if let Some(g) = &opt.g {
         if g.nrows() != nl || g.ncols() != actuated.len() {
             return Err(Error::Input(format!(
@@ -329,17 +339,17 @@ pub(crate) fn closed_form(desc: &RobotDescription, opt: &GenOptions) -> Result<C
         return Ok(ClosedForm::Constant {
             g: g.clone(),
             actuated,
+            passive,
         });
     }
-    let robot = Robot::new(desc.clone())?;
-    match constant_g(&robot) {
+    let robot = robot.map_err(Clone::clone)?;
+    match constant_g(robot) {
         Ok(g) => Ok(ClosedForm::Constant {
             g: g.map(Expr::num),
             actuated,
+            passive,
         }),
-        Err(_) => Ok(ClosedForm::General(Box::new(ClosureReference::new(
-            &robot,
-        )?))),
+        Err(_) => Ok(ClosedForm::General(Box::new(ClosureReference::new(robot)?))),
     }
 }
 
@@ -348,7 +358,7 @@ impl ClosedForm {
     pub fn describe(&self, nl: usize) -> Vec<String> {
         match self {
             ClosedForm::Tree => Vec::new(),
-            ClosedForm::Constant { g, actuated } => {
+            ClosedForm::Constant { g, actuated, .. } => {
                 let mut v = vec![format!(
                     "G = d q_tr / d q_a (constant; rows q1..q{nl}, columns q_a = {actuated:?}):"
                 )];
@@ -399,7 +409,7 @@ pub(crate) fn closed_torques(
     };
     match form {
         ClosedForm::Tree => Ok(Vec::new()),
-        ClosedForm::Constant { g, actuated } => Ok(actuated
+        ClosedForm::Constant { g, actuated, .. } => Ok(actuated
             .iter()
             .enumerate()
             .map(|(c, &a)| {
@@ -455,9 +465,13 @@ pub(crate) fn closed_w(
     };
     match form {
         ClosedForm::Tree => Ok(Vec::new()),
-        ClosedForm::Constant { g, actuated } => Ok((1..=g.nrows())
-            .filter(|p| !actuated.contains(p) && !g.row(p - 1).iter().all(Expr::is_zero))
-            .flat_map(|p| {
+        ClosedForm::Constant {
+            g,
+            actuated,
+            passive,
+        } => Ok(passive
+            .iter()
+            .flat_map(|&p| {
                 actuated
                     .iter()
                     .enumerate()

@@ -309,16 +309,19 @@ pub fn generate(desc: &RobotDescription, opt: &GenOptions) -> Result<Program> {
         reserved.extend(b.grouped.iter().map(|g| g.name.clone()));
     }
     let closed = matches!(opt.model, ModelKind::Closed | ModelKind::W);
-    let form = if closed {
-        closed_form(desc, opt)?
-    } else {
-        ClosedForm::Tree
+    // the numeric robot of the closed models (loop closure, constant G, parallel links)
+    let robot = closed.then(|| crate::Robot::new(desc.clone()));
+    let form = match &robot {
+        Some(robot) => closed_form(desc, opt, robot.as_ref())?,
+        None => ClosedForm::Tree,
     };
     // Closed chains: links kept parallel by the loops take their orientation from their partner.
     let shared: Vec<Option<SharedOrientation<Expr>>> = if opt.model == ModelKind::Closed {
-        crate::Robot::new(desc.clone())
-            .and_then(|r| parallel_links(&r))
-            .unwrap_or_else(|_| vec![None; nl])
+        robot
+            .as_ref()
+            .and_then(|r| r.as_ref().ok())
+            .and_then(|r| parallel_links(r).ok())
+            .unwrap_or_else(|| vec![None; nl])
             .into_iter()
             .map(|s| {
                 s.map(|s| SharedOrientation {
