@@ -156,3 +156,84 @@ fn closed_models_of_a_tree_are_refused() {
     assert!(err.contains("closed loops"), "{err}");
     assert!(!err.contains("panicked"), "{err}");
 }
+
+/// `--lang matlab --output DIR/NAME.m` writes a function file whose function is NAME (MATLAB
+/// calls it by its file name); run by GNU Octave it gives the torques of `robodyn idm`. An output
+/// name that is no MATLAB identifier, or a `--name` other than the file's, is one clear error.
+#[test]
+fn generated_matlab_function_file_agrees_with_idm() {
+    let rx90 = robot("rx90.toml");
+    let file = tmp("generate_m", "rx90_cli.m");
+    let file_s = file.to_str().unwrap();
+    run(&[
+        "generate",
+        &rx90,
+        "--lang",
+        "matlab",
+        "--numeric",
+        "--output",
+        file_s,
+    ]);
+    let code = std::fs::read_to_string(&file).unwrap();
+    assert!(
+        code.contains("function out = rx90_cli(q, qd, qdd, p)"),
+        "{code}"
+    );
+    for (args, why) in [
+        (vec!["--output", "9lives.m"], "MATLAB identifier"),
+        (vec!["--output", file_s, "--name", "other"], "file name"),
+    ] {
+        let out = Command::new(env!("CARGO_BIN_EXE_robodyn"))
+            .args(["generate", &rx90, "--lang", "matlab"])
+            .args(&args)
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(1));
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(why) && !err.contains("panicked"), "{err}");
+    }
+    let octave = Command::new("octave-cli")
+        .args(["--norc", "--quiet", "--eval", "exit(0)"])
+        .output()
+        .map(|o| o.status.success())
+        .unwrap_or(false);
+    if !octave {
+        let msg = "octave-cli not found: generated MATLAB not executed";
+        assert!(std::env::var("ROBODYN_REQUIRE_OCTAVE").is_err(), "{msg}");
+        eprintln!("SKIPPED: {msg}");
+        return;
+    }
+    let (q, qd, qdd) = (
+        "0.1,0.2,0.3,0.4,0.5,0.6",
+        "1,-1,0.5,0.3,-0.2,0.7",
+        "0.3,0.1,-0.4,1,2,-1",
+    );
+    let call = format!("printf('%.17g ', rx90_cli([{q}], [{qd}], [{qdd}], []))");
+    let out = Command::new("octave-cli")
+        .args(["--norc", "--quiet", "--eval", &call])
+        .current_dir(file.parent().unwrap())
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let got: Vec<f64> = String::from_utf8_lossy(&out.stdout)
+        .split_whitespace()
+        .map(|t| t.parse().unwrap())
+        .collect();
+    let idm: serde_json::Value = serde_json::from_str(&run(&[
+        "idm", &rx90, "--q", q, "--qd", qd, "--qdd", qdd, "--format", "json",
+    ]))
+    .unwrap();
+    assert_eq!(got.len(), 6, "{got:?}");
+    for (j, g) in got.iter().enumerate() {
+        let e = idm[0][format!("tau{}", j + 1)].as_f64().unwrap();
+        assert!(
+            (g - e).abs() < 1e-9 * (1.0 + e.abs()),
+            "tau{}: {g} vs {e}",
+            j + 1
+        );
+    }
+}

@@ -1,4 +1,5 @@
-//! Emitters of a [`Program`]: SYMORO-style text, LaTeX, Rust, C99, Python/NumPy and Julia.
+//! Emitters of a [`Program`]: SYMORO-style text, LaTeX, Rust, C99, Python/NumPy, Julia and
+//! MATLAB/GNU Octave.
 //!
 //! Output is deterministic (assignment order, no hash-map iteration) and documents the inputs and
 //! the operation counts in a header comment.
@@ -18,6 +19,8 @@ pub enum Lang {
     C,
     Python,
     Julia,
+    /// MATLAB / GNU Octave: a function file `NAME.m` (1-based indexing).
+    Matlab,
 }
 
 impl Lang {
@@ -29,6 +32,7 @@ impl Lang {
             "c" => Lang::C,
             "python" | "py" => Lang::Python,
             "julia" | "jl" => Lang::Julia,
+            "matlab" | "octave" | "m" => Lang::Matlab,
             _ => return None,
         })
     }
@@ -38,6 +42,21 @@ impl Lang {
             Lang::Text | Lang::Python | Lang::Julia => "# ",
             Lang::Latex => "% ",
             Lang::Rust | Lang::C => "// ",
+            Lang::Matlab => "% ",
+        }
+    }
+
+    /// First index of an array: 1 in Julia and MATLAB, else 0.
+    fn first_index(self) -> usize {
+        usize::from(matches!(self, Lang::Julia | Lang::Matlab))
+    }
+
+    /// `array[i]`, or `array(i)` in MATLAB.
+    fn index(self, array: &str, i: usize) -> String {
+        if self == Lang::Matlab {
+            format!("{array}({i})")
+        } else {
+            format!("{array}[{i}]")
         }
     }
 }
@@ -63,7 +82,7 @@ fn header(p: &Program, lang: Lang) -> String {
         "{c}Operations: {} multiplications, {} additions ({} function calls: sin, cos, sign)",
         k.mul, k.add, k.func
     );
-    let base = usize::from(lang == Lang::Julia);
+    let base = lang.first_index();
     let _ = writeln!(s, "{c}Inputs:");
     for g in &p.inputs {
         let names: Vec<String> = g
@@ -71,8 +90,8 @@ fn header(p: &Program, lang: Lang) -> String {
             .iter()
             .enumerate()
             .map(|(i, s)| match s {
-                Some(s) => format!("{}[{}]={s}", g.name, i + base),
-                None => format!("{}[{}]=unused", g.name, i + base),
+                Some(s) => format!("{}={s}", lang.index(&g.name, i + base)),
+                None => format!("{}=unused", lang.index(&g.name, i + base)),
             })
             .collect();
         let _ = writeln!(s, "{c}  {} ({}): {}", g.name, g.doc, names.join(" "));
@@ -81,7 +100,7 @@ fn header(p: &Program, lang: Lang) -> String {
         .outputs
         .iter()
         .enumerate()
-        .map(|(i, o)| format!("out[{}]={}", i + base, o.name))
+        .map(|(i, o)| format!("{}={}", lang.index("out", i + base), o.name))
         .collect();
     let _ = writeln!(s, "{c}Outputs: {}", outs.join(" "));
     s
@@ -372,7 +391,7 @@ fn emit_code(p: &Program, lang: Lang) -> String {
     let mut s = header(p, lang);
     let name = &p.name;
     let groups: Vec<&str> = p.inputs.iter().map(|g| g.name.as_str()).collect();
-    let base = if lang == Lang::Julia { 1 } else { 0 };
+    let base = lang.first_index();
     let ind = "    ";
     match lang {
         Lang::Rust => {
@@ -408,6 +427,10 @@ fn emit_code(p: &Program, lang: Lang) -> String {
         Lang::Julia => {
             let _ = writeln!(s, "function {name}!(out, {})", groups.join(", "));
         }
+        Lang::Matlab => {
+            let _ = writeln!(s, "function out = {name}({})", groups.join(", "));
+            let _ = writeln!(s, "{ind}out = zeros({}, 1);", p.outputs.len());
+        }
         _ => unreachable!(),
     }
     let decl = match lang {
@@ -416,13 +439,17 @@ fn emit_code(p: &Program, lang: Lang) -> String {
         _ => "",
     };
     let end = match lang {
-        Lang::Rust | Lang::C => ";",
+        Lang::Rust | Lang::C | Lang::Matlab => ";",
         _ => "",
     };
     for g in &p.inputs {
         for (i, sym) in g.symbols.iter().enumerate() {
             if let Some(sym) = sym {
-                let _ = writeln!(s, "{ind}{decl}{sym} = {}[{}]{end}", g.name, i + base);
+                let _ = writeln!(
+                    s,
+                    "{ind}{decl}{sym} = {}{end}",
+                    lang.index(&g.name, i + base)
+                );
             }
         }
     }
@@ -432,8 +459,8 @@ fn emit_code(p: &Program, lang: Lang) -> String {
     for (i, o) in p.outputs.iter().enumerate() {
         let _ = writeln!(
             s,
-            "{ind}out[{}] = {}{end}  {}{}",
-            i + base,
+            "{ind}{} = {}{end}  {}{}",
+            lang.index("out", i + base),
             code(&o.expr, lang, 0),
             lang.comment(),
             o.name
@@ -447,6 +474,7 @@ fn emit_code(p: &Program, lang: Lang) -> String {
         Lang::Julia => {
             let _ = writeln!(s, "{ind}return out\nend");
         }
+        Lang::Matlab => s.push_str("end\n"),
         _ => {}
     }
     s

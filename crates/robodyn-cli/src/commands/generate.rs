@@ -1,5 +1,5 @@
 //! `robodyn generate ROBOT`: customized symbolic models (Table 10.3) as SYMORO-style text, LaTeX
-//! or code (Rust, C, Python, Julia), with operation counts in the header.
+//! or code (Rust, C, Python, Julia, MATLAB/Octave), with operation counts in the header.
 
 use crate::common::CliResult;
 use robodyn::codegen::{generate, BaseParameters, GenOptions, ModelKind};
@@ -36,6 +36,8 @@ pub enum Language {
     C,
     Python,
     Julia,
+    /// MATLAB / GNU Octave function file (named after --output's file stem).
+    Matlab,
 }
 
 #[derive(clap::Args, Debug)]
@@ -113,7 +115,7 @@ pub fn run(a: Args) -> CliResult {
         rotor: !a.no_rotor,
         base,
         g: None,
-        name: a.name.clone(),
+        name: function_name(&a)?,
         optimize: true,
     };
     let prog = generate(&desc, &opt)?;
@@ -124,6 +126,7 @@ pub fn run(a: Args) -> CliResult {
         Language::C => Lang::C,
         Language::Python => Lang::Python,
         Language::Julia => Lang::Julia,
+        Language::Matlab => Lang::Matlab,
     };
     let text = emit(&prog, lang);
     match &a.output {
@@ -136,4 +139,32 @@ pub fn run(a: Args) -> CliResult {
         prog.name, c.mul, c.add
     );
     Ok(())
+}
+
+/// The function name: `--name`, or for MATLAB, which calls a function file by its file name, the
+/// stem of `--output` (`sr400_idm.m` -> `sr400_idm`).
+fn function_name(a: &Args) -> Result<Option<String>, String> {
+    if !matches!(a.lang, Language::Matlab) {
+        return Ok(a.name.clone());
+    }
+    let Some(stem) = a.output.as_ref().and_then(|p| p.file_stem()) else {
+        return Ok(a.name.clone());
+    };
+    let stem = stem.to_string_lossy();
+    let valid = stem.starts_with(|c: char| c.is_ascii_alphabetic())
+        && stem.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
+    if !valid {
+        return Err(format!(
+            "--output {}: a MATLAB function file needs a name that is a MATLAB identifier \
+             (a letter, then letters, digits or underscores)",
+            a.output.as_ref().unwrap().display()
+        ));
+    }
+    match &a.name {
+        Some(n) if n != stem.as_ref() => Err(format!(
+            "--name {n} differs from the file name {stem}.m: MATLAB calls a function file by its \
+             file name"
+        )),
+        _ => Ok(Some(stem.into_owned())),
+    }
 }

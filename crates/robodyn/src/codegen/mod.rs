@@ -286,7 +286,7 @@ pub fn generate(desc: &RobotDescription, opt: &GenOptions) -> Result<Program> {
             .map(|j| joints.contains(&j).then(|| joint_symbol(kind, j)))
             .collect(),
     };
-    let mut inputs = vec![group("q", "q", "joint positions q_j at index j-1")];
+    let mut inputs = vec![group("q", "q", "joint positions q_j, j = 1..NL")];
     let mut reserved: Vec<String> = Vec::new();
     // GAM<j> are inputs of the direct model only; elsewhere they name the tree torques
     let kinds: &[&str] = if opt.model == ModelKind::Ddm {
@@ -419,14 +419,14 @@ pub fn generate(desc: &RobotDescription, opt: &GenOptions) -> Result<Program> {
     let outputs = outputs?;
     match opt.model {
         ModelKind::Idm | ModelKind::Closed => {
-            inputs.push(group("qd", "QP", "joint velocities at index j-1"));
-            inputs.push(group("qdd", "QDP", "joint accelerations at index j-1"));
+            inputs.push(group("qd", "QP", "joint velocities, j = 1..NL"));
+            inputs.push(group("qdd", "QDP", "joint accelerations, j = 1..NL"));
         }
-        ModelKind::H => inputs.push(group("qd", "QP", "joint velocities at index j-1")),
+        ModelKind::H => inputs.push(group("qd", "QP", "joint velocities, j = 1..NL")),
         ModelKind::Inertia | ModelKind::W => {}
         ModelKind::Ddm => {
-            inputs.push(group("qd", "QP", "joint velocities at index j-1"));
-            inputs.push(group("gam", "GAM", "joint torques at index j-1"));
+            inputs.push(group("qd", "QP", "joint velocities, j = 1..NL"));
+            inputs.push(group("gam", "GAM", "joint torques, j = 1..NL"));
         }
     }
     let mut description = describe(desc, opt);

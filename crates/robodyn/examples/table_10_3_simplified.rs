@@ -1,0 +1,103 @@
+//! Which "symmetric links" assumption could give Table 10.3's simplified figures?
+//!
+//! The chapter's simplified case (standard 295 / 245, base 243 / 118) assumes "symmetric links"
+//! without listing which parameters vanish. This sweep zeroes, on every link, each of the 64
+//! subsets of {XY, XZ, YZ, MX, MY, MZ} and generates the SR400's customized closed-chain model
+//! (no friction, rotor inertias kept) with standard parameters and with the symbolic method's
+//! base parameters (a grouped parameter vanishes when its grouping expression does). It prints
+//! the operation counts, fewest base-model additions first, and marks the rows that are at or
+//! below the book in both cells:
+//!
+//!     cargo run --release -p robodyn --example table_10_3_simplified
+//!
+//! See docs/models/generated-code.md for what the sweep shows.
+
+use robodyn::codegen::{generate, BaseParameters, GenOptions, ModelKind};
+use robodyn::Expr;
+
+const CANDIDATES: [&str; 6] = ["XY", "XZ", "YZ", "MX", "MY", "MZ"];
+const BOOK_STANDARD: (usize, usize) = (295, 245);
+const BOOK_BASE: (usize, usize) = (243, 118);
+
+/// `XY3` -> true when its kind is in `zeros`.
+fn vanishes(zeros: &[&str], name: &str) -> bool {
+    let kind = name.trim_end_matches(|c: char| c.is_ascii_digit());
+    kind.len() < name.len() && zeros.contains(&kind)
+}
+
+/// Standard parameters in `zeros` set to zero, on the standard or the base-parameter model.
+fn parameters(
+    desc: &robodyn::RobotDescription,
+    zeros: &[&str],
+    base: bool,
+) -> robodyn::Result<BaseParameters> {
+    let mut p = if base {
+        BaseParameters::symbolic(desc, true, false)?
+    } else {
+        BaseParameters::default()
+    };
+    let sub = |s: &str| vanishes(zeros, s).then(Expr::zero);
+    let (kept, vanished): (Vec<_>, Vec<_>) = p
+        .grouped
+        .into_iter()
+        .partition(|g| !g.expr.substitute(&sub).expand().is_zero());
+    p.grouped = kept;
+    p.zero.extend(vanished.into_iter().map(|g| g.replaces));
+    for j in 1..=desc.nl {
+        for z in zeros {
+            let name = format!("{z}{j}");
+            if !p.grouped.iter().any(|g| g.replaces == name) {
+                p.zero.insert(name);
+            }
+        }
+    }
+    Ok(p)
+}
+
+fn main() -> robodyn::Result<()> {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots/sr400.toml");
+    let desc = robodyn::io::load_description(std::path::Path::new(path))?;
+    let mut rows = Vec::new();
+    for mask in 0..64u32 {
+        let zeros: Vec<&str> = (0..6)
+            .filter(|i| mask >> i & 1 == 1)
+            .map(|i| CANDIDATES[i])
+            .collect();
+        let count = |base: bool| -> robodyn::Result<(usize, usize)> {
+            let opt = GenOptions {
+                model: ModelKind::Closed,
+                friction: false,
+                rotor: true,
+                base: Some(parameters(&desc, &zeros, base)?),
+                ..Default::default()
+            };
+            let c = generate(&desc, &opt)?.count();
+            Ok((c.mul, c.add))
+        };
+        rows.push((zeros.join(" "), count(false)?, count(true)?));
+    }
+    rows.sort_by_key(|r| (r.2 .1, r.2 .0));
+    println!("SR400 closed-chain model; book: standard {BOOK_STANDARD:?}, base {BOOK_BASE:?}");
+    println!(
+        "{:24} {:>16} {:>16}",
+        "zero on every link", "standard", "base"
+    );
+    let within = |c: (usize, usize), b: (usize, usize)| c.0 <= b.0 && c.1 <= b.1;
+    for (zeros, s, b) in rows {
+        let mark = if within(s, BOOK_STANDARD) && within(b, BOOK_BASE) {
+            "  <= book in both"
+        } else {
+            ""
+        };
+        let zeros = if zeros.is_empty() {
+            "(none)".into()
+        } else {
+            zeros
+        };
+        println!(
+            "{zeros:24} {:>7} / {:<6} {:>7} / {:<6}{mark}",
+            s.0, s.1, b.0, b.1
+        );
+    }
+    Ok(())
+}
