@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{robot, run, tmp};
+use common::{octave_available, octave_eval, robot, run, tmp};
 use std::process::Command;
 
 fn has_numpy() -> bool {
@@ -192,15 +192,7 @@ fn generated_matlab_function_file_agrees_with_idm() {
         let err = String::from_utf8_lossy(&out.stderr);
         assert!(err.contains(why) && !err.contains("panicked"), "{err}");
     }
-    let octave = Command::new("octave-cli")
-        .args(["--norc", "--quiet", "--eval", "exit(0)"])
-        .output()
-        .map(|o| o.status.success())
-        .unwrap_or(false);
-    if !octave {
-        let msg = "octave-cli not found: generated MATLAB not executed";
-        assert!(std::env::var("ROBODYN_REQUIRE_OCTAVE").is_err(), "{msg}");
-        eprintln!("SKIPPED: {msg}");
+    if !octave_available() {
         return;
     }
     let (q, qd, qdd) = (
@@ -209,17 +201,7 @@ fn generated_matlab_function_file_agrees_with_idm() {
         "0.3,0.1,-0.4,1,2,-1",
     );
     let call = format!("printf('%.17g ', rx90_cli([{q}], [{qd}], [{qdd}], []))");
-    let out = Command::new("octave-cli")
-        .args(["--norc", "--quiet", "--eval", &call])
-        .current_dir(file.parent().unwrap())
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let got: Vec<f64> = String::from_utf8_lossy(&out.stdout)
+    let got: Vec<f64> = octave_eval(file.parent().unwrap(), &call)
         .split_whitespace()
         .map(|t| t.parse().unwrap())
         .collect();

@@ -44,3 +44,34 @@ pub fn csv(text: &str) -> (Vec<String>, Vec<Vec<f64>>) {
         .collect();
     (head, rows)
 }
+
+/// Whether GNU Octave (`octave-cli`) runs here. Without it a test that needs it skips with a
+/// message, except where ROBODYN_REQUIRE_OCTAVE is set (CI installs Octave): there it fails.
+pub fn octave_available() -> bool {
+    let ok = Command::new("octave-cli")
+        .args(["--norc", "--quiet", "--eval", "exit(0)"])
+        .output()
+        .map(|o| o.status.success())
+        .unwrap_or(false);
+    if !ok {
+        let msg = "octave-cli not found (Debian package `octave`): generated MATLAB not executed";
+        assert!(std::env::var("ROBODYN_REQUIRE_OCTAVE").is_err(), "{msg}");
+        eprintln!("SKIPPED: {msg}");
+    }
+    ok
+}
+
+/// Run `octave-cli --eval CODE` in `dir`, assert success, return standard output.
+pub fn octave_eval(dir: &std::path::Path, code: &str) -> String {
+    let out = Command::new("octave-cli")
+        .args(["--norc", "--quiet", "--eval", code])
+        .current_dir(dir)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "octave {code}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).unwrap()
+}
