@@ -8,6 +8,7 @@ use crate::expr::{Expr, Func, Node};
 use crate::print::{product_parts, term_is_negative};
 use crate::program::Program;
 use num_traits::Signed;
+use std::collections::{HashMap, HashSet};
 use std::fmt::Write;
 
 /// Target language.
@@ -268,7 +269,7 @@ fn emit_latex(p: &Program) -> String {
 }
 
 /// Infix code for C-like languages: powers written as products, rationals as float literals.
-fn code(e: &Expr, lang: Lang, prec: u8) -> String {
+fn code(e: &Expr, lang: Lang, prec: u8, names: &Names) -> String {
     let lit = |x: f64| -> String {
         let s = format!("{x:?}");
         let s = if s.contains('.') || s.contains('e') || s.contains("inf") || s.contains("NaN") {
@@ -302,18 +303,18 @@ fn code(e: &Expr, lang: Lang, prec: u8) -> String {
             Lang::Python => "np.pi".into(),
             _ => "pi".into(),
         },
-        Node::Symbol(s) => s.clone(),
+        Node::Symbol(s) => names.get(s),
         Node::Add(v) => {
             let mut s = String::new();
             for (i, t) in v.iter().enumerate() {
                 if i == 0 {
-                    s += &code(t, lang, 0);
+                    s += &code(t, lang, 0, names);
                 } else if term_is_negative(t) {
                     s += " - ";
-                    s += &code(&-t.clone(), lang, 1);
+                    s += &code(&-t.clone(), lang, 1, names);
                 } else {
                     s += " + ";
-                    s += &code(t, lang, 0);
+                    s += &code(t, lang, 0, names);
                 }
             }
             if prec > 0 {
@@ -330,11 +331,11 @@ fn code(e: &Expr, lang: Lang, prec: u8) -> String {
                 neg = c.as_f64().unwrap_or(0.0) < 0.0;
                 let a = if neg { -c } else { c };
                 if !a.is_one() {
-                    parts.push(code(&a, lang, 2));
+                    parts.push(code(&a, lang, 2, names));
                 }
             }
             for f in &num {
-                push_power(f, lang, &mut parts);
+                push_power(f, lang, &mut parts, names);
             }
             let mut body = if parts.is_empty() {
                 "1.0".to_string()
@@ -343,7 +344,7 @@ fn code(e: &Expr, lang: Lang, prec: u8) -> String {
             };
             for d in &den {
                 let mut dp = Vec::new();
-                push_power(d, lang, &mut dp);
+                push_power(d, lang, &mut dp, names);
                 for x in dp {
                     body = format!("{body}/{x}");
                 }
@@ -358,7 +359,7 @@ fn code(e: &Expr, lang: Lang, prec: u8) -> String {
             }
         }
         Node::Func(f, a) => {
-            let arg = code(a, lang, 0);
+            let arg = code(a, lang, 0, names);
             match (lang, f) {
                 (Lang::Rust, Func::Sign) => format!("sgn({arg})"),
                 // a literal argument has no type of its own: name the method's type
@@ -375,20 +376,78 @@ fn code(e: &Expr, lang: Lang, prec: u8) -> String {
 }
 
 /// x^n written as n factors so that the code performs the counted multiplications.
-fn push_power(f: &Expr, lang: Lang, parts: &mut Vec<String>) {
+fn push_power(f: &Expr, lang: Lang, parts: &mut Vec<String>, names: &Names) {
     match f.node() {
         Node::Pow(b, n) if *n > 0 => {
-            let s = code(b, lang, 2);
+            let s = code(b, lang, 2, names);
             for _ in 0..*n {
                 parts.push(s.clone());
             }
         }
-        _ => parts.push(code(f, lang, 2)),
+        _ => parts.push(code(f, lang, 2, names)),
+    }
+}
+
+/// Identifiers generated code never gives a symbol: the names the code itself uses (argument
+/// arrays, helpers, math functions) and the keywords of Rust, C, Python, Julia and MATLAB.
+const RESERVED: &str = "\
+    q qd qdd p gam out sgn rd_sign np math std f64 sin cos tan sqrt abs fabs sign pi zeros \
+    Inf NaN inf nan \
+    as async await break const continue crate dyn else enum extern false fn for if impl in let \
+    loop match mod move mut pub ref return self Self static struct super trait true type unsafe \
+    use where while abstract become box do final gen macro override priv try typeof unsized \
+    virtual yield \
+    auto case char default double float goto inline int long register restrict short signed \
+    sizeof switch typedef union unsigned void volatile \
+    False None True and assert class def del elif except finally from global import is lambda \
+    nonlocal not or pass raise with \
+    baremodule begin catch elseif end export function local module quote using outer isa \
+    classdef otherwise parfor persistent spmd";
+
+fn is_reserved(name: &str) -> bool {
+    RESERVED.split_whitespace().any(|r| r == name)
+}
+
+/// Names of a program's symbols in generated code. A symbol whose name is reserved (a robot
+/// symbol `p`, `end` or `in`) is written with underscores appended until the name is free; the
+/// caller never sees it, since inputs are passed by position.
+struct Names(HashMap<String, String>);
+
+impl Names {
+    fn new(p: &Program) -> Names {
+        let order: Vec<&str> = p
+            .inputs
+            .iter()
+            .flat_map(|g| g.symbols.iter().flatten())
+            .chain(p.assignments.iter().map(|a| &a.name))
+            .map(String::as_str)
+            .collect();
+        let mut used: HashSet<String> = order.iter().map(|n| n.to_string()).collect();
+        let mut map = HashMap::new();
+        for n in order {
+            if is_reserved(n) && !map.contains_key(n) {
+                let mut m = format!("{n}_");
+                while used.contains(&m) || is_reserved(&m) {
+                    m.push('_');
+                }
+                used.insert(m.clone());
+                map.insert(n.to_string(), m);
+            }
+        }
+        Names(map)
+    }
+
+    fn get(&self, name: &str) -> String {
+        self.0
+            .get(name)
+            .cloned()
+            .unwrap_or_else(|| name.to_string())
     }
 }
 
 fn emit_code(p: &Program, lang: Lang) -> String {
     let mut s = header(p, lang);
+    let names = &Names::new(p);
     let name = &p.name;
     let groups: Vec<&str> = p.inputs.iter().map(|g| g.name.as_str()).collect();
     let base = lang.first_index();
@@ -447,21 +506,27 @@ fn emit_code(p: &Program, lang: Lang) -> String {
             if let Some(sym) = sym {
                 let _ = writeln!(
                     s,
-                    "{ind}{decl}{sym} = {}{end}",
+                    "{ind}{decl}{} = {}{end}",
+                    names.get(sym),
                     lang.index(&g.name, i + base)
                 );
             }
         }
     }
     for a in &p.assignments {
-        let _ = writeln!(s, "{ind}{decl}{} = {}{end}", a.name, code(&a.expr, lang, 0));
+        let _ = writeln!(
+            s,
+            "{ind}{decl}{} = {}{end}",
+            names.get(&a.name),
+            code(&a.expr, lang, 0, names)
+        );
     }
     for (i, o) in p.outputs.iter().enumerate() {
         let _ = writeln!(
             s,
             "{ind}{} = {}{end}  {}{}",
             lang.index("out", i + base),
-            code(&o.expr, lang, 0),
+            code(&o.expr, lang, 0, names),
             lang.comment(),
             o.name
         );

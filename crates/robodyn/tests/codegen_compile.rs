@@ -13,7 +13,7 @@
 //!
 //! Robots: the SR400 (symbolic and numeric), the RX-90, every other bundled robot (the closed
 //! ones as their equivalent trees, and as closed chains), a slider-crank with a prismatic cut
-//! joint and three random trees.
+//! joint, three random trees, and the SCARA with symbols named `end`, `p`, `in`, `out`.
 //!
 //! Every program is compiled (rustc, cc) into a harness that reads inputs on stdin and prints the
 //! outputs; tolerance 1e-10 relative (norm-wise over each output vector).
@@ -330,6 +330,20 @@ fn all_cases() -> Vec<Case> {
         cases.extend(tree_cases(&d, false, 20 + k as u64, name));
     }
     cases.extend(general_closed_cases());
+    // robot symbols named like the code's own arrays or a language's keywords (the SCARA with
+    // D2 -> end, D3 -> p, L1 -> in, G3 -> out): the emitters rename them, inputs go by position
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../robots/scara.toml");
+    let mut text = std::fs::read_to_string(path).unwrap();
+    for (from, to) in [("D2", "end"), ("D3", "p"), ("L1", "in"), ("G3", "out")] {
+        text = text
+            .replace(&format!("\"{from}\""), &format!("\"{to}\""))
+            .replace(&format!("\n{from} = "), &format!("\n{to} = "));
+    }
+    let (d, _) = robodyn::io::toml_format::parse_description(&text, None).unwrap();
+    for s in ["end", "p", "in", "out"] {
+        assert!(d.symbols.contains_key(s), "{s}");
+    }
+    cases.extend(tree_cases(&d, false, 30, "reserved_names"));
     let opts = TreeOptions::default();
     for (k, seed) in [11u64, 12, 13].into_iter().enumerate() {
         let mut r = rng(seed);
