@@ -501,9 +501,20 @@ fn emit_code(p: &Program, lang: Lang) -> String {
         Lang::Rust | Lang::C | Lang::Matlab => ";",
         _ => "",
     };
+    // only the inputs the program reads (-Wall clean C; the header lists every position)
+    let read: HashSet<String> = p
+        .assignments
+        .iter()
+        .chain(&p.outputs)
+        .flat_map(|a| a.expr.symbols())
+        .collect();
     for g in &p.inputs {
+        let unread = !g.symbols.iter().flatten().any(|s| read.contains(s));
+        if lang == Lang::C && unread {
+            let _ = writeln!(s, "{ind}(void){};", g.name);
+        }
         for (i, sym) in g.symbols.iter().enumerate() {
-            if let Some(sym) = sym {
+            if let Some(sym) = sym.as_ref().filter(|s| read.contains(*s)) {
                 let _ = writeln!(
                     s,
                     "{ind}{decl}{} = {}{end}",

@@ -506,7 +506,7 @@ fn c_harness(cases: &[Case]) -> String {
         "#include <math.h>\nstatic inline double rd_sign(double x) { return (x > 0.0) - (x < 0.0); }",
         1,
     );
-    s += "int main(int argc, char **argv) {\n    int which = atoi(argv[1]);\n    int n;\n    if (scanf(\"%d\", &n) != 1) return 1;\n";
+    s += "int main(int argc, char **argv) {\n    if (argc < 2) return 2;\n    int which = atoi(argv[1]);\n    int n;\n    if (scanf(\"%d\", &n) != 1) return 1;\n";
     s += "    static double buf[100000];\n    for (int s = 0; s < n; s++) {\n        switch (which) {\n";
     for (i, c) in cases.iter().enumerate() {
         let total: usize = c.prog.inputs.iter().map(|g| g.symbols.len()).sum();
@@ -559,8 +559,9 @@ fn generated_rust_and_c_agree_with_numeric_models() {
             "-std=c99",
             "-O1",
             "-Wall",
+            "-Wextra",
+            "-pedantic",
             "-Werror",
-            "-Wno-unused-variable",
             "-o",
         ])
         .arg(&cbin)

@@ -14,7 +14,6 @@ pub fn rx90_idm(q: &[f64], qd: &[f64], qdd: &[f64], p: &[f64], out: &mut [f64]) 
     fn sgn(x: f64) -> f64 {
         if x > 0.0 { 1.0 } else if x < 0.0 { -1.0 } else { 0.0 }
     }
-    let q1 = q[0];
     let q2 = q[1];
     let q3 = q[2];
     let q4 = q[3];
