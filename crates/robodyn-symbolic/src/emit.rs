@@ -176,18 +176,7 @@ fn latex(e: &Expr, prec: u8) -> String {
         Node::Pi => "\\pi".into(),
         Node::Symbol(s) => latex_name(s),
         Node::Add(v) => {
-            let mut s = String::new();
-            for (i, t) in v.iter().enumerate() {
-                if i == 0 {
-                    s += &latex(t, 0);
-                } else if term_is_negative(t) {
-                    s += " - ";
-                    s += &latex(&-t.clone(), 0);
-                } else {
-                    s += " + ";
-                    s += &latex(t, 0);
-                }
-            }
+            let s = latex_terms(v).concat();
             if prec > 0 {
                 format!("\\left({s}\\right)")
             } else {
@@ -251,6 +240,62 @@ fn latex(e: &Expr, prec: u8) -> String {
     }
 }
 
+/// The terms of a sum, each with its sign: `a`, ` + b`, ` - c`.
+fn latex_terms(v: &[Expr]) -> Vec<String> {
+    v.iter()
+        .enumerate()
+        .map(|(i, t)| {
+            if i == 0 {
+                latex(t, 0)
+            } else if term_is_negative(t) {
+                format!(" - {}", latex(&-t.clone(), 0))
+            } else {
+                format!(" + {}", latex(t, 0))
+            }
+        })
+        .collect()
+}
+
+/// Printed width, in characters, of a line of an `align*` row (an article's text width).
+const LATEX_LINE_WIDTH: usize = 48;
+
+/// Rough printed width of LaTeX math: its characters less the markup.
+fn latex_width(s: &str) -> usize {
+    [
+        "\\operatorname",
+        "\\mathit",
+        "\\left",
+        "\\right",
+        "\\,",
+        "{",
+        "}",
+        "_",
+        "^",
+    ]
+    .iter()
+    .fold(s.to_string(), |acc, m| acc.replace(m, ""))
+    .chars()
+    .count()
+}
+
+/// The right-hand side of an assignment; a sum too wide for one line is broken between its
+/// terms over several lines of the row.
+fn latex_rhs(e: &Expr) -> String {
+    let Node::Add(v) = e.node() else {
+        return latex(e, 0);
+    };
+    let mut lines: Vec<String> = vec![String::new()];
+    for t in latex_terms(v) {
+        let line = lines.last_mut().expect("one line");
+        if !line.is_empty() && latex_width(line) + latex_width(&t) > LATEX_LINE_WIDTH {
+            lines.push(t);
+        } else {
+            line.push_str(&t);
+        }
+    }
+    lines.join(" \\\\\n&\\qquad")
+}
+
 fn emit_latex(p: &Program) -> String {
     let mut s = header(p, Lang::Latex);
     s.push_str("\\begin{align*}\n");
@@ -262,7 +307,7 @@ fn emit_latex(p: &Program) -> String {
         .collect();
     for (i, a) in all.iter().enumerate() {
         let end = if i + 1 < all.len() { " \\\\" } else { "" };
-        let _ = writeln!(s, "{} &= {}{end}", latex_name(&a.name), latex(&a.expr, 0));
+        let _ = writeln!(s, "{} &= {}{end}", latex_name(&a.name), latex_rhs(&a.expr));
     }
     s.push_str("\\end{align*}\n");
     s
