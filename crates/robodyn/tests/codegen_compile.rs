@@ -676,16 +676,13 @@ fn interpreted_and_python_agree() {
 /// ROBODYN_REQUIRE_OCTAVE=1, so that a missing install fails there instead of skipping.
 #[test]
 fn matlab_code_runs_in_octave_and_agrees() {
-    let has_octave = Command::new("octave-cli")
-        .args(["--norc", "--quiet", "--eval", "exit(0)"])
-        .stdin(Stdio::null())
-        .output()
-        .map(|o| o.status.success())
-        .unwrap_or(false);
-    if !has_octave {
-        let msg = "octave-cli not found (Debian package `octave`): MATLAB emitter not executed";
-        assert!(std::env::var("ROBODYN_REQUIRE_OCTAVE").is_err(), "{msg}");
-        eprintln!("SKIPPED: {msg}");
+    let octave = common::tool_available(
+        "octave-cli",
+        &["--norc", "--quiet", "--eval", "exit(0)"],
+        "ROBODYN_REQUIRE_OCTAVE",
+        "generated MATLAB (Debian package `octave`)",
+    );
+    if !octave {
         return;
     }
     let cases = all_cases();

@@ -3,6 +3,8 @@
 //! no error, and the rows fit the text width (long sums are broken between terms). `.ci/run` installs pdflatex (Debian's texlive-latex-base) and sets
 //! ROBODYN_REQUIRE_LATEX=1, so that a missing install fails there instead of skipping.
 
+mod common;
+
 use robodyn::codegen::{generate, GenOptions, ModelKind};
 use robodyn_symbolic::{emit, Lang};
 use std::path::Path;
@@ -19,24 +21,15 @@ const ROBOTS: [(&str, bool); 8] = [
     ("twoloops", true),
 ];
 
-fn pdflatex_available() -> bool {
-    let ok = Command::new("pdflatex")
-        .arg("--version")
-        .stdout(Stdio::null())
-        .status()
-        .map(|s| s.success())
-        .unwrap_or(false);
-    if !ok {
-        let msg = "pdflatex not found (Debian package texlive-latex-base): LaTeX not typeset";
-        assert!(std::env::var("ROBODYN_REQUIRE_LATEX").is_err(), "{msg}");
-        eprintln!("SKIPPED: {msg}");
-    }
-    ok
-}
-
 #[test]
 fn generated_latex_typesets() {
-    if !pdflatex_available() {
+    let pdflatex = common::tool_available(
+        "pdflatex",
+        &["--version"],
+        "ROBODYN_REQUIRE_LATEX",
+        "generated LaTeX (Debian package texlive-latex-base)",
+    );
+    if !pdflatex {
         return;
     }
     let dir = std::env::temp_dir().join(format!("robodyn-latex-{}", std::process::id()));

@@ -323,10 +323,7 @@ pub(crate) fn closed_form(
             ),
         ));
     }
-    let actuated: Vec<usize> = (1..=nl).filter(|&j| desc.frame(j).actuated).collect();
-    let passive: Vec<usize> = (1..=nl)
-        .filter(|&j| !desc.frame(j).actuated && desc.frame(j).joint.is_movable())
-        .collect();
+    let (actuated, passive) = (desc.actuated_joints(), desc.passive_joints());
     if let Some(g) = &opt.g {
         if g.nrows() != nl || g.ncols() != actuated.len() {
             return Err(Error::Input(format!(

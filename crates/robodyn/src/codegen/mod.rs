@@ -272,9 +272,7 @@ pub fn generate(desc: &RobotDescription, opt: &GenOptions) -> Result<Program> {
     crate::model::validate_structure(desc)?;
     let model = symbolic_model(desc, opt)?;
     let nl = desc.nl;
-    let joints: Vec<usize> = (1..=nl)
-        .filter(|&j| desc.frame(j).joint.is_movable())
-        .collect();
+    let joints = desc.movable_joints();
     let sym = |k: &str, j: usize| Expr::symbol(joint_symbol(k, j));
     let q: Vec<Expr> = (1..=nl).map(|j| sym("q", j)).collect();
     let qd: Vec<Expr> = (1..=nl).map(|j| sym("QP", j)).collect();

@@ -12,6 +12,7 @@ use crate::algorithms::base_parameters::closed::ClosedChainSampler;
 use crate::algorithms::inverse_dynamics::SharedOrientation;
 use crate::error::Result;
 use crate::geometry::frame_transforms;
+use crate::model::path_from_base;
 use crate::Robot;
 use nalgebra::Matrix3;
 
@@ -41,15 +42,11 @@ pub fn parallel_links(robot: &Robot) -> Result<Vec<Option<SharedOrientation<f64>
         ok.then_some(r)
     };
     // revolute joints between link j and the base: the cost of propagating w, wd to link j
-    let depth = |mut j: usize| {
-        let mut d = 0;
-        while j > 0 {
-            if robot.frame(j).joint == crate::model::JointType::Revolute {
-                d += 1;
-            }
-            j = robot.ant(j);
-        }
-        d
+    let depth = |j: usize| {
+        path_from_base(&robot.structure().ant, j)
+            .into_iter()
+            .filter(|&k| robot.frame(k).joint.is_revolute())
+            .count()
     };
     let relative = |m: usize, k: usize| -> Option<Matrix3<f64>> {
         let c0 = rotations[0][m - 1].tr_mul(&rotations[0][k - 1]);

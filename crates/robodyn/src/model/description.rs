@@ -256,4 +256,23 @@ impl RobotDescription {
     pub fn link_mut(&mut self, j: usize) -> &mut LinkDesc {
         &mut self.links[j - 1]
     }
+
+    /// Tree joints 1..NL that are movable (not fixed).
+    pub fn movable_joints(&self) -> Vec<usize> {
+        (1..=self.nl)
+            .filter(|&j| self.frame(j).joint.is_movable())
+            .collect()
+    }
+
+    /// Actuated tree joints (mu = 1), in increasing order: q_a.
+    pub fn actuated_joints(&self) -> Vec<usize> {
+        (1..=self.nl).filter(|&j| self.frame(j).actuated).collect()
+    }
+
+    /// Passive movable tree joints (mu = 0): q_p.
+    pub fn passive_joints(&self) -> Vec<usize> {
+        (1..=self.nl)
+            .filter(|&j| !self.frame(j).actuated && self.frame(j).joint.is_movable())
+            .collect()
+    }
 }

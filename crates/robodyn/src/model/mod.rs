@@ -278,23 +278,17 @@ impl Robot {
 
     /// Tree joints 1..NL that are movable (not fixed).
     pub fn movable_joints(&self) -> Vec<usize> {
-        (1..=self.nl())
-            .filter(|&j| self.frame(j).joint.is_movable())
-            .collect()
+        self.desc.movable_joints()
     }
 
     /// Actuated tree joints (mu = 1), in increasing order: q_a.
     pub fn actuated_joints(&self) -> Vec<usize> {
-        (1..=self.nl())
-            .filter(|&j| self.frame(j).actuated)
-            .collect()
+        self.desc.actuated_joints()
     }
 
     /// Passive movable tree joints (mu = 0): q_p.
     pub fn passive_joints(&self) -> Vec<usize> {
-        (1..=self.nl())
-            .filter(|&j| !self.frame(j).actuated && self.frame(j).joint.is_movable())
-            .collect()
+        self.desc.passive_joints()
     }
 
     /// Numeric standard parameters, 13 per link (XX..FV), link 1 first.
