@@ -18,6 +18,7 @@ pub mod error;
 pub mod geometry;
 pub mod io;
 pub mod model;
+pub mod report;
 pub mod scalar;
 pub mod simulation;
 pub mod testing;
