@@ -87,11 +87,13 @@ impl StartReport {
                 q.join(", ")
             ),
             StartOrigin::Zero => format!(
-                "the file has no assembly: samples on the branch of q = 0 ({branch}); give                  `assembly` to choose another",
-                
+                "the file has no assembly: samples on the branch of q = 0 ({branch}); give \
+                 `assembly` to choose another"
             ),
             StartOrigin::Moved { ratio_at_zero } => format!(
-                "the file has no assembly and q = 0 is {} (sigma_min/sigma_max(Wp) = {}): the                  samples start from the regular configuration q = [{}] ({branch}); give                  `assembly` in the robot file to choose the branch",
+                "the file has no assembly and q = 0 is {} (sigma_min/sigma_max(Wp) = {}): the \
+                 samples start from the regular configuration q = [{}] ({branch}); give \
+                 `assembly` in the robot file to choose the branch",
                 if *ratio_at_zero > 0.0 {
                     "singular or off the parallelogram branch"
                 } else {

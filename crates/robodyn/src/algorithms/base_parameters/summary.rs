@@ -321,6 +321,8 @@ pub struct MethodComparison {
     pub numeric_only: Vec<String>,
     /// Cut joints of the loops the symbolic rules did not fully handle.
     pub unhandled_loops: Vec<usize>,
+    /// Cut joints of the parallelogram loops (handled by 10.51c, 10.55, 10.56).
+    pub parallelograms: Vec<usize>,
 }
 
 /// Compare the base sets of the two methods (names from `names`).
@@ -341,10 +343,38 @@ pub fn compare_methods(
         symbolic_only: only(&sb.base, &nb.base),
         numeric_only: only(&nb.base, &sb.base),
         unhandled_loops: sb.unhandled_loops.clone(),
+        parallelograms: sb.parallelograms.clone(),
     }
 }
 
 impl MethodComparison {
+    /// Why the rules may give more parameters than the numerical method on this robot.
+    pub fn reason(&self) -> String {
+        let mut why = Vec::new();
+        if !self.unhandled_loops.is_empty() {
+            why.push(format!(
+                "the loop(s) cut at joint(s) {:?} are not parallelograms: the rules do not use \
+                 their cut-joint relations (10.51; \"no general systematic choice\", §10.3.4)",
+                self.unhandled_loops
+            ));
+        }
+        if !self.parallelograms.is_empty() {
+            why.push(format!(
+                "through the parallelogram(s) cut at joint(s) {:?} some links keep the \
+                 orientation of a lower link (10.54), so a link can turn about an axis fixed \
+                 to a lower link or move in a plane normal to gravity although its tree path \
+                 says otherwise: rules 5–7 are stated on the tree's branches (r1, r2) and do \
+                 not see these eliminations",
+                self.parallelograms
+            ));
+        }
+        if why.is_empty() {
+            "a relation the rules do not express".into()
+        } else {
+            why.join("; ")
+        }
+    }
+
     /// Same base set.
     pub fn same(&self) -> bool {
         self.symbolic_only.is_empty() && self.numeric_only.is_empty()
@@ -359,15 +389,7 @@ impl MethodComparison {
                 self.numeric_count
             );
         }
-        let why = if self.unhandled_loops.is_empty() {
-            String::new()
-        } else {
-            format!(
-                " (the rules do not use the cut-joint relations (10.51) of the loop(s) cut at \
-                 joint(s) {:?})",
-                self.unhandled_loops
-            )
-        };
+        let why = format!(" ({})", self.reason());
         format!(
             "METHODS DIFFER: the symbolic rules give {} base parameters, the numerical method {}. \
              The NUMERICAL method is the arbiter (its set is minimal){why}. Base by the rules \
@@ -393,15 +415,7 @@ impl MethodComparison {
              `--method numeric` gives the minimal set.\n\n",
             self.numeric_count,
             self.symbolic_count,
-            if self.unhandled_loops.is_empty() {
-                String::new()
-            } else {
-                format!(
-                    " (the loop(s) cut at joint(s) {:?} are not parallelograms: their cut-joint \
-                     relations 10.51 are not used by the rules)",
-                    self.unhandled_loops
-                )
-            },
+            format!(" ({})", self.reason()),
             list(&self.symbolic_only),
             list(&self.numeric_only)
         ))

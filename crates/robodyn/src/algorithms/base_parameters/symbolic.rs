@@ -367,9 +367,9 @@ fn rz(delta: &Expr) -> Matrix3<Expr> {
 pub struct Parallelogram {
     /// Cut joint k of the loop.
     pub cut: usize,
-    /// Tree joints of the loop whose velocities are +-qd of each other (their drive parameters
-    /// group into the lowest one's).
-    pub coupled: Vec<usize>,
+    /// Couples of tree joints of the loop whose velocities are +-qd of each other (their drive
+    /// parameters group into the lowest one's).
+    pub coupled: Vec<(usize, usize)>,
     /// (low, high, lowA_high): link `high` keeps the orientation lowA_high with respect to link
     /// `low` (0 = the base).
     pub pairs: Vec<(usize, usize, Matrix3<Expr>)>,
@@ -396,19 +396,19 @@ fn offset(geo: &Geo, x: usize) -> Vector3<f64> {
     geo.frames[x - 1].transform(&0.0).1
 }
 
-/// Detect a parallelogram loop from the geometry. Two shapes (Figure 10.2):
-///
-/// - four moving links a, b (branch of the cut joint) and c, e (branch of the twin frame)
-///   whose first joints share their point (O_a = O_c): a parallel to e, b parallel to c;
-/// - three moving links and a side of the root link r (or of the base): the branch of two
-///   links [a, b] and the branch of one link [c], the fourth side O_a -> O_c fixed on r:
-///   a parallel to c and b parallel to r (so w_b = w_r, and J_b groups into J_r by 10.55;
-///   with r the base, J_b has no effect).
-///
-/// Every joint of the loop is revolute with its axis parallel to the others (same direction);
-/// opposite sides have equal lengths. The sides are read in the plane of the axes: with
-/// psi_x the angle of link x about the common axis and phi_x the angle of its side in its own
-/// frame, parallel sides have psi_x + phi_x = psi_y + phi_y, so xA_y = Rz(phi_x - phi_y).
+/// Detect a parallelogram loop from the geometry (§10.3.5, Figure 10.2). Every joint of the
+/// loop (tree joints and the cut joint) is revolute, with its axis parallel to the others in
+/// the same direction. The loop is read as a polygon in the plane of the axes: each link of the
+/// loop carries one side, from its joint O_x to the next joint of its branch (or to the cut
+/// joint and its twin, which coincide), and the root link r carries the side between the first
+/// joints of the two branches (read in the frame of the first joint of the cut's branch at
+/// q = 0, a frame fixed on r whose z is the axis). Sides of zero length (two joints on one
+/// point: SR400's O_2 = O_7, the older TwoLoops' O_3 = O_8) are dropped. The loop is a
+/// parallelogram when four sides remain, opposite ones of equal length: the links carrying
+/// opposite sides then keep their relative orientation (eq 10.54, w_x = w_y). With psi_x the
+/// angle of link x about the axis and phi'_x the angle of its side in its frame (plus pi when
+/// the polygon runs the side backwards, on the twin's branch), opposite sides satisfy
+/// psi_x + phi'_x = psi_y + phi'_y + pi, so xA_y = Rz(phi'_x - phi'_y - pi) (derived).
 fn detect_parallelogram(
     desc: &RobotDescription,
     geo: &Geo,
@@ -420,71 +420,171 @@ fn detect_parallelogram(
     if !joints.iter().all(|&x| revolute(x)) {
         return None;
     }
-    let first = *l.branch_i.first().or(l.branch_j.first())?;
+    let (&first_i, &first_j) = (l.branch_i.first()?, l.branch_j.first()?);
     let same_axis = |x: usize| {
-        (0..geo.configs.len()).all(|c| (geo.z(c, x) - geo.z(c, first)).norm() < GEOMETRY_TOLERANCE)
+        (0..geo.configs.len())
+            .all(|c| (geo.z(c, x) - geo.z(c, first_i)).norm() < GEOMETRY_TOLERANCE)
     };
     if !joints.iter().chain([&tw]).all(|&x| same_axis(x)) {
         return None;
     }
-    let phi = |v: nalgebra::Vector2<f64>| v.y.atan2(v.x);
-    let equal = |u: nalgebra::Vector2<f64>, v: nalgebra::Vector2<f64>| {
-        (u.norm() - v.norm()).abs() < GEOMETRY_TOLERANCE && u.norm() > GEOMETRY_TOLERANCE
-    };
-    let pair = |x: usize, px: f64, y: usize, py: f64| {
-        let (lo, plo, hi, phi_hi) = if x < y {
-            (x, px, y, py)
-        } else {
-            (y, py, x, px)
-        };
-        (lo, hi, rz(&exact_angle(plo - phi_hi)))
-    };
-    match (l.branch_i.as_slice(), l.branch_j.as_slice()) {
-        (&[a, b], &[c, e]) => {
-            // O_a = O_c (the two branches start at one point)
-            if (0..geo.configs.len())
-                .any(|cfg| (geo.poses[cfg][a].1 - geo.poses[cfg][c].1).norm() > GEOMETRY_TOLERANCE)
-            {
-                return None;
-            }
-            // link a carries joint b, link b the cut joint k, link c carries e, link e the twin
-            let (sa, sb) = (planar(&offset(geo, b)), planar(&offset(geo, k)));
-            let (sc, se) = (planar(&offset(geo, e)), planar(&offset(geo, tw)));
-            if !equal(sa, se) || !equal(sb, sc) {
-                return None;
-            }
-            Some(Parallelogram {
-                cut: k,
-                coupled: vec![b.min(e), b.max(e)],
-                pairs: vec![pair(a, phi(sa), e, phi(se)), pair(b, phi(sb), c, phi(sc))],
-            })
-        }
-        (&[a, b], &[c]) | (&[c], &[a, b]) => {
-            // end frames: on b and on c (the cut frame and its twin, in either order)
-            let (end_b, end_c) = if l.branch_i.len() == 2 { (k, tw) } else { (tw, k) };
-            let r = l.root;
-            // the root's frame must have the loop's axis too for a planar reading of its side
-            // (same direction: lowA_high is then a rotation about z)
-            if (0..geo.configs.len())
-                .any(|cfg| (geo.z(cfg, r) - geo.z(cfg, a)).norm() > GEOMETRY_TOLERANCE)
-            {
-                return None;
-            }
-            let sr = planar(&(offset(geo, c) - offset(geo, a)));
-            let sa = planar(&offset(geo, b));
-            let sb = planar(&offset(geo, end_b));
-            let sc = planar(&offset(geo, end_c));
-            if !equal(sa, sc) || !equal(sb, sr) {
-                return None;
-            }
-            Some(Parallelogram {
-                cut: k,
-                coupled: vec![a, b, c].into_iter().collect::<BTreeSet<_>>().into_iter().collect(),
-                pairs: vec![pair(a, phi(sa), c, phi(sc)), pair(r, phi(sr), b, phi(sb))],
-            })
-        }
-        _ => None,
+    // sides: (link, planar vector in the link's frame, run backwards)
+    let mut sides: Vec<(usize, Vector3<f64>, bool)> = Vec::new();
+    // root side O_first_j -> O_first_i, in the frame of joint first_i at q = 0
+    let a0 = geo.frames[first_i - 1].transform(&0.0).0;
+    sides.push((
+        l.root,
+        a0.transpose() * (offset(geo, first_i) - offset(geo, first_j)),
+        false,
+    ));
+    let next = |branch: &[usize], n: usize, end: usize| branch.get(n + 1).copied().unwrap_or(end);
+    for (n, &x) in l.branch_i.iter().enumerate() {
+        sides.push((x, offset(geo, next(&l.branch_i, n, k)), false));
     }
+    for (n, &x) in l.branch_j.iter().enumerate().rev() {
+        sides.push((x, offset(geo, next(&l.branch_j, n, tw)), true));
+    }
+    sides.retain(|(_, v, _)| planar(v).norm() > GEOMETRY_TOLERANCE);
+    if sides.len() != 4 {
+        return None;
+    }
+    let len = |n: usize| planar(&sides[n].1).norm();
+    if (len(0) - len(2)).abs() > GEOMETRY_TOLERANCE || (len(1) - len(3)).abs() > GEOMETRY_TOLERANCE
+    {
+        return None;
+    }
+    let angle = |n: usize| {
+        let v = planar(&sides[n].1);
+        v.y.atan2(v.x) + if sides[n].2 { std::f64::consts::PI } else { 0.0 }
+    };
+    let pair = |m: usize, n: usize| {
+        let (x, y) = (sides[m].0, sides[n].0);
+        let (lo, hi, d) = if x < y {
+            (x, y, angle(m) - angle(n) - std::f64::consts::PI)
+        } else {
+            (y, x, angle(n) - angle(m) - std::f64::consts::PI)
+        };
+        // the root side is read in the frame of joint first_i at q = 0: rA_hi = rA_first_i(0) Rz
+        let rot = rz(&exact_angle(d));
+        let a = if x == l.root || y == l.root {
+            frame_expr(desc, first_i).0 * rot
+        } else {
+            rot
+        };
+        (lo, hi, a)
+    };
+    let pairs = vec![pair(0, 2), pair(1, 3)];
+    Some(Parallelogram {
+        cut: k,
+        coupled: coupled_joints(l, &pairs),
+        pairs,
+    })
+}
+
+/// Tree joints of a loop whose velocities are +-qd of each other: the pairs give w_y - w_x =
+/// sum of qd_j on the path root -> y minus those on root -> x (every joint of the loop turns
+/// about the same axis; the joints before the root cancel). A joint couple (u, v) is coupled
+/// when qd_u + s qd_v (s = +-1) is a combination of these relations.
+fn coupled_joints(
+    l: &crate::model::ClosedLoop,
+    pairs: &[(usize, usize, Matrix3<Expr>)],
+) -> Vec<(usize, usize)> {
+    let joints: Vec<usize> = l.tree_joints().collect();
+    let n = joints.len();
+    let path = |x: usize| -> Vec<usize> {
+        for b in [&l.branch_i, &l.branch_j] {
+            if let Some(p) = b.iter().position(|&y| y == x) {
+                return b[..=p].to_vec();
+            }
+        }
+        Vec::new() // the root
+    };
+    let rel: Vec<nalgebra::DVector<f64>> = pairs
+        .iter()
+        .map(|(x, y, _)| {
+            let mut v = nalgebra::DVector::zeros(n);
+            for j in path(*y) {
+                v[joints.iter().position(|&q| q == j).unwrap()] += 1.0;
+            }
+            for j in path(*x) {
+                v[joints.iter().position(|&q| q == j).unwrap()] -= 1.0;
+            }
+            v
+        })
+        .collect();
+    let m = nalgebra::DMatrix::from_columns(&rel);
+    let in_span = |t: &nalgebra::DVector<f64>| {
+        let svd = m.clone().svd(true, true);
+        svd.solve(t, 1e-9)
+            .map(|c| (&m * c - t).norm() < 1e-9)
+            .unwrap_or(false)
+    };
+    let mut out = Vec::new();
+    for u in 0..n {
+        for v in u + 1..n {
+            if [1.0, -1.0].into_iter().any(|s| {
+                let mut t = nalgebra::DVector::zeros(n);
+                t[u] = 1.0;
+                t[v] = s;
+                in_span(&t)
+            }) {
+                out.push((joints[u].min(joints[v]), joints[u].max(joints[v])));
+            }
+        }
+    }
+    out
+}
+
+/// Classes of links with equal angular velocities over every parallelogram (eq 10.54 is
+/// transitive: the older TwoLoops has w_4 = w_8 in one loop and w_8 = w_1 in the other): for
+/// each link, the lowest link of its class and loA_link (composed along the pairs), None for
+/// the lowest itself. Eqs 10.55–10.56 then move J_link into J_lowest.
+fn parallel_classes(ps: &[Parallelogram], nl: usize) -> Vec<Option<(usize, Matrix3<Expr>)>> {
+    let mut adj: Vec<Vec<(usize, Matrix3<Expr>)>> = vec![Vec::new(); nl + 1];
+    for p in ps {
+        for (lo, hi, a) in &p.pairs {
+            adj[*lo].push((*hi, a.clone()));
+            adj[*hi].push((*lo, a.transpose()));
+        }
+    }
+    let mut out: Vec<Option<(usize, Matrix3<Expr>)>> = vec![None; nl + 1];
+    let mut seen = vec![false; nl + 1];
+    for lo in 0..=nl {
+        if seen[lo] || adj[lo].is_empty() {
+            continue;
+        }
+        seen[lo] = true;
+        let mut queue = std::collections::VecDeque::from([(lo, Matrix3::<Expr>::identity())]);
+        while let Some((x, ax)) = queue.pop_front() {
+            for (y, a) in adj[x].clone() {
+                if !seen[y] {
+                    seen[y] = true;
+                    let ay = (&ax * a).map(|e| e.expand());
+                    out[y] = Some((lo, ay.clone()));
+                    queue.push_back((y, ay));
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Classes of coupled joints over every parallelogram (union of the couples).
+fn coupled_classes(ps: &[Parallelogram]) -> Vec<Vec<usize>> {
+    let mut classes: Vec<BTreeSet<usize>> = Vec::new();
+    for p in ps {
+        for &(u, v) in &p.coupled {
+            let hits: Vec<usize> = (0..classes.len())
+                .filter(|&c| classes[c].contains(&u) || classes[c].contains(&v))
+                .collect();
+            let mut merged: BTreeSet<usize> = [u, v].into_iter().collect();
+            for &c in hits.iter().rev() {
+                merged.extend(classes.remove(c));
+            }
+            classes.push(merged);
+        }
+    }
+    classes.into_iter().map(|c| c.into_iter().collect()).collect()
 }
 
 /// What the rules need to know about the robot: its topology, numeric geometry and, per link,
@@ -563,15 +663,16 @@ pub fn symbolic_base_parameters(
             None => unhandled_loops.push(l.cut),
         }
     }
-    for (p, _) in &parallelograms {
-        parallelogram_drive_parameters(p, &mut s);
+    let ps: Vec<Parallelogram> = parallelograms.iter().map(|(p, _)| p.clone()).collect();
+    for class in coupled_classes(&ps) {
+        parallelogram_drive_parameters(&class, &mut s);
     }
+    let classes = parallel_classes(&ps, nl);
     for j in (1..=nl).rev() {
-        let mut tensor_moved = false;
-        for (p, l) in &parallelograms {
+        for (_, l) in &parallelograms {
             cut_joint_relation(desc, l, j, &mut s);
-            tensor_moved |= parallel_links(p, j, &mut s);
         }
+        let tensor_moved = parallel_links(&classes, j, &mut s);
         match ctx.joint(j) {
             JointType::Revolute => theorem_10_1(&ctx, j, tensor_moved, &mut s),
             JointType::Prismatic => {
@@ -733,10 +834,9 @@ fn rotor_inertias(ctx: &Context, s: &mut State) {
 /// w_e = w_a give qd_e = -qd_b; with a side on the root link, qd_c = qd_a = -qd_b): their drive
 /// parameters (energy 1/2 IA qd^2; FV qd and FS sign(qd) through G^T, both even in the sign of
 /// the velocity) group into the lowest joint's.
-fn parallelogram_drive_parameters(p: &Parallelogram, s: &mut State) {
+fn parallelogram_drive_parameters(class: &[usize], s: &mut State) {
     for q in [IA, IA + 1, IA + 2] {
-        let live: Vec<usize> = p
-            .coupled
+        let live: Vec<usize> = class
             .iter()
             .copied()
             .filter(|&j| s.alive[j - 1][q])
@@ -803,21 +903,19 @@ fn cut_joint_relation(desc: &RobotDescription, l: &crate::model::ClosedLoop, j: 
     }
 }
 
-/// Eqs 10.55–10.56: the inertia tensor of the higher link of a parallel pair into the lower
-/// one's, JR_lo = J_lo + loA_hi J_hi hiA_lo. Returns whether link j's tensor moved.
-fn parallel_links(p: &Parallelogram, j: usize, s: &mut State) -> bool {
-    let mut moved = false;
-    for (lo, hi, a) in &p.pairs {
-        if *hi == j {
-            let t = a * s.j_matrix(j) * a.transpose();
-            for q in 0..6 {
-                s.kill(j, q);
-            }
-            s.add_tensor(*lo, &t);
-            moved = true;
-        }
+/// Eqs 10.55–10.56: the inertia tensor of a link whose angular velocity equals that of a
+/// lower link (its class in [`parallel_classes`]) into the lower one's, JR_lo = J_lo +
+/// loA_j J_j jA_lo (into the base: no effect). Returns whether link j's tensor moved.
+fn parallel_links(classes: &[Option<(usize, Matrix3<Expr>)>], j: usize, s: &mut State) -> bool {
+    let Some((lo, a)) = &classes[j] else {
+        return false;
+    };
+    let t = a * s.j_matrix(j) * a.transpose();
+    for q in 0..6 {
+        s.kill(j, q);
     }
-    moved
+    s.add_tensor(*lo, &t);
+    true
 }
 
 /// Theorem 10.1 (revolute j, eqs 10.14–10.19, any gamma and b): YY_j into XX_j, and YY_j, MZ_j,
