@@ -44,10 +44,10 @@ pub fn text(r: &Summary) -> String {
     }
     let width = r.base.iter().map(|b| b.name.len()).max().unwrap_or(1);
     if r.base.iter().any(|b| b.value.is_some()) {
-        s.push_str("\nValues:\n");
+        s.push_str("\nValues (rounded to 12 significant digits):\n");
         for b in &r.base {
             match b.value {
-                Some(v) => s.push_str(&format!("  {:<width$} = {}\n", b.name, short(clean(v)))),
+                Some(v) => s.push_str(&format!("  {:<width$} = {}\n", b.name, value_text(v))),
                 None => s.push_str(&format!("  {:<width$} = (parameters without value)\n", b.name)),
             }
         }
@@ -63,13 +63,15 @@ pub fn text(r: &Summary) -> String {
     s
 }
 
-/// -0 and values below 1e-300 print as 0.
-fn clean(v: f64) -> f64 {
-    if v == 0.0 || v.abs() < 1e-300 {
-        0.0
-    } else {
-        v
+/// A value for display: rounded to 12 significant digits (the rounding of the sums that make
+/// it, 10.899999999999999 -> 10.9), then the shortest decimal; integers without a point, -0 as
+/// 0. JSON keeps the full double.
+pub fn value_text(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() {
+        return if v.is_finite() { "0".into() } else { format!("{v}") };
     }
+    let r: f64 = format!("{v:.11e}").parse().unwrap_or(v);
+    short(r)
 }
 
 /// LaTeX fragment (needs amsmath): the table (tabular, math cells), its legend, the grouping
@@ -87,12 +89,18 @@ pub fn latex(r: &Summary) -> String {
             s.push_str(&format!("% {l}\n"));
         }
     }
+    // Table 10.2's twelve columns fit the text width in \scriptsize; more (friction) in \tiny
+    let size = if t[0].len() > 12 { "tiny" } else { "scriptsize" };
     s.push_str(&format!(
-        "{{\\scriptsize\\setlength{{\\tabcolsep}}{{2pt}}\n\\begin{{tabular}}{{{}}}\n",
+        "{{\\{size}\\setlength{{\\tabcolsep}}{{2pt}}\n\\begin{{tabular}}{{{}}}\n",
         "c".repeat(t[0].len())
     ));
     for (k, row) in t.iter().enumerate() {
-        let cells: Vec<String> = row.iter().map(|x| latex_cell(x)).collect();
+        let cells: Vec<String> = if k == 0 {
+            row.iter().map(|x| latex_header(x)).collect()
+        } else {
+            row.iter().map(|x| latex_cell(x)).collect()
+        };
         s.push_str(&format!("{} \\\\\n", cells.join(" & ")));
         if k == 0 {
             s.push_str("\\hline\n");
@@ -126,15 +134,15 @@ pub fn latex(r: &Summary) -> String {
                 format!(
                     "${}$ & ${}$",
                     latex_name(&b.name),
-                    latex_number(&short(clean(v)))
+                    latex_number(&value_text(v))
                 )
             })
         })
         .collect();
     if !values.is_empty() {
-        // three name-value pairs per row
-        s.push_str("\n\\noindent Values:\\\\\n{\\small\\begin{tabular}{rlrlrl}\n");
-        for chunk in values.chunks(3) {
+        // two name-value pairs per row
+        s.push_str("\n\\noindent Values:\\\\\n{\\small\\begin{tabular}{rlrl}\n");
+        for chunk in values.chunks(2) {
             s.push_str(&format!("{} \\\\\n", chunk.join(" & ")));
         }
         s.push_str("\\end{tabular}}\n");
@@ -222,6 +230,20 @@ fn break_sum(e: &str, width: usize) -> Vec<String> {
         }
     }
     lines
+}
+
+/// A header cell: `XXj` -> `$XX_j$`, `j` -> `$j$`.
+fn latex_header(x: &str) -> String {
+    match x.strip_suffix('j') {
+        Some(p) if !p.is_empty() => {
+            if p == "IA" {
+                "$I_{aj}$".into()
+            } else {
+                format!("${p}_j$")
+            }
+        }
+        _ => format!("${x}$"),
+    }
 }
 
 /// A table cell: names in math mode (`$XXR_{2}$`), `0` and `-` as they are.

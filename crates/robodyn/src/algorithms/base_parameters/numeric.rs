@@ -418,6 +418,28 @@ pub fn numeric_base_parameters(
         .filter(|i| sel.absent.contains(i))
         .collect();
     let ncols = all.len();
+    // size check before any allocation: N <= NL rows per sample, so rows <= max(target + NL,
+    // 20 NL); phi (NL x 13 NL) is allocated too
+    let bound_rows = opt
+        .samples
+        .map(|s| s.saturating_mul(nl))
+        .unwrap_or_else(|| (3 * ncols).min(3000.max(ncols + ncols / 4)).saturating_add(nl).max(20 * nl));
+    let bytes = bound_rows
+        .saturating_mul(ncols.max(1))
+        .saturating_add(nl.saturating_mul(PARAMS_PER_LINK * nl))
+        .saturating_mul(8);
+    if bytes > MAX_OBSERVATION_BYTES {
+        return Err(Error::Input(format!(
+            "{}: the numerical method would need an observation matrix W of about {bound_rows} x \
+             {ncols} ({:.1} GiB, about {:.1} GiB in all); the limit is {:.1} GiB \
+             (MAX_OBSERVATION_BYTES, about 10,000 parameters). Use the symbolic method for this \
+             robot, or fewer drive parameters (--rotor none, --no-friction)",
+            robot.name(),
+            bytes as f64 / (1u64 << 30) as f64,
+            2.5 * bytes as f64 / (1u64 << 30) as f64,
+            MAX_OBSERVATION_BYTES as f64 / (1u64 << 30) as f64
+        )));
+    }
     let mut rng = crate::testing::rng(opt.seed);
     let model = robot.numeric();
     let mut ws = Workspace::new(model);
@@ -426,23 +448,7 @@ pub fn numeric_base_parameters(
     let first = sampler.sample(robot, &mut rng)?;
     let n_rows_per = first.g.as_ref().map_or(nl, |g| g.ncols()).max(1);
     let samples = sample_count(opt, columns.len(), n_rows_per);
-    let rows = samples
-        .checked_mul(n_rows_per)
-        .filter(|r| r.checked_mul(ncols.max(1)).and_then(|e| e.checked_mul(8)).is_some())
-        .ok_or_else(|| Error::Input("the observation matrix size overflows".into()))?;
-    let bytes = rows * ncols.max(1) * 8;
-    if bytes > MAX_OBSERVATION_BYTES {
-        return Err(Error::Input(format!(
-            "{}: the numerical method would need an observation matrix W of {rows} x {ncols} \
-             ({:.1} GiB, about {:.1} GiB in all); the limit is {:.1} GiB (MAX_OBSERVATION_BYTES, \
-             about 10,000 parameters). Use the symbolic method for this robot, or fewer drive \
-             parameters (--rotor none, --no-friction)",
-            robot.name(),
-            bytes as f64 / (1u64 << 30) as f64,
-            2.5 * bytes as f64 / (1u64 << 30) as f64,
-            MAX_OBSERVATION_BYTES as f64 / (1u64 << 30) as f64
-        )));
-    }
+    let rows = samples * n_rows_per;
     let mut w = Mat::<f64>::zeros(rows, ncols);
     let mut s = first;
     for k in 0..samples {
