@@ -356,7 +356,7 @@ fn every_bundled_robot_counts_bounds_and_reproduces_the_full_model() {
                     for p in cmp.symbolic_only.iter().chain(&cmp.numeric_only) {
                         assert!(head.contains(p.as_str()), "{label}: {p} not named: {head}");
                     }
-                    let j = write::json(&rep);
+                    let j = robodyn::report::base_parameters::json(&rep);
                     assert_eq!(j["comparison"]["arbiter"], "numeric");
                     assert_eq!(j["comparison"]["numeric_count"], nb.count());
                     assert_eq!(j["comparison"]["symbolic_count"], sb.count());

@@ -63,11 +63,12 @@ fn values(file: &str) -> BTreeMap<String, f64> {
 }
 
 const IS_MOBILE: &str = "OpenSYMORO writes `is_mobile = False` (Python booleans)";
-const TWOLOOPS_WHY: &str = "both loops are parallelograms (the second has its fixed side on \
-    link 1 and a zero side O3 = O8) and are grouped by 10.51c, 10.55, 10.56; through them links \
-    4 and 8 keep link 1's orientation, so link 5 turns about an axis fixed to link 1 as if it \
-    were between r1 and r2 (rule 5: XX5 XY5 XZ5 YZ5; rule 6: MY4), and the cut-joint relations \
-    10.51a-b group MX7 and MY7: rules 5-7 are stated on the tree's branches and do not see it";
+const TWOLOOPS_WHY: &str = "both loops are parallelograms (the second with its fixed side on \
+    link 1 and a zero side O3 = O8) and are grouped by 10.51c, 10.55, 10.56 (classes of equal \
+    angular velocity {1, 4, 8}, {2, 6}, {3, 7}); through them link 4 keeps link 1's orientation, \
+    so link 5 turns about an axis fixed to link 1, as if it were between r1 and r2 (rule 5: XX5 \
+    XY5 XZ5 YZ5; MY4), and link 7, which keeps link 3's orientation, loses MX7 and MY7 to \
+    relations of the loops: rules 5-7 are stated on the tree's branches and do not see them";
 
 fn expectation(file: &str) -> Expect {
     use Expect::*;

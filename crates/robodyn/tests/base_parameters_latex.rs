@@ -1,6 +1,6 @@
 //! `base-params --format latex` typesets: the base-parameter reports (table with math cells,
 //! legend, grouping equations broken between terms, values) of the SR400 (Table 10.2, with the
-//! comparison comment), the RX-90 and the Orthoglide (its own names, one made unique with `_`)
+//! comparison comment), the RX-90 and the Orthoglide (its own names: `MR11` is link 1's)
 //! go through pdflatex in a minimal document (amsmath) with no error and no overfull line.
 //! `.ci/run` installs pdflatex and sets ROBODYN_REQUIRE_LATEX=1 (a missing install fails there).
 
@@ -66,7 +66,8 @@ fn base_parameter_latex_typesets() {
         if f.exists() {
             let r = report(&f, true, false);
             let tex = robodyn::report::base_parameters::latex(&r);
-            assert!(tex.contains("M11\\_"), "link 11's mass is made unique: {tex}");
+            // link 1's mass is the file's M11: grouped, MR11 (no robodyn name for link 11)
+            assert!(tex.contains("$MR_{11}$"), "{tex}");
             docs.push(("orthoglide", tex));
             break;
         }
