@@ -187,19 +187,39 @@ fn numeric_method_without_values_uses_generic_geometry() {
     assert_eq!(both(&desc, &sel), nb.count());
 }
 
-/// The RX-90 URDF (float geometry from rpy angles): no grouping term is float noise (every
-/// float coefficient is above 1e-12 of the largest of its equation), and the rules agree with
-/// the numerical method.
+/// Float geometry (as a URDF gives it): the RX-90 with its alpha = +-pi/2 written as the floats
+/// +-1.5707963267948966, whose cosines are 6e-17, not 0. The grouping terms those make are
+/// dropped (and counted, for the report), none below 1e-12 of its equation stays, and the rules
+/// still agree with the numerical method; with exact angles nothing is dropped.
 #[test]
-fn urdf_float_noise_is_not_a_grouping_term() {
-    let desc = bundled("rx90.urdf");
-    let sel = ParameterSelection::from_description(&desc, RotorMode::Actuated, true);
-    let sb = symbolic_base_parameters(&desc, &sel).unwrap();
-    for e in &sb.equations {
-        let text = e.to_string();
-        assert!(!text.contains("e-1") && !text.contains("e-2"), "noise in {text}");
+fn float_noise_of_the_geometry_is_not_a_grouping_term() {
+    let mut desc = bundled("rx90.par");
+    let sel = ParameterSelection::from_description(&desc, RotorMode::Actuated, false);
+    let exact = symbolic_base_parameters(&desc, &sel).unwrap();
+    assert_eq!(exact.dropped_float_terms, 0);
+    for j in 1..=6 {
+        let a = desc.frame(j).alpha.eval(&|_| None).unwrap();
+        desc.frame_mut(j).alpha = Expr::num(a);
     }
-    both(&desc, &sel);
+    assert!(desc.frame(2).alpha.as_rational().is_none(), "alpha2 is a float");
+    let sb = symbolic_base_parameters(&desc, &sel).unwrap();
+    assert!(sb.dropped_float_terms > 0, "the float angles make noise terms");
+    for e in &sb.equations {
+        let coefs: Vec<f64> = match e.node() {
+            robodyn_symbolic::Node::Add(v) => v
+                .iter()
+                .filter_map(|t| match t.node() {
+                    robodyn_symbolic::Node::Mul(f) => f[0].as_f64(),
+                    _ => None,
+                })
+                .collect(),
+            _ => Vec::new(),
+        };
+        let big = coefs.iter().fold(1.0f64, |m, c| m.max(c.abs()));
+        assert!(coefs.iter().all(|c| c.abs() >= 1e-12 * big), "noise in {e}");
+    }
+    assert_eq!(sb.base, exact.base);
+    assert_eq!(both(&desc, &sel), exact.count());
 }
 
 /// OpenSYMORO's SR400 without assembly (here: robots/sr400.toml with its assembly removed):

@@ -59,7 +59,7 @@ pub const MAX_OBSERVATION_BYTES: usize = 1 << 30;
 
 /// Up to this many columns the singular values of W are computed (SVD of R) and reported;
 /// beyond, sigma_max comes from power iteration on R and `singular_values` is empty.
-pub const SVD_COLUMNS: usize = 2500;
+pub const SVD_COLUMNS: usize = 800;
 
 /// A consistent state of the equivalent tree with the Jacobian G = dq_tr/dq_a.
 #[derive(Clone, Debug)]
@@ -242,16 +242,28 @@ fn par() -> Par {
 /// form, which does not give that distance column by column.) Blocked: panels of 32 columns,
 /// each factored column by column, then applied to the trailing columns in compact WY form
 /// (I - V T V^T) with faer's matrix products.
-fn qr_in_place(mut a: faer::MatMut<'_, f64>) {
+///
+/// Column c is zero below row `last_row(c)` (nondecreasing in c): each panel works only on the
+/// rows down to the last nonzero row of its columns. A tree's W with its rows ordered by joint
+/// is such a staircase (link j's columns are zero in the rows of the joints after j), and so is
+/// R with its columns reordered, kept ones first ([`refactor`]): both cost far less than a
+/// dense QR.
+fn qr_in_place_staircase(mut a: faer::MatMut<'_, f64>, last_row: &dyn Fn(usize) -> usize) {
     use faer::linalg::matmul::matmul;
     use faer::Accum;
-    let (m, n) = (a.nrows(), a.ncols());
-    let kmax = m.min(n);
+    let (m_all, n) = (a.nrows(), a.ncols());
     const B: usize = 32;
     let mut k = 0;
+    let kmax = m_all.min(n);
     while k < kmax {
         let b = B.min(kmax - k);
         let mut tau = [0.0f64; B];
+        // rows below the panel's last nonzero row stay zero (in the panel and in V)
+        let m = (k..k + b)
+            .map(|c| last_row(c).max(c) + 1)
+            .max()
+            .unwrap_or(m_all)
+            .min(m_all);
         // panel: columns k..k+b, rows k..m (column slices: W is column-major)
         for c in k..k + b {
             let (mut left, mut right) = a.rb_mut().split_at_col_mut(c + 1);
@@ -261,6 +273,7 @@ fn qr_in_place(mut a: faer::MatMut<'_, f64>) {
                 .try_as_col_major_mut()
                 .expect("column-major")
                 .as_slice_mut();
+            let v = &mut v[..m];
             let x0 = v[c];
             let sigma: f64 = v[c + 1..].iter().map(|x| x * x).sum();
             if sigma == 0.0 {
@@ -277,12 +290,12 @@ fn qr_in_place(mut a: faer::MatMut<'_, f64>) {
             // apply H = I - t v v^T (v_c = 1) to the rest of the panel
             let v = &v[c + 1..];
             for cc in 0..(k + b - c - 1) {
-                let y = right
+                let y = &mut right
                     .rb_mut()
                     .col_mut(cc)
                     .try_as_col_major_mut()
                     .expect("column-major")
-                    .as_slice_mut();
+                    .as_slice_mut()[..m];
                 let dot = y[c] + v.iter().zip(&y[c + 1..]).map(|(p, q)| p * q).sum::<f64>();
                 let f = t * dot;
                 y[c] -= f;
@@ -328,12 +341,20 @@ fn upper(a: MatRef<'_, f64>) -> Mat<f64> {
 /// QR of the columns `cols` of R, in that order; returns the new R (cols.len() x cols.len()).
 fn refactor(r: &Mat<f64>, cols: &[usize]) -> Mat<f64> {
     let mut a = Mat::from_fn(r.nrows(), cols.len(), |i, j| r[(i, cols[j])]);
-    qr_in_place(a.as_mut());
+    // column j of R is zero below row cols[j]; the reflectors of the columns before it mix rows
+    // down to the largest of their own, so column j stays zero below the running maximum
+    let mut last = Vec::with_capacity(cols.len());
+    let mut running = 0;
+    for &c in cols {
+        running = running.max(c);
+        last.push(running.min(r.nrows().saturating_sub(1)));
+    }
+    qr_in_place_staircase(a.as_mut(), &|j| last[j]);
     upper(a.as_ref())
 }
 
 /// Largest singular value of an upper triangular R by power iteration on R^T R.
-fn sigma_max(r: &Mat<f64>) -> f64 {
+fn sigma_max(r: MatRef<'_, f64>) -> f64 {
     let n = r.ncols();
     if n == 0 {
         return 0.0;
@@ -394,7 +415,8 @@ fn sigma_min_upper(r: MatRef<'_, f64>) -> f64 {
 fn sample_count(opt: &NumericOptions, ncols: usize, n_rows_per: usize) -> usize {
     opt.samples.unwrap_or_else(|| {
         let target = (3 * ncols).min(3000.max(ncols + ncols / 4));
-        target.div_ceil(n_rows_per).max(20)
+        // at least 20 samples, unless that exceeds the target (large trees: N = NL rows each)
+        target.div_ceil(n_rows_per).max(20.min(target.div_ceil(n_rows_per) + 2))
     })
 }
 
@@ -413,8 +435,11 @@ pub fn numeric_base_parameters(
         )));
     }
     let columns = sel.columns();
-    // W's columns: the existing parameters and the absent ones of the selection, K order
-    let all: Vec<usize> = (0..PARAMS_PER_LINK * nl).filter(|&i| sel.slot(i)).collect();
+    // W's columns: the existing parameters (K order), then the absent ones of the selection
+    let all: Vec<usize> = (0..PARAMS_PER_LINK * nl)
+        .filter(|&i| sel.slot(i) && !sel.absent.contains(&i))
+        .chain((0..PARAMS_PER_LINK * nl).filter(|&i| sel.slot(i) && sel.absent.contains(&i)))
+        .collect();
     let absent: Vec<usize> = all
         .iter()
         .copied()
@@ -452,6 +477,7 @@ pub fn numeric_base_parameters(
     let n_rows_per = first.g.as_ref().map_or(nl, |g| g.ncols()).max(1);
     let samples = sample_count(opt, columns.len(), n_rows_per);
     let rows = samples * n_rows_per;
+    let tree_rows = first.g.is_none();
     let mut w = Mat::<f64>::zeros(rows, ncols);
     let mut s = first;
     for k in 0..samples {
@@ -480,10 +506,18 @@ pub fn numeric_base_parameters(
         }
         for (c, &col) in all.iter().enumerate() {
             for r in 0..n_rows_per {
-                w[(k * n_rows_per + r, c)] = block[(r, col)];
+                // a tree's rows by joint, then sample: the column of link j is zero in the rows
+                // of joints after j (only its ancestors a(j) < j and j itself carry it)
+                let row = if tree_rows {
+                    r * samples + k
+                } else {
+                    k * n_rows_per + r
+                };
+                w[(row, c)] = block[(r, col)];
             }
         }
     }
+    tm("W");
     // 2. no-effect columns (existing parameters); absent columns of no effect are dropped
     let norms: Vec<f64> = (0..ncols).map(|c| w.col(c).norm_l2()).collect();
     let is_absent = |c: usize| sel.absent.contains(&all[c]);
@@ -497,20 +531,44 @@ pub fn numeric_base_parameters(
         .map(|c| all[c])
         .collect();
     // 3. unit columns: existing ones first (K order), then the absent candidates
-    let live: Vec<usize> = (0..ncols)
-        .filter(|&c| !is_absent(c) && !zero(c))
-        .chain((0..ncols).filter(|&c| is_absent(c) && !zero(c)))
-        .collect();
+    let live: Vec<usize> = (0..ncols).filter(|&c| !zero(c)).collect();
     let n_present = live.iter().filter(|&&c| !is_absent(c)).count();
-    let mut a = Mat::from_fn(rows, live.len(), |i, j| w[(i, live[j])] / norms[live[j]]);
+    // scaled and packed to the left in place (live is increasing): no second copy of W
+    for (j, &c) in live.iter().enumerate() {
+        let f = 1.0 / norms[c];
+        if c == j {
+            w.col_mut(j).iter_mut().for_each(|x| *x *= f);
+        } else {
+            let (mut left, right) = w.as_mut().split_at_col_mut(c);
+            let src = right.col(0);
+            left.rb_mut()
+                .col_mut(j)
+                .iter_mut()
+                .zip(src.iter())
+                .for_each(|(d, x)| *d = x * f);
+        }
+    }
+    let mut a = w.as_mut().subcols_mut(0, live.len());
+    // a tree's W is a staircase (rows by joint): column c is zero below the rows of its link
+    let mut last = Vec::with_capacity(live.len());
+    let mut running = 0;
+    for &c in &live {
+        let lr = if tree_rows {
+            (all[c] / PARAMS_PER_LINK + 1) * samples - 1
+        } else {
+            rows - 1
+        };
+        running = running.max(lr.min(rows - 1));
+        last.push(running);
+    }
+    qr_in_place_staircase(a.rb_mut(), &|j| last[j]);
+    let r_all = upper(a.rb());
     drop(w);
-    qr_in_place(a.as_mut());
-    let r_all = upper(a.as_ref());
-    drop(a);
     // R of the existing columns alone (the leading block): sigma_max and tolerance
-    let r_present = Mat::from_fn(n_present, n_present, |i, j| r_all[(i, j)]);
+    let r_present = r_all.as_ref().submatrix(0, 0, n_present, n_present);
     let singular_values: Vec<f64> = if n_present <= SVD_COLUMNS {
         let mut sv = r_present
+            .to_owned()
             .singular_values()
             .map_err(|_| Error::Numerical("the SVD of W did not converge".into()))?;
         sv.sort_by(|x, y| y.total_cmp(x));
@@ -521,8 +579,7 @@ pub fn numeric_base_parameters(
     let smax = singular_values
         .first()
         .copied()
-        .unwrap_or_else(|| sigma_max(&r_present));
-    drop(r_present);
+        .unwrap_or_else(|| sigma_max(r_present));
     let tol = RANK_TOLERANCE * smax;
     // absent columns in the span of the existing ones: distance below tol
     let candidates: Vec<usize> = {
