@@ -37,6 +37,9 @@ fn main() {
             nb.columns.len(),
             t.elapsed().as_secs_f64()
         ),
-        Err(e) => println!("{n} links: error after {:.2} s: {e}", t.elapsed().as_secs_f64()),
+        Err(e) => println!(
+            "{n} links: error after {:.2} s: {e}",
+            t.elapsed().as_secs_f64()
+        ),
     }
 }

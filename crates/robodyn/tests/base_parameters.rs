@@ -353,7 +353,10 @@ fn sr400_symbolic_matches_table_10_2_and_the_chapter_listing() {
     assert_eq!(inertial, 39);
     assert_eq!(sb.parallelograms, vec![9]);
     let zz2 = base_names.iter().position(|n| n == "ZZ2").unwrap();
-    eprintln!("{}", collect_by_coefficient(&sb.equations[zz2], &ParameterNames::standard(8)));
+    eprintln!(
+        "{}",
+        collect_by_coefficient(&sb.equations[zz2], &ParameterNames::standard(8))
+    );
     // values: symbolic grouped values reproduce the closed-chain torques
     let err = check_symbolic_reproduces(&robot, &sb, &mut Sr400Sampler, 5);
     assert!(err < 1e-9, "SR400 symbolic base model error {err:e}");
@@ -483,7 +486,11 @@ fn base_robot_file_reproduces_the_full_model() {
         }
         let full = robot.with_standard_parameters(&k).unwrap();
         let sb = symbolic_base_parameters(robot.description(), &sel).unwrap();
-        let report = Summary::from_symbolic(full.description(), &sb, &ParameterNames::of(full.description()));
+        let report = Summary::from_symbolic(
+            full.description(),
+            &sb,
+            &ParameterNames::of(full.description()),
+        );
         let values: Vec<f64> = report.base.iter().map(|b| b.value.unwrap()).collect();
         let desc = base_robot(robot.description(), &sb.base, &values).unwrap();
         let path = dir.join(format!("{name}-base.toml"));
@@ -523,7 +530,11 @@ fn report_formats_carry_count_and_lists() {
     let robot = sr400();
     let sel = ParameterSelection::new(&robot, RotorMode::Actuated, false);
     let sb = symbolic_base_parameters(robot.description(), &sel).unwrap();
-    let rep = Summary::from_symbolic(robot.description(), &sb, &ParameterNames::of(robot.description()));
+    let rep = Summary::from_symbolic(
+        robot.description(),
+        &sb,
+        &ParameterNames::of(robot.description()),
+    );
     let j = write::json(&rep);
     assert_eq!(j["count"], 42);
     assert_eq!(j["base"].as_array().unwrap().len(), 42);

@@ -361,7 +361,8 @@ fn every_bundled_robot_counts_bounds_and_reproduces_the_full_model() {
                     assert_eq!(j["comparison"]["numeric_count"], nb.count());
                     assert_eq!(j["comparison"]["symbolic_count"], sb.count());
                     assert!(
-                        robodyn::report::base_parameters::latex(&rep).contains("% THE METHODS DIFFER"),
+                        robodyn::report::base_parameters::latex(&rep)
+                            .contains("% THE METHODS DIFFER"),
                         "{label}"
                     );
                 }

@@ -171,7 +171,12 @@ fn every_external_file_symbolic_and_numeric_counts_agree_or_are_explained() {
         return;
     };
     let files = par_files(&dir);
-    assert!(files.len() >= 30, "only {} files in {}", files.len(), dir.display());
+    assert!(
+        files.len() >= 30,
+        "only {} files in {}",
+        files.len(),
+        dir.display()
+    );
     let mut table = Vec::new();
     let mut checked_references = 0;
     for file in &files {
@@ -254,6 +259,10 @@ fn every_external_file_symbolic_and_numeric_counts_agree_or_are_explained() {
             ));
         }
     }
-    assert_eq!(checked_references, REFERENCES.len(), "a reference file is missing");
+    assert_eq!(
+        checked_references,
+        REFERENCES.len(),
+        "a reference file is missing"
+    );
     eprintln!("{}", table.join("\n"));
 }

@@ -47,7 +47,10 @@ fn base_parameter_latex_typesets() {
     assert!(latex.contains("Legend"), "{latex}");
     assert!(latex.contains("Values:"), "{latex}");
     assert!(latex.contains("ZZR_{1} &= "), "{latex}");
-    assert!(latex.contains("&\\quad "), "ZZR1 is broken over lines: {latex}");
+    assert!(
+        latex.contains("&\\quad "),
+        "ZZR1 is broken over lines: {latex}"
+    );
     if !common::tool_available(
         "pdflatex",
         &["--version"],
@@ -90,7 +93,11 @@ fn base_parameter_latex_typesets() {
             .unwrap();
         let log = std::fs::read_to_string(tmp.join(format!("{stem}.log"))).unwrap();
         let errors: Vec<&str> = log.lines().filter(|l| l.starts_with('!')).collect();
-        assert!(out.status.success(), "{stem}: pdflatex failed:\n{}", errors.join("\n"));
+        assert!(
+            out.status.success(),
+            "{stem}: pdflatex failed:\n{}",
+            errors.join("\n")
+        );
         assert!(
             !log.contains("Overfull \\hbox"),
             "{stem}: a line is wider than the text:\n{}",

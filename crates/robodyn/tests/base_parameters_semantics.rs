@@ -5,12 +5,12 @@
 //! regular start on the parallelogram branch, a singular `assembly` is refused), and the size
 //! limit of the numerical method (an error before allocating).
 
+use robodyn::algorithms::base_parameters::closed::StartOrigin;
 use robodyn::algorithms::base_parameters::{
     compare_methods, geometry_robot, numeric_base_parameters, numeric_base_parameters_auto,
     standard_values, symbolic_base_parameters, ClosedChainSampler, NumericOptions, ParameterNames,
     Summary, TreeSampler,
 };
-use robodyn::algorithms::base_parameters::closed::StartOrigin;
 use robodyn::algorithms::regressor::{ParameterSelection, RotorMode, ZeroParameters};
 use robodyn::testing::{random_tree, rng, TreeOptions};
 use robodyn::{Expr, RobotDescription};
@@ -52,7 +52,8 @@ fn a_literal_zero_is_not_a_parameter_a_symbol_with_value_zero_is() {
         }
     }
     let sel = |d: &RobotDescription, z| {
-        ParameterSelection::from_description(d, RotorMode::Actuated, true).with_zero_parameters(d, z)
+        ParameterSelection::from_description(d, RotorMode::Actuated, true)
+            .with_zero_parameters(d, z)
     };
     let full = both(&desc, &sel(&desc, ZeroParameters::Absent));
     // the same robot with the symbols XY6, IA6, FS1..FS6 given the value 0: still parameters
@@ -90,9 +91,17 @@ fn an_absent_parameter_can_hold_grouped_ones() {
     let sel = ParameterSelection::from_description(&desc, RotorMode::Actuated, false)
         .with_zero_parameters(&desc, ZeroParameters::Absent);
     let sb = symbolic_base_parameters(&desc, &sel).unwrap();
-    let r = sb.base.iter().position(|&i| i == mx2).expect("MXR2 is a base parameter");
+    let r = sb
+        .base
+        .iter()
+        .position(|&i| i == mx2)
+        .expect("MXR2 is a base parameter");
     let want = Expr::parse("D3*(M3 + M4 + M5 + M6)").unwrap();
-    assert!((sb.equations[r].clone() - want).expand().is_zero(), "{}", sb.equations[r]);
+    assert!(
+        (sb.equations[r].clone() - want).expand().is_zero(),
+        "{}",
+        sb.equations[r]
+    );
     let (robot, _) = geometry_robot(&desc).unwrap();
     let opt = NumericOptions {
         selection: sel,
@@ -130,7 +139,11 @@ fn equations_use_the_files_names_without_clash() {
     assert_eq!(names.name(9), "M11");
     assert_eq!(names.grouped(9), "MR11");
     let m11 = 13 * 10 + 9;
-    assert_ne!(names.name(m11), "M11", "link 11's mass must not take link 1's name");
+    assert_ne!(
+        names.name(m11),
+        "M11",
+        "link 11's mass must not take link 1's name"
+    );
     let file_symbols: std::collections::BTreeSet<String> = desc
         .links
         .iter()
@@ -147,7 +160,10 @@ fn equations_use_the_files_names_without_clash() {
             "{} clashes with a symbol of the file",
             b.name
         );
-        for tok in b.equation.split(|c: char| !c.is_ascii_alphanumeric() && c != '_') {
+        for tok in b
+            .equation
+            .split(|c: char| !c.is_ascii_alphanumeric() && c != '_')
+        {
             let canonical_only = tok.len() > 1
                 && robodyn::algorithms::base_parameters::symbolic::standard_index(tok, 11)
                     .is_some()
@@ -178,7 +194,10 @@ fn numeric_method_without_values_uses_generic_geometry() {
     let nb = numeric_base_parameters(&robot, &mut TreeSampler, &opt).unwrap();
     let k = standard_values(&desc);
     // only rx90.par's literal-zero friction has values
-    assert!(k.iter().enumerate().all(|(i, v)| v.is_none() == (i % 13 < 11)));
+    assert!(k
+        .iter()
+        .enumerate()
+        .all(|(i, v)| v.is_none() == (i % 13 < 11)));
     let rep = Summary::from_numeric(&desc, &nb, &ParameterNames::of(&desc), &k);
     assert!(rep.base.iter().all(|b| b.value.is_none()));
     assert!(!rep.has_values());
@@ -201,9 +220,15 @@ fn float_noise_of_the_geometry_is_not_a_grouping_term() {
         let a = desc.frame(j).alpha.eval(&|_| None).unwrap();
         desc.frame_mut(j).alpha = Expr::num(a);
     }
-    assert!(desc.frame(2).alpha.as_rational().is_none(), "alpha2 is a float");
+    assert!(
+        desc.frame(2).alpha.as_rational().is_none(),
+        "alpha2 is a float"
+    );
     let sb = symbolic_base_parameters(&desc, &sel).unwrap();
-    assert!(sb.dropped_float_terms > 0, "the float angles make noise terms");
+    assert!(
+        sb.dropped_float_terms > 0,
+        "the float angles make noise terms"
+    );
     for e in &sb.equations {
         let coefs: Vec<f64> = match e.node() {
             robodyn_symbolic::Node::Add(v) => v

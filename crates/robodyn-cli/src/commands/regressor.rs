@@ -46,7 +46,10 @@ pub fn run(a: Args) -> CliResult {
     let nl = robot.nl();
     let t = Table::read(&a.input)?;
     let sel = ParameterSelection::new(&robot, RotorMode::Actuated, !a.no_friction)
-        .with_zero_parameters(robot.description(), ZeroParameters::for_path(&a.robot.robot));
+        .with_zero_parameters(
+            robot.description(),
+            ZeroParameters::for_path(&a.robot.robot),
+        );
     let names = ParameterNames::of(robot.description());
     let closed = if robot.is_tree() {
         None

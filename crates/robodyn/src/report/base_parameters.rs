@@ -48,7 +48,10 @@ pub fn text(r: &Summary) -> String {
         for b in &r.base {
             match b.value {
                 Some(v) => s.push_str(&format!("  {:<width$} = {}\n", b.name, value_text(v))),
-                None => s.push_str(&format!("  {:<width$} = (parameters without value)\n", b.name)),
+                None => s.push_str(&format!(
+                    "  {:<width$} = (parameters without value)\n",
+                    b.name
+                )),
             }
         }
     } else {
@@ -68,7 +71,11 @@ pub fn text(r: &Summary) -> String {
 /// 0. JSON keeps the full double.
 pub fn value_text(v: f64) -> String {
     if v == 0.0 || !v.is_finite() {
-        return if v.is_finite() { "0".into() } else { format!("{v}") };
+        return if v.is_finite() {
+            "0".into()
+        } else {
+            format!("{v}")
+        };
     }
     let r: f64 = format!("{v:.11e}").parse().unwrap_or(v);
     short(r)
@@ -90,7 +97,11 @@ pub fn latex(r: &Summary) -> String {
         }
     }
     // Table 10.2's twelve columns fit the text width in \scriptsize; more (friction) in \tiny
-    let size = if t[0].len() > 12 { "tiny" } else { "scriptsize" };
+    let size = if t[0].len() > 12 {
+        "tiny"
+    } else {
+        "scriptsize"
+    };
     s.push_str(&format!(
         "{{\\{size}\\setlength{{\\tabcolsep}}{{2pt}}\n\\begin{{tabular}}{{{}}}\n",
         "c".repeat(t[0].len())
@@ -363,7 +374,10 @@ mod tests {
 
     #[test]
     fn latex_of_names_and_numbers() {
-        assert_eq!(latex_equation("d3^2*M4 + 1.5e-7*IA2"), "d_{3}^{2} M_{4} + 1.5 \\cdot 10^{-7} I_{a2}");
+        assert_eq!(
+            latex_equation("d3^2*M4 + 1.5e-7*IA2"),
+            "d_{3}^{2} M_{4} + 1.5 \\cdot 10^{-7} I_{a2}"
+        );
         assert_eq!(latex_name("M11_"), "\\mathit{M11\\_}");
     }
 }

@@ -67,7 +67,11 @@ pub struct StartReport {
 impl StartReport {
     /// One sentence for the report.
     pub fn describe(&self) -> String {
-        let q: Vec<String> = self.q.iter().map(|&x| short((x * 1e6).round() / 1e6)).collect();
+        let q: Vec<String> = self
+            .q
+            .iter()
+            .map(|&x| short((x * 1e6).round() / 1e6))
+            .collect();
         let branch = format!(
             "det Wp {} 0, sigma_min/sigma_max(Wp) = {}{}",
             if self.det_sign > 0.0 { ">" } else { "<" },
@@ -285,7 +289,11 @@ impl ClosedChainSampler {
     /// of that in m), each closed from the singular start's q_p: the first regular result on the
     /// parallelogram branch.
     #[allow(clippy::type_complexity)]
-    fn search_start(&mut self, qa0: &[f64], guess: &[f64]) -> Option<(Vec<f64>, Vec<f64>, f64, f64)> {
+    fn search_start(
+        &mut self,
+        qa0: &[f64],
+        guess: &[f64],
+    ) -> Option<(Vec<f64>, Vec<f64>, f64, f64)> {
         let mut rng = crate::testing::rng(0x57a7);
         for attempt in 0..60 {
             let size = 0.05 * (1.0 + attempt as f64 / 4.0).min(16.0);
@@ -308,7 +316,13 @@ impl ClosedChainSampler {
             return true;
         }
         let t = frame_transforms(self.chain.robot(), q);
-        let rot = |j: usize| if j == 0 { Matrix3::identity() } else { t[j - 1].rot };
+        let rot = |j: usize| {
+            if j == 0 {
+                Matrix3::identity()
+            } else {
+                t[j - 1].rot
+            }
+        };
         self.pairs
             .iter()
             .all(|(lo, hi, a)| (rot(*lo).transpose() * rot(*hi) - a).amax() < 1e-6)

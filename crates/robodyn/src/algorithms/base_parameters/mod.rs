@@ -76,7 +76,10 @@ pub fn numeric_base_parameters_auto(
     } else {
         let mut sampler = ClosedChainSampler::new(robot)?;
         let start = sampler.start().clone();
-        Ok((numeric_base_parameters(robot, &mut sampler, opt)?, Some(start)))
+        Ok((
+            numeric_base_parameters(robot, &mut sampler, opt)?,
+            Some(start),
+        ))
     }
 }
 

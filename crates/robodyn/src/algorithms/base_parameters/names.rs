@@ -131,7 +131,8 @@ impl ParameterNames {
 
     /// `e` (over the canonical symbols) with the canonical symbols replaced by these names.
     pub fn rename(&self, e: &Expr) -> Expr {
-        let map: HashMap<String, usize> = (0..self.names.len()).map(|k| (canonical(k), k)).collect();
+        let map: HashMap<String, usize> =
+            (0..self.names.len()).map(|k| (canonical(k), k)).collect();
         e.substitute(&|s: &str| map.get(s).map(|&k| Expr::symbol(self.names[k].clone())))
     }
 }

@@ -324,7 +324,14 @@ fn qr_in_place_staircase(mut a: faer::MatMut<'_, f64>, last_row: &dyn Fn(usize) 
             // A_trail <- (I - V T V^T)^T A_trail = A_trail - V T^T (V^T A_trail)
             let mut trail = a.rb_mut().submatrix_mut(k, k + b, m - k, n - k - b);
             let mut y = Mat::<f64>::zeros(b, n - k - b);
-            matmul(y.as_mut(), Accum::Replace, v.transpose(), trail.rb(), 1.0, par());
+            matmul(
+                y.as_mut(),
+                Accum::Replace,
+                v.transpose(),
+                trail.rb(),
+                1.0,
+                par(),
+            );
             let ty = tm.transpose() * &y;
             matmul(trail.rb_mut(), Accum::Add, &v, &ty, -1.0, par());
         }
@@ -335,7 +342,13 @@ fn qr_in_place_staircase(mut a: faer::MatMut<'_, f64>, last_row: &dyn Fn(usize) 
 /// The n x n upper triangle of a factored `m x n` matrix (rows beyond m are zero).
 fn upper(a: MatRef<'_, f64>) -> Mat<f64> {
     let n = a.ncols();
-    Mat::from_fn(n, n, |i, j| if i <= j && i < a.nrows() { a[(i, j)] } else { 0.0 })
+    Mat::from_fn(n, n, |i, j| {
+        if i <= j && i < a.nrows() {
+            a[(i, j)]
+        } else {
+            0.0
+        }
+    })
 }
 
 /// QR of the columns `cols` of R, in that order; returns the new R (cols.len() x cols.len()).
@@ -416,7 +429,9 @@ fn sample_count(opt: &NumericOptions, ncols: usize, n_rows_per: usize) -> usize 
     opt.samples.unwrap_or_else(|| {
         let target = (3 * ncols).min(3000.max(ncols + ncols / 4));
         // at least 20 samples, unless that exceeds the target (large trees: N = NL rows each)
-        target.div_ceil(n_rows_per).max(20.min(target.div_ceil(n_rows_per) + 2))
+        target
+            .div_ceil(n_rows_per)
+            .max(20.min(target.div_ceil(n_rows_per) + 2))
     })
 }
 
@@ -451,7 +466,12 @@ pub fn numeric_base_parameters(
     let bound_rows = opt
         .samples
         .map(|s| s.saturating_mul(nl))
-        .unwrap_or_else(|| (3 * ncols).min(3000.max(ncols + ncols / 4)).saturating_add(nl).max(20 * nl));
+        .unwrap_or_else(|| {
+            (3 * ncols)
+                .min(3000.max(ncols + ncols / 4))
+                .saturating_add(nl)
+                .max(20 * nl)
+        });
     let bytes = bound_rows
         .saturating_mul(ncols.max(1))
         .saturating_add(nl.saturating_mul(PARAMS_PER_LINK * nl))
@@ -517,7 +537,6 @@ pub fn numeric_base_parameters(
             }
         }
     }
-    tm("W");
     // 2. no-effect columns (existing parameters); absent columns of no effect are dropped
     let norms: Vec<f64> = (0..ncols).map(|c| w.col(c).norm_l2()).collect();
     let is_absent = |c: usize| sel.absent.contains(&all[c]);
@@ -646,7 +665,11 @@ pub fn numeric_base_parameters(
     }
     let mut beta_s = Mat::from_fn(nk, dep.len(), |i, j| r2[(i, nk + j)]);
     if nk > 0 && !dep.is_empty() {
-        faer::linalg::triangular_solve::solve_upper_triangular_in_place(r11, beta_s.as_mut(), par());
+        faer::linalg::triangular_solve::solve_upper_triangular_in_place(
+            r11,
+            beta_s.as_mut(),
+            par(),
+        );
     }
     let col = |k: usize| all[live[k]];
     let mut beta = DMatrix::zeros(nk, dep.len());
@@ -669,4 +692,3 @@ pub fn numeric_base_parameters(
         rows,
     })
 }
-

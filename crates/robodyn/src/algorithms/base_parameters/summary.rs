@@ -410,12 +410,12 @@ impl MethodComparison {
         }
         Some(format!(
             "THE METHODS DIFFER; THE NUMERICAL METHOD IS THE ARBITER: it finds {} base parameters, \
-             the symbolic rules {}{}.\n  base by the rules only: {}\n  base numerically only: {}\n\
+             the symbolic rules {} ({}).\n  base by the rules only: {}\n  base numerically only: {}\n\
              The table and equations below are the symbolic ones (valid, not minimal); \
              `--method numeric` gives the minimal set.\n\n",
             self.numeric_count,
             self.symbolic_count,
-            format!(" ({})", self.reason()),
+            self.reason(),
             list(&self.symbolic_only),
             list(&self.numeric_only)
         ))

@@ -455,7 +455,12 @@ fn detect_parallelogram(
     }
     let angle = |n: usize| {
         let v = planar(&sides[n].1);
-        v.y.atan2(v.x) + if sides[n].2 { std::f64::consts::PI } else { 0.0 }
+        v.y.atan2(v.x)
+            + if sides[n].2 {
+                std::f64::consts::PI
+            } else {
+                0.0
+            }
     };
     let pair = |m: usize, n: usize| {
         let (x, y) = (sides[m].0, sides[n].0);
@@ -584,7 +589,10 @@ fn coupled_classes(ps: &[Parallelogram]) -> Vec<Vec<usize>> {
             classes.push(merged);
         }
     }
-    classes.into_iter().map(|c| c.into_iter().collect()).collect()
+    classes
+        .into_iter()
+        .map(|c| c.into_iter().collect())
+        .collect()
 }
 
 /// What the rules need to know about the robot: its topology, numeric geometry and, per link,
@@ -699,7 +707,11 @@ fn check_geometry_names(desc: &RobotDescription) -> Result<()> {
     }
     exprs.extend(desc.gravity.iter().chain(&desc.vp0));
     for e in exprs {
-        if let Some(n) = e.symbols().into_iter().find(|n| standard_index(n, desc.nl).is_some()) {
+        if let Some(n) = e
+            .symbols()
+            .into_iter()
+            .find(|n| standard_index(n, desc.nl).is_some())
+        {
             return Err(Error::Input(format!(
                 "the geometric symbol `{n}` has the name of a standard parameter; rename it \
                  (the grouping equations use the standard parameters as unknowns)"
@@ -872,7 +884,12 @@ fn lambda10(desc: &RobotDescription, frame: usize) -> [Expr; 10] {
 
 /// Rule 1, eq 10.51c at the higher of the two links holding the cut joint and its twin:
 /// h_i lambda_k^10 = h_j lambda_{k+B}^10 eliminates MX (or MY) of that link.
-fn cut_joint_relation(desc: &RobotDescription, l: &crate::model::ClosedLoop, j: usize, s: &mut State) {
+fn cut_joint_relation(
+    desc: &RobotDescription,
+    l: &crate::model::ClosedLoop,
+    j: usize,
+    s: &mut State,
+) {
     let (li, lj) = (l.link_i, l.link_j);
     if j != li.max(lj) {
         return;
@@ -898,7 +915,11 @@ fn cut_joint_relation(desc: &RobotDescription, l: &crate::model::ClosedLoop, j: 
             s.add(own, q, -(own_c[q].clone() / cstar.clone()) * kstar.clone());
         }
         if !other_c[q].is_zero() {
-            s.add(other, q, (other_c[q].clone() / cstar.clone()) * kstar.clone());
+            s.add(
+                other,
+                q,
+                (other_c[q].clone() / cstar.clone()) * kstar.clone(),
+            );
         }
     }
 }
