@@ -346,7 +346,7 @@ fn latex_equation(e: &str) -> String {
     let mut it = out.chars().peekable();
     while let Some(c) = it.next() {
         res.push(c);
-        if c == '^' {
+        if c == '^' && it.peek() != Some(&'{') {
             let mut exp = String::new();
             while let Some(&d) = it.peek() {
                 if d.is_ascii_digit() || (exp.is_empty() && d == '-') {

@@ -258,7 +258,8 @@ pub fn short(x: f64) -> String {
     }
     let plain = format!("{x}");
     let sci = format!("{x:e}");
-    if plain.len() <= sci.len() {
+    // plain decimals between 1e-4 and 1e15 (0.0008, not 8e-4), else the shorter
+    if (1e-4..1e15).contains(&x.abs()) || plain.len() <= sci.len() {
         plain
     } else {
         sci
