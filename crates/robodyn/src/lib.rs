@@ -3,7 +3,7 @@
 //!
 //! Layout (Pinocchio's Model/Data split):
 //! - [`model`]: what a robot is (description, topology, numeric constants), immutable;
-//! - [`workspace`]: per-evaluation buffers, reused across calls;
+//! - [`data`]: per-evaluation buffers, reused across calls;
 //! - [`algorithms`]: one module per algorithm, free functions over (model, workspace, inputs);
 //! - [`io`]: robot files (TOML, SYMORO .par, URDF) with positioned errors;
 //! - [`geometry`]: iT_j and 0T_j.
@@ -18,13 +18,23 @@ pub mod error;
 pub mod geometry;
 pub mod io;
 pub mod model;
+pub mod data;
+pub(crate) mod linalg;
 pub mod scalar;
 pub mod simulation;
 pub mod testing;
-pub mod workspace;
 
+pub use algorithms::closed_chain::{
+    closed_direct_dynamics, closed_direct_dynamics_into, closed_inverse_dynamics,
+    closed_inverse_dynamics_into, closed_regressor_into, closed_state, loop_closure,
+    loop_closure_into, Branch, ClosedChain, ClosedData, Conditioning, ConditioningLimits,
+};
+pub use algorithms::direct_dynamics::{direct_dynamics, direct_dynamics_into, Method};
+pub use algorithms::inertia_matrix::{h_vector, h_vector_into, inertia_matrix, inertia_matrix_into};
+pub use algorithms::inverse_dynamics::{inverse_dynamics, inverse_dynamics_into};
+pub use algorithms::regressor::{regressor, regressor_into, wrench_torques, wrench_torques_into};
+pub use data::Data;
 pub use error::{Error, Result};
-pub use model::{Robot, RobotDescription};
+pub use model::{BaseMotion, Coordinates, DynModel, Environment, Robot, RobotDescription, Wrench};
 pub use robodyn_symbolic::Expr;
 pub use scalar::DynScalar;
-pub use workspace::Workspace;

@@ -24,10 +24,7 @@ pub struct CsvSink<W: Write> {
 impl CsvSink<std::io::BufWriter<std::fs::File>> {
     /// Create (truncate) a CSV file.
     pub fn create(path: &Path) -> Result<Self> {
-        let f = std::fs::File::create(path).map_err(|e| Error::Io {
-            path: path.display().to_string(),
-            reason: e.to_string(),
-        })?;
+        let f = std::fs::File::create(path).map_err(|e| Error::io(path.display().to_string(), e))?;
         Ok(CsvSink::new(
             std::io::BufWriter::new(f),
             path.display().to_string(),
@@ -49,10 +46,7 @@ impl<W: Write> CsvSink<W> {
     }
 
     fn io(&self, e: std::io::Error) -> Error {
-        Error::Io {
-            path: self.name.clone(),
-            reason: e.to_string(),
-        }
+        Error::io(self.name.clone(), e)
     }
 }
 
@@ -137,10 +131,7 @@ impl TrajectorySink for Tee<'_> {
 /// (bottom) against time.
 pub fn plot_svg(path: &Path, rec: &Recorder) -> Result<()> {
     use plotters::prelude::*;
-    let err = |e: String| Error::Io {
-        path: path.display().to_string(),
-        reason: e,
-    };
+    let err = |e: String| Error::io(path.display().to_string(), std::io::Error::other(e));
     let t = rec
         .series("t")
         .ok_or_else(|| err("the trajectory has no column t".into()))?;

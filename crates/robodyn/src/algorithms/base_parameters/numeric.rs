@@ -21,11 +21,11 @@
 //!    up to rounding), so Phi K = Phi_1 (K1 + beta K2), i.e. K_base = K1 + beta K2.
 
 use super::super::regressor::{
-    closed_chain_regressor, parameter_name, regressor, ParameterSelection, PARAMS_PER_LINK,
+    closed_chain_regressor, parameter_name, tree_regressor, ParameterSelection, PARAMS_PER_LINK,
 };
 use crate::error::{Error, Result};
 use crate::model::Robot;
-use crate::workspace::Workspace;
+use crate::data::Data;
 use nalgebra::DMatrix;
 use rand::{Rng, RngCore};
 
@@ -193,7 +193,7 @@ pub fn numeric_base_parameters(
     let ncols = columns.len();
     let mut rng = crate::testing::rng(opt.seed);
     let model = robot.numeric();
-    let mut ws = Workspace::new(model);
+    let mut ws = Data::new(robot);
     let mut phi = DMatrix::zeros(nl, PARAMS_PER_LINK * nl);
     // first sample fixes N (rows per sample)
     let first = sampler.sample(robot, &mut rng)?;
@@ -213,7 +213,7 @@ pub fn numeric_base_parameters(
                 "the sampler returned a state of the wrong size (NL = {nl} expected)"
             )));
         }
-        regressor(model, &mut ws, &s.q, &s.qd, &s.qdd, &mut phi);
+        tree_regressor(model, &mut ws, &model.env, &s.q, &s.qd, &s.qdd, &mut phi);
         let block = match &s.g {
             Some(g) => closed_chain_regressor(g, &phi)?,
             None => phi.clone(),
