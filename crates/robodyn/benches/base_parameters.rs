@@ -8,7 +8,7 @@ use robodyn::algorithms::base_parameters::{
 };
 use robodyn::algorithms::regressor::{regressor, ParameterSelection, RotorMode, PARAMS_PER_LINK};
 use robodyn::testing::{random_state, random_tree, rng, TreeOptions};
-use robodyn::Workspace;
+use robodyn::Data;
 
 fn bench(c: &mut Criterion) {
     let mut r = rng(30);
@@ -47,7 +47,7 @@ fn bench(c: &mut Criterion) {
     });
     g.finish();
     let [q, qd, qdd] = random_state(&mut r, 30);
-    let mut ws = Workspace::new(robot.numeric());
+    let mut ws = Data::new(&robot);
     let mut phi = nalgebra::DMatrix::zeros(30, PARAMS_PER_LINK * 30);
     c.bench_function("regressor_30_joint_tree", |b| {
         b.iter(|| regressor(robot.numeric(), &mut ws, &q, &qd, &qdd, &mut phi))

@@ -14,12 +14,12 @@ fn bench(c: &mut Criterion) {
         let robot = random_tree(&mut r, n, &TreeOptions::default());
         let model = robot.numeric();
         let [q, qd, tau] = random_state(&mut r, n);
-        let mut iws = InertiaWorkspace::new(model);
+        let mut iws = InertiaData::from_model(model);
         let mut a = DMatrix::zeros(n, n);
         g.bench_with_input(BenchmarkId::new("inertia_matrix", n), &n, |b, _| {
             b.iter(|| inertia_matrix_into(model, &mut iws, black_box(&q), &mut a))
         });
-        let mut ws = DirectWorkspace::new(model);
+        let mut ws = DirectData::from_model(model);
         let mut qdd = vec![0.0; n];
         g.bench_with_input(BenchmarkId::new("composite_ltdl", n), &n, |b, _| {
             b.iter(|| ddm_composite(model, &mut ws, black_box(&q), &qd, &tau, &mut qdd).unwrap())

@@ -7,7 +7,7 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use robodyn::algorithms::closed_chain::ClosedChain;
 use robodyn::algorithms::inverse_dynamics::rnea;
 use robodyn::testing::{random_state, rng};
-use robodyn::{Robot, Workspace};
+use robodyn::{Robot, Data};
 use std::hint::black_box;
 
 mod robots {
@@ -29,7 +29,7 @@ fn bench_robot(c: &mut Criterion, label: &str, robot: Robot, f: GenFn) {
     let n = robot.nl();
     let [q, qd, qdd] = random_state(&mut rng(1), n);
     let model = robot.numeric();
-    let mut ws = Workspace::new(model);
+    let mut ws = Data::from_model(model);
     let mut tau = vec![0.0; n];
     let mut out = vec![0.0; n];
     // same numbers (movable joints only in `out`; both robots have no fixed tree frame)
@@ -114,7 +114,7 @@ fn bench_closed(c: &mut Criterion) {
         assert!((a - b).abs() <= 1e-9 * (1.0 + a.abs()), "{a} vs {b}");
     }
     let model = robot.numeric();
-    let mut tws = Workspace::new(model);
+    let mut tws = Data::from_model(model);
     let mut tau = vec![0.0; robot.nl()];
     let mut g = c.benchmark_group("closed_fivebar");
     g.bench_function("numeric", |b| {

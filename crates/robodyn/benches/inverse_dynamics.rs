@@ -8,7 +8,7 @@ use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use robodyn::algorithms::energy::lagrangian_torques;
 use robodyn::algorithms::inverse_dynamics::{inverse_dynamics, rnea};
 use robodyn::testing::{self, random_state, random_tree, TreeOptions};
-use robodyn::{Robot, Workspace};
+use robodyn::{Robot, Data};
 use std::hint::black_box;
 use std::path::PathBuf;
 
@@ -32,7 +32,7 @@ fn bench(c: &mut Criterion) {
     for (name, robot) in robots() {
         let n = robot.nl();
         let [q, qd, qdd] = random_state(&mut testing::rng(1), n);
-        let mut ws = Workspace::new(robot.numeric());
+        let mut ws = Data::new(&robot);
         let mut tau = vec![0.0; n];
         group.bench_with_input(BenchmarkId::new("rnea", name), &robot, |b, r| {
             b.iter(|| {

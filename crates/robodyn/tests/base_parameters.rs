@@ -11,7 +11,7 @@ use robodyn::algorithms::regressor::{
     parameter_name, regressor, ParameterSelection, RotorMode, PARAMS_PER_LINK,
 };
 use robodyn::testing::{random_inertial, random_tree, rng, TreeOptions};
-use robodyn::{Expr, Robot, RobotDescription, Workspace};
+use robodyn::{Expr, Robot, RobotDescription, Data};
 use std::f64::consts::FRAC_PI_2;
 
 fn sr400() -> Robot {
@@ -117,7 +117,7 @@ fn check_reproduces(robot: &Robot, nb: &NumericBase, sampler: &mut dyn Sampler, 
     let kb = nb.base_values(&k);
     let mut r = rng(seed);
     let nl = robot.nl();
-    let mut ws = Workspace::new(robot.numeric());
+    let mut ws = Data::new(&robot);
     let mut phi = DMatrix::zeros(nl, PARAMS_PER_LINK * nl);
     let mut worst: f64 = 0.0;
     for _ in 0..10 {
@@ -236,7 +236,7 @@ fn check_symbolic_reproduces(
         .collect();
     let mut r = rng(seed);
     let nl = robot.nl();
-    let mut ws = Workspace::new(robot.numeric());
+    let mut ws = Data::new(&robot);
     let mut phi = DMatrix::zeros(nl, PARAMS_PER_LINK * nl);
     let mut worst: f64 = 0.0;
     for _ in 0..10 {

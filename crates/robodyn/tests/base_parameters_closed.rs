@@ -17,7 +17,7 @@ use robodyn::algorithms::regressor::{
     parameter_name, regressor, wrench_torques, ParameterSelection, RotorMode, PARAMS_PER_LINK,
 };
 use robodyn::testing::{random_inertial, rng};
-use robodyn::{Robot, Workspace};
+use robodyn::{Robot, Data};
 
 fn load(file: &str) -> Robot {
     let path = format!("{}/../../robots/{file}", env!("CARGO_MANIFEST_DIR"));
@@ -141,7 +141,7 @@ fn check_against_idm(
     let full = robot.with_standard_parameters(k).unwrap();
     let nl = robot.nl();
     let model = full.numeric();
-    let mut ws = Workspace::new(model);
+    let mut ws = Data::from_model(model);
     let mut phi = DMatrix::zeros(nl, PARAMS_PER_LINK * nl);
     let mut tau_e = vec![0.0; nl];
     let mut r = rng(seed);

@@ -398,7 +398,7 @@ fn a_cl_and_h_cl_match_newton_euler_columns() {
         let mut ws = cc.workspace();
         let nl = r.nl();
         let model = r.numeric();
-        let mut tree_ws = robodyn::Workspace::new(model);
+        let mut tree_ws = robodyn::Data::from_model(model);
         let mut worst: f64 = 0.0;
         for _ in 0..10 {
             let [qa, qp, qd, _] = random_state(&cc, &mut rng, qa0, qp0, range);

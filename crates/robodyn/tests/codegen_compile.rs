@@ -24,7 +24,7 @@ use robodyn::algorithms::inverse_dynamics::rnea;
 use robodyn::codegen::{constant_g, generate, GenOptions, ModelKind};
 use robodyn::model::STANDARD_PARAMETERS;
 use robodyn::testing::{random_state, random_tree_description, rng, TreeOptions};
-use robodyn::{Expr, Robot, RobotDescription, Workspace};
+use robodyn::{Expr, Robot, RobotDescription, Data};
 use robodyn_symbolic::{emit, Lang, Program};
 use std::collections::HashMap;
 use std::io::Write;
@@ -78,7 +78,7 @@ fn parameter_values(prog: &Program, env: &dyn Fn(&str) -> Option<f64>) -> Vec<f6
 }
 
 fn numeric_rnea(robot: &Robot, q: &[f64], qd: &[f64], qdd: &[f64]) -> Vec<f64> {
-    let mut ws = Workspace::new(robot.numeric());
+    let mut ws = Data::new(&robot);
     let mut tau = vec![0.0; robot.nl()];
     rnea(robot.numeric(), &mut ws, q, qd, qdd, &mut tau);
     tau

@@ -9,7 +9,7 @@ use robodyn::algorithms::inverse_dynamics::{
 };
 use robodyn::codegen::parallel_links;
 use robodyn::testing::rng;
-use robodyn::Workspace;
+use robodyn::Data;
 
 /// Example 10.1: theta3 = theta7 + pi/2 - theta2 and theta8 = theta2 - theta7, so link 3 keeps
 /// the orientation of link 7 (up to a quarter turn; link 7, one joint from the base, is the
@@ -45,7 +45,7 @@ fn on_closed_states(
         let model = robot.numeric();
         let mut sampler = ClosedChainSampler::new(&robot).unwrap();
         let mut r = rng(seed);
-        let mut ws = Workspace::new(model);
+        let mut ws = Data::from_model(model);
         let nl = robot.nl();
         for _ in 0..5 {
             let s = sampler.next_state(&mut r).unwrap();

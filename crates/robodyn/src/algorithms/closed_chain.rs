@@ -678,8 +678,9 @@ impl ClosedChain {
             }
         }
         // (10.46): A_cl = G^T A_tr G; (10.47): H_cl = G^T (H_tr + A_tr qdd0)
-        d.ag.gemm(1.0, &a_tr, &d.g, 0.0);
-        d.a_cl.gemm_tr(1.0, &d.g, &d.ag, 0.0);
+        // (small products written out: nalgebra's gemm packs its operands on the heap)
+        mul_into(&a_tr, &d.g, &mut d.ag);
+        tr_mul_into(&d.g, &d.ag, &mut d.a_cl);
         for r in 0..d.nl {
             let mut v = d.tau_tr[r];
             for c in 0..d.nl {
@@ -1064,7 +1065,7 @@ pub fn closed_regressor_into(
     let model = chain.robot().numeric();
     let mut full = std::mem::replace(&mut d.phi, DMatrix::zeros(0, 0));
     tree_regressor(model, &mut d.tree, env, &d.q_tr, &d.qd_tr, &d.qdd_tr, &mut full);
-    phi.gemm_tr(1.0, &d.g, &full, 0.0);
+    tr_mul_into(&d.g, &full, phi);
     d.phi = full;
     tree_wrench_torques(model, &mut d.tree, env, &d.q_tr, &mut d.tau_tr);
     ClosedChain::project(d, &d.tau_tr, tau_e);
@@ -1111,4 +1112,22 @@ pub(crate) fn refine_closure(chain: &ClosedChain, q_a: &[f64], q_p: &[f64]) -> V
         norm = nt;
     }
     q_p
+}
+
+/// out = a b (dense, written out: no heap packing).
+fn mul_into(a: &DMatrix<f64>, b: &DMatrix<f64>, out: &mut DMatrix<f64>) {
+    for c in 0..b.ncols() {
+        for r in 0..a.nrows() {
+            out[(r, c)] = (0..a.ncols()).map(|k| a[(r, k)] * b[(k, c)]).sum();
+        }
+    }
+}
+
+/// out = a^T b (dense, written out: no heap packing).
+fn tr_mul_into(a: &DMatrix<f64>, b: &DMatrix<f64>, out: &mut DMatrix<f64>) {
+    for c in 0..b.ncols() {
+        for r in 0..a.ncols() {
+            out[(r, c)] = (0..a.nrows()).map(|k| a[(k, r)] * b[(k, c)]).sum();
+        }
+    }
 }
