@@ -161,6 +161,7 @@ pub struct ClosedData {
     start_qa: Vec<f64>,
     start_qp: Vec<f64>,
     start_w: DMatrix<f64>,
+    start_rcond: f64,
     a_cl: DMatrix<f64>,
     chol: DMatrix<f64>,
     h_cl: DVector<f64>,
@@ -203,6 +204,7 @@ impl ClosedData {
             start_qa: vec![0.0; n],
             start_qp: vec![0.0; p],
             start_w: DMatrix::zeros(p, n),
+            start_rcond: 0.0,
             a_cl: DMatrix::zeros(n, n),
             chol: DMatrix::zeros(n, n),
             h_cl: DVector::zeros(n),
@@ -483,6 +485,7 @@ impl ClosedChain {
         d.start_qa.copy_from_slice(&b.q_a);
         d.start_qp.copy_from_slice(&b.q_p);
         d.start_w.copy_from(&b.w);
+        d.start_rcond = b.rcond;
         let dist = q_a
             .iter()
             .zip(&b.q_a)
@@ -591,6 +594,7 @@ impl ClosedChain {
         b.q_a.copy_from_slice(&d.start_qa);
         b.q_p.copy_from_slice(&d.start_qp);
         b.w.copy_from(&d.start_w);
+        b.rcond = d.start_rcond;
     }
 
     fn conditioning(&self, b: &Branch, a_cl: Option<f64>) -> Conditioning {
