@@ -264,8 +264,8 @@ fn run(
     let mut summary = SimSummary::default();
     let stop = |t: f64, e: Error| -> Error {
         match e {
-            Error::Numerical(m) => Error::Numerical(format!("simulation stopped at t = {t}: {m}")),
-            other => other,
+            Error::Io { .. } | Error::Input(_) | Error::Dimension { .. } => e,
+            other => Error::Numerical(format!("simulation stopped at t = {t}: {other}")),
         }
     };
     loop {

@@ -100,8 +100,11 @@ impl ClosedChainSampler {
         // through a singular configuration (where it may switch assembly branch: the SR400's
         // parallelogram flattens at q7 = q2 and q7 = q2 + pi) and any point whose Wp is below
         // `min_wp_ratio` (near one, G = [I; W] is inaccurate).
+        // (the tracker's limit is on the 1-norm reciprocal condition number, which can be p
+        // times smaller than sigma_min / sigma_max: the sample itself is checked on the latter)
+        let p = self.chain.n_equations().max(1) as f64;
         let limits = ConditioningLimits {
-            wp_hard: self.min_wp_ratio,
+            wp_hard: self.min_wp_ratio / p,
             ..*self.chain.limits()
         };
         let chain = self.chain.clone().with_limits(limits);
@@ -114,7 +117,9 @@ impl ClosedChainSampler {
         let mut branch = chain.branch_from(&target, &qp).ok()?;
         let mut v = |s: f64| -> Vec<f64> { (0..n).map(|_| rng.random_range(-s..s)).collect() };
         let (qd, qdd) = (v(self.qd_max), v(self.qdd_max));
-        closed_state(&chain, &mut branch, &target, &qd, &qdd).ok()
+        let state = closed_state(&chain, &mut branch, &target, &qd, &qdd).ok()?;
+        let sv = state.wp.clone().svd(false, false).singular_values;
+        (sv.min() >= self.min_wp_ratio * sv.max()).then_some(state)
     }
 
     /// The next consistent state (also returned by [`Sampler::sample`]).
