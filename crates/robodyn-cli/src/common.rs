@@ -153,7 +153,13 @@ impl TableOutput {
         rows: &[Vec<f64>],
         json_extra: &[serde_json::Map<String, serde_json::Value>],
     ) -> CliResult {
-        write_table_with(self.output.as_deref(), self.format, headers, rows, json_extra)
+        write_table_with(
+            self.output.as_deref(),
+            self.format,
+            headers,
+            rows,
+            json_extra,
+        )
     }
 }
 

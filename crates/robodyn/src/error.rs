@@ -299,7 +299,12 @@ impl Error {
 }
 
 /// Check that `v` has `n` entries, all finite: the entry check of every checked function.
-pub(crate) fn check_vector(what: &str, v: &[f64], n: usize, context: impl FnOnce() -> String) -> Result<()> {
+pub(crate) fn check_vector(
+    what: &str,
+    v: &[f64],
+    n: usize,
+    context: impl FnOnce() -> String,
+) -> Result<()> {
     if v.len() != n {
         return Err(Error::dimension(what, n, v.len(), context()));
     }

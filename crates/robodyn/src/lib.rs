@@ -14,12 +14,12 @@
 
 pub mod algorithms;
 pub mod codegen;
+pub mod data;
 pub mod error;
 pub mod geometry;
 pub mod io;
-pub mod model;
-pub mod data;
 pub(crate) mod linalg;
+pub mod model;
 pub mod scalar;
 pub mod simulation;
 pub mod testing;
@@ -30,7 +30,9 @@ pub use algorithms::closed_chain::{
     loop_closure_into, Branch, ClosedChain, ClosedData, Conditioning, ConditioningLimits,
 };
 pub use algorithms::direct_dynamics::{direct_dynamics, direct_dynamics_into, Method};
-pub use algorithms::inertia_matrix::{h_vector, h_vector_into, inertia_matrix, inertia_matrix_into};
+pub use algorithms::inertia_matrix::{
+    h_vector, h_vector_into, inertia_matrix, inertia_matrix_into,
+};
 pub use algorithms::inverse_dynamics::{inverse_dynamics, inverse_dynamics_into};
 pub use algorithms::regressor::{regressor, regressor_into, wrench_torques, wrench_torques_into};
 pub use data::Data;

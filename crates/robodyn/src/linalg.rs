@@ -210,7 +210,8 @@ mod tests {
         let b = [1.0, -2.0, 0.5];
         let mut x = b;
         lu.solve(&mut x);
-        let r = &a * nalgebra::DVector::from_column_slice(&x) - nalgebra::DVector::from_column_slice(&b);
+        let r = &a * nalgebra::DVector::from_column_slice(&x)
+            - nalgebra::DVector::from_column_slice(&b);
         assert!(r.amax() < 1e-14);
         let mut y = b;
         lu.solve_transpose(&mut y);

@@ -11,7 +11,7 @@ use robodyn::algorithms::regressor::{
     parameter_name, tree_regressor, ParameterSelection, RotorMode, PARAMS_PER_LINK,
 };
 use robodyn::testing::{random_inertial, random_tree, rng, TreeOptions};
-use robodyn::{Expr, Robot, RobotDescription, Data};
+use robodyn::{Data, Expr, Robot, RobotDescription};
 use std::f64::consts::FRAC_PI_2;
 
 fn sr400() -> Robot {
@@ -122,7 +122,15 @@ fn check_reproduces(robot: &Robot, nb: &NumericBase, sampler: &mut dyn Sampler, 
     let mut worst: f64 = 0.0;
     for _ in 0..10 {
         let s = sampler.sample(robot, &mut r).unwrap();
-        tree_regressor(robot.numeric(), &mut ws, &robot.numeric().env, &s.q, &s.qd, &s.qdd, &mut phi);
+        tree_regressor(
+            robot.numeric(),
+            &mut ws,
+            &robot.numeric().env,
+            &s.q,
+            &s.qd,
+            &s.qdd,
+            &mut phi,
+        );
         let gt = s.g.clone().unwrap_or_else(|| DMatrix::identity(nl, nl));
         let y = gt.transpose() * &phi;
         let full: Vec<f64> = (0..y.nrows())
@@ -241,7 +249,15 @@ fn check_symbolic_reproduces(
     let mut worst: f64 = 0.0;
     for _ in 0..10 {
         let s = sampler.sample(robot, &mut r).unwrap();
-        tree_regressor(robot.numeric(), &mut ws, &robot.numeric().env, &s.q, &s.qd, &s.qdd, &mut phi);
+        tree_regressor(
+            robot.numeric(),
+            &mut ws,
+            &robot.numeric().env,
+            &s.q,
+            &s.qd,
+            &s.qdd,
+            &mut phi,
+        );
         let gt = s.g.clone().unwrap_or_else(|| DMatrix::identity(nl, nl));
         let y = gt.transpose() * &phi;
         for row in 0..y.nrows() {

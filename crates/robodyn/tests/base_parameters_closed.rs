@@ -11,12 +11,13 @@ use robodyn::algorithms::base_parameters::{
     compare_methods, numeric_base_parameters, symbolic_base_parameters, ClosedChainSampler,
     NumericBase, NumericOptions, Report, Sampler, SymbolicBase, TreeSampler,
 };
-use robodyn::{closed_inverse_dynamics, inverse_dynamics, ClosedChain};
 use robodyn::algorithms::regressor::{
-    parameter_name, tree_regressor, tree_wrench_torques, ParameterSelection, RotorMode, PARAMS_PER_LINK,
+    parameter_name, tree_regressor, tree_wrench_torques, ParameterSelection, RotorMode,
+    PARAMS_PER_LINK,
 };
 use robodyn::testing::{random_inertial, rng};
-use robodyn::{Robot, Data};
+use robodyn::{closed_inverse_dynamics, inverse_dynamics, ClosedChain};
+use robodyn::{Data, Robot};
 
 fn load(file: &str) -> Robot {
     let path = format!("{}/../../robots/{file}", env!("CARGO_MANIFEST_DIR"));
@@ -155,14 +156,23 @@ fn check_against_idm(
             (Some(cc), Some(sm)) => {
                 let st = sm.next_state(&mut r).unwrap();
                 let pick = |v: &DVector<f64>| -> Vec<f64> {
-                    cc.coordinates().frames().iter().map(|&j| v[j - 1]).collect()
+                    cc.coordinates()
+                        .frames()
+                        .iter()
+                        .map(|&j| v[j - 1])
+                        .collect()
                 };
                 let mut b = cc
                     .branch_from(st.q_a.as_slice(), st.q_p.as_slice())
                     .unwrap();
-                let idm =
-                    closed_inverse_dynamics(cc, &mut b, &pick(&st.q), &pick(&st.qd), &pick(&st.qdd))
-                        .unwrap();
+                let idm = closed_inverse_dynamics(
+                    cc,
+                    &mut b,
+                    &pick(&st.q),
+                    &pick(&st.qd),
+                    &pick(&st.qdd),
+                )
+                .unwrap();
                 let s = idm.state;
                 let v = |x: DVector<f64>| -> Vec<f64> { x.iter().copied().collect() };
                 (v(s.q), v(s.qd), v(s.qdd), s.g, idm.gamma_cl)

@@ -62,8 +62,7 @@ fn sr400_example_10_1_torque_relations() {
     let mut worst: f64 = 0.0;
     for _ in 0..30 {
         let [qa, qp, qd, qdd] = random_state(&cc, &mut rng, qa0, qp0, range);
-        let idm = closed_inverse_dynamics(&cc, &mut at(&cc, &qa, &qp), &qa, &qd, &qdd)
-            .unwrap();
+        let idm = closed_inverse_dynamics(&cc, &mut at(&cc, &qa, &qp), &qa, &qd, &qdd).unwrap();
         let t = |j: usize| idm.gamma_tr[j - 1];
         let scale = idm.gamma_tr.amax();
         // q_a = [θ1 θ2 θ4 θ5 θ6 θ7]
@@ -97,8 +96,7 @@ fn virtual_power_and_lagrange_form() {
         let (mut w_vp, mut w_l): (f64, f64) = (0.0, 0.0);
         for _ in 0..20 {
             let [qa, qp, qd, qdd] = random_state(&cc, &mut rng, qa0, qp0, range);
-            let idm = closed_inverse_dynamics(&cc, &mut at(&cc, &qa, &qp), &qa, &qd, &qdd)
-                .unwrap();
+            let idm = closed_inverse_dynamics(&cc, &mut at(&cc, &qa, &qp), &qa, &qd, &qdd).unwrap();
             // Γ_cl' qd_a = Γ_tr' qd_tr
             let p_cl = idm.gamma_cl.dot(&DVector::from_column_slice(&qd));
             let p_tr = idm.gamma_tr.dot(&idm.state.qd);
@@ -144,8 +142,7 @@ fn kinetic_energy_matches_a_cl() {
         for _ in 0..10 {
             let [qa, qp, qd, _] = random_state(&cc, &mut rng, qa0, qp0, range);
             let tau = vec![0.0; qa.len()];
-            let ddm = closed_direct_dynamics(&cc, &mut at(&cc, &qa, &qp), &qa, &qd, &tau)
-                .unwrap();
+            let ddm = closed_direct_dynamics(&cc, &mut at(&cc, &qa, &qp), &qa, &qd, &tau).unwrap();
             let qdv = DVector::from_column_slice(&qd);
             let ke_a = 0.5 * qdv.dot(&(&ddm.a_cl * &qdv));
             let (ke, _) = energy(&r, &ddm.state);
@@ -201,8 +198,7 @@ fn power_balance_matches_gamma_cl_along_smooth_paths() {
             let d = |h: f64, e_at: &mut dyn FnMut(f64) -> f64| (e_at(h) - e_at(-h)) / (2.0 * h);
             let de = (4.0 * d(5e-4, &mut e_at) - d(1e-3, &mut e_at)) / 3.0;
             let [q, qd, qdd] = path(0.0);
-            let idm = closed_inverse_dynamics(&cc, &mut at(&cc, &q, &qp), &q, &qd, &qdd)
-                .unwrap();
+            let idm = closed_inverse_dynamics(&cc, &mut at(&cc, &q, &qp), &q, &qd, &qdd).unwrap();
             let power = idm.gamma_cl.dot(&DVector::from_column_slice(&qd));
             let e = (de - power).abs() / power.abs().max(1.0);
             worst = worst.max(e);
@@ -221,11 +217,9 @@ fn idm_of_ddm_is_identity() {
         for _ in 0..20 {
             let [qa, qp, qd, _] = random_state(&cc, &mut rng, qa0, qp0, range);
             let tau = uniform(&mut rng, qa.len(), 20.0);
-            let ddm = closed_direct_dynamics(&cc, &mut at(&cc, &qa, &qp), &qa, &qd, &tau)
-                .unwrap();
+            let ddm = closed_direct_dynamics(&cc, &mut at(&cc, &qa, &qp), &qa, &qd, &tau).unwrap();
             let qdd: Vec<f64> = ddm.qdd_a.iter().copied().collect();
-            let idm = closed_inverse_dynamics(&cc, &mut at(&cc, &qa, &qp), &qa, &qd, &qdd)
-                .unwrap();
+            let idm = closed_inverse_dynamics(&cc, &mut at(&cc, &qa, &qp), &qa, &qd, &qdd).unwrap();
             let scale = tau.iter().fold(0.0_f64, |a, b| a.max(b.abs()));
             for (k, t) in tau.iter().enumerate() {
                 let e = (idm.gamma_cl[k] - t).abs() / scale;
@@ -390,7 +384,8 @@ fn conservative_simulation_keeps_energy_and_closure() {
             if step % 100 == 0 {
                 let (e, _) = e_of(&mut sys, &q, &v);
                 drift = drift.max((e - e0).abs() / ke0.max(e0.abs()));
-                residual = residual.max(loop_closure(&sys.cc, &mut sys.branch, &q).unwrap().residual);
+                residual =
+                    residual.max(loop_closure(&sys.cc, &mut sys.branch, &q).unwrap().residual);
             }
         }
         println!(
@@ -416,8 +411,7 @@ fn a_cl_and_h_cl_match_newton_euler_columns() {
         for _ in 0..10 {
             let [qa, qp, qd, _] = random_state(&cc, &mut rng, qa0, qp0, range);
             let tau = uniform(&mut rng, qa.len(), 10.0);
-            let d = closed_direct_dynamics(&cc, &mut at(&cc, &qa, &qp), &qa, &qd, &tau)
-                .unwrap();
+            let d = closed_direct_dynamics(&cc, &mut at(&cc, &qa, &qp), &qa, &qd, &tau).unwrap();
             let q = d.state.q.as_slice();
             let zeros = vec![0.0; nl];
             let mut t0 = vec![0.0; nl];
@@ -434,8 +428,8 @@ fn a_cl_and_h_cl_match_newton_euler_columns() {
             }
             let g = &d.state.g;
             let a_ne = g.transpose() * &a_tr * g;
-            let s0 = closed_state(&cc, &mut at(&cc, &qa, &qp), &qa, &qd, &vec![0.0; qa.len()])
-                .unwrap();
+            let s0 =
+                closed_state(&cc, &mut at(&cc, &qa, &qp), &qa, &qd, &vec![0.0; qa.len()]).unwrap();
             let mut h = vec![0.0; nl];
             rnea(
                 model,

@@ -6,9 +6,11 @@
 
 use rand::Rng;
 use robodyn::geometry::frame_transforms;
-use robodyn::{closed_direct_dynamics, closed_inverse_dynamics, closed_state, loop_closure, ClosedChain};
 use robodyn::simulation::{
     simulate, ClosedChainDynamics, Dynamics, Integrator, Recorder, SimOptions, TorqueInput,
+};
+use robodyn::{
+    closed_direct_dynamics, closed_inverse_dynamics, closed_state, loop_closure, ClosedChain,
 };
 use robodyn::{Expr, Robot};
 use std::path::PathBuf;

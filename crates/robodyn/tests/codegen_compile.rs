@@ -24,7 +24,7 @@ use robodyn::algorithms::inverse_dynamics::rnea;
 use robodyn::codegen::{constant_g, generate, GenOptions, ModelKind};
 use robodyn::model::STANDARD_PARAMETERS;
 use robodyn::testing::{random_state, random_tree_description, rng, TreeOptions};
-use robodyn::{Expr, Robot, RobotDescription, Data};
+use robodyn::{Data, Expr, Robot, RobotDescription};
 use robodyn_symbolic::{emit, Lang, Program};
 use std::collections::HashMap;
 use std::io::Write;
@@ -931,10 +931,7 @@ fn generated_w_is_the_derivative_of_loop_closure() {
                 }
             };
             let w = wprog.evaluate(&value).unwrap();
-            let (pj, aj) = (
-                cc.passive_coordinates().frames(),
-                cc.coordinates().frames(),
-            );
+            let (pj, aj) = (cc.passive_coordinates().frames(), cc.coordinates().frames());
             let qa: Vec<f64> = aj.iter().map(|&j| st.q[j - 1]).collect();
             let qp: Vec<f64> = pj.iter().map(|&j| st.q[j - 1]).collect();
             let b = cc.branch_from(&qa, &qp).unwrap();

@@ -53,8 +53,7 @@ fn round_trip_through_newton_euler() {
             assert!(err <= 1e-9 * scale, "{method:?} case {case}: {err:e}");
             // qdd -> tau -> qdd
             inverse_dynamics_into(&robot, &mut data, env, &q, &qd, &qdd0, &mut tau).unwrap();
-            direct_dynamics_into(&robot, &mut data, env, &q, &qd, &tau, *method, &mut qdd)
-                .unwrap();
+            direct_dynamics_into(&robot, &mut data, env, &q, &qd, &tau, *method, &mut qdd).unwrap();
             for j in 0..nm {
                 let e = (qdd[j] - qdd0[j]).abs();
                 assert!(
@@ -141,7 +140,10 @@ fn negative_inertia_is_an_error() {
     let robot = Robot::new(d).unwrap();
     for method in METHODS {
         let e = direct_dynamics(&robot, &[0.1, 0.2, 0.3], &[0.0; 3], &[0.0; 3], method);
-        assert!(matches!(e, Err(Error::Singular { .. })), "{method:?}: {e:?}");
+        assert!(
+            matches!(e, Err(Error::Singular { .. })),
+            "{method:?}: {e:?}"
+        );
     }
 }
 
@@ -155,7 +157,13 @@ fn bad_state_is_an_input_error() {
         inf[1] = f64::INFINITY;
         let e = direct_dynamics(&robot, &vec![0.0; m], &vec![0.0; m], &inf, method);
         assert!(matches!(e, Err(Error::NotFinite { index: 1, .. })));
-        let e = direct_dynamics(&robot, &vec![0.0; m - 1], &vec![0.0; m], &vec![0.0; m], method);
+        let e = direct_dynamics(
+            &robot,
+            &vec![0.0; m - 1],
+            &vec![0.0; m],
+            &vec![0.0; m],
+            method,
+        );
         assert!(matches!(e, Err(Error::Dimension { .. })));
     }
 }

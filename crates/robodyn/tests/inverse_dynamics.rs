@@ -17,10 +17,10 @@ use robodyn::algorithms::energy::{
     kinetic_energy, lagrangian_torques, potential_energy, total_energy, total_energy_rate,
     wrench_power,
 };
-use robodyn::{inverse_dynamics, inverse_dynamics_into};
 use robodyn::model::JointType;
 use robodyn::testing::{self, random_state, random_tree_description, TreeOptions};
-use robodyn::{Error, Expr, Robot, RobotDescription, Data};
+use robodyn::{inverse_dynamics, inverse_dynamics_into};
+use robodyn::{Data, Error, Expr, Robot, RobotDescription};
 use std::path::PathBuf;
 
 /// Tolerance of the Lagrangian vs Newton–Euler comparison (issue 2).

@@ -70,7 +70,10 @@ fn rx90_toml_par_and_urdf_give_the_same_torques() {
             .zip(u.frame(j).geometric())
             .enumerate()
         {
-            let value = |r: &Robot, e: &Expr| e.eval(&|s| r.description().symbols.get(s).copied()).unwrap();
+            let value = |r: &Robot, e: &Expr| {
+                e.eval(&|s| r.description().symbols.get(s).copied())
+                    .unwrap()
+            };
             let (a, b) = (value(&t, a), value(&u, b));
             assert!(
                 (a - b).abs() < 1e-15,

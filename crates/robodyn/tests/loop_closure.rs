@@ -37,7 +37,11 @@ fn random_config(
 }
 
 /// Loop closure at q_a from a guess of q_p (a branch started there).
-fn solve(cc: &ClosedChain, qa: &[f64], guess: &[f64]) -> robodyn::Result<robodyn::algorithms::closed_chain::ClosureSolution> {
+fn solve(
+    cc: &ClosedChain,
+    qa: &[f64],
+    guess: &[f64],
+) -> robodyn::Result<robodyn::algorithms::closed_chain::ClosureSolution> {
     let mut b = cc.branch_from(qa, guess)?;
     loop_closure(cc, &mut b, qa)
 }
@@ -216,9 +220,7 @@ fn unreachable_configuration_names_the_loop() {
     let r = robot("fivebar.toml");
     let lc = ClosedChain::new(&r).unwrap();
     // proximal tips 0.447 m apart, distal links reach 0.4 m together
-    let e = lc
-        .branch_from(&[0.0, -FRAC_PI_2], &[0.0, 0.0])
-        .unwrap_err();
+    let e = lc.branch_from(&[0.0, -FRAC_PI_2], &[0.0, 0.0]).unwrap_err();
     let msg = e.to_string();
     assert!(matches!(e, Error::LoopNotClosed { .. }), "{msg}");
     assert!(

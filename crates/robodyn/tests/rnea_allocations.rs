@@ -7,9 +7,9 @@ use nalgebra::DMatrix;
 use robodyn::algorithms::inverse_dynamics::rnea;
 use robodyn::testing::{self, random_state, random_tree, TreeOptions};
 use robodyn::{
-    closed_direct_dynamics_into, closed_inverse_dynamics_into, direct_dynamics_into,
-    h_vector_into, inertia_matrix_into, inverse_dynamics_into, loop_closure_into, regressor_into,
-    ClosedChain, ClosedData, Data, Method,
+    closed_direct_dynamics_into, closed_inverse_dynamics_into, direct_dynamics_into, h_vector_into,
+    inertia_matrix_into, inverse_dynamics_into, loop_closure_into, regressor_into, ClosedChain,
+    ClosedData, Data, Method,
 };
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
@@ -125,8 +125,10 @@ fn checked_tree_functions_allocate_nothing() {
                 inverse_dynamics_into(robot, &mut data, &env, &s[0], &s[1], &s[2], &mut tau)
                     .unwrap();
                 for method in [Method::Composite, Method::ArticulatedBody] {
-                    direct_dynamics_into(robot, &mut data, &env, &s[0], &s[1], &tau, method, &mut qdd)
-                        .unwrap();
+                    direct_dynamics_into(
+                        robot, &mut data, &env, &s[0], &s[1], &tau, method, &mut qdd,
+                    )
+                    .unwrap();
                 }
                 inertia_matrix_into(robot, &mut data, &s[0], &mut a).unwrap();
                 h_vector_into(robot, &mut data, &env, &s[0], &s[1], &mut h).unwrap();
@@ -151,9 +153,15 @@ fn checked_tree_functions_allocate_nothing() {
 /// nothing but start the tracker), nothing is allocated.
 #[test]
 fn closed_chain_steady_state_allocates_nothing() {
-    for (file, amplitude) in [("sr400.toml", 0.4), ("fivebar.toml", 0.1), ("twoloops.toml", 1.0)] {
+    for (file, amplitude) in [
+        ("sr400.toml", 0.4),
+        ("fivebar.toml", 0.1),
+        ("twoloops.toml", 1.0),
+    ] {
         let robot = robodyn::io::load(
-            &PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../robots").join(file),
+            &PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+                .join("../../robots")
+                .join(file),
         )
         .unwrap();
         let chain = ClosedChain::new(&robot).unwrap();
@@ -164,7 +172,8 @@ fn closed_chain_steady_state_allocates_nothing() {
         let env = robot.environment();
         let (mut q, mut qd) = (q0.clone(), vec![0.0; n]);
         let qdd = vec![0.5; n];
-        let (mut tau, mut acc, mut qp) = (vec![0.0; n], vec![0.0; n], vec![0.0; chain.n_equations()]);
+        let (mut tau, mut acc, mut qp) =
+            (vec![0.0; n], vec![0.0; n], vec![0.0; chain.n_equations()]);
         let step = |k: usize, q: &mut Vec<f64>, qd: &mut Vec<f64>| {
             let t = k as f64 * 1e-3;
             for i in 0..n {
@@ -182,11 +191,27 @@ fn closed_chain_steady_state_allocates_nothing() {
         for k in 2..1000 {
             step(k, &mut q, &mut qd);
             let c = closed_inverse_dynamics_into(
-                &chain, &mut data, &mut branch, env, &q, &qd, &qdd, &mut tau,
+                &chain,
+                &mut data,
+                &mut branch,
+                env,
+                &q,
+                &qd,
+                &qdd,
+                &mut tau,
             )
             .unwrap();
-            closed_direct_dynamics_into(&chain, &mut data, &mut branch, env, &q, &qd, &tau, &mut acc)
-                .unwrap();
+            closed_direct_dynamics_into(
+                &chain,
+                &mut data,
+                &mut branch,
+                env,
+                &q,
+                &qd,
+                &tau,
+                &mut acc,
+            )
+            .unwrap();
             loop_closure_into(&chain, &mut data, &mut branch, &q, &mut qp).unwrap();
             checksum += tau[0] + acc[0] + qp[0] + c.wp;
         }

@@ -2,8 +2,8 @@
 //! dissipation, power balance, inputs, partial output of diverging runs, the SVG plot.
 
 use robodyn::algorithms::direct_dynamics::Method;
-use robodyn::model::param;
 use robodyn::algorithms::energy::{kinetic_energy, potential_energy};
+use robodyn::model::param;
 use robodyn::simulation::{
     plot_svg, simulate, CsvSink, Dynamics, Integrator, Ode, Recorder, SimOptions, Stepper,
     TimeSeries, TorqueInput, TreeDynamics,

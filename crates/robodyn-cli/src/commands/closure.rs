@@ -2,7 +2,9 @@
 //! variables q_p (and the cut-joint variables) for given actuated variables q_a, and with
 //! `--jacobian` W = d q_p / d q_a (10.30).
 
-use crate::common::{conditioning_json, parse_list, start_branch, warn_conditioning, CliResult, RobotArgs};
+use crate::common::{
+    conditioning_json, parse_list, start_branch, warn_conditioning, CliResult, RobotArgs,
+};
 use robodyn::{loop_closure, ClosedChain};
 use serde_json::json;
 

@@ -82,8 +82,17 @@ pub fn run(a: Args) -> CliResult {
     let mut rows = Vec::with_capacity(states.len());
     for (k, [q, qd, tau]) in states.iter().enumerate() {
         let mut qdd = vec![0.0; coords.len()];
-        direct_dynamics_into(&robot, &mut data, env, q, qd, tau, a.method.into(), &mut qdd)
-            .map_err(|e| e.in_row(k + 1))?;
+        direct_dynamics_into(
+            &robot,
+            &mut data,
+            env,
+            q,
+            qd,
+            tau,
+            a.method.into(),
+            &mut qdd,
+        )
+        .map_err(|e| e.in_row(k + 1))?;
         rows.push(qdd);
     }
     a.out.write(&a.names.columns("qdd", coords), &rows)
@@ -111,17 +120,9 @@ fn run_closed(a: Args, robot: robodyn::Robot) -> CliResult {
     let (mut rows, mut extra) = (Vec::new(), Vec::new());
     for (k, [q, qd, tau]) in states.iter().enumerate() {
         let mut qdd = vec![0.0; coords.len()];
-        let c = closed_direct_dynamics_into(
-            &chain,
-            &mut data,
-            &mut branch,
-            env,
-            q,
-            qd,
-            tau,
-            &mut qdd,
-        )
-        .map_err(|e| e.in_row(k + 1))?;
+        let c =
+            closed_direct_dynamics_into(&chain, &mut data, &mut branch, env, q, qd, tau, &mut qdd)
+                .map_err(|e| e.in_row(k + 1))?;
         warn_conditioning(&chain, k + 1, states.len(), &c);
         rows.push(qdd);
         extra.push(conditioning_json(&c));

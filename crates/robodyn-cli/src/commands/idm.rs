@@ -89,17 +89,9 @@ fn run_closed(a: Args, robot: robodyn::Robot) -> CliResult {
     let (mut rows, mut extra) = (Vec::new(), Vec::new());
     for (k, [q, qd, qdd]) in states.iter().enumerate() {
         let mut tau = vec![0.0; coords.len()];
-        let c = closed_inverse_dynamics_into(
-            &chain,
-            &mut data,
-            &mut branch,
-            env,
-            q,
-            qd,
-            qdd,
-            &mut tau,
-        )
-        .map_err(|e| e.in_row(k + 1))?;
+        let c =
+            closed_inverse_dynamics_into(&chain, &mut data, &mut branch, env, q, qd, qdd, &mut tau)
+                .map_err(|e| e.in_row(k + 1))?;
         warn_conditioning(&chain, k + 1, states.len(), &c);
         rows.push(tau);
         extra.push(conditioning_json(&c));

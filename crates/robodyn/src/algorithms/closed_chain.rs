@@ -327,8 +327,18 @@ impl ClosedChain {
             .assembly
             .clone()
             .unwrap_or_else(|| vec![0.0; robot.nl()]);
-        let qa: Vec<f64> = self.coords.frames().iter().map(|&j| reference[j - 1]).collect();
-        let qp: Vec<f64> = self.passive.frames().iter().map(|&j| reference[j - 1]).collect();
+        let qa: Vec<f64> = self
+            .coords
+            .frames()
+            .iter()
+            .map(|&j| reference[j - 1])
+            .collect();
+        let qp: Vec<f64> = self
+            .passive
+            .frames()
+            .iter()
+            .map(|&j| reference[j - 1])
+            .collect();
         match self.branch_from(&qa, &qp) {
             Err(Error::Singular { rcond, .. }) if robot.description().assembly.is_none() => {
                 Err(Error::SingularStart {
@@ -344,7 +354,8 @@ impl ClosedChain {
     /// from the guess (damped Newton) and Wp must be regular there. Allocates.
     pub fn branch_from(&self, q_a: &[f64], q_p_guess: &[f64]) -> Result<Branch> {
         self.coords.check("q_a", q_a, "actuated joints")?;
-        self.passive.check("q_p guess", q_p_guess, "passive joints")?;
+        self.passive
+            .check("q_p guess", q_p_guess, "passive joints")?;
         let mut d = ClosedData::new(self);
         let sol = self.closure.solve_from_guess(&mut d.lw, q_a, q_p_guess)?;
         d.qa.copy_from_slice(q_a);
@@ -514,11 +525,10 @@ impl ClosedChain {
                 d.pred[r] = x;
             }
             let outcome = self.correct(d).and_then(|()| {
-                let jump = d
-                    .qp
-                    .iter()
-                    .zip(&d.pred)
-                    .fold(0.0_f64, |m, (x, y)| m.max((x - y).abs()));
+                let jump =
+                    d.qp.iter()
+                        .zip(&d.pred)
+                        .fold(0.0_f64, |m, (x, y)| m.max((x - y).abs()));
                 if d.lu.det_sign() != b.sign {
                     return Err(StepFailure::SignChange);
                 }
@@ -608,12 +618,7 @@ impl ClosedChain {
 
     /// Check the inputs, move the tracker to q_a and fill the consistent tree state for
     /// (qd_a, qdd_a) into d.q_tr, d.qd_tr, d.qdd_tr (10.29, 10.42).
-    fn state_into(
-        &self,
-        d: &mut ClosedData,
-        b: &mut Branch,
-        x: [(&str, &[f64]); 3],
-    ) -> Result<()> {
+    fn state_into(&self, d: &mut ClosedData, b: &mut Branch, x: [(&str, &[f64]); 3]) -> Result<()> {
         self.check_data(d, b)?;
         for (name, v) in x {
             self.coords.check(name, v, "actuated joints")?;
@@ -661,7 +666,8 @@ impl ClosedChain {
         qdd_a: &mut [f64],
     ) -> Result<Conditioning> {
         env.check(self.robot().nl())?;
-        self.coords.check_output("qdd_a", qdd_a, "actuated joints")?;
+        self.coords
+            .check_output("qdd_a", qdd_a, "actuated joints")?;
         self.coords.check("tau", x[2], "actuated joints")?;
         // the consistent state with qdd_a = 0: qdd_tr = [0; -Wp^-1 Ψ]
         let z = std::mem::take(&mut d.zeros_n);
@@ -673,7 +679,15 @@ impl ClosedChain {
         let mut a_tr = std::mem::replace(&mut d.tree.a, DMatrix::zeros(0, 0));
         composite_inertia_matrix(model, &mut d.tree, &d.q_tr, &mut a_tr);
         let z = std::mem::take(&mut d.tree.zeros);
-        rnea_with_environment(model, &mut d.tree, env, &d.q_tr, &d.qd_tr, &z, &mut d.tau_tr);
+        rnea_with_environment(
+            model,
+            &mut d.tree,
+            env,
+            &d.q_tr,
+            &d.qd_tr,
+            &z,
+            &mut d.tau_tr,
+        );
         d.tree.zeros = z;
         if let Some(v) = coulomb_smoothing.filter(|v| *v > 0.0) {
             for &j in self.robot().coordinates().frames() {
@@ -854,9 +868,7 @@ pub fn loop_closure_into(
 ) -> Result<Conditioning> {
     chain.check_data(data, branch)?;
     chain.coords.check("q_a", q_a, "actuated joints")?;
-    chain
-        .passive
-        .check_output("q_p", q_p, "passive joints")?;
+    chain.passive.check_output("q_p", q_p, "passive joints")?;
     chain.track(data, branch, q_a)?;
     q_p.copy_from_slice(&branch.q_p);
     Ok(chain.conditioning(branch, None))
@@ -896,7 +908,11 @@ pub fn closed_state(
     qdd_a: &[f64],
 ) -> Result<ClosedState> {
     let mut d = ClosedData::new(chain);
-    chain.state_into(&mut d, branch, [("q_a", q_a), ("qd_a", qd_a), ("qdd_a", qdd_a)])?;
+    chain.state_into(
+        &mut d,
+        branch,
+        [("q_a", q_a), ("qd_a", qd_a), ("qdd_a", qdd_a)],
+    )?;
     let cond = chain.conditioning(branch, None);
     Ok(chain.state_result(&d, branch, cond))
 }
@@ -916,8 +932,14 @@ pub fn closed_inverse_dynamics_into(
     tau_a: &mut [f64],
 ) -> Result<Conditioning> {
     env.check(chain.robot().nl())?;
-    chain.coords.check_output("tau_a", tau_a, "actuated joints")?;
-    chain.state_into(data, branch, [("q_a", q_a), ("qd_a", qd_a), ("qdd_a", qdd_a)])?;
+    chain
+        .coords
+        .check_output("tau_a", tau_a, "actuated joints")?;
+    chain.state_into(
+        data,
+        branch,
+        [("q_a", q_a), ("qd_a", qd_a), ("qdd_a", qdd_a)],
+    )?;
     let d = data;
     rnea_with_environment(
         chain.robot().numeric(),
@@ -954,7 +976,11 @@ pub fn closed_inverse_dynamics(
         gamma_cl.as_mut_slice(),
     )?;
     let lc = &chain.closure;
-    let gp: Vec<f64> = lc.passive_joints().iter().map(|&j| d.tau_tr[j - 1]).collect();
+    let gp: Vec<f64> = lc
+        .passive_joints()
+        .iter()
+        .map(|&j| d.tau_tr[j - 1])
+        .collect();
     // (10.37): Wp^T λ = -Γ_p
     let mut lambda: Vec<f64> = gp.iter().map(|x| -x).collect();
     d.lu.solve_transpose(&mut lambda);
@@ -1060,15 +1086,32 @@ pub fn closed_regressor_into(
             "Phi",
             n * PARAMS_PER_LINK * nl,
             phi.len(),
-            format!("{n} x {} (actuated joints x 13 per link)", PARAMS_PER_LINK * nl),
+            format!(
+                "{n} x {} (actuated joints x 13 per link)",
+                PARAMS_PER_LINK * nl
+            ),
         ));
     }
-    chain.coords.check_output("tau_e", tau_e, "actuated joints")?;
-    chain.state_into(data, branch, [("q_a", x[0]), ("qd_a", x[1]), ("qdd_a", x[2])])?;
+    chain
+        .coords
+        .check_output("tau_e", tau_e, "actuated joints")?;
+    chain.state_into(
+        data,
+        branch,
+        [("q_a", x[0]), ("qd_a", x[1]), ("qdd_a", x[2])],
+    )?;
     let d = data;
     let model = chain.robot().numeric();
     let mut full = std::mem::replace(&mut d.phi, DMatrix::zeros(0, 0));
-    tree_regressor(model, &mut d.tree, env, &d.q_tr, &d.qd_tr, &d.qdd_tr, &mut full);
+    tree_regressor(
+        model,
+        &mut d.tree,
+        env,
+        &d.q_tr,
+        &d.qd_tr,
+        &d.qdd_tr,
+        &mut full,
+    );
     tr_mul_into(&d.g, &full, phi);
     d.phi = full;
     tree_wrench_torques(model, &mut d.tree, env, &d.q_tr, &mut d.tau_tr);

@@ -318,9 +318,8 @@ pub fn ddm_aba(
                     ));
                 }
                 let kk = b.art_inertia[k] - u * u.transpose() / d;
-                let alpha = kk * b.gamma[k]
-                    + b.art_bias[k]
-                    + u * ((b.art_tau[k] - b.art_bias[k][ax]) / d);
+                let alpha =
+                    kk * b.gamma[k] + b.art_bias[k] + u * ((b.art_tau[k] - b.art_bias[k][ax]) / d);
                 b.art_u[k] = u;
                 b.art_d[k] = d;
                 (kk, alpha)

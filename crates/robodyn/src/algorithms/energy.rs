@@ -193,7 +193,11 @@ fn convert_environment<T: DynScalar>(e: &Environment) -> Environment<T> {
 }
 
 /// Check joint vectors over the movable joints and scatter them into tree arrays (NL entries).
-fn tree_arrays<const K: usize>(robot: &Robot, names: [&str; K], x: [&[f64]; K]) -> Result<[Vec<f64>; K]> {
+fn tree_arrays<const K: usize>(
+    robot: &Robot,
+    names: [&str; K],
+    x: [&[f64]; K],
+) -> Result<[Vec<f64>; K]> {
     let c = robot.coordinates();
     let mut out: [Vec<f64>; K] = std::array::from_fn(|_| vec![0.0; robot.nl()]);
     for k in 0..K {
@@ -218,7 +222,10 @@ pub fn kinetic_energy(robot: &Robot, q: &[f64], qd: &[f64]) -> Result<f64> {
     let [q, qd] = tree_arrays(robot, ["q", "qd"], [q, qd])?;
     let m = robot.numeric();
     let b = &m.env.base;
-    finite(energies(m, &q, &qd, &b.w0, &b.v0).kinetic, "the kinetic energy")
+    finite(
+        energies(m, &q, &qd, &b.w0, &b.v0).kinetic,
+        "the kinetic energy",
+    )
 }
 
 /// Potential energy in the gravity field (J, [9.25]), zero at 0P = 0. `q` over the movable
@@ -336,5 +343,8 @@ pub fn lagrangian_torques(
         )));
     }
     let c = robot.coordinates();
-    Ok(DVector::from_iterator(c.len(), c.frames().iter().map(|&j| tau[j - 1])))
+    Ok(DVector::from_iterator(
+        c.len(),
+        c.frames().iter().map(|&j| tau[j - 1]),
+    ))
 }

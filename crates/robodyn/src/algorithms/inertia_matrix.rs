@@ -192,6 +192,13 @@ pub fn h_vector_into(
 pub fn h_vector(robot: &Robot, q: &[f64], qd: &[f64]) -> Result<DVector<f64>> {
     let mut data = Data::new(robot);
     let mut h = DVector::zeros(robot.dof());
-    h_vector_into(robot, &mut data, robot.environment(), q, qd, h.as_mut_slice())?;
+    h_vector_into(
+        robot,
+        &mut data,
+        robot.environment(),
+        q,
+        qd,
+        h.as_mut_slice(),
+    )?;
     Ok(h)
 }

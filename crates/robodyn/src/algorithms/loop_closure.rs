@@ -515,7 +515,12 @@ impl LoopClosure {
             n,
             &format!("actuated joints {:?}", self.actuated),
         )?;
-        self.check_len("guess", guess, p, &format!("passive joints {:?}", self.passive))?;
+        self.check_len(
+            "guess",
+            guess,
+            p,
+            &format!("passive joints {:?}", self.passive),
+        )?;
         let mut qp: Vec<f64> = guess.to_vec();
         let initial = qp.clone();
         let nl = self.robot.nl();

@@ -16,7 +16,9 @@
 
 use crate::data::Data;
 use crate::error::{Error, Result};
-use crate::model::{DynModel, Environment, JointType, Robot, RobotDescription, STANDARD_PARAMETERS};
+use crate::model::{
+    DynModel, Environment, JointType, Robot, RobotDescription, STANDARD_PARAMETERS,
+};
 use nalgebra::{DMatrix, Matrix3, SMatrix, Vector3};
 
 use super::inverse_dynamics::{check_state, forward_pass, on_tree_arrays};

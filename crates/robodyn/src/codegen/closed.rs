@@ -193,7 +193,8 @@ impl ClosureReference {
         })?;
         let qa = branch.q_a().to_vec();
         let zeros = vec![0.0; qa.len()];
-        let s = crate::algorithms::closed_chain::closed_state(&cc, &mut branch, &qa, &zeros, &zeros)?;
+        let s =
+            crate::algorithms::closed_chain::closed_state(&cc, &mut branch, &qa, &zeros, &zeros)?;
         Ok(ClosureReference {
             lc: cc.closure().clone(),
             wp: s.wp,

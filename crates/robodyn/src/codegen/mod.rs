@@ -22,10 +22,10 @@ use crate::algorithms::inertia_matrix::composite_inertia_matrix;
 use crate::algorithms::inverse_dynamics::{
     backward_recursion_sharing, forward_recursion_sharing, rnea, SharedOrientation,
 };
+use crate::data::Data;
 use crate::error::{Error, Item, Result};
 use crate::model::{DynModel, RobotDescription, STANDARD_PARAMETERS};
 use crate::scalar::DynScalar as _;
-use crate::data::Data;
 use nalgebra::DMatrix;
 use robodyn_symbolic::program::{name_value, record};
 use robodyn_symbolic::{cmp_expr, Assignment, Expr, InputGroup, Program};

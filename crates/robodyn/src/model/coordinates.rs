@@ -87,7 +87,12 @@ impl Coordinates {
     /// Check the length of an output vector.
     pub(crate) fn check_output(&self, what: &str, v: &[f64], kind: &str) -> Result<()> {
         if v.len() != self.len() {
-            return Err(crate::Error::dimension(what, self.len(), v.len(), self.describe(kind)));
+            return Err(crate::Error::dimension(
+                what,
+                self.len(),
+                v.len(),
+                self.describe(kind),
+            ));
         }
         Ok(())
     }

@@ -156,7 +156,11 @@ impl Environment<f64> {
             check_vector(what, v.as_slice(), 3, String::new)?;
         }
         for (k, w) in self.wrenches.iter().enumerate() {
-            if w.force.iter().chain(w.moment.iter()).any(|x| !x.is_finite()) {
+            if w.force
+                .iter()
+                .chain(w.moment.iter())
+                .any(|x| !x.is_finite())
+            {
                 return Err(Error::Input(format!(
                     "the external wrench of link {} is not finite",
                     k + 1

@@ -10,11 +10,11 @@ mod structure;
 
 pub use constants::{DynModel, FrameConstants, LinkConstants};
 pub use coordinates::Coordinates;
-pub use environment::{BaseMotion, Environment, Wrench};
 pub use description::{
     param, FrameDesc, JointType, LinkDesc, RobotDescription, GEOMETRIC_PARAMETERS,
     STANDARD_PARAMETERS, WRENCH_COMPONENTS,
 };
+pub use environment::{BaseMotion, Environment, Wrench};
 pub use structure::{path_from_base, ClosedLoop, Structure, StructureType};
 
 use crate::error::{Error, Item, Result};
@@ -213,7 +213,10 @@ impl Robot {
         let value = |e: &Expr| e.eval(&env).expect("checked above");
         let numeric = DynModel::build(&desc, value, |_, _, e| value(e));
         let movable = desc.movable_joints();
-        let names = movable.iter().map(|&j| desc.frame(j).name.clone()).collect();
+        let names = movable
+            .iter()
+            .map(|&j| desc.frame(j).name.clone())
+            .collect();
         let coords = Coordinates::new(movable, names, desc.nl);
         Ok(Robot {
             desc,

@@ -139,7 +139,12 @@ impl Dynamics for TreeDynamics<'_> {
     }
     fn energy(&mut self, q: &[f64], qd: &[f64]) -> Result<f64> {
         self.scatter(q, qd);
-        Ok(mechanical_energy(self.robot, &mut self.ws, &self.q, &self.qd))
+        Ok(mechanical_energy(
+            self.robot,
+            &mut self.ws,
+            &self.q,
+            &self.qd,
+        ))
     }
 }
 

@@ -24,7 +24,8 @@ pub struct CsvSink<W: Write> {
 impl CsvSink<std::io::BufWriter<std::fs::File>> {
     /// Create (truncate) a CSV file.
     pub fn create(path: &Path) -> Result<Self> {
-        let f = std::fs::File::create(path).map_err(|e| Error::io(path.display().to_string(), e))?;
+        let f =
+            std::fs::File::create(path).map_err(|e| Error::io(path.display().to_string(), e))?;
         Ok(CsvSink::new(
             std::io::BufWriter::new(f),
             path.display().to_string(),

@@ -23,9 +23,9 @@
 use super::super::regressor::{
     closed_chain_regressor, parameter_name, tree_regressor, ParameterSelection, PARAMS_PER_LINK,
 };
+use crate::data::Data;
 use crate::error::{Error, Result};
 use crate::model::Robot;
-use crate::data::Data;
 use nalgebra::DMatrix;
 use rand::{Rng, RngCore};
 
