@@ -37,11 +37,18 @@ use nalgebra::{DMatrix, DVector};
 
 /// Conditioning limits of a closed chain: reciprocal 1-norm condition numbers
 /// 1 / (||M||_1 ||M^-1||_1) below which a result is flagged (`soft`) or refused (`hard`).
+///
+/// The default hard limit of Wp, 1e-5, comes from the closure tolerance (1e-12): at a fold of the
+/// closure manifold (a parallel singularity, e.g. the five-bar's distal links aligned) q_p is
+/// determined only to its square root, ~1e-6 rad or m, and the reciprocal condition number
+/// reached there is ~1e-6: anything below 1e-5 is indistinguishable from exactly singular, and
+/// W ~ 1/rcond is then meaningless. Below the soft limit 1e-3, W and the closed-chain torques
+/// are amplified more than a thousand times: correct, but sensitive to every input.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ConditioningLimits {
-    /// Wp below this: warning (default 1e-4).
+    /// Wp below this: warning (default 1e-3).
     pub wp_soft: f64,
-    /// Wp below this: [`Error::Singular`] (default 1e-9).
+    /// Wp below this: [`Error::Singular`] (default 1e-5).
     pub wp_hard: f64,
     /// A_cl below this: warning (default 1e-8).
     pub a_cl_soft: f64,
@@ -52,8 +59,8 @@ pub struct ConditioningLimits {
 impl Default for ConditioningLimits {
     fn default() -> Self {
         ConditioningLimits {
-            wp_soft: 1e-4,
-            wp_hard: 1e-9,
+            wp_soft: 1e-3,
+            wp_hard: 1e-5,
             a_cl_soft: 1e-8,
             a_cl_hard: 1e-13,
         }
@@ -511,8 +518,12 @@ impl ClosedChain {
         let mut failure: StepFailure;
         loop {
             let t = if s + h >= 1.0 - 1e-12 { 1.0 } else { s + h };
-            for k in 0..d.n {
-                d.qa[k] = d.start_qa[k] + t * (q_a[k] - d.start_qa[k]);
+            if t == 1.0 {
+                d.qa.copy_from_slice(q_a);
+            } else {
+                for k in 0..d.n {
+                    d.qa[k] = d.start_qa[k] + t * (q_a[k] - d.start_qa[k]);
+                }
             }
             // predictor (10.29): q_p + W (q_a - q_a_branch)
             let mut pred_step: f64 = 0.0;
