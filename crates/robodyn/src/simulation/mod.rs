@@ -153,6 +153,7 @@ impl Dynamics for TreeDynamics<'_> {
 pub struct SimOptions {
     /// Simulated time span [0, duration].
     pub duration: f64,
+    /// The integration scheme.
     pub integrator: Integrator,
     /// Time between output rows (the integrators land exactly on these times).
     pub output_dt: f64,
@@ -163,8 +164,11 @@ pub struct SimOptions {
 /// What happened.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct SimSummary {
+    /// Time reached (s).
     pub t_end: f64,
+    /// Rows written.
     pub rows: usize,
+    /// Integrator counters.
     pub stats: Stats,
 }
 

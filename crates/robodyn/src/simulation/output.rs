@@ -7,7 +7,9 @@ use std::path::Path;
 
 /// Receives the trajectory: the column names once, then one row per output time.
 pub trait TrajectorySink {
+    /// Receive the column names.
     fn begin(&mut self, headers: &[String]) -> Result<()>;
+    /// Receive one row.
     fn row(&mut self, values: &[f64]) -> Result<()>;
     /// Flush; called at the end and when the simulation stops on an error.
     fn finish(&mut self) -> Result<()> {
@@ -42,6 +44,7 @@ impl<W: Write> CsvSink<W> {
         }
     }
 
+    /// The writer.
     pub fn into_inner(self) -> W {
         self.out
     }
@@ -78,7 +81,9 @@ impl<W: Write> TrajectorySink for CsvSink<W> {
 /// Keeps the trajectory in memory.
 #[derive(Clone, Debug, Default)]
 pub struct Recorder {
+    /// Column names.
     pub headers: Vec<String>,
+    /// Rows.
     pub rows: Vec<Vec<f64>>,
 }
 
