@@ -14,18 +14,25 @@
 #![warn(missing_docs)]
 
 pub mod algorithms;
+#[cfg(feature = "codegen")]
 #[allow(missing_docs)] // documented by the code-generation work (issue 14.8)
 pub mod codegen;
 pub mod data;
 pub mod error;
 pub mod geometry;
+#[cfg(feature = "io")]
 #[allow(missing_docs)] // documented by the readers' rewrite (issue 14.8)
 pub mod io;
 pub(crate) mod linalg;
 pub mod model;
 pub mod scalar;
 pub mod simulation;
+#[cfg(feature = "testing")]
 pub mod testing;
+// The library's own samplers use the seeded generator without exposing the test helpers.
+#[cfg(not(feature = "testing"))]
+#[allow(dead_code)]
+pub(crate) mod testing;
 
 pub use algorithms::closed_chain::{
     closed_direct_dynamics, closed_direct_dynamics_into, closed_inverse_dynamics,

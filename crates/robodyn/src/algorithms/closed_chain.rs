@@ -319,6 +319,7 @@ impl ClosedChain {
         self
     }
 
+    #[cfg_attr(not(feature = "codegen"), allow(dead_code))]
     pub(crate) fn closure(&self) -> &LoopClosure {
         &self.closure
     }

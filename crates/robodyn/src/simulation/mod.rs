@@ -14,7 +14,9 @@ pub mod output;
 pub use closed::ClosedChainDynamics;
 pub use input::{TimeSeries, TorqueInput};
 pub use integrators::{Integrator, Ode, Stats, Stepper};
-pub use output::{plot_svg, CsvSink, Recorder, Tee, TrajectorySink};
+#[cfg(feature = "plot")]
+pub use output::plot_svg;
+pub use output::{CsvSink, Recorder, Tee, TrajectorySink};
 
 use crate::algorithms::direct_dynamics::{ddm, Method};
 use crate::data::Data;

@@ -133,6 +133,7 @@ impl TrajectorySink for Tee<'_> {
     }
 }
 
+#[cfg(feature = "plot")]
 /// SVG plot of a recorded trajectory: the joint positions `q<j>` (top) and the total energy
 /// (bottom) against time.
 pub fn plot_svg(path: &Path, rec: &Recorder) -> Result<()> {
