@@ -79,7 +79,7 @@ fn sr400(c: &mut Criterion) {
     c.bench_function("sr400 loop closure, tracker moved 0.2 rad", |b| {
         b.iter(|| {
             k += 1;
-            let target = if k % 2 == 0 { &qa } else { &far };
+            let target = if k.is_multiple_of(2) { &qa } else { &far };
             loop_closure_into(&cc, &mut data, &mut branch, black_box(target), &mut qp)
                 .expect("closes");
             qp[0]

@@ -24,7 +24,8 @@ fn main() -> robodyn::Result<()> {
         .chain(["rcond_wp".to_string()])
         .collect();
     println!("{}", header.join(","));
-    let (mut q, mut qd, mut qdd, mut tau) = (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+    let (mut q, mut qd, mut qdd, mut tau) =
+        (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
     for row in 0..=20 {
         let t = row as f64 * 0.1;
         for k in 0..n {

@@ -14,7 +14,8 @@ fn main() -> robodyn::Result<()> {
     let mut data = Data::new(&robot); // one per thread
     let mut env = robot.environment().clone(); // gravity, base motion, wrenches of the file
     let last = robot.nl(); // the link the contact force acts on
-    let (mut q, mut qd, mut qdd, mut tau) = (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+    let (mut q, mut qd, mut qdd, mut tau) =
+        (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
     let mut peak = vec![0.0f64; n];
     for tick in 0..2000 {
         let t = tick as f64 * 1e-3;

@@ -32,9 +32,18 @@ fn main() -> robodyn::Result<()> {
     let phi = regressor(&robot, &q, &qd, &qdd)?;
     let gamma_b = DVector::from_iterator(
         n,
-        (0..n).map(|r| base.base.iter().zip(&values).map(|(&c, v)| phi[(r, c)] * v).sum::<f64>()),
+        (0..n).map(|r| {
+            base.base
+                .iter()
+                .zip(&values)
+                .map(|(&c, v)| phi[(r, c)] * v)
+                .sum::<f64>()
+        }),
     );
     let gamma = inverse_dynamics(&robot, &q, &qd, &qdd)?;
-    println!("max |Phi_b K_b - Gamma| = {:.1e} N m", (gamma_b - gamma).amax());
+    println!(
+        "max |Phi_b K_b - Gamma| = {:.1e} N m",
+        (gamma_b - gamma).amax()
+    );
     Ok(())
 }

@@ -88,7 +88,7 @@ pub enum Error {
     #[error("{}{item}: {reason}", fmt_loc(.location))]
     Physical {
         /// Where in the source file, when known.
-        location: Location,
+        location: Box<Location>,
         /// The link parameter concerned.
         item: Item,
         /// Why.
@@ -227,10 +227,12 @@ impl Error {
 
     /// Attach a file name (and a line, if the error has none yet).
     pub fn at(mut self, file: Option<&str>, line: Option<usize>) -> Error {
-        if let Error::Invalid { location, .. }
-        | Error::Parse { location, .. }
-        | Error::Physical { location, .. } = &mut self
-        {
+        let location = match &mut self {
+            Error::Invalid { location, .. } | Error::Parse { location, .. } => Some(location),
+            Error::Physical { location, .. } => Some(&mut **location),
+            _ => None,
+        };
+        if let Some(location) = location {
             if location.file.is_none() {
                 location.file = file.map(str::to_string);
             }
@@ -252,7 +254,7 @@ impl Error {
     /// A physically inconsistent parameter.
     pub fn physical(item: Item, reason: impl Into<String>) -> Error {
         Error::Physical {
-            location: Location::default(),
+            location: Box::default(),
             item,
             reason: reason.into(),
         }

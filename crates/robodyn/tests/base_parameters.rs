@@ -117,7 +117,7 @@ fn check_reproduces(robot: &Robot, nb: &NumericBase, sampler: &mut dyn Sampler, 
     let kb = nb.base_values(&k);
     let mut r = rng(seed);
     let nl = robot.nl();
-    let mut ws = Data::new(&robot);
+    let mut ws = Data::new(robot);
     let mut phi = DMatrix::zeros(nl, PARAMS_PER_LINK * nl);
     let mut worst: f64 = 0.0;
     for _ in 0..10 {
@@ -244,7 +244,7 @@ fn check_symbolic_reproduces(
         .collect();
     let mut r = rng(seed);
     let nl = robot.nl();
-    let mut ws = Data::new(&robot);
+    let mut ws = Data::new(robot);
     let mut phi = DMatrix::zeros(nl, PARAMS_PER_LINK * nl);
     let mut worst: f64 = 0.0;
     for _ in 0..10 {

@@ -78,7 +78,7 @@ fn parameter_values(prog: &Program, env: &dyn Fn(&str) -> Option<f64>) -> Vec<f6
 }
 
 fn numeric_rnea(robot: &Robot, q: &[f64], qd: &[f64], qdd: &[f64]) -> Vec<f64> {
-    let mut ws = Data::new(&robot);
+    let mut ws = Data::new(robot);
     let mut tau = vec![0.0; robot.nl()];
     rnea(robot.numeric(), &mut ws, q, qd, qdd, &mut tau);
     tau
