@@ -14,7 +14,7 @@
 //! [`Error::Singular`] naming the joint, never a NaN.
 
 use crate::algorithms::inertia_matrix::composite_inertia_matrix;
-use crate::algorithms::inverse_dynamics::{check_state, on_tree_arrays, rnea_with_environment};
+use crate::algorithms::inverse_dynamics::{rnea_with_environment, tree_vector_map};
 use crate::data::Data;
 use crate::error::{Error, Result};
 use crate::model::{DynModel, Environment, JointType, Robot};
@@ -390,18 +390,17 @@ pub fn direct_dynamics_into(
     method: Method,
     qdd: &mut [f64],
 ) -> Result<()> {
-    check_state(robot, data, ["q", "qd", "tau"], [q, qd, tau])?;
-    env.check(robot.nl())?;
-    let c = robot.coordinates();
-    c.check_output("qdd", qdd, "movable joints")?;
-    let model = robot.numeric();
-    on_tree_arrays(robot, data, [q, qd, tau], |data, q, qd, tau| {
-        let mut out = std::mem::take(&mut data.tau);
-        let r = ddm(model, data, env, method, q, qd, tau, &mut out);
-        c.gather(&out, qdd);
-        data.tau = out;
-        r
-    })
+    let names = ["q", "qd", "tau"];
+    tree_vector_map(
+        robot,
+        data,
+        env,
+        names,
+        [q, qd, tau],
+        "qdd",
+        qdd,
+        |m, d, q, qd, tau, a| ddm(m, d, env, method, q, qd, tau, a),
+    )?
 }
 
 /// Direct dynamic model with the robot's environment: qdd over the movable joints. Allocates;

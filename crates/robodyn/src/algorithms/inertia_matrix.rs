@@ -9,7 +9,9 @@
 //! Ia_j is on the diagonal. Written once over [`DynScalar`]: the symbolic generator runs it on
 //! expressions.
 
-use crate::algorithms::inverse_dynamics::{check_state, on_tree_arrays, rnea_with_environment};
+use crate::algorithms::inverse_dynamics::{
+    check_state, on_tree_arrays, rnea_with_environment, tree_vector_map,
+};
 use crate::data::Data;
 use crate::error::Result;
 use crate::model::{DynModel, Environment, JointType, Robot};
@@ -172,20 +174,21 @@ pub fn h_vector_into(
     qd: &[f64],
     h: &mut [f64],
 ) -> Result<()> {
-    check_state(robot, data, ["q", "qd", "qd"], [q, qd, qd])?;
-    env.check(robot.nl())?;
-    let c = robot.coordinates();
-    c.check_output("H", h, "movable joints")?;
-    let model = robot.numeric();
-    on_tree_arrays(robot, data, [q, qd, qd], |data, q, qd, _| {
-        let mut t = std::mem::take(&mut data.tau);
-        let z = std::mem::take(&mut data.zeros);
-        rnea_with_environment(model, data, env, q, qd, &z, &mut t);
-        c.gather(&t, h);
-        data.tau = t;
-        data.zeros = z;
-    });
-    Ok(())
+    let names = ["q", "qd", "qd"];
+    tree_vector_map(
+        robot,
+        data,
+        env,
+        names,
+        [q, qd, qd],
+        "H",
+        h,
+        |m, d, q, qd, _, t| {
+            let z = std::mem::take(&mut d.zeros);
+            rnea_with_environment(m, d, env, q, qd, &z, t);
+            d.zeros = z;
+        },
+    )
 }
 
 /// H(q, qd) over the movable joints with the robot's environment; allocates.

@@ -413,6 +413,35 @@ pub(crate) fn on_tree_arrays<R>(
     r
 }
 
+/// The frame of the checked tree functions that map joint vectors to a joint vector: check the
+/// inputs `x` (named `names`), the data, the environment and the output's length; run `kernel`
+/// on tree arrays (scattered from the movable joints when some frames are fixed) writing a tree
+/// array; gather it into `out`. Allocation-free.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn tree_vector_map<R>(
+    robot: &Robot,
+    data: &mut Data,
+    env: &Environment,
+    names: [&str; 3],
+    x: [&[f64]; 3],
+    out_name: &str,
+    out: &mut [f64],
+    kernel: impl FnOnce(&DynModel<f64>, &mut Data, &[f64], &[f64], &[f64], &mut [f64]) -> R,
+) -> Result<R> {
+    check_state(robot, data, names, x)?;
+    env.check(robot.nl())?;
+    let c = robot.coordinates();
+    c.check_output(out_name, out, "movable joints")?;
+    let model = robot.numeric();
+    Ok(on_tree_arrays(robot, data, x, |data, a, b, d| {
+        let mut t = std::mem::take(&mut data.tau);
+        let r = kernel(model, data, a, b, d, &mut t);
+        c.gather(&t, out);
+        data.tau = t;
+        r
+    }))
+}
+
 /// Inverse dynamic model (eqs 10.3–10.12) into `tau`: the joint torques (N m) / forces (N) of the
 /// movable joints for positions `q` (rad, m), velocities `qd` and accelerations `qdd`, all with
 /// `robot.coordinates().len()` entries in frame order, under the per-call inputs `env`
@@ -430,18 +459,17 @@ pub fn inverse_dynamics_into(
     qdd: &[f64],
     tau: &mut [f64],
 ) -> Result<()> {
-    check_state(robot, data, ["q", "qd", "qdd"], [q, qd, qdd])?;
-    env.check(robot.nl())?;
-    let c = robot.coordinates();
-    c.check_output("tau", tau, "movable joints")?;
-    let model = robot.numeric();
-    on_tree_arrays(robot, data, [q, qd, qdd], |data, q, qd, qdd| {
-        let mut t = std::mem::take(&mut data.tau);
-        rnea_with_environment(model, data, env, q, qd, qdd, &mut t);
-        c.gather(&t, tau);
-        data.tau = t;
-    });
-    Ok(())
+    let names = ["q", "qd", "qdd"];
+    tree_vector_map(
+        robot,
+        data,
+        env,
+        names,
+        [q, qd, qdd],
+        "tau",
+        tau,
+        |m, d, q, qd, qdd, t| rnea_with_environment(m, d, env, q, qd, qdd, t),
+    )
 }
 
 /// Inverse dynamic model with the robot's own environment: Gamma (N m, N) of the movable joints

@@ -21,7 +21,7 @@ use crate::model::{
 };
 use nalgebra::{DMatrix, Matrix3, SMatrix, Vector3};
 
-use super::inverse_dynamics::{check_state, forward_pass, on_tree_arrays};
+use super::inverse_dynamics::{check_state, forward_pass, on_tree_arrays, tree_vector_map};
 
 /// Number of standard parameters per link.
 pub const PARAMS_PER_LINK: usize = 13;
@@ -302,18 +302,17 @@ pub fn wrench_torques_into(
     q: &[f64],
     tau_e: &mut [f64],
 ) -> Result<()> {
-    check_state(robot, data, ["q", "q", "q"], [q, q, q])?;
-    env.check(robot.nl())?;
-    let c = robot.coordinates();
-    c.check_output("tau_e", tau_e, "movable joints")?;
-    let model = robot.numeric();
-    on_tree_arrays(robot, data, [q, q, q], |data, q, _, _| {
-        let mut t = std::mem::take(&mut data.tau);
-        tree_wrench_torques(model, data, env, q, &mut t);
-        c.gather(&t, tau_e);
-        data.tau = t;
-    });
-    Ok(())
+    let names = ["q", "q", "q"];
+    tree_vector_map(
+        robot,
+        data,
+        env,
+        names,
+        [q, q, q],
+        "tau_e",
+        tau_e,
+        |m, d, q, _, _, t| tree_wrench_torques(m, d, env, q, t),
+    )
 }
 
 /// The regressor (N x 13 NL) at one state with the robot's environment; allocates.
