@@ -46,7 +46,7 @@ pub struct Data<T: DynScalar = f64> {
     pub(crate) art_d: Vec<T>,
     pub(crate) art_tau: Vec<T>,
     pub(crate) acc: Vec<Vector6<T>>,
-    /// The regressor of the tree (NL x 13 NL).
+    /// The regressor of the tree (NL x 13 NL), sized at the first regressor call.
     pub(crate) phi: DMatrix<T>,
     /// Tree arrays (NL entries, joint j at j-1) the public joint vectors scatter into.
     pub(crate) q: Vec<T>,
@@ -113,7 +113,7 @@ impl<T: DynScalar> Data<T> {
             art_d: vec![T::zero(); nl + 1],
             art_tau: vec![T::zero(); nl + 1],
             acc: v6(),
-            phi: DMatrix::from_element(nl, 13 * nl, T::zero()),
+            phi: DMatrix::from_element(0, 0, T::zero()),
             q: z(),
             qd: z(),
             qdd: z(),

@@ -219,7 +219,7 @@ impl ClosedData {
             v_nl: DVector::zeros(nl),
             col_n: DVector::zeros(n),
             zeros_n: vec![0.0; n],
-            phi: DMatrix::zeros(nl, PARAMS_PER_LINK * nl),
+            phi: DMatrix::zeros(0, 0),
         }
     }
 }
@@ -1115,6 +1115,9 @@ pub fn closed_regressor_into(
     let d = data;
     let model = chain.robot().numeric();
     let mut full = std::mem::replace(&mut d.phi, DMatrix::zeros(0, 0));
+    if full.shape() != (nl, PARAMS_PER_LINK * nl) {
+        full = DMatrix::zeros(nl, PARAMS_PER_LINK * nl); // first call only
+    }
     tree_regressor(
         model,
         &mut d.tree,

@@ -284,6 +284,9 @@ pub fn regressor_into(
     let model = robot.numeric();
     on_tree_arrays(robot, data, [q, qd, qdd], |data, q, qd, qdd| {
         let mut full = std::mem::replace(&mut data.phi, DMatrix::zeros(0, 0));
+        if full.shape() != (nl, PARAMS_PER_LINK * nl) {
+            full = DMatrix::zeros(nl, PARAMS_PER_LINK * nl); // first call only
+        }
         tree_regressor(model, data, env, q, qd, qdd, &mut full);
         for (r, &j) in c.frames().iter().enumerate() {
             phi.row_mut(r).copy_from(&full.row(j - 1));
