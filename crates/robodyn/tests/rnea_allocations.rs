@@ -114,6 +114,9 @@ fn checked_tree_functions_allocate_nothing() {
         let (mut tau, mut qdd, mut h) = (vec![0.0; m], vec![0.0; m], vec![0.0; m]);
         let mut a = DMatrix::zeros(m, m);
         let mut phi = DMatrix::zeros(m, 13 * nl);
+        // the regressor's tree buffer is sized at its first call
+        let s0 = &states[0];
+        regressor_into(robot, &mut data, &env, &s0[0], &s0[1], &s0[2], &mut phi).unwrap();
         counter_counts();
         let before = allocations();
         let mut checksum = 0.0;
