@@ -145,6 +145,22 @@ impl TableOutput {
     pub fn write(&self, headers: &[String], rows: &[Vec<f64>]) -> CliResult {
         write_table(self.output.as_deref(), self.format, headers, rows)
     }
+
+    /// Write rows with extra JSON fields per row.
+    pub fn write_with(
+        &self,
+        headers: &[String],
+        rows: &[Vec<f64>],
+        json_extra: &[serde_json::Map<String, serde_json::Value>],
+    ) -> CliResult {
+        write_table_with(
+            self.output.as_deref(),
+            self.format,
+            headers,
+            rows,
+            json_extra,
+        )
+    }
 }
 
 /// Write rows of named columns as CSV or JSON (a list of objects) to a file or stdout.
@@ -153,6 +169,18 @@ pub fn write_table(
     format: TableFormat,
     headers: &[String],
     rows: &[Vec<f64>],
+) -> CliResult {
+    write_table_with(path, format, headers, rows, &[])
+}
+
+/// [`write_table`] with extra fields per row in JSON output (e.g. a closed chain's
+/// conditioning); CSV output leaves them out.
+pub fn write_table_with(
+    path: Option<&Path>,
+    format: TableFormat,
+    headers: &[String],
+    rows: &[Vec<f64>],
+    json_extra: &[serde_json::Map<String, serde_json::Value>],
 ) -> CliResult {
     let mut out: Box<dyn Write> = match path {
         Some(p) => Box::new(std::io::BufWriter::new(
@@ -171,12 +199,17 @@ pub fn write_table(
         TableFormat::Json => {
             let v: Vec<serde_json::Map<String, serde_json::Value>> = rows
                 .iter()
-                .map(|r| {
-                    headers
+                .enumerate()
+                .map(|(k, r)| {
+                    let mut o: serde_json::Map<String, serde_json::Value> = headers
                         .iter()
                         .zip(r)
                         .map(|(h, x)| (h.clone(), serde_json::json!(x)))
-                        .collect()
+                        .collect();
+                    if let Some(e) = json_extra.get(k) {
+                        o.extend(e.clone());
+                    }
+                    o
                 })
                 .collect();
             serde_json::to_writer_pretty(&mut out, &v)?;
@@ -186,112 +219,141 @@ pub fn write_table(
     Ok(())
 }
 
-/// One state per row: three per-joint columns (e.g. `q qd qdd` or `q qd tau`), for `joints` in
-/// that order, with a label naming its origin for error messages.
-pub type LabelledStates = Vec<(String, [Vec<f64>; 3])>;
+/// How joint columns are named.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Names {
+    /// By frame number: `q3`, `tau3` (the default for .toml and .par robots).
+    #[default]
+    Frame,
+    /// By joint name: `q_shoulder_pan_joint` (URDF joint names; `j<frame>` when the file
+    /// gives none).
+    Joint,
+}
 
-/// Read states of `joints` from a CSV file (`input`, columns `<name><j>`) or from the comma lists
-/// of the command line (`lists`, the first one required, the others default to zeros). `what`
-/// names the joints in messages ("movable tree joints", "actuated joints (closed chain)").
+/// Column naming option shared by the commands that read or write joint columns.
+#[derive(Args, Debug, Clone, Copy)]
+pub struct NamesArg {
+    /// Name joint columns by frame number (`q3`) or by joint name (`q_shoulder_pan_joint`).
+    #[arg(long, value_enum, default_value = "frame")]
+    pub names: Names,
+}
+
+impl NamesArg {
+    /// Column name of entry k of a joint vector: `<prefix><frame>` or `<prefix>_<name>`.
+    pub fn column(&self, prefix: &str, coords: &robodyn::Coordinates, k: usize) -> String {
+        match self.names {
+            Names::Frame => format!("{prefix}{}", coords.frame(k)),
+            Names::Joint => format!("{prefix}_{}", coords.name(k)),
+        }
+    }
+
+    /// Column names of a joint vector.
+    pub fn columns(&self, prefix: &str, coords: &robodyn::Coordinates) -> Vec<String> {
+        (0..coords.len())
+            .map(|k| self.column(prefix, coords, k))
+            .collect()
+    }
+}
+
+/// One state per row: three per-joint columns (e.g. `q qd qdd` or `q qd tau`) over `coords`.
+pub type States = Vec<[Vec<f64>; 3]>;
+
+/// Read states over `coords` from a CSV file (`input`, columns named by `names`) or from the
+/// comma lists of the command line (`lists`, the first one required, the others default to
+/// zeros). `what` names the joints in messages ("movable joints", "actuated joints").
 pub fn read_joint_states(
     input: Option<&Path>,
-    names: [&str; 3],
+    prefixes: [&str; 3],
     lists: [Option<&str>; 3],
-    joints: &[usize],
+    coords: &robodyn::Coordinates,
+    names: NamesArg,
     what: &str,
-) -> CliResult<LabelledStates> {
-    let n = joints.len();
+) -> CliResult<States> {
+    let n = coords.len();
     if let Some(path) = input {
         let t = Table::read(path)?;
-        let cols: Vec<[usize; 3]> = joints
-            .iter()
-            .map(|j| {
+        let cols: Vec<[usize; 3]> = (0..n)
+            .map(|k| {
                 Ok([
-                    t.column(&format!("{}{j}", names[0]))?,
-                    t.column(&format!("{}{j}", names[1]))?,
-                    t.column(&format!("{}{j}", names[2]))?,
+                    t.column(&names.column(prefixes[0], coords, k))?,
+                    t.column(&names.column(prefixes[1], coords, k))?,
+                    t.column(&names.column(prefixes[2], coords, k))?,
                 ])
             })
             .collect::<CliResult<_>>()?;
         return Ok(t
             .rows
             .iter()
-            .enumerate()
-            .map(|(k, r)| {
-                let s = std::array::from_fn(|i| cols.iter().map(|c| r[c[i]]).collect());
-                (format!("{}: data row {}", t.file, k + 1), s)
-            })
+            .map(|r| std::array::from_fn(|i| cols.iter().map(|c| r[c[i]]).collect()))
             .collect());
     }
     if lists[0].is_none() {
         return Err(format!(
             "give --input states.csv or --{} (with --{}, --{})",
-            names[0], names[1], names[2]
+            prefixes[0], prefixes[1], prefixes[2]
         )
         .into());
     }
     let mut s = [vec![0.0; n], vec![0.0; n], vec![0.0; n]];
     for k in 0..3 {
         if let Some(v) = lists[k] {
-            let vals = parse_list(names[k], v)?;
+            let vals = parse_list(prefixes[k], v)?;
             if vals.len() != n {
                 return Err(format!(
-                    "--{} has {} values, the robot has {n} {what} ({joints:?})",
-                    names[k],
-                    vals.len()
+                    "--{} has {} values, the robot has {n} {what} ({:?})",
+                    prefixes[k],
+                    vals.len(),
+                    coords.frames()
                 )
                 .into());
             }
             s[k] = vals;
         }
     }
-    Ok(vec![("the given state".to_string(), s)])
+    Ok(vec![s])
 }
 
-/// Spread values of `joints` into a vector of NL entries (index j-1), zeros elsewhere.
-pub fn scatter(joints: &[usize], nl: usize, values: &[f64]) -> Vec<f64> {
-    let mut v = vec![0.0; nl];
-    for (j, x) in joints.iter().zip(values) {
-        v[j - 1] = *x;
-    }
-    v
-}
-
-/// Continuation steps between consecutive rows of a closed-chain table.
-const CONTINUATION_STEPS: usize = 8;
-
-/// Closed chains: evaluate a model row after row, each row's loop closure continued from the
-/// previous row's solution (the first from `guess`, else from the robot's assembly configuration).
-/// `eval(ws, q_a, x, y, q_p)` gets the row's three columns and the solved q_p.
-pub fn closed_chain_rows(
-    cc: &robodyn::algorithms::closed_chain::ClosedChain,
-    states: &LabelledStates,
+/// The branch tracker of a closed chain: from `--guess` (q_p at the first q_a) when given, else
+/// the robot's assembly.
+pub fn start_branch(
+    chain: &robodyn::ClosedChain,
+    first_qa: &[f64],
     guess: Option<&str>,
-    mut eval: impl FnMut(
-        &mut robodyn::algorithms::closed_chain::ClosedChainWorkspace,
-        &[f64],
-        &[f64],
-        &[f64],
-        &[f64],
-    ) -> robodyn::Result<Vec<f64>>,
-) -> CliResult<Vec<Vec<f64>>> {
-    let guess = guess.map(|g| parse_list("guess", g)).transpose()?;
-    let mut ws = cc.workspace();
-    let mut rows = Vec::with_capacity(states.len());
-    let mut previous: Option<(Vec<f64>, Vec<f64>)> = None;
-    for (what, [q, x, y]) in states {
-        // continuation from the previous row keeps the assembly branch even when consecutive
-        // rows are far apart (a plain Newton solve from the previous q_p may jump branches)
-        let s = match &previous {
-            None => cc.solve_from_reference(&mut ws, q, guess.as_deref()),
-            Some((qa0, qp0)) => {
-                cc.closure()
-                    .solve_continuation(&mut ws.closure, q, qa0, qp0, CONTINUATION_STEPS)
-            }
-        }
-        .map_err(|e| format!("{what}: {e}"))?;
-        rows.push(eval(&mut ws, q, x, y, &s.q_p).map_err(|e| format!("{what}: {e}"))?);
-        previous = Some((q.clone(), s.q_p));
+) -> CliResult<robodyn::Branch> {
+    Ok(match guess {
+        Some(g) => chain.branch_from(first_qa, &parse_list("guess", g)?)?,
+        None => chain.assembly_branch()?,
+    })
+}
+
+/// Say on stderr that a closed-chain row is near a singularity.
+pub fn warn_conditioning(
+    chain: &robodyn::ClosedChain,
+    row: usize,
+    rows: usize,
+    c: &robodyn::Conditioning,
+) {
+    if c.warning {
+        let which = if rows > 1 {
+            format!("row {row}: ")
+        } else {
+            String::new()
+        };
+        eprintln!(
+            "robodyn: warning: {which}near a singular configuration: {}; the result is \
+             sensitive to its inputs",
+            c.describe(chain.limits())
+        );
     }
-    Ok(rows)
+}
+
+/// JSON fields of a closed chain's conditioning: `rcond_wp`, `rcond_a_cl`, `singularity_warning`.
+pub fn conditioning_json(c: &robodyn::Conditioning) -> serde_json::Map<String, serde_json::Value> {
+    let mut o = serde_json::Map::new();
+    o.insert("rcond_wp".into(), serde_json::json!(c.wp));
+    if let Some(a) = c.a_cl {
+        o.insert("rcond_a_cl".into(), serde_json::json!(a));
+    }
+    o.insert("singularity_warning".into(), serde_json::json!(c.warning));
+    o
 }

@@ -6,9 +6,11 @@ use robodyn::algorithms::base_parameters::{
     numeric_base_parameters, symbolic_base_parameters, ClosedChainSampler, NumericOptions,
     TreeSampler,
 };
-use robodyn::algorithms::regressor::{regressor, ParameterSelection, RotorMode, PARAMS_PER_LINK};
+use robodyn::algorithms::regressor::{
+    tree_regressor, ParameterSelection, RotorMode, PARAMS_PER_LINK,
+};
 use robodyn::testing::{random_state, random_tree, rng, TreeOptions};
-use robodyn::Workspace;
+use robodyn::Data;
 
 fn bench(c: &mut Criterion) {
     let mut r = rng(30);
@@ -57,10 +59,20 @@ fn bench(c: &mut Criterion) {
     });
     g.finish();
     let [q, qd, qdd] = random_state(&mut r, 30);
-    let mut ws = Workspace::new(robot.numeric());
+    let mut ws = Data::new(&robot);
     let mut phi = nalgebra::DMatrix::zeros(30, PARAMS_PER_LINK * 30);
     c.bench_function("regressor_30_joint_tree", |b| {
-        b.iter(|| regressor(robot.numeric(), &mut ws, &q, &qd, &qdd, &mut phi))
+        b.iter(|| {
+            tree_regressor(
+                robot.numeric(),
+                &mut ws,
+                &robot.numeric().env,
+                &q,
+                &qd,
+                &qdd,
+                &mut phi,
+            )
+        })
     });
 }
 

@@ -1,11 +1,15 @@
 //! Closed-chain inverse and direct dynamic models of the Acma SR400 (10.40, 10.46–10.48),
-//! including the loop closure (warm start from the previous solution, as in a trajectory), and
-//! the closed-chain direct model as the simulator evaluates it (`ClosedChainDynamics`).
+//! including the loop closure on the branch tracker (at the tracker's point: "warm"), the
+//! allocation-free `_into` forms, and the closed-chain direct model as the simulator evaluates
+//! it (`ClosedChainDynamics`).
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use robodyn::algorithms::closed_chain::ClosedChain;
 use robodyn::simulation::{
     simulate, ClosedChainDynamics, Dynamics, Integrator, Recorder, SimOptions, TorqueInput,
+};
+use robodyn::{
+    closed_direct_dynamics, closed_direct_dynamics_into, closed_inverse_dynamics,
+    closed_inverse_dynamics_into, loop_closure_into, ClosedChain, ClosedData,
 };
 use std::hint::black_box;
 use std::path::PathBuf;
@@ -14,37 +18,71 @@ fn sr400(c: &mut Criterion) {
     let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../robots/sr400.toml");
     let robot = robodyn::io::load(&p).expect("bundled SR400");
     let cc = ClosedChain::new(&robot).expect("closed chain");
-    let mut ws = cc.workspace();
     let qa = [0.1, 0.3, 0.2, -0.4, 0.5, 1.2];
     let qd = [0.3, -0.2, 0.5, 0.1, -0.6, 0.4];
     let qdd = [1.0, -0.5, 0.7, 2.0, -1.0, 0.3];
     let tau = [5.0, -100.0, 2.0, 1.0, 0.5, 30.0];
-    let guess = cc
-        .solve_positions(&mut ws, &qa, Some(&[2.4, -0.9]))
-        .expect("closes")
-        .q_p;
+    let mut branch = cc.branch_from(&qa, &[2.4, -0.9]).expect("closes");
     c.bench_function("sr400 closed-chain idm (warm closure)", |b| {
         b.iter(|| {
-            cc.inverse_dynamics(&mut ws, black_box(&qa), &qd, &qdd, Some(&guess))
+            closed_inverse_dynamics(&cc, &mut branch, black_box(&qa), &qd, &qdd)
                 .expect("idm")
                 .gamma_cl
         })
     });
     c.bench_function("sr400 closed-chain ddm (warm closure)", |b| {
         b.iter(|| {
-            cc.direct_dynamics(&mut ws, black_box(&qa), &qd, &tau, Some(&guess))
+            closed_direct_dynamics(&cc, &mut branch, black_box(&qa), &qd, &tau)
                 .expect("ddm")
                 .qdd_a
         })
     });
-    let lc = cc.closure();
-    let mut lws = lc.workspace();
-    let far = [2.4 + 0.2, -0.9 - 0.2];
-    c.bench_function("sr400 loop closure (guess 0.2 rad off)", |b| {
+    let mut data = ClosedData::new(&cc);
+    let env = robot.environment();
+    let mut out = [0.0; 6];
+    c.bench_function("sr400 closed-chain idm_into (warm closure)", |b| {
         b.iter(|| {
-            lc.solve(&mut lws, black_box(&qa), Some(&far))
-                .expect("closes")
-                .q_p
+            closed_inverse_dynamics_into(
+                &cc,
+                &mut data,
+                &mut branch,
+                env,
+                black_box(&qa),
+                &qd,
+                &qdd,
+                &mut out,
+            )
+            .expect("idm");
+            out[0]
+        })
+    });
+    c.bench_function("sr400 closed-chain ddm_into (warm closure)", |b| {
+        b.iter(|| {
+            closed_direct_dynamics_into(
+                &cc,
+                &mut data,
+                &mut branch,
+                env,
+                black_box(&qa),
+                &qd,
+                &tau,
+                &mut out,
+            )
+            .expect("ddm");
+            out[0]
+        })
+    });
+    // the tracker moving back and forth by 0.2 rad on every actuated joint: continuation
+    let far = qa.map(|x| x + 0.2);
+    let mut qp = [0.0; 2];
+    let mut k = 0usize;
+    c.bench_function("sr400 loop closure, tracker moved 0.2 rad", |b| {
+        b.iter(|| {
+            k += 1;
+            let target = if k.is_multiple_of(2) { &qa } else { &far };
+            loop_closure_into(&cc, &mut data, &mut branch, black_box(target), &mut qp)
+                .expect("closes");
+            qp[0]
         })
     });
 }
@@ -56,8 +94,10 @@ fn sr400(c: &mut Criterion) {
 fn sr400_simulation(c: &mut Criterion) {
     let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../robots/sr400.toml");
     let robot = robodyn::io::load(&p).expect("bundled SR400");
-    let mut sys = ClosedChainDynamics::new(&robot).expect("closed chain");
+    let cc = ClosedChain::new(&robot).expect("closed chain");
     let q0 = [0.1, 0.3, 0.2, -0.4, 0.5, 1.2];
+    let start = cc.branch_from(&q0, &[2.4, -0.9]).expect("closes");
+    let mut sys = ClosedChainDynamics::new(cc.clone(), start.clone());
     let qd = [0.3, -0.2, 0.5, 0.1, -0.6, 0.4];
     let tau = [5.0, -100.0, 2.0, 1.0, 0.5, 30.0];
     let mut qdd = [0.0; 6];
@@ -95,7 +135,7 @@ fn sr400_simulation(c: &mut Criterion) {
         "sr400 closed-chain simulation, 100 RK4 steps of 1 ms",
         |b| {
             b.iter(|| {
-                let mut sys = ClosedChainDynamics::new(&robot).expect("closed chain");
+                let mut sys = ClosedChainDynamics::new(cc.clone(), start.clone());
                 let mut rec = Recorder::default();
                 simulate(&mut sys, &input, &q0, &qd, &opts, &mut rec, &mut |_| {}).expect("runs");
                 rec.rows.len()

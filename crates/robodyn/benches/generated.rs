@@ -1,13 +1,15 @@
 //! Generated customized inverse dynamic model (Rust, numeric values substituted) against the
 //! numeric Newton–Euler `rnea` on the SR400 (equivalent tree) and the RX-90; and the generated
 //! closed-chain model of the five-bar (G depending on q) against the numeric route on the same
-//! closed state: `rnea`, constraint Jacobian and W (`ClosedChain::constraints`), G^T Gamma_tr.
+//! closed state: `closed_inverse_dynamics_into` on the branch tracker (closure at the tracker's
+//! point, W, G, Psi, `rnea`, G^T Gamma_tr).
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use robodyn::algorithms::closed_chain::ClosedChain;
 use robodyn::algorithms::inverse_dynamics::rnea;
 use robodyn::testing::{random_state, rng};
-use robodyn::{Robot, Workspace};
+use robodyn::{
+    closed_inverse_dynamics, closed_inverse_dynamics_into, ClosedChain, ClosedData, Data, Robot,
+};
 use std::hint::black_box;
 
 mod robots {
@@ -29,7 +31,7 @@ fn bench_robot(c: &mut Criterion, label: &str, robot: Robot, f: GenFn) {
     let n = robot.nl();
     let [q, qd, qdd] = random_state(&mut rng(1), n);
     let model = robot.numeric();
-    let mut ws = Workspace::new(model);
+    let mut ws = Data::from_model(model);
     let mut tau = vec![0.0; n];
     let mut out = vec![0.0; n];
     // same numbers (movable joints only in `out`; both robots have no fixed tree frame)
@@ -99,37 +101,37 @@ fn benches(c: &mut Criterion) {
 fn bench_closed(c: &mut Criterion) {
     let robot = Robot::new(robots::fivebar_description()).unwrap();
     let cc = ClosedChain::new(&robot).unwrap();
-    let mut ws = cc.workspace();
-    let qa = cc.reference_actuated();
-    let qa: Vec<f64> = qa.iter().map(|x| x + 0.1).collect();
-    let sol = cc.solve_from_reference(&mut ws, &qa, None).unwrap();
-    let idm = cc
-        .inverse_dynamics(&mut ws, &qa, &[0.7, -0.4], &[1.5, 2.0], Some(&sol.q_p))
-        .unwrap();
+    let mut branch = cc.assembly_branch().unwrap();
+    let qa: Vec<f64> = branch.q_a().iter().map(|x| x + 0.1).collect();
+    let (qda, qdda) = ([0.7, -0.4], [1.5, 2.0]);
+    let idm = closed_inverse_dynamics(&cc, &mut branch, &qa, &qda, &qdda).unwrap();
     let st = &idm.state;
-    let (q, qd, qdd) = (st.q.clone(), st.qd.clone(), st.qdd.clone());
+    let v = |x: &nalgebra::DVector<f64>| -> Vec<f64> { x.iter().copied().collect() };
+    let (q, qd, qdd) = (v(&st.q), v(&st.qd), v(&st.qdd));
     let mut out = vec![0.0; cc.dof()];
     gen_fivebar::fivebar_closed(&q, &qd, &qdd, &[], &mut out);
     for (a, b) in idm.gamma_cl.iter().zip(&out) {
         assert!((a - b).abs() <= 1e-9 * (1.0 + a.abs()), "{a} vs {b}");
     }
-    let model = robot.numeric();
-    let mut tws = Workspace::new(model);
-    let mut tau = vec![0.0; robot.nl()];
+    let mut data = ClosedData::new(&cc);
+    let env = robot.environment();
+    let mut tau = vec![0.0; cc.dof()];
     let mut g = c.benchmark_group("closed_fivebar");
+    // the numeric route on the branch (closure at the tracker's point, W, G, Psi, rnea, G^T)
     g.bench_function("numeric", |b| {
         b.iter(|| {
-            rnea(
-                model,
-                &mut tws,
-                black_box(&q),
-                black_box(&qd),
-                black_box(&qdd),
+            closed_inverse_dynamics_into(
+                &cc,
+                &mut data,
+                &mut branch,
+                env,
+                black_box(&qa),
+                &qda,
+                &qdda,
                 &mut tau,
-            );
-            let cons = cc.constraints(&mut ws, black_box(&q)).unwrap();
-            let gamma = cons.g.tr_mul(&nalgebra::DVector::from_column_slice(&tau));
-            black_box(gamma);
+            )
+            .unwrap();
+            black_box(&tau);
         })
     });
     bench_generated(

@@ -1,14 +1,15 @@
-//! Inverse dynamic model benchmarks: `rnea` with a reused workspace (the hot path), the
-//! allocating `inverse_dynamics` wrapper, and the Lagrangian route (hyper-dual AD, O(n^2)) as
+//! Inverse dynamic model benchmarks: `rnea` with a reused `Data` (the kernel), the checked
+//! `inverse_dynamics_into`, the allocating `inverse_dynamics`, and the Lagrangian route (hyper-dual AD, O(n^2)) as
 //! baselines, on the SR400's equivalent tree (8 links) and a random 30-joint tree.
 //!
 //! Short run: `cargo bench -p robodyn --bench inverse_dynamics -- --warm-up-time 1 --measurement-time 3`
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use robodyn::algorithms::energy::lagrangian_torques;
-use robodyn::algorithms::inverse_dynamics::{inverse_dynamics, rnea};
+use robodyn::algorithms::inverse_dynamics::rnea;
 use robodyn::testing::{self, random_state, random_tree, TreeOptions};
-use robodyn::{Robot, Workspace};
+use robodyn::{inverse_dynamics, inverse_dynamics_into};
+use robodyn::{Data, Robot};
 use std::hint::black_box;
 use std::path::PathBuf;
 
@@ -32,7 +33,7 @@ fn bench(c: &mut Criterion) {
     for (name, robot) in robots() {
         let n = robot.nl();
         let [q, qd, qdd] = random_state(&mut testing::rng(1), n);
-        let mut ws = Workspace::new(robot.numeric());
+        let mut ws = Data::new(&robot);
         let mut tau = vec![0.0; n];
         group.bench_with_input(BenchmarkId::new("rnea", name), &robot, |b, r| {
             b.iter(|| {
@@ -47,6 +48,27 @@ fn bench(c: &mut Criterion) {
                 black_box(&tau);
             })
         });
+        // the checked in-place API over the movable joints (these robots have no fixed frame)
+        assert_eq!(robot.dof(), n);
+        group.bench_with_input(
+            BenchmarkId::new("inverse_dynamics_into", name),
+            &robot,
+            |b, r| {
+                b.iter(|| {
+                    inverse_dynamics_into(
+                        r,
+                        &mut ws,
+                        r.environment(),
+                        black_box(&q),
+                        black_box(&qd),
+                        black_box(&qdd),
+                        &mut tau,
+                    )
+                    .unwrap();
+                    black_box(&tau);
+                })
+            },
+        );
         group.bench_with_input(
             BenchmarkId::new("inverse_dynamics", name),
             &robot,

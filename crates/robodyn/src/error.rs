@@ -1,6 +1,7 @@
 //! Errors are values: every error says where (file, line, frame, link, loop) and why.
 
 use std::fmt;
+use std::sync::Arc;
 
 /// What part of a robot description an error refers to.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -37,8 +38,11 @@ impl fmt::Display for Item {
 /// Position in a source file.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct Location {
+    /// File name.
     pub file: Option<String>,
+    /// 1-based line.
     pub line: Option<usize>,
+    /// 1-based column.
     pub column: Option<usize>,
 }
 
@@ -57,28 +61,137 @@ impl fmt::Display for Location {
     }
 }
 
-/// The error type of the library.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+/// The error type of the library. Callers match on the variant; the message says where and why
+/// in words (no library message names a command-line flag).
+#[derive(Debug, Clone, thiserror::Error)]
+#[non_exhaustive]
 pub enum Error {
-    /// A robot description is invalid (bad structure, unknown symbol, NaN, negative mass...).
+    /// A robot description is invalid (bad structure, unknown symbol, NaN...).
     #[error("{}{item}: {reason}", fmt_loc(.location))]
     Invalid {
+        /// Where in the source file, when known.
         location: Location,
+        /// The frame, link, symbol... concerned.
         item: Item,
+        /// Why.
         reason: String,
     },
     /// A file could not be parsed.
     #[error("{}{reason}", fmt_loc(.location))]
-    Parse { location: Location, reason: String },
-    /// Input data (states, sizes) do not fit the robot.
+    Parse {
+        /// File, line and column.
+        location: Location,
+        /// Why.
+        reason: String,
+    },
+    /// A physically inconsistent parameter (negative mass, rotor inertia or friction).
+    #[error("{}{item}: {reason}", fmt_loc(.location))]
+    Physical {
+        /// Where in the source file, when known.
+        location: Box<Location>,
+        /// The link parameter concerned.
+        item: Item,
+        /// Why.
+        reason: String,
+    },
+    /// A vector or matrix has the wrong size for the model (or a `Data` was made for another
+    /// model).
+    #[error("{what} has {got} entries, {expected} expected ({context})")]
+    Dimension {
+        /// The argument (`q`, `qd`, `tau`, `A`, `data`...).
+        what: String,
+        /// The size the model needs.
+        expected: usize,
+        /// The size given.
+        got: usize,
+        /// What the entries are (e.g. "movable joints [1, 2, 4]").
+        context: String,
+    },
+    /// An input is NaN or infinite.
+    #[error("{what}[{index}] = {value} is not a finite number")]
+    NotFinite {
+        /// The argument.
+        what: String,
+        /// 0-based index of the first non-finite entry.
+        index: usize,
+        /// Its value.
+        value: f64,
+    },
+    /// A matrix is singular (or so ill-conditioned that a solve is meaningless): its reciprocal
+    /// condition number `rcond` is below `limit`.
+    #[error("{what} is singular at {at}: reciprocal condition number {rcond:.3e} (limit {limit:.1e}){}", fmt_hint(.hint))]
+    Singular {
+        /// Which matrix (`Wp`, `A_cl`, `A`), with what it is the derivative of.
+        what: String,
+        /// 1 / (||M||_1 ||M^-1||_1) (0 when the factorization broke down).
+        rcond: f64,
+        /// The hard limit it fell below.
+        limit: f64,
+        /// The configuration (joint values).
+        at: String,
+        /// What it means for the mechanism.
+        hint: String,
+    },
+    /// The loop-closure equations have no solution near the guess.
+    #[error("{loop_label} does not close at {at}: closure residual {residual:.3e} (tolerance {tolerance:.1e}); {hint}")]
+    LoopNotClosed {
+        /// "loop 1 (cut joint 5 between links 2 and 4)".
+        loop_label: String,
+        /// Largest closure residual reached (m or rad).
+        residual: f64,
+        /// The tolerance it had to meet.
+        tolerance: f64,
+        /// The actuated values (and the guess).
+        at: String,
+        /// What to do.
+        hint: String,
+    },
+    /// A configuration cannot be reached on the branch tracker's assembly branch.
+    #[error("q_a = {at} cannot be reached on the assembly branch: {reason}")]
+    BranchLost {
+        /// The target actuated values.
+        at: String,
+        /// Why (a singularity or fold on the path, no convergence).
+        reason: String,
+    },
+    /// A closed robot without an assembly whose default start (q = 0) is singular.
+    #[error("{robot}: the loops close at q = 0 but Wp is singular there (reciprocal condition number {rcond:.1e}): the start of loop closure does not define an assembly branch; give the joint values of an assembled, regular configuration (the robot's `assembly`, or an explicit start q_a, q_p)")]
+    SingularStart {
+        /// Robot name.
+        robot: String,
+        /// Reciprocal condition number of Wp at q = 0.
+        rcond: f64,
+    },
+    /// An error in row `row` (1-based) of a table of states.
+    #[error("row {row}: {source}")]
+    Row {
+        /// 1-based row number.
+        row: usize,
+        /// The error of that row.
+        source: Box<Error>,
+    },
+    /// Input/output error on a file.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: String,
+        /// The operating system's error.
+        source: Arc<std::io::Error>,
+    },
+    /// Other input data that do not fit the robot (message only).
     #[error("{0}")]
     Input(String),
-    /// A numerical failure (singular matrix, no convergence), with what was involved.
+    /// Other numerical failures (no convergence...), with what was involved (message only).
     #[error("{0}")]
     Numerical(String),
-    /// I/O.
-    #[error("{path}: {reason}")]
-    Io { path: String, reason: String },
+}
+
+fn fmt_hint(h: &str) -> String {
+    if h.is_empty() {
+        String::new()
+    } else {
+        format!("; {h}")
+    }
 }
 
 fn fmt_loc(l: &Location) -> String {
@@ -91,6 +204,7 @@ fn fmt_loc(l: &Location) -> String {
 }
 
 impl Error {
+    /// An invalid description item.
     pub fn invalid(item: Item, reason: impl Into<String>) -> Error {
         Error::Invalid {
             location: Location::default(),
@@ -99,6 +213,7 @@ impl Error {
         }
     }
 
+    /// A parse error at a line of a file.
     pub fn parse(file: Option<&str>, line: usize, reason: impl Into<String>) -> Error {
         Error::Parse {
             location: Location {
@@ -112,7 +227,12 @@ impl Error {
 
     /// Attach a file name (and a line, if the error has none yet).
     pub fn at(mut self, file: Option<&str>, line: Option<usize>) -> Error {
-        if let Error::Invalid { location, .. } | Error::Parse { location, .. } = &mut self {
+        let location = match &mut self {
+            Error::Invalid { location, .. } | Error::Parse { location, .. } => Some(location),
+            Error::Physical { location, .. } => Some(&mut **location),
+            _ => None,
+        };
+        if let Some(location) = location {
             if location.file.is_none() {
                 location.file = file.map(str::to_string);
             }
@@ -123,13 +243,82 @@ impl Error {
         self
     }
 
-    /// The description item an `Invalid` error refers to.
+    /// The description item an `Invalid` or `Physical` error refers to.
     pub fn item(&self) -> Option<&Item> {
         match self {
-            Error::Invalid { item, .. } => Some(item),
+            Error::Invalid { item, .. } | Error::Physical { item, .. } => Some(item),
             _ => None,
+        }
+    }
+
+    /// A physically inconsistent parameter.
+    pub fn physical(item: Item, reason: impl Into<String>) -> Error {
+        Error::Physical {
+            location: Box::default(),
+            item,
+            reason: reason.into(),
+        }
+    }
+
+    /// An I/O error on `path`, keeping the operating system's error as the source.
+    pub fn io(path: impl Into<String>, source: std::io::Error) -> Error {
+        Error::Io {
+            path: path.into(),
+            source: Arc::new(source),
+        }
+    }
+
+    /// A vector of the wrong size.
+    pub fn dimension(
+        what: impl Into<String>,
+        expected: usize,
+        got: usize,
+        context: impl Into<String>,
+    ) -> Error {
+        Error::Dimension {
+            what: what.into(),
+            expected,
+            got,
+            context: context.into(),
+        }
+    }
+
+    /// This error as the error of row `row` (1-based) of a table.
+    pub fn in_row(self, row: usize) -> Error {
+        Error::Row {
+            row,
+            source: Box::new(self),
+        }
+    }
+
+    /// The error itself, or the error of its row for [`Error::Row`].
+    pub fn innermost(&self) -> &Error {
+        match self {
+            Error::Row { source, .. } => source.innermost(),
+            e => e,
         }
     }
 }
 
+/// Check that `v` has `n` entries, all finite: the entry check of every checked function.
+pub(crate) fn check_vector(
+    what: &str,
+    v: &[f64],
+    n: usize,
+    context: impl FnOnce() -> String,
+) -> Result<()> {
+    if v.len() != n {
+        return Err(Error::dimension(what, n, v.len(), context()));
+    }
+    if let Some(index) = v.iter().position(|x| !x.is_finite()) {
+        return Err(Error::NotFinite {
+            what: what.into(),
+            index,
+            value: v[index],
+        });
+    }
+    Ok(())
+}
+
+/// The result type of the library.
 pub type Result<T, E = Error> = std::result::Result<T, E>;

@@ -6,11 +6,14 @@ use nalgebra::{Matrix3, Matrix4, Vector3};
 /// A rigid transformation: orientation matrix and origin position.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Transform {
+    /// Orientation (rotation matrix) of the frame.
     pub rot: Matrix3<f64>,
+    /// Origin of the frame (m).
     pub pos: Vector3<f64>,
 }
 
 impl Transform {
+    /// The identity transformation.
     pub fn identity() -> Self {
         Transform {
             rot: Matrix3::identity(),
@@ -26,6 +29,7 @@ impl Transform {
         }
     }
 
+    /// The inverse transformation.
     pub fn inverse(&self) -> Transform {
         let rt = self.rot.transpose();
         Transform {

@@ -16,8 +16,11 @@ pub trait DynScalar:
     + num_traits::Zero
     + num_traits::One
 {
+    /// The constant x.
     fn from_f64(x: f64) -> Self;
+    /// sin(x).
     fn sin(&self) -> Self;
+    /// cos(x).
     fn cos(&self) -> Self;
     /// sign(x) in {-1, 0, 1} (Coulomb friction).
     fn sign(&self) -> Self;

@@ -8,10 +8,10 @@ use robodyn::algorithms::base_parameters::{
     numeric_base_parameters, ConsistentSample, NumericBase, NumericOptions, Sampler, TreeSampler,
 };
 use robodyn::algorithms::regressor::{
-    parameter_name, regressor, ParameterSelection, RotorMode, PARAMS_PER_LINK,
+    parameter_name, tree_regressor, ParameterSelection, RotorMode, PARAMS_PER_LINK,
 };
 use robodyn::testing::{random_inertial, random_tree, rng, TreeOptions};
-use robodyn::{Expr, Robot, RobotDescription, Workspace};
+use robodyn::{Data, Expr, Robot, RobotDescription};
 use std::f64::consts::FRAC_PI_2;
 
 fn sr400() -> Robot {
@@ -117,12 +117,20 @@ fn check_reproduces(robot: &Robot, nb: &NumericBase, sampler: &mut dyn Sampler, 
     let kb = nb.base_values(&k);
     let mut r = rng(seed);
     let nl = robot.nl();
-    let mut ws = Workspace::new(robot.numeric());
+    let mut ws = Data::new(robot);
     let mut phi = DMatrix::zeros(nl, PARAMS_PER_LINK * nl);
     let mut worst: f64 = 0.0;
     for _ in 0..10 {
         let s = sampler.sample(robot, &mut r).unwrap();
-        regressor(robot.numeric(), &mut ws, &s.q, &s.qd, &s.qdd, &mut phi);
+        tree_regressor(
+            robot.numeric(),
+            &mut ws,
+            &robot.numeric().env,
+            &s.q,
+            &s.qd,
+            &s.qdd,
+            &mut phi,
+        );
         let gt = s.g.clone().unwrap_or_else(|| DMatrix::identity(nl, nl));
         let y = gt.transpose() * &phi;
         let full: Vec<f64> = (0..y.nrows())
@@ -236,12 +244,20 @@ fn check_symbolic_reproduces(
         .collect();
     let mut r = rng(seed);
     let nl = robot.nl();
-    let mut ws = Workspace::new(robot.numeric());
+    let mut ws = Data::new(robot);
     let mut phi = DMatrix::zeros(nl, PARAMS_PER_LINK * nl);
     let mut worst: f64 = 0.0;
     for _ in 0..10 {
         let s = sampler.sample(robot, &mut r).unwrap();
-        regressor(robot.numeric(), &mut ws, &s.q, &s.qd, &s.qdd, &mut phi);
+        tree_regressor(
+            robot.numeric(),
+            &mut ws,
+            &robot.numeric().env,
+            &s.q,
+            &s.qd,
+            &s.qdd,
+            &mut phi,
+        );
         let gt = s.g.clone().unwrap_or_else(|| DMatrix::identity(nl, nl));
         let y = gt.transpose() * &phi;
         for row in 0..y.nrows() {

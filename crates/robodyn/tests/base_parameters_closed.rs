@@ -11,13 +11,13 @@ use robodyn::algorithms::base_parameters::{
     compare_methods, numeric_base_parameters, symbolic_base_parameters, ClosedChainSampler,
     NumericBase, NumericOptions, ParameterNames, Sampler, Summary, SymbolicBase, TreeSampler,
 };
-use robodyn::algorithms::closed_chain::ClosedChain;
-use robodyn::algorithms::inverse_dynamics::inverse_dynamics;
 use robodyn::algorithms::regressor::{
-    parameter_name, regressor, wrench_torques, ParameterSelection, RotorMode, PARAMS_PER_LINK,
+    parameter_name, tree_regressor, tree_wrench_torques, ParameterSelection, RotorMode,
+    PARAMS_PER_LINK,
 };
 use robodyn::testing::{random_inertial, rng};
-use robodyn::{Robot, Workspace};
+use robodyn::{closed_inverse_dynamics, inverse_dynamics, ClosedChain};
+use robodyn::{Data, Robot};
 
 fn load(file: &str) -> Robot {
     let path = format!("{}/../../robots/{file}", env!("CARGO_MANIFEST_DIR"));
@@ -141,41 +141,53 @@ fn check_against_idm(
     let full = robot.with_standard_parameters(k).unwrap();
     let nl = robot.nl();
     let model = full.numeric();
-    let mut ws = Workspace::new(model);
+    let mut ws = Data::from_model(model);
     let mut phi = DMatrix::zeros(nl, PARAMS_PER_LINK * nl);
     let mut tau_e = vec![0.0; nl];
     let mut r = rng(seed);
     let mut worst: f64 = 0.0;
     let (mut closed, mut sampler) = (None, None);
     if !robot.is_tree() {
-        let cc = ClosedChain::new(&full).unwrap();
-        let cws = cc.workspace();
-        closed = Some((cc, cws));
+        closed = Some(ClosedChain::new(&full).unwrap());
         sampler = Some(ClosedChainSampler::new(&full).unwrap());
     }
     for _ in 0..10 {
         let (q, qd, qdd, g, gamma) = match (&mut closed, &mut sampler) {
-            (Some((cc, cws)), Some(sm)) => {
+            (Some(cc), Some(sm)) => {
                 let st = sm.next_state(&mut r).unwrap();
-                let pick = |v: &[f64]| -> Vec<f64> {
-                    cc.actuated_joints().iter().map(|&j| v[j - 1]).collect()
+                let pick = |v: &DVector<f64>| -> Vec<f64> {
+                    cc.coordinates()
+                        .frames()
+                        .iter()
+                        .map(|&j| v[j - 1])
+                        .collect()
                 };
-                let qp: Vec<f64> = cc.passive_joints().iter().map(|&j| st.q[j - 1]).collect();
-                let idm = cc
-                    .inverse_dynamics(cws, &pick(&st.q), &pick(&st.qd), &pick(&st.qdd), Some(&qp))
+                let mut b = cc
+                    .branch_from(st.q_a.as_slice(), st.q_p.as_slice())
                     .unwrap();
+                let idm = closed_inverse_dynamics(
+                    cc,
+                    &mut b,
+                    &pick(&st.q),
+                    &pick(&st.qd),
+                    &pick(&st.qdd),
+                )
+                .unwrap();
                 let s = idm.state;
-                (s.q, s.qd, s.qdd, s.constraints.g, idm.gamma_cl)
+                let v = |x: DVector<f64>| -> Vec<f64> { x.iter().copied().collect() };
+                (v(s.q), v(s.qd), v(s.qdd), s.g, idm.gamma_cl)
             }
             _ => {
                 let s = TreeSampler.sample(&full, &mut r).unwrap();
+                // the bundled trees have no fixed frame: tree arrays are the joint vectors
+                assert_eq!(full.dof(), nl);
                 let t = inverse_dynamics(&full, &s.q, &s.qd, &s.qdd).unwrap();
                 let g = DMatrix::identity(nl, nl);
                 (s.q, s.qd, s.qdd, g, t)
             }
         };
-        regressor(model, &mut ws, &q, &qd, &qdd, &mut phi);
-        wrench_torques(model, &mut ws, &q, &mut tau_e);
+        tree_regressor(model, &mut ws, &model.env, &q, &qd, &qdd, &mut phi);
+        tree_wrench_torques(model, &mut ws, &model.env, &q, &mut tau_e);
         let y = g.transpose() * &phi;
         let te = g.transpose() * DVector::from_column_slice(&tau_e);
         let scale = gamma.amax().max(1e-12);

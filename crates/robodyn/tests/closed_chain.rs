@@ -5,12 +5,15 @@
 mod common;
 
 use common::{cases, robot, ROBOTS};
-use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
+use nalgebra::{DMatrix, DVector};
 use rand::Rng;
-use robodyn::algorithms::closed_chain::{ClosedChain, ClosedDynamics, ClosedState};
+use robodyn::algorithms::closed_chain::ClosedState;
+use robodyn::algorithms::energy::{kinetic_energy, potential_energy};
 use robodyn::algorithms::inverse_dynamics::rnea;
-use robodyn::algorithms::loop_closure::LoopClosure;
-use robodyn::{Error, Robot};
+use robodyn::{
+    closed_direct_dynamics, closed_direct_dynamics_into, closed_inverse_dynamics, closed_state,
+    loop_closure, Branch, ClosedChain, ClosedData, Error, Robot,
+};
 use std::f64::consts::{FRAC_PI_2, PI};
 
 fn uniform(rng: &mut impl Rng, n: usize, s: f64) -> Vec<f64> {
@@ -31,13 +34,19 @@ fn random_state(
         .zip(uniform(rng, n, range))
         .map(|(a, b)| a + b)
         .collect();
-    let lc = cc.closure();
-    let mut ws = lc.workspace();
-    let qp = lc
-        .solve_continuation(&mut ws, &qa, qa0, qp0, 8)
-        .unwrap()
-        .q_p;
-    [qa, qp, uniform(rng, n, 1.5), uniform(rng, n, 3.0)]
+    let mut branch = cc.branch_from(qa0, qp0).unwrap();
+    let qp = loop_closure(cc, &mut branch, &qa).unwrap().q_p;
+    [
+        qa,
+        qp.iter().copied().collect(),
+        uniform(rng, n, 1.5),
+        uniform(rng, n, 3.0),
+    ]
+}
+
+/// A branch tracker at a closed configuration.
+fn at(cc: &ClosedChain, qa: &[f64], qp: &[f64]) -> Branch {
+    cc.branch_from(qa, qp).unwrap()
 }
 
 fn rel(a: f64, b: f64, scale: f64) -> f64 {
@@ -48,15 +57,12 @@ fn rel(a: f64, b: f64, scale: f64) -> f64 {
 fn sr400_example_10_1_torque_relations() {
     let r = robot("sr400.toml");
     let cc = ClosedChain::new(&r).unwrap();
-    let mut ws = cc.workspace();
     let mut rng = robodyn::testing::rng(10);
     let (qa0, qp0, range) = (ROBOTS[0].1, ROBOTS[0].2, ROBOTS[0].3);
     let mut worst: f64 = 0.0;
     for _ in 0..30 {
         let [qa, qp, qd, qdd] = random_state(&cc, &mut rng, qa0, qp0, range);
-        let idm = cc
-            .inverse_dynamics(&mut ws, &qa, &qd, &qdd, Some(&qp))
-            .unwrap();
+        let idm = closed_inverse_dynamics(&cc, &mut at(&cc, &qa, &qp), &qa, &qd, &qdd).unwrap();
         let t = |j: usize| idm.gamma_tr[j - 1];
         let scale = idm.gamma_tr.amax();
         // q_a = [θ1 θ2 θ4 θ5 θ6 θ7]
@@ -87,17 +93,14 @@ fn virtual_power_and_lagrange_form() {
     let mut rng = robodyn::testing::rng(11);
     for (name, r, qa0, qp0, range) in cases() {
         let cc = ClosedChain::new(&r).unwrap();
-        let mut ws = cc.workspace();
         let (mut w_vp, mut w_l): (f64, f64) = (0.0, 0.0);
         for _ in 0..20 {
             let [qa, qp, qd, qdd] = random_state(&cc, &mut rng, qa0, qp0, range);
-            let idm = cc
-                .inverse_dynamics(&mut ws, &qa, &qd, &qdd, Some(&qp))
-                .unwrap();
+            let idm = closed_inverse_dynamics(&cc, &mut at(&cc, &qa, &qp), &qa, &qd, &qdd).unwrap();
             // Γ_cl' qd_a = Γ_tr' qd_tr
             let p_cl = idm.gamma_cl.dot(&DVector::from_column_slice(&qd));
-            let p_tr = idm.gamma_tr.dot(&DVector::from_column_slice(&idm.state.qd));
-            let scale = idm.gamma_tr.amax() * DVector::from_column_slice(&idm.state.qd).amax();
+            let p_tr = idm.gamma_tr.dot(&idm.state.qd);
+            let scale = idm.gamma_tr.amax() * idm.state.qd.amax();
             let e = rel(p_cl, p_tr, scale);
             w_vp = w_vp.max(e);
             assert!(e < 1e-10, "{name}: power {p_cl} vs {p_tr}");
@@ -112,9 +115,8 @@ fn virtual_power_and_lagrange_form() {
                 assert!(e < 1e-10, "{name}");
             }
             // passive rows of (10.36): Γ_p + Wp^T λ = 0
-            let c = &idm.state.constraints;
-            let wl = c.wp.transpose() * &idm.lambda;
-            for (k, &j) in cc.passive_joints().iter().enumerate() {
+            let wl = idm.state.wp.transpose() * &idm.lambda;
+            for (k, &j) in cc.passive_coordinates().frames().iter().enumerate() {
                 assert!(rel(idm.gamma_tr[j - 1], -wl[k], idm.gamma_tr.amax()) < 1e-10);
             }
         }
@@ -122,24 +124,13 @@ fn virtual_power_and_lagrange_form() {
     }
 }
 
-/// Kinetic and potential energy of the tree at a consistent state, from the loop-closure
-/// kinematics (absolute velocities of the links), not from Newton–Euler.
-fn energy(r: &Robot, lc: &LoopClosure, s: &ClosedState) -> (f64, f64) {
-    let mut ws = lc.workspace();
-    lc.kinematics(&mut ws, &s.q, Some(&s.qd), None);
-    let m = r.numeric();
-    let (mut ke, mut pe) = (0.0, 0.0);
-    for j in 1..=r.nl() {
-        let l = m.link(j);
-        let rot: Matrix3<f64> = ws.rot[j];
-        let (w, v) = (ws.w[j], ws.v[j]);
-        let ms: Vector3<f64> = rot * l.ms;
-        let jo = rot * l.inertia * rot.transpose();
-        ke += 0.5 * l.mass * v.dot(&v) + v.dot(&w.cross(&ms)) + 0.5 * w.dot(&(jo * w));
-        ke += 0.5 * l.ia * s.qd[j - 1] * s.qd[j - 1];
-        pe -= m.gravity.dot(&(ws.pos[j] * l.mass + ms));
-    }
-    (ke, pe)
+/// Kinetic and potential energy of the tree at a consistent state, by the Lagrangian route's
+/// energies (link velocities 10.1–10.2), not from Newton–Euler.
+fn energy(r: &Robot, s: &ClosedState) -> (f64, f64) {
+    (
+        kinetic_energy(r, s.q.as_slice(), s.qd.as_slice()).unwrap(),
+        potential_energy(r, s.q.as_slice()).unwrap(),
+    )
 }
 
 #[test]
@@ -147,17 +138,14 @@ fn kinetic_energy_matches_a_cl() {
     let mut rng = robodyn::testing::rng(12);
     for (name, r, qa0, qp0, range) in cases() {
         let cc = ClosedChain::new(&r).unwrap();
-        let mut ws = cc.workspace();
         let mut worst: f64 = 0.0;
         for _ in 0..10 {
             let [qa, qp, qd, _] = random_state(&cc, &mut rng, qa0, qp0, range);
             let tau = vec![0.0; qa.len()];
-            let ddm = cc
-                .direct_dynamics(&mut ws, &qa, &qd, &tau, Some(&qp))
-                .unwrap();
+            let ddm = closed_direct_dynamics(&cc, &mut at(&cc, &qa, &qp), &qa, &qd, &tau).unwrap();
             let qdv = DVector::from_column_slice(&qd);
             let ke_a = 0.5 * qdv.dot(&(&ddm.a_cl * &qdv));
-            let (ke, _) = energy(&r, cc.closure(), &ddm.state);
+            let (ke, _) = energy(&r, &ddm.state);
             let e = (ke - ke_a).abs() / ke.abs().max(1e-3);
             worst = worst.max(e);
             assert!(
@@ -182,7 +170,6 @@ fn power_balance_matches_gamma_cl_along_smooth_paths() {
         }
         let r = Robot::new(d).unwrap();
         let cc = ClosedChain::new(&r).unwrap();
-        let mut ws = cc.workspace();
         let mut worst: f64 = 0.0;
         for _ in 0..4 {
             let [c0, qp, _, _] = random_state(&cc, &mut rng, qa0, qp0, range * 0.5);
@@ -204,16 +191,14 @@ fn power_balance_matches_gamma_cl_along_smooth_paths() {
             };
             let mut e_at = |t: f64| {
                 let [q, qd, qdd] = path(t);
-                let s = cc.state(&mut ws, &q, &qd, &qdd, Some(&qp)).unwrap();
-                let (ke, pe) = energy(&r, cc.closure(), &s);
+                let s = closed_state(&cc, &mut at(&cc, &q, &qp), &q, &qd, &qdd).unwrap();
+                let (ke, pe) = energy(&r, &s);
                 ke + pe
             };
             let d = |h: f64, e_at: &mut dyn FnMut(f64) -> f64| (e_at(h) - e_at(-h)) / (2.0 * h);
             let de = (4.0 * d(5e-4, &mut e_at) - d(1e-3, &mut e_at)) / 3.0;
             let [q, qd, qdd] = path(0.0);
-            let idm = cc
-                .inverse_dynamics(&mut ws, &q, &qd, &qdd, Some(&qp))
-                .unwrap();
+            let idm = closed_inverse_dynamics(&cc, &mut at(&cc, &q, &qp), &q, &qd, &qdd).unwrap();
             let power = idm.gamma_cl.dot(&DVector::from_column_slice(&qd));
             let e = (de - power).abs() / power.abs().max(1.0);
             worst = worst.max(e);
@@ -228,18 +213,13 @@ fn idm_of_ddm_is_identity() {
     let mut rng = robodyn::testing::rng(14);
     for (name, r, qa0, qp0, range) in cases() {
         let cc = ClosedChain::new(&r).unwrap();
-        let mut ws = cc.workspace();
         let mut worst: f64 = 0.0;
         for _ in 0..20 {
             let [qa, qp, qd, _] = random_state(&cc, &mut rng, qa0, qp0, range);
             let tau = uniform(&mut rng, qa.len(), 20.0);
-            let ddm = cc
-                .direct_dynamics(&mut ws, &qa, &qd, &tau, Some(&qp))
-                .unwrap();
+            let ddm = closed_direct_dynamics(&cc, &mut at(&cc, &qa, &qp), &qa, &qd, &tau).unwrap();
             let qdd: Vec<f64> = ddm.qdd_a.iter().copied().collect();
-            let idm = cc
-                .inverse_dynamics(&mut ws, &qa, &qd, &qdd, Some(&qp))
-                .unwrap();
+            let idm = closed_inverse_dynamics(&cc, &mut at(&cc, &qa, &qp), &qa, &qd, &qdd).unwrap();
             let scale = tau.iter().fold(0.0_f64, |a, b| a.max(b.abs()));
             for (k, t) in tau.iter().enumerate() {
                 let e = (idm.gamma_cl[k] - t).abs() / scale;
@@ -247,7 +227,7 @@ fn idm_of_ddm_is_identity() {
                 assert!(e < 1e-9, "{name}: tau {} vs {t}", idm.gamma_cl[k]);
             }
             // the passive accelerations of the ddm are the consistent ones (10.42)
-            for (k, &j) in cc.passive_joints().iter().enumerate() {
+            for (k, &j) in cc.passive_coordinates().frames().iter().enumerate() {
                 assert!((ddm.qdd_p[k] - idm.state.qdd[j - 1]).abs() < 1e-8 * scale.max(1.0));
             }
         }
@@ -256,19 +236,20 @@ fn idm_of_ddm_is_identity() {
 }
 
 #[test]
-fn closed_dynamics_adapter_uses_previous_solution() {
+fn tracker_follows_a_walk_in_small_steps() {
     let r = robot("fivebar.toml");
-    let mut sys = ClosedDynamics::new(&r).unwrap();
-    assert_eq!(sys.dof(), 2);
-    sys.set_guess(&[0.0, 0.0]);
+    let cc = ClosedChain::new(&r).unwrap();
+    assert_eq!(cc.dof(), 2);
+    let mut b = cc.branch_from(&[0.0, 0.0], &[0.0, 0.0]).unwrap();
     let mut qa = [0.0, 0.0];
-    // walk in small steps: each solve starts from the previous q_p
+    // walk in small steps: each evaluation continues from the tracker's previous point
     for _ in 0..20 {
         qa[0] += 0.01;
         qa[1] -= 0.01;
-        let a = sys.accel(&qa, &[0.1, -0.2], &[0.0, 0.0]).unwrap();
-        assert!(a.iter().all(|x| x.is_finite()));
-        assert!(sys.closure_residual(&qa).unwrap() < 1e-11);
+        let a = closed_direct_dynamics(&cc, &mut b, &qa, &[0.1, -0.2], &[0.0, 0.0]).unwrap();
+        assert!(a.qdd_a.iter().all(|x| x.is_finite()));
+        assert_eq!(b.q_a(), &qa[..]);
+        assert!(loop_closure(&cc, &mut b, &qa).unwrap().residual < 1e-11);
     }
 }
 
@@ -276,19 +257,22 @@ fn closed_dynamics_adapter_uses_previous_solution() {
 fn bad_inputs_are_errors() {
     let r = robot("fourbar.toml");
     let cc = ClosedChain::new(&r).unwrap();
-    let mut ws = cc.workspace();
-    let e = cc
-        .inverse_dynamics(&mut ws, &[0.0, 1.0], &[0.0], &[0.0], None)
-        .unwrap_err();
+    let mut b = cc.assembly_branch().unwrap();
+    let e = closed_inverse_dynamics(&cc, &mut b, &[0.0, 1.0], &[0.0], &[0.0]).unwrap_err();
     assert!(
-        matches!(e, Error::Input(_)) && e.to_string().contains("actuated"),
+        matches!(
+            e,
+            Error::Dimension {
+                expected: 1,
+                got: 2,
+                ..
+            }
+        ) && e.to_string().contains("actuated"),
         "{e}"
     );
-    let e = cc
-        .direct_dynamics(&mut ws, &[0.0], &[f64::NAN], &[0.0], None)
-        .unwrap_err();
+    let e = closed_direct_dynamics(&cc, &mut b, &[0.0], &[f64::NAN], &[0.0]).unwrap_err();
     assert!(
-        matches!(e, Error::Input(_)) && e.to_string().contains("finite"),
+        matches!(e, Error::NotFinite { .. }) && e.to_string().contains("finite"),
         "{e}"
     );
     // a tree is not a closed chain
@@ -300,15 +284,35 @@ fn bad_inputs_are_errors() {
     assert!(ClosedChain::new(&tree).is_err());
 }
 
+/// A closed chain evaluated on a tracker (what a simulator holds).
+struct Sys {
+    cc: ClosedChain,
+    data: ClosedData,
+    branch: Branch,
+}
+
 /// One RK4 step of (q_a, qd_a) under zero torques.
-fn rk4(sys: &mut ClosedDynamics, q: &[f64], v: &[f64], dt: f64) -> (Vec<f64>, Vec<f64>) {
+fn rk4(sys: &mut Sys, q: &[f64], v: &[f64], dt: f64) -> (Vec<f64>, Vec<f64>) {
     let n = q.len();
     let zero = vec![0.0; n];
     let add = |a: &[f64], b: &[f64], h: f64| -> Vec<f64> {
         a.iter().zip(b).map(|(x, y)| x + h * y).collect()
     };
-    let acc = |sys: &mut ClosedDynamics, q: &[f64], v: &[f64]| -> Vec<f64> {
-        sys.accel(q, v, &zero).unwrap().iter().copied().collect()
+    let acc = |sys: &mut Sys, q: &[f64], v: &[f64]| -> Vec<f64> {
+        let mut a = vec![0.0; q.len()];
+        let env = sys.cc.robot().environment().clone();
+        closed_direct_dynamics_into(
+            &sys.cc,
+            &mut sys.data,
+            &mut sys.branch,
+            &env,
+            q,
+            v,
+            &zero,
+            &mut a,
+        )
+        .unwrap();
+        a
     };
     let (k1q, k1v) = (v.to_vec(), acc(sys, q, v));
     let (q2, v2) = (add(q, &k1q, dt / 2.0), add(v, &k1v, dt / 2.0));
@@ -358,12 +362,16 @@ fn conservative_simulation_keeps_energy_and_closure() {
             l.params[12] = robodyn::Expr::zero();
         }
         let r = Robot::new(d).unwrap();
-        let mut sys = ClosedDynamics::new(&r).unwrap();
-        sys.set_guess(&qp0);
-        let e_of = |sys: &mut ClosedDynamics, q: &[f64], v: &[f64]| {
+        let cc = ClosedChain::new(&r).unwrap();
+        let mut sys = Sys {
+            data: ClosedData::new(&cc),
+            branch: cc.branch_from(&qa0, &qp0).unwrap(),
+            cc,
+        };
+        let e_of = |sys: &mut Sys, q: &[f64], v: &[f64]| {
             let z = vec![0.0; q.len()];
-            let s = sys.model.state(&mut sys.ws, q, v, &z, None).unwrap();
-            let (ke, pe) = energy(&r, sys.model.closure(), &s);
+            let s = closed_state(&sys.cc, &mut sys.branch, q, v, &z).unwrap();
+            let (ke, pe) = energy(&r, &s);
             (ke + pe, ke)
         };
         let (mut q, mut v) = (qa0.clone(), v0.clone());
@@ -376,7 +384,8 @@ fn conservative_simulation_keeps_energy_and_closure() {
             if step % 100 == 0 {
                 let (e, _) = e_of(&mut sys, &q, &v);
                 drift = drift.max((e - e0).abs() / ke0.max(e0.abs()));
-                residual = residual.max(sys.closure_residual(&q).unwrap());
+                residual =
+                    residual.max(loop_closure(&sys.cc, &mut sys.branch, &q).unwrap().residual);
             }
         }
         println!(
@@ -395,18 +404,15 @@ fn a_cl_and_h_cl_match_newton_euler_columns() {
     let mut rng = robodyn::testing::rng(23);
     for (name, r, qa0, qp0, range) in cases() {
         let cc = ClosedChain::new(&r).unwrap();
-        let mut ws = cc.workspace();
         let nl = r.nl();
         let model = r.numeric();
-        let mut tree_ws = robodyn::Workspace::new(model);
+        let mut tree_ws = robodyn::Data::from_model(model);
         let mut worst: f64 = 0.0;
         for _ in 0..10 {
             let [qa, qp, qd, _] = random_state(&cc, &mut rng, qa0, qp0, range);
             let tau = uniform(&mut rng, qa.len(), 10.0);
-            let d = cc
-                .direct_dynamics(&mut ws, &qa, &qd, &tau, Some(&qp))
-                .unwrap();
-            let q = &d.state.q;
+            let d = closed_direct_dynamics(&cc, &mut at(&cc, &qa, &qp), &qa, &qd, &tau).unwrap();
+            let q = d.state.q.as_slice();
             let zeros = vec![0.0; nl];
             let mut t0 = vec![0.0; nl];
             rnea(model, &mut tree_ws, q, &zeros, &zeros, &mut t0);
@@ -420,13 +426,19 @@ fn a_cl_and_h_cl_match_newton_euler_columns() {
                     a_tr[(i, j - 1)] = t[i] - t0[i];
                 }
             }
-            let g = &d.state.constraints.g;
+            let g = &d.state.g;
             let a_ne = g.transpose() * &a_tr * g;
-            let s0 = cc
-                .state(&mut ws, &qa, &qd, &vec![0.0; qa.len()], Some(&qp))
-                .unwrap();
+            let s0 =
+                closed_state(&cc, &mut at(&cc, &qa, &qp), &qa, &qd, &vec![0.0; qa.len()]).unwrap();
             let mut h = vec![0.0; nl];
-            rnea(model, &mut tree_ws, &s0.q, &s0.qd, &s0.qdd, &mut h);
+            rnea(
+                model,
+                &mut tree_ws,
+                s0.q.as_slice(),
+                s0.qd.as_slice(),
+                s0.qdd.as_slice(),
+                &mut h,
+            );
             let h_ne = g.transpose() * DVector::from_column_slice(&h);
             let sa = a_ne.amax().max(1e-12);
             let sh = h_ne.amax().max(1.0);

@@ -5,10 +5,12 @@
 //! friction power, and idm(ddm(tau)) = tau through the API the CLI uses.
 
 use rand::Rng;
-use robodyn::algorithms::closed_chain::ClosedChain;
 use robodyn::geometry::frame_transforms;
 use robodyn::simulation::{
     simulate, ClosedChainDynamics, Dynamics, Integrator, Recorder, SimOptions, TorqueInput,
+};
+use robodyn::{
+    closed_direct_dynamics, closed_inverse_dynamics, closed_state, loop_closure, ClosedChain,
 };
 use robodyn::{Expr, Robot};
 use std::path::PathBuf;
@@ -44,8 +46,15 @@ fn dopri(rtol: f64, atol: f64) -> Integrator {
     }
 }
 
+/// The simulated system of a closed robot on its assembly branch.
+fn system(r: &Robot) -> ClosedChainDynamics {
+    let cc = ClosedChain::new(r).unwrap();
+    let b = cc.assembly_branch().unwrap();
+    ClosedChainDynamics::new(cc, b)
+}
+
 fn run(r: &Robot, q0: &[f64], qd0: &[f64], duration: f64, output_dt: f64) -> Recorder {
-    let mut sys = ClosedChainDynamics::new(r).unwrap();
+    let mut sys = system(r);
     let n = sys.dof();
     let mut rec = Recorder::default();
     let opts = SimOptions {
@@ -163,9 +172,9 @@ fn viscous_friction_dissipates_the_integrated_friction_power() {
     ] {
         let r = variant(name, g, 1.0);
         let cc = ClosedChain::new(&r).unwrap();
-        let mut ws = cc.workspace();
         let n = cc.dof();
-        let q0 = cc.reference_actuated();
+        let mut b = cc.assembly_branch().unwrap();
+        let q0 = b.q_a().to_vec();
         let rec = run(&r, &q0, &qd0, 2.0, 1e-3);
         let ce = col(&rec, "energy");
         let fv: Vec<f64> = (1..=r.nl()).map(|j| r.numeric().link(j).fv).collect();
@@ -174,8 +183,7 @@ fn viscous_friction_dissipates_the_integrated_friction_power() {
         for row in &rec.rows {
             let qa: Vec<f64> = row[1..1 + n].to_vec();
             let qda: Vec<f64> = row[1 + n..1 + 2 * n].to_vec();
-            let s = cc
-                .state(&mut ws, &qa, &qda, &vec![0.0; n], None)
+            let s = closed_state(&cc, &mut b, &qa, &qda, &vec![0.0; n])
                 .unwrap_or_else(|e| panic!("{name}: {e}"));
             power.push(s.qd.iter().zip(&fv).map(|(v, f)| f * v * v).sum::<f64>());
         }
@@ -209,8 +217,8 @@ fn viscous_friction_dissipates_the_integrated_friction_power() {
 
 #[test]
 fn idm_of_ddm_is_tau_for_all_bundled_closed_robots() {
-    // The CLI's route: q_p from the reference assembly (solve_from_reference, previous row's
-    // solution afterwards), ddm, then idm at the same state.
+    // The CLI's route: one branch tracker from the reference assembly, rows continued from the
+    // previous row, ddm, then idm at the same state.
     let mut rng = robodyn::testing::rng(41);
     for name in [
         "sr400.toml",
@@ -222,10 +230,9 @@ fn idm_of_ddm_is_tau_for_all_bundled_closed_robots() {
         let r = load(name);
         assert!(!r.is_tree());
         let cc = ClosedChain::new(&r).unwrap();
-        let mut ws = cc.workspace();
         let n = cc.dof();
-        let qa0 = cc.reference_actuated();
-        let mut guess: Option<Vec<f64>> = None;
+        let mut b = cc.assembly_branch().unwrap();
+        let qa0 = b.q_a().to_vec();
         let mut worst: f64 = 0.0;
         for _ in 0..20 {
             let qa: Vec<f64> = qa0
@@ -234,24 +241,17 @@ fn idm_of_ddm_is_tau_for_all_bundled_closed_robots() {
                 .collect();
             let qd: Vec<f64> = (0..n).map(|_| rng.random_range(-1.0..1.0)).collect();
             let tau: Vec<f64> = (0..n).map(|_| rng.random_range(-20.0..20.0)).collect();
-            let s = cc
-                .solve_from_reference(&mut ws, &qa, guess.as_deref())
+            let d = closed_direct_dynamics(&cc, &mut b, &qa, &qd, &tau)
                 .unwrap_or_else(|e| panic!("{name}: {e}"));
-            let d = cc
-                .direct_dynamics(&mut ws, &qa, &qd, &tau, Some(&s.q_p))
-                .unwrap();
             let qdd: Vec<f64> = d.qdd_a.iter().copied().collect();
-            let i = cc
-                .inverse_dynamics(&mut ws, &qa, &qd, &qdd, Some(&s.q_p))
-                .unwrap();
+            let i = closed_inverse_dynamics(&cc, &mut b, &qa, &qd, &qdd).unwrap();
             let scale = tau.iter().fold(1.0_f64, |a, b| a.max(b.abs()));
             for (k, t) in tau.iter().enumerate() {
                 let e = (i.gamma_cl[k] - t).abs() / scale;
                 worst = worst.max(e);
                 assert!(e < 1e-9, "{name}: tau{k} {} vs {t}", i.gamma_cl[k]);
             }
-            assert!(placement_gap(&r, &s.q_tr) < 1e-10);
-            guess = Some(s.q_p);
+            assert!(placement_gap(&r, i.state.q.as_slice()) < 1e-10);
         }
         println!("{name}: idm(ddm(tau)) vs tau: max relative error {worst:.2e}");
     }
@@ -263,21 +263,21 @@ fn reference_start_is_the_assembly_branch() {
     // closure satisfies Example 10.1: theta3 = theta7 + pi/2 - theta2, theta8 = theta2 - theta7.
     let r = load("sr400.toml");
     let cc = ClosedChain::new(&r).unwrap();
-    let mut ws = cc.workspace();
     let qa = [0.1, 0.3, 0.2, -0.4, 0.5, 0.6];
-    let s = cc.solve_from_reference(&mut ws, &qa, None).unwrap();
-    let (t2, t7) = (s.q_tr[1], s.q_tr[6]);
+    let s = loop_closure(&cc, &mut cc.assembly_branch().unwrap(), &qa).unwrap();
+    let q_tr = s.q_tree.as_slice();
+    let (t2, t7) = (q_tr[1], q_tr[6]);
     let wrap = |x: f64| {
         (x + std::f64::consts::PI).rem_euclid(2.0 * std::f64::consts::PI) - std::f64::consts::PI
     };
-    assert!(wrap(s.q_tr[2] - (t7 + std::f64::consts::FRAC_PI_2 - t2)).abs() < 1e-9);
-    assert!(wrap(s.q_tr[7] - (t2 - t7)).abs() < 1e-9);
+    assert!(wrap(q_tr[2] - (t7 + std::f64::consts::FRAC_PI_2 - t2)).abs() < 1e-9);
+    assert!(wrap(q_tr[7] - (t2 - t7)).abs() < 1e-9);
     // the simulator's first evaluation starts there too
-    let mut sys = ClosedChainDynamics::new(&r).unwrap();
+    let mut sys = system(&r);
     let mut out = vec![0.0; sys.extra_columns().len()];
     sys.extra_values(&qa, &[0.0; 6], &mut out).unwrap();
-    for (k, &j) in sys.passive_joints().iter().enumerate() {
-        assert!(wrap(out[1 + k] - s.q_tr[j - 1]).abs() < 1e-9, "q{j}");
+    for (k, &j) in cc.passive_coordinates().frames().iter().enumerate() {
+        assert!(wrap(out[1 + k] - q_tr[j - 1]).abs() < 1e-9, "q{j}");
     }
 }
 
@@ -287,7 +287,7 @@ fn falling_into_a_singularity_is_a_clear_error() {
     // singularity, Wp singular): the run stops with an error value that says so, and the rows
     // written before it are closed loops.
     let r = load("fivebar.toml");
-    let mut sys = ClosedChainDynamics::new(&r).unwrap();
+    let mut sys = system(&r);
     let mut rec = Recorder::default();
     let opts = SimOptions {
         duration: 2.0,

@@ -24,7 +24,7 @@ use robodyn::algorithms::inverse_dynamics::rnea;
 use robodyn::codegen::{constant_g, generate, GenOptions, ModelKind};
 use robodyn::model::STANDARD_PARAMETERS;
 use robodyn::testing::{random_state, random_tree_description, rng, TreeOptions};
-use robodyn::{Expr, Robot, RobotDescription, Workspace};
+use robodyn::{Data, Expr, Robot, RobotDescription};
 use robodyn_symbolic::{emit, Lang, Program};
 use std::collections::HashMap;
 use std::io::Write;
@@ -78,7 +78,7 @@ fn parameter_values(prog: &Program, env: &dyn Fn(&str) -> Option<f64>) -> Vec<f6
 }
 
 fn numeric_rnea(robot: &Robot, q: &[f64], qd: &[f64], qdd: &[f64]) -> Vec<f64> {
-    let mut ws = Workspace::new(robot.numeric());
+    let mut ws = Data::new(robot);
     let mut tau = vec![0.0; robot.nl()];
     rnea(robot.numeric(), &mut ws, q, qd, qdd, &mut tau);
     tau
@@ -231,7 +231,6 @@ fn closed_states(
     seed: u64,
 ) -> Vec<robodyn::algorithms::closed_chain::ClosedIdm> {
     let mut r = rng(seed);
-    let mut ws = cc.workspace();
     let n = qa0.len();
     (0..3)
         .map(|_| {
@@ -241,14 +240,14 @@ fn closed_states(
                 .map(|x| x + r.random_range(-range..range))
                 .collect();
             let [_, qda, qdda] = random_state(&mut r, n);
-            let sol = cc
-                .closure()
-                .solve_continuation(&mut ws.closure, &qa, qa0, qp0, 16)
-                .unwrap();
-            cc.inverse_dynamics(&mut ws, &qa, &qda, &qdda, Some(&sol.q_p))
-                .unwrap()
+            let mut b = cc.branch_from(qa0, qp0).unwrap();
+            robodyn::closed_inverse_dynamics(cc, &mut b, &qa, &qda, &qdda).unwrap()
         })
         .collect()
+}
+
+fn v(x: &nalgebra::DVector<f64>) -> Vec<f64> {
+    x.iter().copied().collect()
 }
 
 /// The closed and w models of every closed robot whose G depends on q (all but the SR400).
@@ -275,9 +274,9 @@ fn general_closed_cases() -> Vec<Case> {
                 .map(|s| {
                     let st = &s.state;
                     if model == ModelKind::W {
-                        vec![st.q.clone(), p.clone()]
+                        vec![v(&st.q), p.clone()]
                     } else {
-                        vec![st.q.clone(), st.qd.clone(), st.qdd.clone(), p.clone()]
+                        vec![v(&st.q), v(&st.qd), v(&st.qdd), p.clone()]
                     }
                 })
                 .collect();
@@ -286,7 +285,7 @@ fn general_closed_cases() -> Vec<Case> {
                 .map(|s| {
                     if model == ModelKind::W {
                         // row by row: passive joint, then actuated joint
-                        s.state.constraints.w.transpose().as_slice().to_vec()
+                        s.state.w.transpose().as_slice().to_vec()
                     } else {
                         s.gamma_cl.as_slice().to_vec()
                     }
@@ -910,8 +909,6 @@ fn generated_w_is_the_derivative_of_loop_closure() {
     for (k, (label, robot, qa0, qp0, range)) in common::cases().into_iter().enumerate() {
         let desc = robot.description().clone();
         let cc = ClosedChain::new(&robot).unwrap();
-        let lc = cc.closure();
-        let mut ws = cc.workspace();
         let gen = |model| {
             let opt = GenOptions {
                 model,
@@ -934,16 +931,17 @@ fn generated_w_is_the_derivative_of_loop_closure() {
                 }
             };
             let w = wprog.evaluate(&value).unwrap();
-            let (pj, aj) = (lc.passive_joints(), lc.actuated_joints());
+            let (pj, aj) = (cc.passive_coordinates().frames(), cc.coordinates().frames());
             let qa: Vec<f64> = aj.iter().map(|&j| st.q[j - 1]).collect();
             let qp: Vec<f64> = pj.iter().map(|&j| st.q[j - 1]).collect();
+            let b = cc.branch_from(&qa, &qp).unwrap();
             let h = 1e-5;
             let mut worst = 0.0f64;
             for (c, _) in aj.iter().enumerate() {
-                let mut solve = |d: f64| {
+                let solve = |d: f64| {
                     let mut x = qa.clone();
                     x[c] += d;
-                    lc.solve(&mut ws.closure, &x, Some(&qp)).unwrap().q_p
+                    robodyn::loop_closure(&cc, &mut b.clone(), &x).unwrap().q_p
                 };
                 let (plus, minus) = (solve(h), solve(-h));
                 for r in 0..pj.len() {

@@ -50,13 +50,15 @@ fn general_closed_chain_needs_a_closed_reference() {
         "{e}"
     );
     // with a closed assembly configuration the model is generated
-    let cc = robodyn::algorithms::closed_chain::ClosedChain::new(&robot).unwrap();
-    let mut ws = cc.workspace();
+    let cc = robodyn::ClosedChain::new(&robot).unwrap();
     let sol = [[1.0, 1.0], [-1.0, 1.0], [1.0, -1.0], [2.0, 2.0]]
         .iter()
-        .find_map(|g| cc.solve_positions(&mut ws, &[0.3], Some(g)).ok())
+        .find_map(|g| {
+            let mut b = cc.branch_from(&[0.3], g).ok()?;
+            robodyn::loop_closure(&cc, &mut b, &[0.3]).ok()
+        })
         .expect("the four-bar closes at q1 = 0.3");
-    d.assembly = Some(sol.q_tr.clone());
+    d.assembly = Some(sol.q_tree.iter().copied().collect());
     let prog = generate(&d, &opt).unwrap();
     assert_eq!(prog.outputs.len(), 1);
     assert_eq!(prog.outputs[0].name, "GAMCL1");

@@ -44,7 +44,10 @@ fn trans(x: f64, y: f64, z: f64) -> Matrix4<f64> {
 /// The six parameters of frame j with the joint variable added: (gamma, b, alpha, d, theta, r).
 fn parameters(robot: &Robot, j: usize, q: f64) -> [f64; 6] {
     let f = robot.frame(j);
-    let v = |e| robot.value(e).unwrap();
+    let v = |e: &robodyn::Expr| {
+        e.eval(&|s| robot.description().symbols.get(s).copied())
+            .unwrap()
+    };
     let (mut theta, mut r) = (v(&f.theta), v(&f.r));
     match f.joint {
         JointType::Revolute => theta += q,

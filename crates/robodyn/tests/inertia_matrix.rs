@@ -3,13 +3,14 @@
 //! symbolic scalar.
 
 use nalgebra::{DMatrix, DVector, Vector3};
-use robodyn::algorithms::inertia_matrix::{
-    h_vector, h_vector_into, inertia_matrix, inertia_matrix_into, InertiaWorkspace,
-};
+use robodyn::algorithms::inertia_matrix::composite_inertia_matrix;
 use robodyn::algorithms::inverse_dynamics::rnea;
 use robodyn::model::{param, DynModel, JointType, LinkDesc, RobotDescription};
 use robodyn::testing::{random_state, random_tree, random_tree_description, rng, TreeOptions};
-use robodyn::{Expr, Robot, Workspace};
+use robodyn::{
+    h_vector, h_vector_into, inertia_matrix, inertia_matrix_into, inverse_dynamics, Data, Expr,
+    Robot,
+};
 
 /// The same robot with g = 0, no friction and no external wrench (rotor inertia kept), fixed base.
 fn inertial_only(robot: &Robot) -> Robot {
@@ -38,8 +39,10 @@ fn a_is_symmetric_positive_definite_and_equals_newton_euler_columns() {
     for case in 0..40 {
         let n = 2 + case % 29;
         let robot = random_tree(&mut r, n, &TreeOptions::default());
-        let [q, _, _] = random_state(&mut r, n);
+        let m = robot.dof();
+        let [q, _, _] = random_state(&mut r, m);
         let a = inertia_matrix(&robot, &q).unwrap();
+        assert_eq!(a.shape(), (m, m), "over the movable joints");
         let scale = max_abs(&a);
         assert!(scale > 0.0);
         // symmetric
@@ -47,30 +50,17 @@ fn a_is_symmetric_positive_definite_and_equals_newton_euler_columns() {
             max_abs(&(&a - a.transpose())) <= 1e-12 * scale,
             "case {case}"
         );
-        // positive definite on the movable joints
-        let mov = robot.movable_joints();
-        let sub = DMatrix::from_fn(mov.len(), mov.len(), |i, j| a[(mov[i] - 1, mov[j] - 1)]);
-        let eig = sub.symmetric_eigenvalues();
+        // positive definite
+        let eig = a.clone().symmetric_eigenvalues();
         assert!(eig.min() > 0.0, "case {case}: min eigenvalue {}", eig.min());
-        // fixed frames: zero rows and columns
-        for j in 1..=n {
-            if robot.frame(j).joint == JointType::Fixed {
-                assert!(a.row(j - 1).iter().all(|x| *x == 0.0));
-                assert!(a.column(j - 1).iter().all(|x| *x == 0.0));
-            }
-        }
         // reference: column i = Newton–Euler with g = 0, qd = 0, qdd = e_i on the inertial-only robot
         let reference = inertial_only(&robot);
-        let model = reference.numeric();
-        let mut ws = Workspace::new(model);
-        let zero = vec![0.0; n];
-        let mut col = vec![0.0; n];
-        let mut ane = DMatrix::zeros(n, n);
-        for &i in &mov {
-            let mut e = vec![0.0; n];
-            e[i - 1] = 1.0;
-            rnea(model, &mut ws, &q, &zero, &e, &mut col);
-            ane.set_column(i - 1, &DVector::from_column_slice(&col));
+        let zero = vec![0.0; m];
+        let mut ane = DMatrix::zeros(m, m);
+        for i in 0..m {
+            let mut e = vec![0.0; m];
+            e[i] = 1.0;
+            ane.set_column(i, &inverse_dynamics(&reference, &q, &zero, &e).unwrap());
         }
         let err = max_abs(&(&a - &ane));
         worst = worst.max(err / scale);
@@ -80,10 +70,11 @@ fn a_is_symmetric_positive_definite_and_equals_newton_euler_columns() {
         );
         // tree sparsity: A_ij = 0 unless one is an ancestor of the other
         let s = robot.structure();
-        for i in 1..=n {
-            for j in 1..=n {
+        let c = robot.coordinates();
+        for (x, &i) in c.frames().iter().enumerate() {
+            for (y, &j) in c.frames().iter().enumerate() {
                 if !s.is_ancestor(i, j) && !s.is_ancestor(j, i) {
-                    assert_eq!(a[(i - 1, j - 1)], 0.0, "A_{i}{j}");
+                    assert_eq!(a[(x, y)], 0.0, "A_{i}{j}");
                 }
             }
         }
@@ -102,18 +93,11 @@ fn newton_euler_is_a_qdd_plus_h() {
         d.wp0 = [0.1, 0.4, -0.3].map(Expr::num);
         d.vp0 = [0.5, 0.0, -1.0].map(Expr::num);
         let robot = Robot::new(d).unwrap();
-        let [q, qd, qdd] = random_state(&mut r, n);
+        let [q, qd, qdd] = random_state(&mut r, robot.dof());
         let a = inertia_matrix(&robot, &q).unwrap();
         let h = h_vector(&robot, &q, &qd).unwrap();
-        let tau =
-            robodyn::algorithms::inverse_dynamics::inverse_dynamics(&robot, &q, &qd, &qdd).unwrap();
-        let mut qv = DVector::from_column_slice(&qdd);
-        for j in 1..=n {
-            if robot.frame(j).joint == JointType::Fixed {
-                qv[j - 1] = 0.0;
-            }
-        }
-        let pred = &a * qv + h;
+        let tau = inverse_dynamics(&robot, &q, &qd, &qdd).unwrap();
+        let pred = &a * DVector::from_column_slice(&qdd) + h;
         let scale = tau.amax().max(1.0);
         assert!(
             (&pred - &tau).amax() <= 1e-10 * scale,
@@ -132,14 +116,17 @@ fn kinetic_energy_from_link_velocities() {
         let n = 2 + case;
         let robot = random_tree(&mut r, n, &TreeOptions::default());
         let [q, qd, _] = random_state(&mut r, n);
-        let a = inertia_matrix(&robot, &q).unwrap();
+        let c = robot.coordinates();
+        let pick = |v: &[f64]| -> Vec<f64> { c.frames().iter().map(|&j| v[j - 1]).collect() };
+        let a = inertia_matrix(&robot, &pick(&q)).unwrap();
         let mut qdv = DVector::from_column_slice(&qd);
         for j in 1..=n {
             if robot.frame(j).joint == JointType::Fixed {
                 qdv[j - 1] = 0.0;
             }
         }
-        let t_a = 0.5 * qdv.dot(&(&a * &qdv));
+        let qdm = DVector::from_vec(pick(qdv.as_slice()));
+        let t_a = 0.5 * qdm.dot(&(&a * &qdm));
         let model = robot.numeric();
         let mut w = vec![Vector3::zeros(); n + 1];
         let mut v = vec![Vector3::zeros(); n + 1];
@@ -219,11 +206,12 @@ fn symbolic_scalar_matches_numeric() {
         let sym: DynModel<Expr> = DynModel::build(desc, |e| e.clone(), |_, _, e| e.clone());
         let qs: Vec<Expr> = (1..=n).map(|j| Expr::symbol(format!("q{j}"))).collect();
         let qds: Vec<Expr> = (1..=n).map(|j| Expr::symbol(format!("qd{j}"))).collect();
-        let mut ws = InertiaWorkspace::new(&sym);
+        let mut ws = Data::from_model(&sym);
         let mut a_sym = DMatrix::from_element(n, n, Expr::zero());
-        inertia_matrix_into(&sym, &mut ws, &qs, &mut a_sym);
+        composite_inertia_matrix(&sym, &mut ws, &qs, &mut a_sym);
         let mut h_sym = vec![Expr::zero(); n];
-        h_vector_into(&sym, &mut ws, &qs, &qds, &mut h_sym);
+        let zeros = vec![Expr::zero(); n];
+        rnea(&sym, &mut ws, &qs, &qds, &zeros, &mut h_sym);
         let [q, qd, _] = random_state(&mut r, n);
         let env = |s: &str| -> Option<f64> {
             let k: usize = s
@@ -237,15 +225,26 @@ fn symbolic_scalar_matches_numeric() {
                 q[k - 1]
             })
         };
-        let a = inertia_matrix(&robot, &q).unwrap();
-        let h = h_vector(&robot, &q, &qd).unwrap();
-        for i in 0..n {
-            for j in 0..n {
-                let v = a_sym[(i, j)].eval(&env).unwrap();
-                assert!((v - a[(i, j)]).abs() <= 1e-10 * (1.0 + a[(i, j)].abs()));
+        // the checked API over the movable joints, and its allocation-free form
+        let c = robot.coordinates();
+        let pick = |v: &[f64]| -> Vec<f64> { c.frames().iter().map(|&j| v[j - 1]).collect() };
+        let (qm, qdm) = (pick(&q), pick(&qd));
+        let a = inertia_matrix(&robot, &qm).unwrap();
+        let h = h_vector(&robot, &qm, &qdm).unwrap();
+        let mut data = Data::new(&robot);
+        let mut a2 = DMatrix::zeros(c.len(), c.len());
+        inertia_matrix_into(&robot, &mut data, &qm, &mut a2).unwrap();
+        let mut h2 = vec![0.0; c.len()];
+        h_vector_into(&robot, &mut data, robot.environment(), &qm, &qdm, &mut h2).unwrap();
+        assert_eq!(a, a2);
+        assert_eq!(h.as_slice(), &h2[..]);
+        for (x, &i) in c.frames().iter().enumerate() {
+            for (y, &j) in c.frames().iter().enumerate() {
+                let v = a_sym[(i - 1, j - 1)].eval(&env).unwrap();
+                assert!((v - a[(x, y)]).abs() <= 1e-10 * (1.0 + a[(x, y)].abs()));
             }
-            let v = h_sym[i].eval(&env).unwrap();
-            assert!((v - h[i]).abs() <= 1e-10 * (1.0 + h[i].abs()), "H{i}");
+            let v = h_sym[i - 1].eval(&env).unwrap();
+            assert!((v - h[x]).abs() <= 1e-10 * (1.0 + h[x].abs()), "H{i}");
         }
     }
 }
@@ -254,7 +253,18 @@ fn symbolic_scalar_matches_numeric() {
 fn bad_input_is_an_error() {
     let mut r = rng(15);
     let robot = random_tree(&mut r, 4, &TreeOptions::default());
-    assert!(inertia_matrix(&robot, &[0.0; 3]).is_err());
-    assert!(inertia_matrix(&robot, &[0.0, f64::NAN, 0.0, 0.0]).is_err());
-    assert!(h_vector(&robot, &[0.0; 4], &[0.0; 5]).is_err());
+    let m = robot.dof();
+    assert!(matches!(
+        inertia_matrix(&robot, &vec![0.0; m - 1]),
+        Err(robodyn::Error::Dimension { .. })
+    ));
+    let mut nan = vec![0.0; m];
+    nan[1] = f64::NAN;
+    assert!(matches!(
+        inertia_matrix(&robot, &nan),
+        Err(robodyn::Error::NotFinite { index: 1, .. })
+    ));
+    assert!(h_vector(&robot, &vec![0.0; m], &vec![0.0; m + 1]).is_err());
+    let mut a = DMatrix::zeros(m + 1, m);
+    assert!(inertia_matrix_into(&robot, &mut Data::new(&robot), &vec![0.0; m], &mut a).is_err());
 }

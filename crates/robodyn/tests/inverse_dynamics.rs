@@ -17,10 +17,10 @@ use robodyn::algorithms::energy::{
     kinetic_energy, lagrangian_torques, potential_energy, total_energy, total_energy_rate,
     wrench_power,
 };
-use robodyn::algorithms::inverse_dynamics::{inverse_dynamics, rnea};
 use robodyn::model::JointType;
 use robodyn::testing::{self, random_state, random_tree_description, TreeOptions};
-use robodyn::{Error, Expr, Robot, RobotDescription, Workspace};
+use robodyn::{inverse_dynamics, inverse_dynamics_into};
+use robodyn::{Data, Error, Expr, Robot, RobotDescription};
 use std::path::PathBuf;
 
 /// Tolerance of the Lagrangian vs Newton–Euler comparison (issue 2).
@@ -54,9 +54,18 @@ fn random_options<R: Rng>(rng: &mut R) -> TreeOptions {
 }
 
 /// Newton–Euler torques with a reused workspace.
-fn ne(robot: &Robot, ws: &mut Workspace, s: &[Vec<f64>; 3]) -> DVector<f64> {
-    let mut tau = DVector::zeros(robot.nl());
-    rnea(robot.numeric(), ws, &s[0], &s[1], &s[2], tau.as_mut_slice());
+fn ne(robot: &Robot, ws: &mut Data, s: &[Vec<f64>; 3]) -> DVector<f64> {
+    let mut tau = DVector::zeros(robot.dof());
+    inverse_dynamics_into(
+        robot,
+        ws,
+        robot.environment(),
+        &s[0],
+        &s[1],
+        &s[2],
+        tau.as_mut_slice(),
+    )
+    .unwrap();
     tau
 }
 
@@ -92,9 +101,9 @@ fn lagrangian_matches_newton_euler_on_random_trees() {
                 n_general += (!f.gamma.is_zero() || !f.b.is_zero()) as usize;
             }
             robots += 1;
-            let mut ws = Workspace::new(robot.numeric());
+            let mut ws = Data::new(&robot);
             for _ in 0..3 {
-                let s = random_state(&mut rng, n);
+                let s = random_state(&mut rng, robot.dof());
                 let tau_ne = ne(&robot, &mut ws, &s);
                 let tau_l = lagrangian_torques(&robot, &s[0], &s[1], &s[2]).unwrap();
                 assert!(tau_ne.norm() > 1e-3, "degenerate reference torques");
@@ -125,7 +134,7 @@ fn lagrangian_matches_newton_euler_on_sr400_tree() {
     let robot = sr400();
     assert_eq!(robot.nl(), 8);
     let mut rng = testing::rng(400);
-    let mut ws = Workspace::new(robot.numeric());
+    let mut ws = Data::new(&robot);
     let mut worst = 0.0f64;
     for _ in 0..50 {
         let s = random_state(&mut rng, 8);
@@ -227,13 +236,13 @@ fn power_balance() {
             if !has_movable_joint(&robot) {
                 continue;
             }
-            let s = random_state(&mut rng, n);
+            let s = random_state(&mut rng, robot.dof());
             let tau = inverse_dynamics(&robot, &s[0], &s[1], &s[2]).unwrap();
             let (mut input, mut scale, mut friction) = (0.0, 0.0, 0.0);
-            for j in robot.movable_joints() {
-                let (qd, l) = (s[1][j - 1], robot.numeric().link(j));
-                input += qd * tau[j - 1];
-                scale += (qd * tau[j - 1]).abs();
+            for (k, &j) in robot.coordinates().frames().iter().enumerate() {
+                let (qd, l) = (s[1][k], robot.numeric().link(j));
+                input += qd * tau[k];
+                scale += (qd * tau[k]).abs();
                 friction += l.fs * qd.abs() + l.fv * qd * qd;
             }
             let p_env = wrench_power(&robot, &s[0], &s[1]).unwrap();
@@ -262,12 +271,12 @@ fn energy_rate_matches_finite_difference() {
             },
         ))
         .unwrap();
-        let s = random_state(&mut rng, n);
+        let s = random_state(&mut rng, robot.dof());
         let at = |t: f64| {
-            let q: Vec<f64> = (0..n)
+            let q: Vec<f64> = (0..s[0].len())
                 .map(|k| s[0][k] + s[1][k] * t + 0.5 * s[2][k] * t * t)
                 .collect();
-            let qd: Vec<f64> = (0..n).map(|k| s[1][k] + s[2][k] * t).collect();
+            let qd: Vec<f64> = (0..s[0].len()).map(|k| s[1][k] + s[2][k] * t).collect();
             total_energy(&robot, &q, &qd).unwrap()
         };
         let h = 1e-4;
@@ -300,10 +309,11 @@ fn energies_match_newton_euler_quadratic_form_and_gravity_torques() {
             l.wrench = std::array::from_fn(|_| Expr::zero());
         }
         let bare = Robot::new(bare).unwrap();
-        let s = random_state(&mut rng, n);
-        let z = vec![0.0; n];
-        let mut a = nalgebra::DMatrix::zeros(n, n);
-        for k in 0..n {
+        let m = robot.dof();
+        let s = random_state(&mut rng, m);
+        let z = vec![0.0; m];
+        let mut a = nalgebra::DMatrix::zeros(m, m);
+        for k in 0..m {
             let mut e = z.clone();
             e[k] = 1.0;
             a.set_column(k, &inverse_dynamics(&bare, &s[0], &z, &e).unwrap());
@@ -325,7 +335,7 @@ fn energies_match_newton_euler_quadratic_form_and_gravity_torques() {
             inverse_dynamics(&r, &s[0], &z, &z).unwrap()
         };
         let h = 1e-5;
-        for k in robot.movable_joints() {
+        for k in 1..=m {
             let mut qp = s[0].clone();
             let mut qm = s[0].clone();
             qp[k - 1] += h;
@@ -352,20 +362,24 @@ fn bad_input_is_an_error() {
     nan[2] = f64::NAN;
     assert!(matches!(
         lagrangian_torques(&robot, &short, &z, &z),
-        Err(Error::Input(_))
+        Err(Error::Dimension {
+            expected: 8,
+            got: 7,
+            ..
+        })
     ));
     assert!(matches!(
         lagrangian_torques(&robot, &z, &nan, &z),
-        Err(Error::Input(_))
+        Err(Error::NotFinite { index: 2, .. })
     ));
     let err = kinetic_energy(&robot, &nan, &z).unwrap_err().to_string();
-    assert!(err.contains("q3"), "{err}");
+    assert!(err.contains("q[2]"), "{err}");
     assert!(matches!(
         potential_energy(&robot, &short),
-        Err(Error::Input(_))
+        Err(Error::Dimension { .. })
     ));
     assert!(matches!(
         total_energy(&robot, &z, &[f64::INFINITY; 8]),
-        Err(Error::Input(_))
+        Err(Error::NotFinite { .. })
     ));
 }

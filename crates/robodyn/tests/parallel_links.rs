@@ -9,7 +9,7 @@ use robodyn::algorithms::inverse_dynamics::{
 };
 use robodyn::codegen::parallel_links;
 use robodyn::testing::rng;
-use robodyn::Workspace;
+use robodyn::Data;
 
 /// Example 10.1: theta3 = theta7 + pi/2 - theta2 and theta8 = theta2 - theta7, so link 3 keeps
 /// the orientation of link 7 (up to a quarter turn; link 7, one joint from the base, is the
@@ -45,18 +45,21 @@ fn on_closed_states(
         let model = robot.numeric();
         let mut sampler = ClosedChainSampler::new(&robot).unwrap();
         let mut r = rng(seed);
-        let mut ws = Workspace::new(model);
+        let mut ws = Data::from_model(model);
         let nl = robot.nl();
         for _ in 0..5 {
             let s = sampler.next_state(&mut r).unwrap();
+            // the bundled closed robots have no fixed tree frame: tree arrays = joint vectors
+            assert_eq!(robot.dof(), nl);
+            let (q, qd, qdd) = (s.q.as_slice(), s.qd.as_slice(), s.qdd.as_slice());
             let mut plain = vec![0.0; nl];
-            rnea(model, &mut ws, &s.q, &s.qd, &s.qdd, &mut plain);
+            rnea(model, &mut ws, q, qd, qdd, &mut plain);
             let mut sharing = vec![0.0; nl];
-            forward_recursion_sharing(model, &mut ws, &s.q, &s.qd, &s.qdd, &shared);
-            backward_recursion(model, &mut ws, &s.qd, &s.qdd, &mut sharing);
+            forward_recursion_sharing(model, &mut ws, q, qd, qdd, &shared);
+            backward_recursion(model, &mut ws, qd, qdd, &mut sharing);
             let mut moved = vec![0.0; nl];
-            forward_recursion_sharing(model, &mut ws, &s.q, &s.qd, &s.qdd, &shared);
-            backward_recursion_sharing(model, &mut ws, &s.qd, &s.qdd, &mut moved, &shared);
+            forward_recursion_sharing(model, &mut ws, q, qd, qdd, &shared);
+            backward_recursion_sharing(model, &mut ws, qd, qdd, &mut moved, &shared);
             f(name, &s, &plain, &sharing, &moved);
         }
     }
@@ -89,7 +92,7 @@ fn sharing_recursion_equals_tree_recursion_on_closed_states() {
 fn moved_moments_keep_the_closed_chain_torques() {
     let mut changed = 0.0f64;
     on_closed_states(1057, |name, s, plain, _, tau| {
-        let g = &s.constraints.g;
+        let g = &s.g;
         let a = g.tr_mul(&nalgebra::DVector::from_column_slice(plain));
         let b = g.tr_mul(&nalgebra::DVector::from_column_slice(tau));
         let scale = a.amax().max(1.0);

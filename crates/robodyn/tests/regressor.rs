@@ -1,10 +1,9 @@
 //! The regressor (computed recursively) against the Newton–Euler torques: Phi K + Gamma_e = Gamma.
 
 use nalgebra::DVector;
-use robodyn::algorithms::inverse_dynamics::rnea;
-use robodyn::algorithms::regressor::{regressor, wrench_torques, PARAMS_PER_LINK};
+use robodyn::algorithms::regressor::PARAMS_PER_LINK;
 use robodyn::testing::{random_state, random_tree, rng, TreeOptions};
-use robodyn::Workspace;
+use robodyn::{inverse_dynamics, regressor, wrench_torques};
 
 #[test]
 fn regressor_times_standard_parameters_is_newton_euler() {
@@ -21,20 +20,16 @@ fn regressor_times_standard_parameters_is_newton_euler() {
             ..TreeOptions::default()
         };
         let robot = random_tree(&mut r, n, &opt);
-        let model = robot.numeric();
         let k = DVector::from_vec(robot.standard_parameters());
-        let mut ws = Workspace::new(model);
-        let mut phi = nalgebra::DMatrix::zeros(n, PARAMS_PER_LINK * n);
-        let mut tau = vec![0.0; n];
-        let mut tau_e = vec![0.0; n];
+        let m = robot.dof();
         for _ in 0..5 {
-            let [q, qd, qdd] = random_state(&mut r, n);
-            rnea(model, &mut ws, &q, &qd, &qdd, &mut tau);
-            regressor(model, &mut ws, &q, &qd, &qdd, &mut phi);
-            wrench_torques(model, &mut ws, &q, &mut tau_e);
+            let [q, qd, qdd] = random_state(&mut r, m);
+            let tau = inverse_dynamics(&robot, &q, &qd, &qdd).unwrap();
+            let phi = regressor(&robot, &q, &qd, &qdd).unwrap();
+            let tau_e = wrench_torques(&robot, &q).unwrap();
             let pred = &phi * &k;
             let scale = tau.iter().fold(1.0f64, |a, t| a.max(t.abs()));
-            for j in 0..n {
+            for j in 0..m {
                 let err = (pred[j] + tau_e[j] - tau[j]).abs() / scale;
                 worst = worst.max(err);
                 assert!(
@@ -65,13 +60,11 @@ fn wrench_term_is_newton_euler_of_massless_robot() {
         let massless = robot
             .with_standard_parameters(&vec![0.0; PARAMS_PER_LINK * n])
             .unwrap();
-        let mut ws = Workspace::new(robot.numeric());
-        let [q, qd, qdd] = random_state(&mut r, n);
-        let mut tau = vec![0.0; n];
-        rnea(massless.numeric(), &mut ws, &q, &qd, &qdd, &mut tau);
-        let mut tau_e = vec![0.0; n];
-        wrench_torques(robot.numeric(), &mut ws, &q, &mut tau_e);
-        for j in 0..n {
+        let m = robot.dof();
+        let [q, qd, qdd] = random_state(&mut r, m);
+        let tau = inverse_dynamics(&massless, &q, &qd, &qdd).unwrap();
+        let tau_e = wrench_torques(&robot, &q).unwrap();
+        for j in 0..m {
             assert!(
                 (tau[j] - tau_e[j]).abs() <= 1e-12 * (1.0 + tau[j].abs()),
                 "seed {seed}, joint {}: {} vs {}",
@@ -95,18 +88,16 @@ fn each_column_is_newton_euler_of_a_unit_parameter() {
         ..TreeOptions::default()
     };
     let robot = random_tree(&mut r, n, &opt);
-    let [q, qd, qdd] = random_state(&mut r, n);
-    let mut ws = Workspace::new(robot.numeric());
-    let mut phi = nalgebra::DMatrix::zeros(n, PARAMS_PER_LINK * n);
-    regressor(robot.numeric(), &mut ws, &q, &qd, &qdd, &mut phi);
+    let m = robot.dof();
+    let [q, qd, qdd] = random_state(&mut r, m);
+    let phi = regressor(&robot, &q, &qd, &qdd).unwrap();
     for c in 0..PARAMS_PER_LINK * n {
         let mut k = vec![0.0; PARAMS_PER_LINK * n];
         k[c] = 1.0;
         // masses must be >= 0 for Robot::new: unit values are fine.
         let unit = robot.with_standard_parameters(&k).unwrap();
-        let mut tau = vec![0.0; n];
-        rnea(unit.numeric(), &mut ws, &q, &qd, &qdd, &mut tau);
-        for j in 0..n {
+        let tau = inverse_dynamics(&unit, &q, &qd, &qdd).unwrap();
+        for j in 0..m {
             assert!(
                 (tau[j] - phi[(j, c)]).abs() <= 1e-12 * (1.0 + tau[j].abs()),
                 "column {} row {}: {} vs NE {}",

@@ -1,9 +1,16 @@
-//! `rnea` allocates nothing once its workspace is built: a counting global allocator (counting
+//! The per-call API allocates nothing once its `Data` is built (trees: inverse and direct
+//! dynamics, A, H, the regressor; closed chains: loop closure, inverse and direct dynamics along a
+//! trajectory, once the branch tracker is on the branch): a counting global allocator (counting
 //! only on the calling thread, so the test harness's own threads do not interfere).
 
+use nalgebra::DMatrix;
 use robodyn::algorithms::inverse_dynamics::rnea;
 use robodyn::testing::{self, random_state, random_tree, TreeOptions};
-use robodyn::Workspace;
+use robodyn::{
+    closed_direct_dynamics_into, closed_inverse_dynamics_into, direct_dynamics_into, h_vector_into,
+    inertia_matrix_into, inverse_dynamics_into, loop_closure_into, regressor_into, ClosedChain,
+    ClosedData, Data, Method,
+};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 use std::path::PathBuf;
@@ -44,27 +51,37 @@ fn allocations() -> usize {
     ALLOCATIONS.with(|c| c.get())
 }
 
-#[test]
-fn rnea_allocates_nothing_after_the_workspace_is_built() {
+fn counter_counts() {
+    // The counter sees this thread's allocations: one Vec proves it counts.
+    let before = allocations();
+    let probe = vec![1u8; 16];
+    assert_eq!(allocations(), before + 1, "the counting allocator counts");
+    drop(probe);
+}
+
+fn robots() -> Vec<robodyn::Robot> {
     let sr400 = robodyn::io::load(
         &PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../robots/sr400.toml"),
     )
     .unwrap();
     let mut rng = testing::rng(5);
     let mut robots = vec![sr400];
+    // random trees with fixed frames (the public vectors scatter into the tree arrays)
     for n in [2, 13, 30] {
         robots.push(random_tree(&mut rng, n, &TreeOptions::default()));
     }
-    for robot in &robots {
+    robots
+}
+
+#[test]
+fn rnea_allocates_nothing_after_the_workspace_is_built() {
+    let mut rng = testing::rng(5);
+    for robot in &robots() {
         let n = robot.nl();
         let states: Vec<_> = (0..20).map(|_| random_state(&mut rng, n)).collect();
-        let mut ws = Workspace::new(robot.numeric());
+        let mut ws = Data::new(robot);
         let mut tau = vec![0.0; n];
-        // The counter sees this thread's allocations: one Vec proves it counts.
-        let before = allocations();
-        let probe = vec![1u8; 16];
-        assert_eq!(allocations(), before + 1, "the counting allocator counts");
-        drop(probe);
+        counter_counts();
         let before = allocations();
         let mut checksum = 0.0;
         for _ in 0..50 {
@@ -80,6 +97,133 @@ fn rnea_allocates_nothing_after_the_workspace_is_built() {
             0,
             "{}: rnea allocated {} times in 1000 calls",
             robot.name(),
+            after - before
+        );
+    }
+}
+
+#[test]
+fn checked_tree_functions_allocate_nothing() {
+    let mut rng = testing::rng(6);
+    for robot in &robots() {
+        let m = robot.dof();
+        let nl = robot.nl();
+        let states: Vec<_> = (0..10).map(|_| random_state(&mut rng, m)).collect();
+        let mut data = Data::new(robot);
+        let mut env = robot.environment().clone();
+        let (mut tau, mut qdd, mut h) = (vec![0.0; m], vec![0.0; m], vec![0.0; m]);
+        let mut a = DMatrix::zeros(m, m);
+        let mut phi = DMatrix::zeros(m, 13 * nl);
+        // the regressor's tree buffer is sized at its first call
+        let s0 = &states[0];
+        regressor_into(robot, &mut data, &env, &s0[0], &s0[1], &s0[2], &mut phi).unwrap();
+        counter_counts();
+        let before = allocations();
+        let mut checksum = 0.0;
+        for k in 0..20 {
+            for s in &states {
+                // a contact force that changes at every call: a field of the environment
+                env.set_wrench_on_link(nl, [k as f64, 0.0, 1.0].into(), [0.0; 3].into())
+                    .unwrap();
+                inverse_dynamics_into(robot, &mut data, &env, &s[0], &s[1], &s[2], &mut tau)
+                    .unwrap();
+                for method in [Method::Composite, Method::ArticulatedBody] {
+                    direct_dynamics_into(
+                        robot, &mut data, &env, &s[0], &s[1], &tau, method, &mut qdd,
+                    )
+                    .unwrap();
+                }
+                inertia_matrix_into(robot, &mut data, &s[0], &mut a).unwrap();
+                h_vector_into(robot, &mut data, &env, &s[0], &s[1], &mut h).unwrap();
+                regressor_into(robot, &mut data, &env, &s[0], &s[1], &s[2], &mut phi).unwrap();
+                checksum += qdd.iter().sum::<f64>() + a[(0, 0)] + h[0] + phi[(0, 0)];
+            }
+        }
+        let after = allocations();
+        assert!(checksum.is_finite());
+        assert_eq!(
+            after - before,
+            0,
+            "{}: the checked tree functions allocated {} times",
+            robot.name(),
+            after - before
+        );
+    }
+}
+
+/// Closed chains in a control loop: q_a moves along a smooth trajectory (1 ms steps), each call
+/// continues the branch tracker from the previous point. After the first calls (which size
+/// nothing but start the tracker), nothing is allocated.
+#[test]
+fn closed_chain_steady_state_allocates_nothing() {
+    for (file, amplitude) in [
+        ("sr400.toml", 0.4),
+        ("fivebar.toml", 0.1),
+        ("twoloops.toml", 1.0),
+    ] {
+        let robot = robodyn::io::load(
+            &PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+                .join("../../robots")
+                .join(file),
+        )
+        .unwrap();
+        let chain = ClosedChain::new(&robot).unwrap();
+        let mut branch = chain.assembly_branch().unwrap();
+        let q0 = branch.q_a().to_vec();
+        let n = chain.dof();
+        let mut data = ClosedData::new(&chain);
+        let env = robot.environment();
+        let (mut q, mut qd) = (q0.clone(), vec![0.0; n]);
+        let qdd = vec![0.5; n];
+        let (mut tau, mut acc, mut qp) =
+            (vec![0.0; n], vec![0.0; n], vec![0.0; chain.n_equations()]);
+        let step = |k: usize, q: &mut Vec<f64>, qd: &mut Vec<f64>| {
+            let t = k as f64 * 1e-3;
+            for i in 0..n {
+                let w = 1.0 + i as f64 * 0.3;
+                q[i] = q0[i] + amplitude * (w * t).sin();
+                qd[i] = amplitude * w * (w * t).cos();
+            }
+        };
+        step(1, &mut q, &mut qd);
+        closed_inverse_dynamics_into(&chain, &mut data, &mut branch, env, &q, &qd, &qdd, &mut tau)
+            .unwrap();
+        counter_counts();
+        let before = allocations();
+        let mut checksum = 0.0;
+        for k in 2..1000 {
+            step(k, &mut q, &mut qd);
+            let c = closed_inverse_dynamics_into(
+                &chain,
+                &mut data,
+                &mut branch,
+                env,
+                &q,
+                &qd,
+                &qdd,
+                &mut tau,
+            )
+            .unwrap();
+            closed_direct_dynamics_into(
+                &chain,
+                &mut data,
+                &mut branch,
+                env,
+                &q,
+                &qd,
+                &tau,
+                &mut acc,
+            )
+            .unwrap();
+            loop_closure_into(&chain, &mut data, &mut branch, &q, &mut qp).unwrap();
+            checksum += tau[0] + acc[0] + qp[0] + c.wp;
+        }
+        let after = allocations();
+        assert!(checksum.is_finite());
+        assert_eq!(
+            after - before,
+            0,
+            "{file}: the closed-chain functions allocated {} times in 3000 calls",
             after - before
         );
     }

@@ -2,9 +2,10 @@
 //! variables q_p (and the cut-joint variables) for given actuated variables q_a, and with
 //! `--jacobian` W = d q_p / d q_a (10.30).
 
-use crate::common::{parse_list, CliResult, RobotArgs};
-use robodyn::algorithms::closed_chain::{ClosedChain, ClosedChainWorkspace};
-use robodyn::algorithms::loop_closure::ClosureSolution;
+use crate::common::{
+    conditioning_json, parse_list, start_branch, warn_conditioning, CliResult, RobotArgs,
+};
+use robodyn::{loop_closure, ClosedChain};
 use serde_json::json;
 
 #[derive(clap::Args, Debug)]
@@ -14,9 +15,9 @@ pub struct Args {
     /// Actuated joint values q_a, comma separated, in joint order (see `robodyn info`).
     #[arg(long, allow_hyphen_values = true)]
     pub qa: String,
-    /// Initial guess of q_p (passive tree joints in joint order); default: continuation from
-    /// the robot's `assembly` configuration (else q = 0) when the loops close there, else
-    /// damped Newton from its q_p.
+    /// Guess of q_p (passive tree joints in joint order) at the given q_a, which then picks the
+    /// assembly branch; default: continuation from the robot's `assembly` configuration (else
+    /// q = 0) along the straight path in q_a, on its branch.
     #[arg(long, allow_hyphen_values = true)]
     pub guess: Option<String>,
     /// Also print W = d q_p / d q_a.
@@ -32,41 +33,18 @@ pub enum Format {
     Json,
 }
 
-/// Solve q_p for q_a from `guess`, else from the reference assembly
-/// ([`ClosedChain::solve_from_reference`]).
-pub fn solve(
-    cc: &ClosedChain,
-    ws: &mut ClosedChainWorkspace,
-    q_a: &[f64],
-    guess: Option<&[f64]>,
-) -> CliResult<ClosureSolution> {
-    Ok(cc.solve_from_reference(ws, q_a, guess)?)
-}
-
 pub fn run(a: Args) -> CliResult {
     let robot = a.robot.load()?;
     let cc = ClosedChain::new(&robot)?;
-    let mut ws = cc.workspace();
     let qa = parse_list("qa", &a.qa)?;
-    let guess = a
-        .guess
-        .as_deref()
-        .map(|g| parse_list("guess", g))
-        .transpose()?;
-    let s = solve(&cc, &mut ws, &qa, guess.as_deref())?;
-    let w = if a.jacobian {
-        Some(cc.constraints(&mut ws, &s.q_tr)?.w)
-    } else {
-        None
-    };
-    let act = cc.actuated_joints();
-    let pas = cc.passive_joints();
-    let cuts: Vec<usize> = cc
-        .closure()
-        .loops()
-        .iter()
-        .map(|l| l.topology.cut)
-        .collect();
+    let mut branch = start_branch(&cc, &qa, a.guess.as_deref())?;
+    let s = loop_closure(&cc, &mut branch, &qa)?;
+    warn_conditioning(&cc, 1, 1, &s.conditioning);
+    let w = a.jacobian.then(|| s.w.clone());
+    let act = cc.coordinates().frames();
+    let pas = cc.passive_coordinates().frames();
+    let cuts: Vec<usize> = cc.loops().iter().map(|l| l.topology.cut).collect();
+    let (q_p, q_c) = (s.q_p.as_slice(), s.q_c.as_slice());
     match a.format {
         Format::Json => {
             let named = |js: &[usize], v: &[f64]| -> serde_json::Map<String, serde_json::Value> {
@@ -78,11 +56,13 @@ pub fn run(a: Args) -> CliResult {
             let mut o = json!({
                 "robot": robot.name(),
                 "q_a": named(act, &qa),
-                "q_p": named(pas, &s.q_p),
-                "q_c": named(&cuts, &s.q_c),
+                "q_p": named(pas, q_p),
+                "q_c": named(&cuts, q_c),
                 "residual": s.residual,
-                "iterations": s.iterations,
             });
+            for (k, v) in conditioning_json(&s.conditioning) {
+                o[k] = v;
+            }
             if let Some(w) = &w {
                 let rows: Vec<Vec<f64>> = (0..w.nrows())
                     .map(|r| w.row(r).iter().copied().collect())
@@ -111,12 +91,13 @@ pub fn run(a: Args) -> CliResult {
             println!("actuated q_a:");
             list(act, &qa);
             println!("passive q_p:");
-            list(pas, &s.q_p);
+            list(pas, q_p);
             println!("cut joints q_c:");
-            list(&cuts, &s.q_c);
+            list(&cuts, q_c);
             println!(
-                "closure residual {:.3e} after {} iteration(s)",
-                s.residual, s.iterations
+                "closure residual {:.3e}; {}",
+                s.residual,
+                s.conditioning.describe(cc.limits())
             );
             if let Some(w) = &w {
                 let cols: Vec<String> = act

@@ -2,15 +2,17 @@
 //! (columns q<j>, qd<j>, tau<j>) or from `--q/--qd/--tau`.
 //!
 //! For a closed-chain robot the states, torques and accelerations are those of the actuated
-//! joints only: qdd_a = A_cl^-1 (Γ_cl - H_cl) (10.46–10.48) at the consistent tree state (q_p by
-//! loop closure, each row continued from the previous row's solution, the first from `--guess`,
-//! else from the robot's assembly configuration as `closure` does).
+//! joints only: qdd_a = A_cl^-1 (Γ_cl - H_cl) (10.46–10.48) at the consistent tree state, every
+//! row on the assembly branch (the library's branch tracker, started at the robot's `assembly`
+//! or `--guess`); rows near a singularity are flagged on stderr and in JSON.
 
 use crate::common::{
-    closed_chain_rows, read_joint_states, scatter, CliResult, RobotArgs, TableOutput,
+    conditioning_json, read_joint_states, start_branch, warn_conditioning, CliResult, NamesArg,
+    RobotArgs, TableOutput,
 };
-use robodyn::algorithms::direct_dynamics::{ddm, DirectWorkspace, Method};
-use robodyn::algorithms::inverse_dynamics::check_state;
+use robodyn::{
+    closed_direct_dynamics_into, direct_dynamics_into, ClosedChain, ClosedData, Data, Method,
+};
 use std::path::PathBuf;
 
 /// Direct-dynamics algorithm.
@@ -53,7 +55,10 @@ pub struct Args {
     pub method: MethodArg,
     #[command(flatten)]
     pub out: TableOutput,
-    /// Closed chains: initial guess of q_p for the first state (passive tree joints in order).
+    #[command(flatten)]
+    pub names: NamesArg,
+    /// Closed chains: start the assembly branch at the first state's q_a with this guess of q_p
+    /// (passive tree joints in order) instead of the robot's `assembly`.
     #[arg(long, allow_hyphen_values = true)]
     pub guess: Option<String>,
 }
@@ -63,47 +68,65 @@ pub fn run(a: Args) -> CliResult {
     if !robot.is_tree() {
         return run_closed(a, robot);
     }
-    let joints = robot.movable_joints();
-    let nl = robot.nl();
+    let coords = robot.coordinates();
     let states = read_joint_states(
         a.input.as_deref(),
         ["q", "qd", "tau"],
         [a.q.as_deref(), a.qd.as_deref(), a.tau.as_deref()],
-        &joints,
-        "movable tree joints",
+        coords,
+        a.names,
+        "movable joints",
     )?;
-    let model = robot.numeric();
-    let mut ws = DirectWorkspace::new(model);
-    let mut qdd = vec![0.0; nl];
+    let mut data = Data::new(&robot);
+    let env = robot.environment();
     let mut rows = Vec::with_capacity(states.len());
-    for (what, [q, qd, tau]) in &states {
-        let [q, qd, tau] = [q, qd, tau].map(|v| scatter(&joints, nl, v));
-        check_state(&robot, "q", &q)?;
-        ddm(model, &mut ws, a.method.into(), &q, &qd, &tau, &mut qdd)
-            .map_err(|e| format!("{what}: {e}"))?;
-        rows.push(joints.iter().map(|j| qdd[j - 1]).collect());
+    for (k, [q, qd, tau]) in states.iter().enumerate() {
+        let mut qdd = vec![0.0; coords.len()];
+        direct_dynamics_into(
+            &robot,
+            &mut data,
+            env,
+            q,
+            qd,
+            tau,
+            a.method.into(),
+            &mut qdd,
+        )
+        .map_err(|e| e.in_row(k + 1))?;
+        rows.push(qdd);
     }
-    let headers: Vec<String> = joints.iter().map(|j| format!("qdd{j}")).collect();
-    a.out.write(&headers, &rows)
+    a.out.write(&a.names.columns("qdd", coords), &rows)
 }
 
 /// Closed chains: columns q<j>, qd<j>, tau<j> of the actuated joints in, qdd<j> of the actuated
-/// joints out (the `--method` is the closed-chain model's A_cl, H_cl).
+/// joints out (the `--method` is the closed-chain model's A_cl, H_cl), every row on the branch.
 fn run_closed(a: Args, robot: robodyn::Robot) -> CliResult {
-    use robodyn::algorithms::closed_chain::ClosedChain;
-    let cc = ClosedChain::new(&robot)?;
-    let joints = cc.actuated_joints().to_vec();
+    let chain = ClosedChain::new(&robot)?;
+    let coords = chain.coordinates();
     let states = read_joint_states(
         a.input.as_deref(),
         ["q", "qd", "tau"],
         [a.q.as_deref(), a.qd.as_deref(), a.tau.as_deref()],
-        &joints,
+        coords,
+        a.names,
         "actuated joints (closed chain)",
     )?;
-    let rows = closed_chain_rows(&cc, &states, a.guess.as_deref(), |ws, q, x, y, q_p| {
-        let r = cc.direct_dynamics(ws, q, x, y, Some(q_p))?;
-        Ok(r.qdd_a.iter().copied().collect())
-    })?;
-    let headers: Vec<String> = joints.iter().map(|j| format!("qdd{j}")).collect();
-    a.out.write(&headers, &rows)
+    let Some(first) = states.first() else {
+        return a.out.write(&a.names.columns("qdd", coords), &[]);
+    };
+    let mut branch = start_branch(&chain, &first[0], a.guess.as_deref())?;
+    let mut data = ClosedData::new(&chain);
+    let env = robot.environment();
+    let (mut rows, mut extra) = (Vec::new(), Vec::new());
+    for (k, [q, qd, tau]) in states.iter().enumerate() {
+        let mut qdd = vec![0.0; coords.len()];
+        let c =
+            closed_direct_dynamics_into(&chain, &mut data, &mut branch, env, q, qd, tau, &mut qdd)
+                .map_err(|e| e.in_row(k + 1))?;
+        warn_conditioning(&chain, k + 1, states.len(), &c);
+        rows.push(qdd);
+        extra.push(conditioning_json(&c));
+    }
+    a.out
+        .write_with(&a.names.columns("qdd", coords), &rows, &extra)
 }

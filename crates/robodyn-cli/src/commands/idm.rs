@@ -2,14 +2,15 @@
 //! (columns q<j>, qd<j>, qdd<j>) or from `--q/--qd/--qdd`.
 //!
 //! For a closed-chain robot the states and torques are those of the actuated joints only:
-//! Γ_cl = G^T Γ_tr (10.40) at the consistent tree state (q_p solved by loop closure, each row
-//! continued from the previous row's solution; the first from `--guess`, else as `closure` does).
+//! Γ_cl = G^T Γ_tr (10.40) at the consistent tree state, every row on the assembly branch
+//! (the library's branch tracker: each row continued from the previous one, the first from the
+//! robot's `assembly` or `--guess`); rows near a singularity are flagged on stderr and in JSON.
 
 use crate::common::{
-    closed_chain_rows, read_joint_states, scatter, CliResult, RobotArgs, TableOutput,
+    conditioning_json, read_joint_states, start_branch, warn_conditioning, CliResult, NamesArg,
+    RobotArgs, TableOutput,
 };
-use robodyn::algorithms::inverse_dynamics::{check_state, rnea};
-use robodyn::Workspace;
+use robodyn::{closed_inverse_dynamics_into, inverse_dynamics_into, ClosedChain, ClosedData, Data};
 use std::path::PathBuf;
 
 #[derive(clap::Args, Debug)]
@@ -32,7 +33,10 @@ pub struct Args {
     pub qdd: Option<String>,
     #[command(flatten)]
     pub out: TableOutput,
-    /// Closed chains: initial guess of q_p for the first state (passive tree joints in order).
+    #[command(flatten)]
+    pub names: NamesArg,
+    /// Closed chains: start the assembly branch at the first state's q_a with this guess of q_p
+    /// (passive tree joints in order) instead of the robot's `assembly`.
     #[arg(long, allow_hyphen_values = true)]
     pub guess: Option<String>,
 }
@@ -42,45 +46,56 @@ pub fn run(a: Args) -> CliResult {
     if !robot.is_tree() {
         return run_closed(a, robot);
     }
-    let joints = robot.movable_joints();
-    let nl = robot.nl();
+    let coords = robot.coordinates();
     let states = read_joint_states(
         a.input.as_deref(),
         ["q", "qd", "qdd"],
         [a.q.as_deref(), a.qd.as_deref(), a.qdd.as_deref()],
-        &joints,
-        "movable tree joints",
+        coords,
+        a.names,
+        "movable joints",
     )?;
-    let model = robot.numeric();
-    let mut ws = Workspace::new(model);
-    let mut tau = vec![0.0; nl];
+    let mut data = Data::new(&robot);
+    let env = robot.environment();
     let mut rows = Vec::with_capacity(states.len());
-    for (_, [q, qd, qdd]) in &states {
-        let [q, qd, qdd] = [q, qd, qdd].map(|v| scatter(&joints, nl, v));
-        check_state(&robot, "q", &q)?;
-        rnea(model, &mut ws, &q, &qd, &qdd, &mut tau);
-        rows.push(joints.iter().map(|j| tau[j - 1]).collect());
+    for (k, [q, qd, qdd]) in states.iter().enumerate() {
+        let mut tau = vec![0.0; coords.len()];
+        inverse_dynamics_into(&robot, &mut data, env, q, qd, qdd, &mut tau)
+            .map_err(|e| e.in_row(k + 1))?;
+        rows.push(tau);
     }
-    let headers: Vec<String> = joints.iter().map(|j| format!("tau{j}")).collect();
-    a.out.write(&headers, &rows)
+    a.out.write(&a.names.columns("tau", coords), &rows)
 }
 
-/// Closed chains: columns of the actuated joints in, tau<j> of the actuated joints out.
+/// Closed chains: columns of the actuated joints in, tau<j> of the actuated joints out, every
+/// row on the branch tracker (library: continuation from the previous row).
 fn run_closed(a: Args, robot: robodyn::Robot) -> CliResult {
-    use robodyn::algorithms::closed_chain::ClosedChain;
-    let cc = ClosedChain::new(&robot)?;
-    let joints = cc.actuated_joints().to_vec();
+    let chain = ClosedChain::new(&robot)?;
+    let coords = chain.coordinates();
     let states = read_joint_states(
         a.input.as_deref(),
         ["q", "qd", "qdd"],
         [a.q.as_deref(), a.qd.as_deref(), a.qdd.as_deref()],
-        &joints,
+        coords,
+        a.names,
         "actuated joints (closed chain)",
     )?;
-    let rows = closed_chain_rows(&cc, &states, a.guess.as_deref(), |ws, q, x, y, q_p| {
-        let r = cc.inverse_dynamics(ws, q, x, y, Some(q_p))?;
-        Ok(r.gamma_cl.iter().copied().collect())
-    })?;
-    let headers: Vec<String> = joints.iter().map(|j| format!("tau{j}")).collect();
-    a.out.write(&headers, &rows)
+    let Some(first) = states.first() else {
+        return a.out.write(&a.names.columns("tau", coords), &[]);
+    };
+    let mut branch = start_branch(&chain, &first[0], a.guess.as_deref())?;
+    let mut data = ClosedData::new(&chain);
+    let env = robot.environment();
+    let (mut rows, mut extra) = (Vec::new(), Vec::new());
+    for (k, [q, qd, qdd]) in states.iter().enumerate() {
+        let mut tau = vec![0.0; coords.len()];
+        let c =
+            closed_inverse_dynamics_into(&chain, &mut data, &mut branch, env, q, qd, qdd, &mut tau)
+                .map_err(|e| e.in_row(k + 1))?;
+        warn_conditioning(&chain, k + 1, states.len(), &c);
+        rows.push(tau);
+        extra.push(conditioning_json(&c));
+    }
+    a.out
+        .write_with(&a.names.columns("tau", coords), &rows, &extra)
 }

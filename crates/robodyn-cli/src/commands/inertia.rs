@@ -2,7 +2,7 @@
 //! composite-link method, over the movable joints (rotor inertias on the diagonal).
 
 use crate::common::{parse_list, write_table, CliResult, RobotArgs, TableFormat};
-use robodyn::algorithms::inertia_matrix::inertia_matrix;
+use robodyn::inertia_matrix;
 use std::io::Write;
 use std::path::PathBuf;
 
@@ -23,27 +23,14 @@ pub struct Args {
 
 pub fn run(a: Args) -> CliResult {
     let robot = a.robot.load()?;
-    let joints = robot.movable_joints();
-    let mut q = vec![0.0; robot.nl()];
-    if let Some(s) = &a.q {
-        let vals = parse_list("q", s)?;
-        if vals.len() != joints.len() {
-            return Err(format!(
-                "--q has {} values, the robot has {} movable tree joints ({:?})",
-                vals.len(),
-                joints.len(),
-                joints
-            )
-            .into());
-        }
-        for (j, x) in joints.iter().zip(vals) {
-            q[j - 1] = x;
-        }
-    }
+    let joints = robot.coordinates().frames().to_vec();
+    let q = match &a.q {
+        Some(s) => parse_list("q", s)?,
+        None => vec![0.0; joints.len()],
+    };
     let m = inertia_matrix(&robot, &q)?;
-    let rows: Vec<Vec<f64>> = joints
-        .iter()
-        .map(|&i| joints.iter().map(|&j| m[(i - 1, j - 1)]).collect())
+    let rows: Vec<Vec<f64>> = (0..joints.len())
+        .map(|i| m.row(i).iter().copied().collect())
         .collect();
     match a.format {
         TableFormat::Csv => {
@@ -51,7 +38,7 @@ pub fn run(a: Args) -> CliResult {
             write_table(a.output.as_deref(), a.format, &headers, &rows)
         }
         TableFormat::Json => {
-            let v = serde_json::json!({ "joints": joints, "q": joints.iter().map(|j| q[j - 1]).collect::<Vec<_>>(), "A": rows });
+            let v = serde_json::json!({ "joints": joints, "q": q, "A": rows });
             let text = serde_json::to_string_pretty(&v)?;
             match &a.output {
                 Some(p) => {

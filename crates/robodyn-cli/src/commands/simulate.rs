@@ -163,21 +163,16 @@ pub fn run(a: Args) -> CliResult {
             let joints = d.joints().to_vec();
             (Box::new(d), joints, "movable tree joints", None)
         } else {
-            let d = ClosedChainDynamics::new(&robot)?.with_coulomb_smoothing(smoothing);
-            let joints = d.actuated_joints().to_vec();
-            let q0 = d.model().reference_actuated();
-            if a.q0.is_none() {
-                let (m, z) = (d.model(), vec![0.0; q0.len()]);
-                let mut ws = m.workspace();
-                m.solve_from_reference(&mut ws, &q0, None)
-                    .and_then(|s| m.state(&mut ws, &q0, &z, &z, Some(&s.q_p)))
-                    .map_err(|e| {
-                        format!(
-                            "the default initial state (the actuated values {q0:?} of the \
-                             assembly configuration) cannot be simulated: {e}\n  give --q0"
-                        )
-                    })?;
-            }
+            let chain = robodyn::ClosedChain::new(&robot)?;
+            let branch = chain.assembly_branch().map_err(|e| {
+                format!(
+                    "the simulation starts on the branch of the assembly configuration, which \
+                     cannot be used: {e}"
+                )
+            })?;
+            let q0 = branch.q_a().to_vec();
+            let d = ClosedChainDynamics::new(chain, branch).with_coulomb_smoothing(smoothing);
+            let joints = d.chain().coordinates().frames().to_vec();
             (
                 Box::new(d),
                 joints,

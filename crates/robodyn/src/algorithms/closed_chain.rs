@@ -1,484 +1,1195 @@
-//! Dynamic models of robots with closed kinematic chains (§10.3.2–10.3.3): the equivalent tree's
-//! Newton–Euler model projected on the actuated joints.
+//! Dynamic models of robots with closed kinematic chains (§10.3.1–10.3.3): the equivalent tree's
+//! Newton–Euler model projected on the actuated joints, evaluated on one assembly branch.
 //!
-//! - kinematic constraints: W = -Wp^-1 Wa (10.30), G = d q_tr / d q_a (rows by joint number,
-//!   10.40), qd_p = W qd_a (10.29), qdd_p = W qdd_a - Wp^-1 Ψ (10.42);
+//! - kinematic constraints: W = -Wp^-1 Wa (10.30), G = d q_tr / d q_a (10.40),
+//!   qd_p = W qd_a (10.29), qdd_p = W qdd_a - Wp^-1 Ψ (10.42);
 //! - inverse model: Γ_cl = G^T Γ_tr (10.40), Lagrange multipliers λ = -Wp^-T Γ_p (10.37) and
 //!   Γ_cl = Γ_a + Wa^T λ (10.36, upper part);
 //! - direct model: A_cl (10.46), H_cl (10.47), qdd_a = A_cl^-1 (Γ_cl - H_cl) (10.48, Cholesky).
 //!
-//! [`ClosedChain`] is the immutable model (built once from a [`Robot`]); [`ClosedChainWorkspace`]
-//! holds the buffers and the previous closure solution (the next solve's guess).
+//! [`ClosedChain`] is the model (built once from a [`Robot`]), [`ClosedData`] its per-evaluation
+//! buffers and [`Branch`] the branch tracker: the assembly branch (sign of det Wp) and the last
+//! closed point reached on it. Every evaluation at q_a first moves the tracker to q_a by
+//! continuation along the straight path in q_a (predictor q_p + W dq_a, Newton corrector, steps
+//! halved on failure), checking at every step that det Wp keeps its sign, that Wp stays above the
+//! hard conditioning limit and that the corrector lands within the predictor's reach. A result
+//! therefore depends on (model, branch, inputs) only, never on a hidden history.
+//!
+//! Public vectors: q_a, qd_a, qdd_a, Γ_cl over the actuated joints
+//! ([`ClosedChain::coordinates`]); q_p over the passive joints
+//! ([`ClosedChain::passive_coordinates`]); tree states (Γ_tr, q_tr...) over the movable joints of
+//! the equivalent tree (`chain.robot().coordinates()`).
+//!
+//! Allocation: the `_into` functions allocate nothing once the tracker is on the branch (the
+//! small p x p solves use [`crate::linalg`]'s in-place LU); starting a branch
+//! ([`ClosedChain::assembly_branch`], [`ClosedChain::branch_from`]) allocates.
 
-use crate::algorithms::inertia_matrix::{inertia_matrix_into, InertiaWorkspace};
-use crate::algorithms::inverse_dynamics::rnea;
-use crate::algorithms::loop_closure::{ClosureSolution, LoopClosure, LoopWorkspace};
+use crate::algorithms::inertia_matrix::composite_inertia_matrix;
+use crate::algorithms::inverse_dynamics::rnea_with_environment;
+use crate::algorithms::loop_closure::{LoopClosure, LoopConstraint, LoopWorkspace};
+use crate::algorithms::regressor::{tree_regressor, tree_wrench_torques, PARAMS_PER_LINK};
+use crate::data::Data;
 use crate::error::{Error, Result};
-use crate::model::Robot;
-use crate::workspace::Workspace;
+use crate::linalg::{norm1, rcond_cholesky, SmallLu};
+use crate::model::{Coordinates, Environment, Robot};
+use crate::scalar::DynScalar;
 use nalgebra::{DMatrix, DVector};
 
-/// Closed-chain dynamic model: loop closure plus the equivalent tree.
-#[derive(Clone, Debug)]
-pub struct ClosedChain {
-    closure: LoopClosure,
+/// Conditioning limits of a closed chain: reciprocal 1-norm condition numbers
+/// 1 / (||M||_1 ||M^-1||_1) below which a result is flagged (`soft`) or refused (`hard`).
+///
+/// The default hard limit of Wp, 1e-5, comes from the closure tolerance (1e-12): at a fold of the
+/// closure manifold (a parallel singularity, e.g. the five-bar's distal links aligned) q_p is
+/// determined only to its square root, ~1e-6 rad or m, and the reciprocal condition number
+/// reached there is ~1e-6: anything below 1e-5 is indistinguishable from exactly singular, and
+/// W ~ 1/rcond is then meaningless. Below the soft limit 1e-3, W and the closed-chain torques
+/// are amplified more than a thousand times: correct, but sensitive to every input.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ConditioningLimits {
+    /// Wp below this: warning (default 1e-3).
+    pub wp_soft: f64,
+    /// Wp below this: [`Error::Singular`] (default 1e-5).
+    pub wp_hard: f64,
+    /// A_cl below this: warning (default 1e-8).
+    pub a_cl_soft: f64,
+    /// A_cl below this: [`Error::Singular`] (default 1e-13).
+    pub a_cl_hard: f64,
 }
 
-/// Buffers of the closed-chain models.
-#[derive(Clone, Debug)]
-pub struct ClosedChainWorkspace {
-    pub closure: LoopWorkspace,
-    pub tree: Workspace<f64>,
-    tau: Vec<f64>,
-    zeros: Vec<f64>,
-    inertia: InertiaWorkspace<f64>,
-    a_tr: DMatrix<f64>,
-}
-
-/// Constraint matrices at a closed configuration (eqs 10.27–10.30, 10.40).
-#[derive(Clone, Debug)]
-pub struct Constraints {
-    /// Wa (p x N), columns in actuated-joint order.
-    pub wa: DMatrix<f64>,
-    /// Wp (p x p), columns in passive-joint order.
-    pub wp: DMatrix<f64>,
-    /// W = -Wp^-1 Wa (p x N).
-    pub w: DMatrix<f64>,
-    /// G = d q_tr / d q_a (NL x N), rows by joint number (fixed frames zero).
-    pub g: DMatrix<f64>,
-    wp_lu: nalgebra::LU<f64, nalgebra::Dyn, nalgebra::Dyn>,
-}
-
-impl Constraints {
-    /// Wp^-1 x.
-    pub fn wp_solve(&self, x: &DVector<f64>) -> DVector<f64> {
-        self.wp_lu.solve(x).expect("Wp checked regular")
+impl Default for ConditioningLimits {
+    fn default() -> Self {
+        ConditioningLimits {
+            wp_soft: 1e-3,
+            wp_hard: 1e-5,
+            a_cl_soft: 1e-8,
+            a_cl_hard: 1e-13,
+        }
     }
 }
 
-/// A consistent state of the equivalent tree: q_tr, qd_tr, qdd_tr (NL entries, by joint number).
+/// Conditioning of a closed-chain result, returned next to it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Conditioning {
+    /// Reciprocal 1-norm condition number of Wp at the configuration.
+    pub wp: f64,
+    /// Reciprocal 1-norm condition number of A_cl (direct model only).
+    pub a_cl: Option<f64>,
+    /// True when a value is below its soft limit: the configuration is near a singularity and
+    /// the result is sensitive to its inputs.
+    pub warning: bool,
+}
+
+impl Conditioning {
+    /// "reciprocal condition number of Wp 3.2e-6 (warning below 1e-4)", for messages.
+    pub fn describe(&self, limits: &ConditioningLimits) -> String {
+        let mut s = format!(
+            "reciprocal condition number of Wp {:.1e} (warning below {:.0e})",
+            self.wp, limits.wp_soft
+        );
+        if let Some(a) = self.a_cl {
+            s.push_str(&format!(
+                ", of A_cl {a:.1e} (warning below {:.0e})",
+                limits.a_cl_soft
+            ));
+        }
+        s
+    }
+}
+
+/// Closed-chain model: the loop-closure equations of its loops on the equivalent tree, the
+/// actuated and passive coordinates, the conditioning limits and the continuation settings.
 #[derive(Clone, Debug)]
+pub struct ClosedChain {
+    closure: LoopClosure,
+    coords: Coordinates,
+    passive: Coordinates,
+    limits: ConditioningLimits,
+    max_step: f64,
+}
+
+/// The branch tracker of a closed chain: the assembly branch (sign of det Wp) and the last
+/// closed configuration reached on it, owned by the caller. Made by
+/// [`ClosedChain::assembly_branch`] or [`ClosedChain::branch_from`]; every closed-chain
+/// evaluation moves it to its q_a (on error it stays where it was).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Branch {
+    q_a: Vec<f64>,
+    q_p: Vec<f64>,
+    /// W at (q_a, q_p): the predictor of the next step.
+    w: DMatrix<f64>,
+    sign: f64,
+    rcond: f64,
+}
+
+impl Branch {
+    /// The actuated values of the tracker's point.
+    pub fn q_a(&self) -> &[f64] {
+        &self.q_a
+    }
+
+    /// The passive values of the tracker's point.
+    pub fn q_p(&self) -> &[f64] {
+        &self.q_p
+    }
+
+    /// Sign of det Wp on the branch (+1 or -1): the branch invariant.
+    pub fn det_sign(&self) -> f64 {
+        self.sign
+    }
+
+    /// Reciprocal condition number of Wp at the tracker's point.
+    pub fn rcond(&self) -> f64 {
+        self.rcond
+    }
+}
+
+/// Per-evaluation buffers of a [`ClosedChain`] (its tree's [`Data`] included). One per thread.
+#[derive(Clone, Debug)]
+pub struct ClosedData {
+    n: usize,
+    p: usize,
+    nl: usize,
+    tree: Data,
+    lw: LoopWorkspace,
+    q_tr: Vec<f64>,
+    qd_tr: Vec<f64>,
+    qdd_tr: Vec<f64>,
+    tau_tr: Vec<f64>,
+    r: DVector<f64>,
+    jac: DMatrix<f64>,
+    lu: SmallLu,
+    w: DMatrix<f64>,
+    g: DMatrix<f64>,
+    psi: DVector<f64>,
+    qa: Vec<f64>,
+    qp: Vec<f64>,
+    pred: Vec<f64>,
+    dx: Vec<f64>,
+    start_qa: Vec<f64>,
+    start_qp: Vec<f64>,
+    start_w: DMatrix<f64>,
+    start_rcond: f64,
+    a_cl: DMatrix<f64>,
+    chol: DMatrix<f64>,
+    h_cl: DVector<f64>,
+    ag: DMatrix<f64>,
+    v_nl: DVector<f64>,
+    col_n: DVector<f64>,
+    zeros_n: Vec<f64>,
+    phi: DMatrix<f64>,
+}
+
+impl ClosedData {
+    /// The tree's buffers (shared with the closed-chain evaluation).
+    pub(crate) fn tree_mut(&mut self) -> &mut Data {
+        &mut self.tree
+    }
+
+    /// The buffers of `chain`'s evaluations.
+    pub fn new(chain: &ClosedChain) -> ClosedData {
+        let (n, p, nl) = (chain.dof(), chain.n_equations(), chain.robot().nl());
+        ClosedData {
+            n,
+            p,
+            nl,
+            tree: Data::new(chain.robot()),
+            lw: chain.closure.workspace(),
+            q_tr: vec![0.0; nl],
+            qd_tr: vec![0.0; nl],
+            qdd_tr: vec![0.0; nl],
+            tau_tr: vec![0.0; nl],
+            r: DVector::zeros(p),
+            jac: DMatrix::zeros(p, nl),
+            lu: SmallLu::new(p),
+            w: DMatrix::zeros(p, n),
+            g: DMatrix::zeros(nl, n),
+            psi: DVector::zeros(p),
+            qa: vec![0.0; n],
+            qp: vec![0.0; p],
+            pred: vec![0.0; p],
+            dx: vec![0.0; p],
+            start_qa: vec![0.0; n],
+            start_qp: vec![0.0; p],
+            start_w: DMatrix::zeros(p, n),
+            start_rcond: 0.0,
+            a_cl: DMatrix::zeros(n, n),
+            chol: DMatrix::zeros(n, n),
+            h_cl: DVector::zeros(n),
+            ag: DMatrix::zeros(nl, n),
+            v_nl: DVector::zeros(nl),
+            col_n: DVector::zeros(n),
+            zeros_n: vec![0.0; n],
+            phi: DMatrix::zeros(0, 0),
+        }
+    }
+}
+
+/// Why a continuation step was refused.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum StepFailure {
+    NoConvergence,
+    Singular,
+    SignChange,
+    IllConditioned(f64),
+    Jump,
+}
+
+/// Largest corrector iterations of one continuation step.
+const CORRECTOR_ITERATIONS: usize = 12;
+/// The corrected q_p may differ from the prediction by half the predicted motion plus this.
+const JUMP_FLOOR: f64 = 1e-3;
+
+fn fmt_vec(v: &[f64]) -> String {
+    let s: Vec<String> = v.iter().map(|x| format!("{x:.6}")).collect();
+    format!("[{}]", s.join(", "))
+}
+
+impl ClosedChain {
+    /// The closed-chain model of `robot`: chooses the independent closure equations of each
+    /// loop by rank (see [`crate::algorithms::loop_closure`]) and checks that they are as many as
+    /// the passive joints. Error for a tree or a wrong number of actuators.
+    pub fn new(robot: &Robot) -> Result<ClosedChain> {
+        let closure = LoopClosure::new(robot)?;
+        let coords_of = |js: &[usize]| {
+            Coordinates::new(
+                js.to_vec(),
+                js.iter().map(|&j| robot.frame(j).name.clone()).collect(),
+                robot.nl(),
+            )
+        };
+        Ok(ClosedChain {
+            coords: coords_of(closure.actuated_joints()),
+            passive: coords_of(closure.passive_joints()),
+            closure,
+            limits: ConditioningLimits::default(),
+            max_step: 0.25,
+        })
+    }
+
+    /// The equivalent tree.
+    pub fn robot(&self) -> &Robot {
+        self.closure.robot()
+    }
+
+    /// Coordinates of the public vectors: the actuated joints q_a, in frame order.
+    pub fn coordinates(&self) -> &Coordinates {
+        &self.coords
+    }
+
+    /// Coordinates of q_p: the passive tree joints, in frame order.
+    pub fn passive_coordinates(&self) -> &Coordinates {
+        &self.passive
+    }
+
+    /// N, the degrees of freedom (actuated joints).
+    pub fn dof(&self) -> usize {
+        self.coords.len()
+    }
+
+    /// p, the number of independent closure equations (= passive joints).
+    pub fn n_equations(&self) -> usize {
+        self.closure.n_equations()
+    }
+
+    /// The loops with their kept closure equations.
+    pub fn loops(&self) -> &[LoopConstraint] {
+        self.closure.loops()
+    }
+
+    /// The conditioning limits.
+    pub fn limits(&self) -> &ConditioningLimits {
+        &self.limits
+    }
+
+    /// The same chain with other conditioning limits.
+    pub fn with_limits(mut self, limits: ConditioningLimits) -> Self {
+        self.limits = limits;
+        self
+    }
+
+    /// Closure tolerance: the largest kept closure equation at a solution (m or rad; default
+    /// 1e-12).
+    pub fn tolerance(&self) -> f64 {
+        self.closure.tolerance
+    }
+
+    /// The same chain with another closure tolerance (> 0).
+    pub fn with_tolerance(mut self, tolerance: f64) -> Self {
+        self.closure.tolerance = tolerance;
+        self
+    }
+
+    #[cfg_attr(not(feature = "codegen"), allow(dead_code))]
+    pub(crate) fn closure(&self) -> &LoopClosure {
+        &self.closure
+    }
+
+    /// A tracker on the branch of the robot's assembly configuration (its `assembly`, else
+    /// q = 0). Errors: [`Error::LoopNotClosed`] when the loops do not close near it,
+    /// [`Error::SingularStart`] when the robot has no assembly and Wp is singular at q = 0
+    /// (the start does not define a branch), [`Error::Singular`] for a singular assembly.
+    pub fn assembly_branch(&self) -> Result<Branch> {
+        let robot = self.robot();
+        let reference = robot
+            .description()
+            .assembly
+            .clone()
+            .unwrap_or_else(|| vec![0.0; robot.nl()]);
+        let qa: Vec<f64> = self
+            .coords
+            .frames()
+            .iter()
+            .map(|&j| reference[j - 1])
+            .collect();
+        let qp: Vec<f64> = self
+            .passive
+            .frames()
+            .iter()
+            .map(|&j| reference[j - 1])
+            .collect();
+        match self.branch_from(&qa, &qp) {
+            Err(Error::Singular { rcond, .. }) if robot.description().assembly.is_none() => {
+                Err(Error::SingularStart {
+                    robot: robot.name().to_string(),
+                    rcond,
+                })
+            }
+            r => r,
+        }
+    }
+
+    /// A tracker on the branch through (q_a, q_p ≈ `q_p_guess`): the loops are closed at q_a
+    /// from the guess (damped Newton) and Wp must be regular there. Allocates.
+    pub fn branch_from(&self, q_a: &[f64], q_p_guess: &[f64]) -> Result<Branch> {
+        self.coords.check("q_a", q_a, "actuated joints")?;
+        self.passive
+            .check("q_p guess", q_p_guess, "passive joints")?;
+        let mut d = ClosedData::new(self);
+        let sol = self.closure.solve_from_guess(&mut d.lw, q_a, q_p_guess)?;
+        d.qa.copy_from_slice(q_a);
+        d.qp.copy_from_slice(&sol.q_p);
+        self.closure.assemble(&d.qa, &d.qp, &mut d.q_tr);
+        self.factor_wp(&mut d);
+        let rcond = d.lu.rcond();
+        if rcond < self.limits.wp_hard {
+            return Err(self.singular_wp(rcond, &d.q_tr));
+        }
+        let mut b = Branch {
+            q_a: q_a.to_vec(),
+            q_p: sol.q_p,
+            w: DMatrix::zeros(self.n_equations(), self.dof()),
+            sign: d.lu.det_sign(),
+            rcond,
+        };
+        self.compute_w(&mut d);
+        b.w.copy_from(&d.w);
+        Ok(b)
+    }
+
+    fn singular_wp(&self, rcond: f64, q_tr: &[f64]) -> Error {
+        let labels: Vec<String> = self.loops().iter().map(|l| l.label()).collect();
+        Error::Singular {
+            what: format!(
+                "Wp (derivative of the closure equations of {} with respect to the passive \
+                 joints {:?})",
+                labels.join(", "),
+                self.passive.frames()
+            ),
+            rcond,
+            limit: self.limits.wp_hard,
+            at: format!("q_tr = {}", fmt_vec(q_tr)),
+            hint: "the mechanism is at a singular configuration: q_p is not determined by q_a"
+                .into(),
+        }
+    }
+
+    fn check_data(&self, d: &ClosedData, b: &Branch) -> Result<()> {
+        if d.n != self.dof() || d.p != self.n_equations() || d.nl != self.robot().nl() {
+            return Err(Error::dimension(
+                "closed data",
+                self.dof(),
+                d.n,
+                "actuated joints: the ClosedData was made for another closed chain",
+            ));
+        }
+        if b.q_a.len() != self.dof() || b.q_p.len() != self.n_equations() {
+            return Err(Error::dimension(
+                "branch",
+                self.dof(),
+                b.q_a.len(),
+                "actuated joints: the Branch was made for another closed chain",
+            ));
+        }
+        Ok(())
+    }
+
+    /// Kinematics at d.q_tr, the constraint Jacobian and the LU of Wp (in d.lu).
+    fn factor_wp(&self, d: &mut ClosedData) {
+        let lc = &self.closure;
+        lc.kinematics(&mut d.lw, &d.q_tr, None, None);
+        lc.constraint_jacobian(&mut d.lw, &mut d.jac);
+        for (c, &j) in lc.passive_joints().iter().enumerate() {
+            for r in 0..d.p {
+                d.lu.lu[(r, c)] = d.jac[(r, j - 1)];
+            }
+        }
+        d.lu.factor();
+    }
+
+    /// W = -Wp^-1 Wa into d.w (after [`Self::factor_wp`]) and G = [I; W] into d.g (tree rows).
+    fn compute_w(&self, d: &mut ClosedData) {
+        let lc = &self.closure;
+        for (c, &j) in lc.actuated_joints().iter().enumerate() {
+            for r in 0..d.p {
+                d.w[(r, c)] = -d.jac[(r, j - 1)];
+            }
+        }
+        let mut w = std::mem::replace(&mut d.w, DMatrix::zeros(0, 0));
+        d.lu.solve_matrix(&mut w);
+        d.w = w;
+        d.g.fill(0.0);
+        for (c, &j) in lc.actuated_joints().iter().enumerate() {
+            d.g[(j - 1, c)] = 1.0;
+        }
+        for (r, &j) in lc.passive_joints().iter().enumerate() {
+            for c in 0..d.n {
+                d.g[(j - 1, c)] = d.w[(r, c)];
+            }
+        }
+    }
+
+    /// Newton corrector at d.qa from d.pred into d.qp; on success the placements, the Jacobian
+    /// and the LU of Wp are those of the solution.
+    fn correct(&self, d: &mut ClosedData) -> std::result::Result<(), StepFailure> {
+        let lc = &self.closure;
+        d.qp.copy_from_slice(&d.pred);
+        let mut previous = f64::INFINITY;
+        for _ in 0..CORRECTOR_ITERATIONS {
+            lc.assemble(&d.qa, &d.qp, &mut d.q_tr);
+            lc.kinematics(&mut d.lw, &d.q_tr, None, None);
+            lc.residual(&d.lw, &mut d.r);
+            if d.r.amax() <= lc.tolerance {
+                self.factor_wp(d);
+                if !d.lu.regular {
+                    return Err(StepFailure::Singular);
+                }
+                if lc.flipped_loop(&d.lw).is_some() {
+                    return Err(StepFailure::Jump);
+                }
+                return Ok(());
+            }
+            self.factor_wp(d);
+            if !d.lu.regular {
+                return Err(StepFailure::Singular);
+            }
+            for (x, r) in d.dx.iter_mut().zip(d.r.iter()) {
+                *x = -r;
+            }
+            d.lu.solve(&mut d.dx);
+            let step = d.dx.iter().fold(0.0_f64, |a, b| a.max(b.abs()));
+            if !step.is_finite() || step > 0.5 * previous {
+                return Err(StepFailure::NoConvergence);
+            }
+            previous = step;
+            for (q, x) in d.qp.iter_mut().zip(&d.dx) {
+                *q += x;
+            }
+        }
+        Err(StepFailure::NoConvergence)
+    }
+
+    /// Move the tracker to q_a by continuation (see the module documentation). On success the
+    /// buffers of `d` hold the closed configuration (placements, Wp factors, W, G).
+    fn track(&self, d: &mut ClosedData, b: &mut Branch, q_a: &[f64]) -> Result<()> {
+        d.start_qa.copy_from_slice(&b.q_a);
+        d.start_qp.copy_from_slice(&b.q_p);
+        d.start_w.copy_from(&b.w);
+        d.start_rcond = b.rcond;
+        let dist = q_a
+            .iter()
+            .zip(&b.q_a)
+            .fold(0.0_f64, |m, (x, y)| m.max((x - y).abs()));
+        let max_h = if dist == 0.0 {
+            1.0
+        } else {
+            (self.max_step / dist).min(1.0)
+        };
+        let mut h = max_h;
+        let mut s = 0.0;
+        let mut failure: StepFailure;
+        loop {
+            let t = if s + h >= 1.0 - 1e-12 { 1.0 } else { s + h };
+            if t == 1.0 {
+                d.qa.copy_from_slice(q_a);
+            } else {
+                for k in 0..d.n {
+                    d.qa[k] = d.start_qa[k] + t * (q_a[k] - d.start_qa[k]);
+                }
+            }
+            // predictor (10.29): q_p + W (q_a - q_a_branch)
+            let mut pred_step: f64 = 0.0;
+            for r in 0..d.p {
+                let mut x = b.q_p[r];
+                for c in 0..d.n {
+                    x += b.w[(r, c)] * (d.qa[c] - b.q_a[c]);
+                }
+                pred_step = pred_step.max((x - b.q_p[r]).abs());
+                d.pred[r] = x;
+            }
+            let outcome = self.correct(d).and_then(|()| {
+                let jump =
+                    d.qp.iter()
+                        .zip(&d.pred)
+                        .fold(0.0_f64, |m, (x, y)| m.max((x - y).abs()));
+                if d.lu.det_sign() != b.sign {
+                    return Err(StepFailure::SignChange);
+                }
+                let rcond = d.lu.rcond();
+                if rcond < self.limits.wp_hard {
+                    return Err(StepFailure::IllConditioned(rcond));
+                }
+                if jump > 0.5 * pred_step + JUMP_FLOOR {
+                    return Err(StepFailure::Jump);
+                }
+                Ok(rcond)
+            });
+            match outcome {
+                Ok(rcond) => {
+                    self.compute_w(d);
+                    b.q_a.copy_from_slice(&d.qa);
+                    b.q_p.copy_from_slice(&d.qp);
+                    b.w.copy_from(&d.w);
+                    b.rcond = rcond;
+                    s = t;
+                    if t == 1.0 {
+                        return Ok(());
+                    }
+                    h = (2.0 * h).min(max_h);
+                }
+                Err(f) => {
+                    failure = f;
+                    if let (1.0, StepFailure::IllConditioned(rcond)) = (t, f) {
+                        // the target itself is singular (reached on the branch)
+                        if h <= max_h / 64.0 || s == 0.0 && dist == 0.0 {
+                            self.restore(d, b);
+                            return Err(self.singular_wp(rcond, &d.q_tr));
+                        }
+                    }
+                    h *= 0.5;
+                    if h * dist.max(1.0) < 1e-9 {
+                        break;
+                    }
+                }
+            }
+        }
+        // where it failed: the last tried q_a
+        let near = fmt_vec(&d.qa);
+        self.restore(d, b);
+        let reason = match failure {
+            StepFailure::SignChange => format!(
+                "the path crosses a singular configuration (det Wp changes sign near q_a = \
+                 {near}): the configuration belongs to another assembly branch or lies beyond \
+                 a singularity"
+            ),
+            StepFailure::IllConditioned(r) => format!(
+                "Wp is singular on the path near q_a = {near} (reciprocal condition number \
+                 {r:.1e} < {:.0e})",
+                self.limits.wp_hard
+            ),
+            StepFailure::Singular => format!("Wp is singular on the path near q_a = {near}"),
+            StepFailure::Jump => format!(
+                "the closure solution jumps to another assembly near q_a = {near} (a fold or \
+                 bifurcation of the branch)"
+            ),
+            StepFailure::NoConvergence => format!(
+                "the closure equations have no solution near q_a = {near} on the branch (beyond \
+                 the reach of the mechanism)"
+            ),
+        };
+        Err(Error::BranchLost {
+            at: fmt_vec(q_a),
+            reason,
+        })
+    }
+
+    fn restore(&self, d: &ClosedData, b: &mut Branch) {
+        b.q_a.copy_from_slice(&d.start_qa);
+        b.q_p.copy_from_slice(&d.start_qp);
+        b.w.copy_from(&d.start_w);
+        b.rcond = d.start_rcond;
+    }
+
+    fn conditioning(&self, b: &Branch, a_cl: Option<f64>) -> Conditioning {
+        let l = &self.limits;
+        Conditioning {
+            wp: b.rcond,
+            a_cl,
+            warning: b.rcond < l.wp_soft || a_cl.is_some_and(|a| a < l.a_cl_soft),
+        }
+    }
+
+    /// Check the inputs, move the tracker to q_a and fill the consistent tree state for
+    /// (qd_a, qdd_a) into d.q_tr, d.qd_tr, d.qdd_tr (10.29, 10.42).
+    fn state_into(&self, d: &mut ClosedData, b: &mut Branch, x: [(&str, &[f64]); 3]) -> Result<()> {
+        self.check_data(d, b)?;
+        for (name, v) in x {
+            self.coords.check(name, v, "actuated joints")?;
+        }
+        let (q_a, qd_a, qdd_a) = (x[0].1, x[1].1, x[2].1);
+        self.track(d, b, q_a)?;
+        let lc = &self.closure;
+        lc.assemble(&b.q_a, &b.q_p, &mut d.q_tr);
+        for r in 0..d.nl {
+            let (mut v, mut a) = (0.0, 0.0);
+            for c in 0..d.n {
+                v += d.g[(r, c)] * qd_a[c];
+                a += d.g[(r, c)] * qdd_a[c];
+            }
+            d.qd_tr[r] = v;
+            d.qdd_tr[r] = a;
+        }
+        lc.kinematics(&mut d.lw, &d.q_tr, Some(&d.qd_tr), None);
+        lc.psi(&d.lw, &mut d.psi);
+        // qdd_p += -Wp^-1 Ψ (10.42)
+        for (x, p) in d.dx.iter_mut().zip(d.psi.iter()) {
+            *x = -p;
+        }
+        d.lu.solve(&mut d.dx);
+        for (r, &j) in lc.passive_joints().iter().enumerate() {
+            d.qdd_tr[j - 1] += d.dx[r];
+        }
+        Ok(())
+    }
+
+    /// Γ_cl = G^T Γ_tr into `out` after [`Self::state_into`] and the tree torques in d.tau_tr.
+    fn project(d: &ClosedData, tree: &[f64], out: &mut [f64]) {
+        for (c, o) in out.iter_mut().enumerate() {
+            *o = (0..d.nl).map(|r| d.g[(r, c)] * tree[r]).sum();
+        }
+    }
+
+    fn direct_into(
+        &self,
+        d: &mut ClosedData,
+        b: &mut Branch,
+        env: &Environment,
+        x: [&[f64]; 3],
+        coulomb_smoothing: Option<f64>,
+        qdd_a: &mut [f64],
+    ) -> Result<Conditioning> {
+        env.check(self.robot().nl())?;
+        self.coords
+            .check_output("qdd_a", qdd_a, "actuated joints")?;
+        self.coords.check("tau", x[2], "actuated joints")?;
+        // the consistent state with qdd_a = 0: qdd_tr = [0; -Wp^-1 Ψ]
+        let z = std::mem::take(&mut d.zeros_n);
+        let r = self.state_into(d, b, [("q_a", x[0]), ("qd_a", x[1]), ("qdd_a", &z)]);
+        d.zeros_n = z;
+        r?;
+        let model = self.robot().numeric();
+        // A_tr by composite links, H_tr = Γ_tr(q, qd, 0) (10.32)
+        let mut a_tr = std::mem::replace(&mut d.tree.a, DMatrix::zeros(0, 0));
+        composite_inertia_matrix(model, &mut d.tree, &d.q_tr, &mut a_tr);
+        let z = std::mem::take(&mut d.tree.zeros);
+        rnea_with_environment(
+            model,
+            &mut d.tree,
+            env,
+            &d.q_tr,
+            &d.qd_tr,
+            &z,
+            &mut d.tau_tr,
+        );
+        d.tree.zeros = z;
+        if let Some(v) = coulomb_smoothing.filter(|v| *v > 0.0) {
+            for &j in self.robot().coordinates().frames() {
+                let s = d.qd_tr[j - 1];
+                d.tau_tr[j - 1] -= model.link(j).fs * (s.sign() - (s / v).tanh());
+            }
+        }
+        // (10.46): A_cl = G^T A_tr G; (10.47): H_cl = G^T (H_tr + A_tr qdd0)
+        // (small products written out: nalgebra's gemm packs its operands on the heap)
+        mul_into(&a_tr, &d.g, &mut d.ag);
+        tr_mul_into(&d.g, &d.ag, &mut d.a_cl);
+        for r in 0..d.nl {
+            let mut v = d.tau_tr[r];
+            for c in 0..d.nl {
+                v += a_tr[(r, c)] * d.qdd_tr[c];
+            }
+            d.v_nl[r] = v;
+        }
+        d.tree.a = a_tr;
+        d.h_cl.gemv_tr(1.0, &d.g, &d.v_nl, 0.0);
+        d.chol.copy_from(&d.a_cl);
+        let buf = std::mem::replace(&mut d.chol, DMatrix::zeros(0, 0));
+        let Some(chol) = nalgebra::Cholesky::new(buf) else {
+            d.chol = DMatrix::zeros(d.n, d.n);
+            return Err(self.singular_a_cl(0.0, &d.q_tr));
+        };
+        let rcond = rcond_cholesky(&chol, norm1(&d.a_cl), &mut d.col_n);
+        if rcond < self.limits.a_cl_hard {
+            d.chol = chol.unpack_dirty();
+            return Err(self.singular_a_cl(rcond, &d.q_tr));
+        }
+        for c in 0..d.n {
+            d.col_n[c] = x[2][c] - d.h_cl[c];
+        }
+        chol.solve_mut(&mut d.col_n);
+        d.chol = chol.unpack_dirty();
+        qdd_a.copy_from_slice(d.col_n.as_slice());
+        // (10.42): qdd_p = W qdd_a - Wp^-1 Ψ (already in qdd_tr's passive rows)
+        let lc = &self.closure;
+        for (c, &j) in lc.actuated_joints().iter().enumerate() {
+            d.qdd_tr[j - 1] = qdd_a[c];
+        }
+        for (r, &j) in lc.passive_joints().iter().enumerate() {
+            let a: f64 = (0..d.n).map(|c| d.w[(r, c)] * qdd_a[c]).sum();
+            d.qdd_tr[j - 1] += a;
+        }
+        Ok(self.conditioning(b, Some(rcond)))
+    }
+
+    fn singular_a_cl(&self, rcond: f64, q_tr: &[f64]) -> Error {
+        Error::Singular {
+            what: "the closed-chain inertia matrix A_cl (10.46)".into(),
+            rcond,
+            limit: self.limits.a_cl_hard,
+            at: format!("q_tr = {}", fmt_vec(q_tr)),
+            hint: "check masses and inertias, or the configuration is singular".into(),
+        }
+    }
+
+    /// Tree vector (NL) over the movable joints of the equivalent tree.
+    fn tree_vector(&self, v: &[f64]) -> DVector<f64> {
+        let c = self.robot().coordinates();
+        DVector::from_iterator(c.len(), c.frames().iter().map(|&j| v[j - 1]))
+    }
+
+    fn state_result(&self, d: &ClosedData, b: &Branch, cond: Conditioning) -> ClosedState {
+        let c = self.robot().coordinates();
+        let lc = &self.closure;
+        let g = DMatrix::from_fn(c.len(), d.n, |r, col| d.g[(c.frame(r) - 1, col)]);
+        let wa = DMatrix::from_fn(d.p, d.n, |r, col| d.jac[(r, lc.actuated_joints()[col] - 1)]);
+        let wp = DMatrix::from_fn(d.p, d.p, |r, col| d.jac[(r, lc.passive_joints()[col] - 1)]);
+        ClosedState {
+            q_a: DVector::from_column_slice(&b.q_a),
+            q_p: DVector::from_column_slice(&b.q_p),
+            q: self.tree_vector(&d.q_tr),
+            qd: self.tree_vector(&d.qd_tr),
+            qdd: self.tree_vector(&d.qdd_tr),
+            psi: d.psi.clone(),
+            wa,
+            wp,
+            w: d.w.clone(),
+            g,
+            conditioning: cond,
+        }
+    }
+}
+
+/// A closed configuration on the tracker's branch.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ClosureSolution {
+    /// q_a (actuated joints).
+    pub q_a: DVector<f64>,
+    /// q_p (passive joints, [`ClosedChain::passive_coordinates`]).
+    pub q_p: DVector<f64>,
+    /// Cut-joint variables q_c (NL+1..NJ), rad or m.
+    pub q_c: DVector<f64>,
+    /// q_tr over the movable joints of the equivalent tree.
+    pub q_tree: DVector<f64>,
+    /// W = d q_p / d q_a (p x N, 10.30).
+    pub w: DMatrix<f64>,
+    /// Largest residual of all candidate closure equations (m or rad).
+    pub residual: f64,
+    /// Conditioning of Wp.
+    pub conditioning: Conditioning,
+}
+
+/// A consistent state of the equivalent tree (10.29, 10.42) with its constraint matrices.
+#[derive(Clone, Debug, PartialEq)]
 pub struct ClosedState {
-    pub closure: ClosureSolution,
-    pub q: Vec<f64>,
-    pub qd: Vec<f64>,
-    pub qdd: Vec<f64>,
-    /// Ψ of (10.28).
+    /// q_a.
+    pub q_a: DVector<f64>,
+    /// q_p.
+    pub q_p: DVector<f64>,
+    /// q_tr over the movable joints of the equivalent tree.
+    pub q: DVector<f64>,
+    /// qd_tr = G qd_a.
+    pub qd: DVector<f64>,
+    /// qdd_tr = G qdd_a + [0; -Wp^-1 Ψ].
+    pub qdd: DVector<f64>,
+    /// Ψ of (10.28) (p entries).
     pub psi: DVector<f64>,
-    pub constraints: Constraints,
+    /// Wa (p x N), columns in actuated order.
+    pub wa: DMatrix<f64>,
+    /// Wp (p x p), columns in passive order.
+    pub wp: DMatrix<f64>,
+    /// W = -Wp^-1 Wa (p x N).
+    pub w: DMatrix<f64>,
+    /// G = d q_tr / d q_a (movable joints x N).
+    pub g: DMatrix<f64>,
+    /// Conditioning of Wp.
+    pub conditioning: Conditioning,
 }
 
 /// Result of the closed-chain inverse dynamic model.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct ClosedIdm {
-    /// Γ_cl (N), actuated-joint order: G^T Γ_tr (10.40).
+    /// Γ_cl (N), actuated order: G^T Γ_tr (10.40).
     pub gamma_cl: DVector<f64>,
-    /// Γ_tr (NL, by joint number) of the equivalent tree at the consistent state.
+    /// Γ_tr (movable joints of the tree) at the consistent state.
     pub gamma_tr: DVector<f64>,
     /// Lagrange multipliers λ = -Wp^-T Γ_p (10.37): the cut-joint reactions along the kept
     /// closure equations.
     pub lambda: DVector<f64>,
     /// Γ_cl by the multiplier form Γ_a + Wa^T λ (10.36).
     pub gamma_cl_lagrange: DVector<f64>,
+    /// The consistent state.
     pub state: ClosedState,
 }
 
 /// Result of the closed-chain direct dynamic model.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct ClosedDdm {
     /// qdd_a (10.48).
     pub qdd_a: DVector<f64>,
     /// qdd_p (10.42).
     pub qdd_p: DVector<f64>,
-    /// A_cl (10.46) and H_cl (10.47).
+    /// A_cl (10.46).
     pub a_cl: DMatrix<f64>,
+    /// H_cl (10.47).
     pub h_cl: DVector<f64>,
+    /// The consistent state (qdd with the computed qdd_a).
     pub state: ClosedState,
+    /// Conditioning of Wp and A_cl.
+    pub conditioning: Conditioning,
 }
 
-impl ClosedChain {
-    /// Build the model of a closed-chain robot (see [`LoopClosure::new`] for the checks).
-    pub fn new(robot: &Robot) -> Result<ClosedChain> {
-        let closure = LoopClosure::new(robot)?;
-        Ok(ClosedChain { closure })
-    }
+/// Loop closure on the tracker's branch into `q_p` (passive joints): moves `branch` to `q_a`
+/// (actuated joints, rad or m). Allocation-free on the branch.
+///
+/// Errors: [`Error::Dimension`] / [`Error::NotFinite`] for bad inputs, [`Error::BranchLost`]
+/// when q_a cannot be reached on the branch, [`Error::Singular`] when Wp is singular at q_a.
+pub fn loop_closure_into(
+    chain: &ClosedChain,
+    data: &mut ClosedData,
+    branch: &mut Branch,
+    q_a: &[f64],
+    q_p: &mut [f64],
+) -> Result<Conditioning> {
+    chain.check_data(data, branch)?;
+    chain.coords.check("q_a", q_a, "actuated joints")?;
+    chain.passive.check_output("q_p", q_p, "passive joints")?;
+    chain.track(data, branch, q_a)?;
+    q_p.copy_from_slice(&branch.q_p);
+    Ok(chain.conditioning(branch, None))
+}
 
-    pub fn closure(&self) -> &LoopClosure {
-        &self.closure
-    }
+/// Loop closure on the tracker's branch: q_p, the cut-joint variables, W and the conditioning
+/// at q_a. Allocates.
+pub fn loop_closure(
+    chain: &ClosedChain,
+    branch: &mut Branch,
+    q_a: &[f64],
+) -> Result<ClosureSolution> {
+    let mut d = ClosedData::new(chain);
+    let mut q_p = vec![0.0; chain.n_equations()];
+    let cond = loop_closure_into(chain, &mut d, branch, q_a, &mut q_p)?;
+    let lc = &chain.closure;
+    lc.assemble(&branch.q_a, &branch.q_p, &mut d.q_tr);
+    lc.kinematics(&mut d.lw, &d.q_tr, None, None);
+    Ok(ClosureSolution {
+        q_a: DVector::from_column_slice(q_a),
+        q_p: DVector::from_vec(q_p),
+        q_c: DVector::from_vec(lc.cut_variables(&d.lw)),
+        q_tree: chain.tree_vector(&d.q_tr),
+        w: d.w.clone(),
+        residual: lc.max_residual(&d.lw),
+        conditioning: cond,
+    })
+}
 
-    pub fn robot(&self) -> &Robot {
-        self.closure.robot()
-    }
+/// The consistent tree state for (q_a, qd_a, qdd_a) on the tracker's branch: q_p by loop
+/// closure, qd_p = W qd_a (10.29), qdd_p = W qdd_a - Wp^-1 Ψ (10.42). Allocates.
+pub fn closed_state(
+    chain: &ClosedChain,
+    branch: &mut Branch,
+    q_a: &[f64],
+    qd_a: &[f64],
+    qdd_a: &[f64],
+) -> Result<ClosedState> {
+    let mut d = ClosedData::new(chain);
+    chain.state_into(
+        &mut d,
+        branch,
+        [("q_a", q_a), ("qd_a", qd_a), ("qdd_a", qdd_a)],
+    )?;
+    let cond = chain.conditioning(branch, None);
+    Ok(chain.state_result(&d, branch, cond))
+}
 
-    /// N, the degrees of freedom (number of actuated joints).
-    pub fn dof(&self) -> usize {
-        self.closure.dof()
-    }
+/// Closed-chain inverse dynamic model into `tau_a`: Γ_cl = G^T Γ_tr (10.40, N m or N) of the
+/// actuated joints for q_a, qd_a, qdd_a (actuated joints) under `env`, on the tracker's branch.
+/// Allocation-free on the branch. Returns the conditioning of Wp (check `warning`).
+#[allow(clippy::too_many_arguments)]
+pub fn closed_inverse_dynamics_into(
+    chain: &ClosedChain,
+    data: &mut ClosedData,
+    branch: &mut Branch,
+    env: &Environment,
+    q_a: &[f64],
+    qd_a: &[f64],
+    qdd_a: &[f64],
+    tau_a: &mut [f64],
+) -> Result<Conditioning> {
+    env.check(chain.robot().nl())?;
+    chain
+        .coords
+        .check_output("tau_a", tau_a, "actuated joints")?;
+    chain.state_into(
+        data,
+        branch,
+        [("q_a", q_a), ("qd_a", qd_a), ("qdd_a", qdd_a)],
+    )?;
+    let d = data;
+    rnea_with_environment(
+        chain.robot().numeric(),
+        &mut d.tree,
+        env,
+        &d.q_tr,
+        &d.qd_tr,
+        &d.qdd_tr,
+        &mut d.tau_tr,
+    );
+    ClosedChain::project(d, &d.tau_tr, tau_a);
+    Ok(chain.conditioning(branch, None))
+}
 
-    pub fn actuated_joints(&self) -> &[usize] {
-        self.closure.actuated_joints()
-    }
+/// Closed-chain inverse dynamic model with the robot's environment: Γ_cl, Γ_tr, the Lagrange
+/// multipliers (10.37) and the consistent state. Allocates.
+pub fn closed_inverse_dynamics(
+    chain: &ClosedChain,
+    branch: &mut Branch,
+    q_a: &[f64],
+    qd_a: &[f64],
+    qdd_a: &[f64],
+) -> Result<ClosedIdm> {
+    let mut d = ClosedData::new(chain);
+    let mut gamma_cl = DVector::zeros(chain.dof());
+    let cond = closed_inverse_dynamics_into(
+        chain,
+        &mut d,
+        branch,
+        chain.robot().environment(),
+        q_a,
+        qd_a,
+        qdd_a,
+        gamma_cl.as_mut_slice(),
+    )?;
+    let lc = &chain.closure;
+    let gp: Vec<f64> = lc
+        .passive_joints()
+        .iter()
+        .map(|&j| d.tau_tr[j - 1])
+        .collect();
+    // (10.37): Wp^T λ = -Γ_p
+    let mut lambda: Vec<f64> = gp.iter().map(|x| -x).collect();
+    d.lu.solve_transpose(&mut lambda);
+    let lambda = DVector::from_vec(lambda);
+    let state = chain.state_result(&d, branch, cond);
+    let ga = DVector::from_iterator(
+        chain.dof(),
+        lc.actuated_joints().iter().map(|&j| d.tau_tr[j - 1]),
+    );
+    let gamma_cl_lagrange = ga + state.wa.transpose() * &lambda;
+    Ok(ClosedIdm {
+        gamma_cl,
+        gamma_tr: chain.tree_vector(&d.tau_tr),
+        lambda,
+        gamma_cl_lagrange,
+        state,
+    })
+}
 
-    pub fn passive_joints(&self) -> &[usize] {
-        self.closure.passive_joints()
-    }
+/// Closed-chain direct dynamic model into `qdd_a`: qdd_a = A_cl^-1 (Γ_cl - H_cl) (10.46–10.48,
+/// rad/s² or m/s²) for q_a, qd_a and the actuated torques `tau_a` under `env`, on the tracker's
+/// branch. Allocation-free on the branch. Returns the conditioning of Wp and A_cl.
+#[allow(clippy::too_many_arguments)]
+pub fn closed_direct_dynamics_into(
+    chain: &ClosedChain,
+    data: &mut ClosedData,
+    branch: &mut Branch,
+    env: &Environment,
+    q_a: &[f64],
+    qd_a: &[f64],
+    tau_a: &[f64],
+    qdd_a: &mut [f64],
+) -> Result<Conditioning> {
+    chain.direct_into(data, branch, env, [q_a, qd_a, tau_a], None, qdd_a)
+}
 
-    pub fn workspace(&self) -> ClosedChainWorkspace {
-        let nl = self.robot().nl();
-        ClosedChainWorkspace {
-            closure: self.closure.workspace(),
-            tree: Workspace::new(self.robot().numeric()),
-            tau: vec![0.0; nl],
-            zeros: vec![0.0; nl],
-            inertia: InertiaWorkspace::new(self.robot().numeric()),
-            a_tr: DMatrix::zeros(nl, nl),
+/// [`closed_direct_dynamics_into`] with the Coulomb friction of every tree joint taken as
+/// Fs tanh(qd / v) instead of Fs sign(qd) (the simulator's smoothing; v > 0).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn closed_direct_dynamics_smoothed(
+    chain: &ClosedChain,
+    data: &mut ClosedData,
+    branch: &mut Branch,
+    env: &Environment,
+    x: [&[f64]; 3],
+    coulomb_smoothing: Option<f64>,
+    qdd_a: &mut [f64],
+) -> Result<Conditioning> {
+    chain.direct_into(data, branch, env, x, coulomb_smoothing, qdd_a)
+}
+
+/// Closed-chain direct dynamic model with the robot's environment: qdd_a, qdd_p, A_cl, H_cl and
+/// the consistent state. Allocates.
+pub fn closed_direct_dynamics(
+    chain: &ClosedChain,
+    branch: &mut Branch,
+    q_a: &[f64],
+    qd_a: &[f64],
+    tau_a: &[f64],
+) -> Result<ClosedDdm> {
+    let mut d = ClosedData::new(chain);
+    let mut qdd_a = DVector::zeros(chain.dof());
+    let cond = chain.direct_into(
+        &mut d,
+        branch,
+        chain.robot().environment(),
+        [q_a, qd_a, tau_a],
+        None,
+        qdd_a.as_mut_slice(),
+    )?;
+    let lc = &chain.closure;
+    let qdd_p = DVector::from_iterator(
+        chain.n_equations(),
+        lc.passive_joints().iter().map(|&j| d.qdd_tr[j - 1]),
+    );
+    Ok(ClosedDdm {
+        qdd_a,
+        qdd_p,
+        a_cl: d.a_cl.clone(),
+        h_cl: d.h_cl.clone(),
+        state: chain.state_result(&d, branch, cond),
+        conditioning: cond,
+    })
+}
+
+/// Regressor of the closed chain into `phi` (N x 13 NL): G^T Φ (10.40), so that
+/// Γ_cl = G^T Φ K + Γ_e,cl, and Γ_e,cl = G^T Γ_e into `tau_e` (actuated joints), for q_a, qd_a,
+/// qdd_a on the tracker's branch under `env`. Allocation-free on the branch.
+#[allow(clippy::too_many_arguments)]
+pub fn closed_regressor_into(
+    chain: &ClosedChain,
+    data: &mut ClosedData,
+    branch: &mut Branch,
+    env: &Environment,
+    x: [&[f64]; 3],
+    phi: &mut DMatrix<f64>,
+    tau_e: &mut [f64],
+) -> Result<Conditioning> {
+    env.check(chain.robot().nl())?;
+    let (n, nl) = (chain.dof(), chain.robot().nl());
+    if phi.shape() != (n, PARAMS_PER_LINK * nl) {
+        return Err(Error::dimension(
+            "Phi",
+            n * PARAMS_PER_LINK * nl,
+            phi.len(),
+            format!(
+                "{n} x {} (actuated joints x 13 per link)",
+                PARAMS_PER_LINK * nl
+            ),
+        ));
+    }
+    chain
+        .coords
+        .check_output("tau_e", tau_e, "actuated joints")?;
+    chain.state_into(
+        data,
+        branch,
+        [("q_a", x[0]), ("qd_a", x[1]), ("qdd_a", x[2])],
+    )?;
+    let d = data;
+    let model = chain.robot().numeric();
+    let mut full = std::mem::replace(&mut d.phi, DMatrix::zeros(0, 0));
+    if full.shape() != (nl, PARAMS_PER_LINK * nl) {
+        full = DMatrix::zeros(nl, PARAMS_PER_LINK * nl); // first call only
+    }
+    tree_regressor(
+        model,
+        &mut d.tree,
+        env,
+        &d.q_tr,
+        &d.qd_tr,
+        &d.qdd_tr,
+        &mut full,
+    );
+    tr_mul_into(&d.g, &full, phi);
+    d.phi = full;
+    tree_wrench_torques(model, &mut d.tree, env, &d.q_tr, &mut d.tau_tr);
+    ClosedChain::project(d, &d.tau_tr, tau_e);
+    Ok(chain.conditioning(branch, None))
+}
+
+/// Tree state (q_tr, qd_tr) of the last evaluation in `data`, over tree arrays (NL entries):
+/// for the simulator's energy.
+pub(crate) fn last_tree_state(data: &ClosedData) -> (&[f64], &[f64]) {
+    (&data.q_tr, &data.qd_tr)
+}
+
+/// The closure residual (max over all loops' candidate equations) at the last evaluation.
+pub(crate) fn last_residual(chain: &ClosedChain, data: &ClosedData) -> f64 {
+    chain.closure.max_residual(&data.lw)
+}
+
+/// Newton steps on the kept closure equations (q_p -= Wp^-1 phi) beyond the closure tolerance,
+/// until the residual stops decreasing: q_p at q_a to the rounding level (for the numerical
+/// base parameters, whose rank decision would see the solver's 1e-12).
+pub(crate) fn refine_closure(chain: &ClosedChain, q_a: &[f64], q_p: &[f64]) -> Vec<f64> {
+    let lc = &chain.closure;
+    let mut d = ClosedData::new(chain);
+    let mut q_p = q_p.to_vec();
+    let residual = |d: &mut ClosedData, q_p: &[f64]| {
+        lc.assemble(q_a, q_p, &mut d.q_tr);
+        chain.factor_wp(d);
+        lc.residual(&d.lw, &mut d.r);
+        d.r.amax()
+    };
+    let mut norm = residual(&mut d, &q_p);
+    for _ in 0..6 {
+        if norm == 0.0 || !d.lu.regular {
+            break;
         }
-    }
-
-    /// q_p for q_a (damped Newton from `guess`, else the previous solution, else zeros).
-    pub fn solve_positions(
-        &self,
-        ws: &mut ClosedChainWorkspace,
-        q_a: &[f64],
-        guess: Option<&[f64]>,
-    ) -> Result<ClosureSolution> {
-        self.closure.solve(&mut ws.closure, q_a, guess)
-    }
-
-    /// The reference configuration q_tr (NL entries): the description's `assembly`, else zeros.
-    pub fn reference(&self) -> Vec<f64> {
-        self.robot()
-            .description()
-            .assembly
-            .clone()
-            .unwrap_or_else(|| vec![0.0; self.robot().nl()])
-    }
-
-    /// The actuated values (q_a) of the reference configuration [`ClosedChain::reference`].
-    pub fn reference_actuated(&self) -> Vec<f64> {
-        let r = self.reference();
-        self.actuated_joints().iter().map(|&j| r[j - 1]).collect()
-    }
-
-    /// q_p for q_a on the reference assembly branch (the default start of loop closure). With
-    /// a `guess`, damped Newton from it. Without: when the loops close at the reference
-    /// configuration (the file's `assembly`, else q = 0), by continuation (16 steps) from there,
-    /// so that the answer lies on the reference branch; otherwise damped Newton from the
-    /// reference q_p.
-    pub fn solve_from_reference(
-        &self,
-        ws: &mut ClosedChainWorkspace,
-        q_a: &[f64],
-        guess: Option<&[f64]>,
-    ) -> Result<ClosureSolution> {
-        if guess.is_some() {
-            return self.solve_positions(ws, q_a, guess);
+        let mut step: Vec<f64> = d.r.iter().copied().collect();
+        d.lu.solve(&mut step);
+        let trial: Vec<f64> = q_p.iter().zip(&step).map(|(a, b)| a - b).collect();
+        let nt = residual(&mut d, &trial);
+        if nt >= norm {
+            break;
         }
-        let reference = self.reference();
-        let ref_a = self.reference_actuated();
-        let ref_p: Vec<f64> = self
-            .passive_joints()
-            .iter()
-            .map(|&j| reference[j - 1])
-            .collect();
-        let lc = &self.closure;
-        if q_a.len() == self.dof() {
-            if let Ok(s0) = lc.solve(&mut ws.closure, &ref_a, Some(&ref_p)) {
-                if s0.iterations == 0 {
-                    return lc.solve_continuation(&mut ws.closure, q_a, &ref_a, &ref_p, 16);
-                }
-            }
-        }
-        self.solve_positions(ws, q_a, Some(&ref_p))
+        q_p = trial;
+        norm = nt;
     }
+    q_p
+}
 
-    /// Wa, Wp, W and G at a closed configuration q_tr (error if Wp is singular).
-    pub fn constraints(&self, ws: &mut ClosedChainWorkspace, q_tr: &[f64]) -> Result<Constraints> {
-        let lc = &self.closure;
-        let (p, nl) = (lc.n_equations(), self.robot().nl());
-        lc.kinematics(&mut ws.closure, q_tr, None, None);
-        let mut jac = DMatrix::zeros(p, nl);
-        lc.constraint_jacobian(&ws.closure, &mut jac);
-        let wa = jac.select_columns(lc.actuated_columns().iter());
-        let wp = jac.select_columns(lc.passive_columns().iter());
-        lc.check_wp(&wp, q_tr)?;
-        let wp_lu = wp.clone().lu();
-        let w = -wp_lu
-            .solve(&wa)
-            .ok_or_else(|| Error::Numerical(format!("Wp is singular at q_tr = {q_tr:?}")))?;
-        let n = lc.dof();
-        let mut g = DMatrix::zeros(nl, n);
-        for (c, &j) in lc.actuated_joints().iter().enumerate() {
-            g[(j - 1, c)] = 1.0;
+/// out = a b (dense, written out: no heap packing).
+fn mul_into(a: &DMatrix<f64>, b: &DMatrix<f64>, out: &mut DMatrix<f64>) {
+    for c in 0..b.ncols() {
+        for r in 0..a.nrows() {
+            out[(r, c)] = (0..a.ncols()).map(|k| a[(r, k)] * b[(k, c)]).sum();
         }
-        for (r, &j) in lc.passive_joints().iter().enumerate() {
-            g.row_mut(j - 1).copy_from(&w.row(r));
-        }
-        Ok(Constraints {
-            wa,
-            wp,
-            w,
-            g,
-            wp_lu,
-        })
-    }
-
-    fn check(&self, name: &str, v: &[f64]) -> Result<()> {
-        let n = self.dof();
-        if v.len() != n {
-            return Err(Error::Input(format!(
-                "{name} has {} entries, the robot has {n} actuated joints {:?}",
-                v.len(),
-                self.actuated_joints()
-            )));
-        }
-        if let Some(k) = v.iter().position(|x| !x.is_finite()) {
-            return Err(Error::Input(format!(
-                "{name}[{}] (joint {}) = {} is not a finite number",
-                k + 1,
-                self.actuated_joints()[k],
-                v[k]
-            )));
-        }
-        Ok(())
-    }
-
-    /// The consistent tree state for (q_a, qd_a, qdd_a): q_p by loop closure, qd_p = W qd_a
-    /// (10.29), qdd_p = W qdd_a - Wp^-1 Ψ (10.42).
-    pub fn state(
-        &self,
-        ws: &mut ClosedChainWorkspace,
-        q_a: &[f64],
-        qd_a: &[f64],
-        qdd_a: &[f64],
-        guess: Option<&[f64]>,
-    ) -> Result<ClosedState> {
-        self.check("q_a", q_a)?;
-        self.check("qd_a", qd_a)?;
-        self.check("qdd_a", qdd_a)?;
-        let sol = self.solve_positions(ws, q_a, guess)?;
-        let q = sol.q_tr.clone();
-        let c = self.constraints(ws, &q)?;
-        let qd_col = &c.g * DVector::from_column_slice(qd_a);
-        let qd: Vec<f64> = qd_col.iter().copied().collect();
-        let lc = &self.closure;
-        let mut psi = DVector::zeros(lc.n_equations());
-        lc.kinematics(&mut ws.closure, &q, Some(&qd), None);
-        lc.psi(&ws.closure, &mut psi);
-        let qdd_p0 = -c.wp_solve(&psi);
-        let mut qdd: Vec<f64> = (&c.g * DVector::from_column_slice(qdd_a))
-            .iter()
-            .copied()
-            .collect();
-        for (r, &j) in lc.passive_joints().iter().enumerate() {
-            qdd[j - 1] += qdd_p0[r];
-        }
-        Ok(ClosedState {
-            closure: sol,
-            q,
-            qd,
-            qdd,
-            psi,
-            constraints: c,
-        })
-    }
-
-    /// Inverse dynamic model: Γ_cl = G^T Γ_tr (10.40) with Γ_tr by Newton–Euler at the consistent
-    /// tree state, and the Lagrange multipliers (10.37).
-    pub fn inverse_dynamics(
-        &self,
-        ws: &mut ClosedChainWorkspace,
-        q_a: &[f64],
-        qd_a: &[f64],
-        qdd_a: &[f64],
-        guess: Option<&[f64]>,
-    ) -> Result<ClosedIdm> {
-        let state = self.state(ws, q_a, qd_a, qdd_a, guess)?;
-        rnea(
-            self.robot().numeric(),
-            &mut ws.tree,
-            &state.q,
-            &state.qd,
-            &state.qdd,
-            &mut ws.tau,
-        );
-        let gamma_tr = DVector::from_column_slice(&ws.tau);
-        let c = &state.constraints;
-        let gamma_cl = c.g.transpose() * &gamma_tr;
-        let gp = DVector::from_iterator(
-            self.passive_joints().len(),
-            self.passive_joints().iter().map(|j| gamma_tr[j - 1]),
-        );
-        let ga = DVector::from_iterator(
-            self.dof(),
-            self.actuated_joints().iter().map(|j| gamma_tr[j - 1]),
-        );
-        // (10.37): Wp^T λ = -Γ_p
-        let lambda = -c
-            .wp
-            .transpose()
-            .lu()
-            .solve(&gp)
-            .ok_or_else(|| Error::Numerical("Wp^T is singular".into()))?;
-        let gamma_cl_lagrange = ga + c.wa.transpose() * &lambda;
-        Ok(ClosedIdm {
-            gamma_cl,
-            gamma_tr,
-            lambda,
-            gamma_cl_lagrange,
-            state,
-        })
-    }
-
-    /// Direct dynamic model: qdd_a = A_cl^-1 (Γ_cl - H_cl) (10.46–10.48) and qdd_p (10.42).
-    pub fn direct_dynamics(
-        &self,
-        ws: &mut ClosedChainWorkspace,
-        q_a: &[f64],
-        qd_a: &[f64],
-        tau_a: &[f64],
-        guess: Option<&[f64]>,
-    ) -> Result<ClosedDdm> {
-        self.direct_dynamics_smoothed(ws, q_a, qd_a, tau_a, guess, None)
-    }
-
-    /// [`ClosedChain::direct_dynamics`] with the Coulomb friction of every tree joint (actuated
-    /// and passive) taken as Fs tanh(qd / v) instead of Fs sign(qd) when `coulomb_smoothing` is
-    /// `Some(v)`, v > 0 (for simulation: the exact sign makes the right-hand side discontinuous).
-    pub fn direct_dynamics_smoothed(
-        &self,
-        ws: &mut ClosedChainWorkspace,
-        q_a: &[f64],
-        qd_a: &[f64],
-        tau_a: &[f64],
-        guess: Option<&[f64]>,
-        coulomb_smoothing: Option<f64>,
-    ) -> Result<ClosedDdm> {
-        use crate::scalar::DynScalar;
-        self.check("tau", tau_a)?;
-        let n = self.dof();
-        let zero_a = vec![0.0; n];
-        // state with qdd_a = 0: qdd_tr = [0; -Wp^-1 Ψ]
-        let mut state = self.state(ws, q_a, qd_a, &zero_a, guess)?;
-        // A_tr by composite links (rows/columns of fixed frames zero, Ia_j on the diagonal)
-        inertia_matrix_into(
-            self.robot().numeric(),
-            &mut ws.inertia,
-            &state.q,
-            &mut ws.a_tr,
-        );
-        let a_tr = &ws.a_tr;
-        // H_tr = Γ_tr(q, qd, 0) (10.32)
-        rnea(
-            self.robot().numeric(),
-            &mut ws.tree,
-            &state.q,
-            &state.qd,
-            &ws.zeros,
-            &mut ws.tau,
-        );
-        let mut h_tr = DVector::from_column_slice(&ws.tau);
-        if let Some(v) = coulomb_smoothing.filter(|v| *v > 0.0) {
-            let model = self.robot().numeric();
-            for j in self.robot().movable_joints() {
-                let s = state.qd[j - 1];
-                h_tr[j - 1] -= model.link(j).fs * (s.sign() - (s / v).tanh());
-            }
-        }
-        let g = &state.constraints.g;
-        // (10.46): A_cl = A_aa + A_ap W + W^T A_pa + W^T A_pp W = G^T A_tr G
-        let a_cl = g.transpose() * a_tr * g;
-        // (10.47): H_cl = H_a + W^T H_p - (A_ap + W^T A_pp) Wp^-1 Ψ = G^T (H_tr + A_tr qdd0)
-        let qdd0 = DVector::from_column_slice(&state.qdd);
-        let h_cl = g.transpose() * (h_tr + a_tr * &qdd0);
-        let chol = a_cl.clone().cholesky().ok_or_else(|| {
-            Error::Numerical(format!(
-                "the closed-chain inertia matrix A_cl is not positive definite at q_a = {q_a:?} \
-                 (check masses and inertias)"
-            ))
-        })?;
-        let qdd_a = chol.solve(&(DVector::from_column_slice(tau_a) - &h_cl));
-        // (10.42)
-        let qdd_p = &state.constraints.w * &qdd_a - state.constraints.wp_solve(&state.psi);
-        for (r, &j) in self.passive_joints().iter().enumerate() {
-            state.qdd[j - 1] = qdd_p[r];
-        }
-        for (c, &j) in self.actuated_joints().iter().enumerate() {
-            state.qdd[j - 1] = qdd_a[c];
-        }
-        Ok(ClosedDdm {
-            qdd_a,
-            qdd_p,
-            a_cl,
-            h_cl,
-            state,
-        })
     }
 }
 
-/// A closed-chain robot seen as a system in the actuated coordinates: the loops are re-solved
-/// at every call with the previous solution as guess, so they never drift. The first call
-/// starts from the reference assembly ([`ClosedChain::solve_from_reference`]) unless a guess
-/// was set. The simulator's [`crate::simulation::Dynamics`] implementation is
-/// [`crate::simulation::ClosedChainDynamics`].
-#[derive(Clone, Debug)]
-pub struct ClosedDynamics {
-    pub model: ClosedChain,
-    pub ws: ClosedChainWorkspace,
-}
-
-impl ClosedDynamics {
-    pub fn new(robot: &Robot) -> Result<ClosedDynamics> {
-        let model = ClosedChain::new(robot)?;
-        let ws = model.workspace();
-        Ok(ClosedDynamics { model, ws })
-    }
-
-    /// N.
-    pub fn dof(&self) -> usize {
-        self.model.dof()
-    }
-
-    /// q_p for q_a: from the previous solution, or the reference assembly at the first call.
-    pub fn solve(&mut self, q_a: &[f64]) -> Result<ClosureSolution> {
-        if self.ws.closure.last_qp.is_some() {
-            self.model.solve_positions(&mut self.ws, q_a, None)
-        } else {
-            self.model.solve_from_reference(&mut self.ws, q_a, None)
+/// out = a^T b (dense, written out: no heap packing).
+fn tr_mul_into(a: &DMatrix<f64>, b: &DMatrix<f64>, out: &mut DMatrix<f64>) {
+    for c in 0..b.ncols() {
+        for r in 0..a.ncols() {
+            out[(r, c)] = (0..a.nrows()).map(|k| a[(k, r)] * b[(k, c)]).sum();
         }
-    }
-
-    /// qdd_a for (q_a, qd_a, Γ_cl).
-    pub fn accel(&mut self, q_a: &[f64], qd_a: &[f64], tau: &[f64]) -> Result<DVector<f64>> {
-        self.accel_smoothed(q_a, qd_a, tau, None)
-    }
-
-    /// qdd_a with the Coulomb friction smoothed ([`ClosedChain::direct_dynamics_smoothed`]).
-    pub fn accel_smoothed(
-        &mut self,
-        q_a: &[f64],
-        qd_a: &[f64],
-        tau: &[f64],
-        coulomb_smoothing: Option<f64>,
-    ) -> Result<DVector<f64>> {
-        if self.ws.closure.last_qp.is_none() {
-            self.model.solve_from_reference(&mut self.ws, q_a, None)?;
-        }
-        // guess None: the previous solution
-        Ok(self
-            .model
-            .direct_dynamics_smoothed(&mut self.ws, q_a, qd_a, tau, None, coulomb_smoothing)?
-            .qdd_a)
-    }
-
-    /// Largest closure residual (over the loops) of q_a's solution.
-    pub fn closure_residual(&mut self, q_a: &[f64]) -> Result<f64> {
-        Ok(self.solve(q_a)?.residual)
-    }
-
-    /// Set the guess of q_p for the next solve (e.g. the initial assembly).
-    pub fn set_guess(&mut self, q_p: &[f64]) {
-        self.ws.closure.last_qp = Some(q_p.to_vec());
     }
 }

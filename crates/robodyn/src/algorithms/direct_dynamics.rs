@@ -7,15 +7,17 @@
 //! - [`ddm_aba`]: the O(n) recursive Newton–Euler direct model (articulated bodies), written with
 //!   jA_i, jP_i and the 6x6 spatial inertia about O_j.
 //!
-//! Both are allocation-free with a [`DirectWorkspace`]. State vectors have NL entries (joint j
-//! at index j-1); fixed frames are ignored in Gamma and get qdd = 0. A singular or
-//! non-positive-definite model (e.g. a massless chain end) is an [`Error::Numerical`] naming the
-//! joint, never a NaN.
+//! The checked functions [`direct_dynamics`] / [`direct_dynamics_into`] work over the movable
+//! joints; [`ddm_composite`] and [`ddm_aba`] are the kernels on tree arrays (NL entries, fixed
+//! frames ignored in Gamma and given qdd = 0). All are allocation-free with a [`Data`]. A
+//! singular or non-positive-definite model (e.g. a massless chain end) is an
+//! [`Error::Singular`] naming the joint, never a NaN.
 
-use crate::algorithms::inertia_matrix::{h_vector_into, inertia_matrix_into, InertiaWorkspace};
-use crate::algorithms::inverse_dynamics::check_state;
+use crate::algorithms::inertia_matrix::composite_inertia_matrix;
+use crate::algorithms::inverse_dynamics::{rnea_with_environment, tree_vector_map};
+use crate::data::Data;
 use crate::error::{Error, Result};
-use crate::model::{DynModel, JointType, Robot};
+use crate::model::{DynModel, Environment, JointType, Robot};
 use crate::scalar::DynScalar;
 use nalgebra::{DMatrix, DVector, Matrix3, Matrix6, Vector3, Vector6};
 
@@ -32,81 +34,24 @@ pub enum Method {
     ArticulatedBody,
 }
 
-/// Buffers of the articulated-body algorithm (index j = link j; index 0 is the base).
-/// Spatial vectors are [linear; angular] in R_j about O_j: V = [V_j; w_j], F = [f_j; m_j].
-#[derive(Clone, Debug)]
-pub struct AbaWorkspace {
-    rot: Vec<Matrix3<f64>>,
-    pos: Vec<Vector3<f64>>,
-    w: Vec<Vector3<f64>>,
-    /// Velocity-dependent acceleration of O_j and link j (the gamma_j of Vd_j = jT_i Vd_i + gamma_j + a_j qdd_j).
-    gamma: Vec<Vector6<f64>>,
-    /// Articulated inertia J*_j about O_j.
-    ia: Vec<Matrix6<f64>>,
-    /// Articulated bias wrench beta*_j.
-    pa: Vec<Vector6<f64>>,
-    /// u_j = J*_j a_j.
-    u: Vec<Vector6<f64>>,
-    /// H_j = a_j' J*_j a_j + Ia_j.
-    d: Vec<f64>,
-    /// Gamma_j minus friction.
-    tau: Vec<f64>,
-    /// Classical accelerations [Vd_j; wd_j].
-    acc: Vec<Vector6<f64>>,
-}
-
-impl AbaWorkspace {
-    pub fn new(model: &DynModel<f64>) -> Self {
-        let n = model.nl + 1;
-        AbaWorkspace {
-            rot: vec![Matrix3::identity(); n],
-            pos: vec![Vector3::zeros(); n],
-            w: vec![Vector3::zeros(); n],
-            gamma: vec![Vector6::zeros(); n],
-            ia: vec![Matrix6::zeros(); n],
-            pa: vec![Vector6::zeros(); n],
-            u: vec![Vector6::zeros(); n],
-            d: vec![0.0; n],
-            tau: vec![0.0; n],
-            acc: vec![Vector6::zeros(); n],
-        }
-    }
-}
-
-/// Buffers of both direct-dynamics methods, sized once from the model.
-#[derive(Clone, Debug)]
-pub struct DirectWorkspace {
-    pub inertia: InertiaWorkspace<f64>,
-    /// A(q), then its L'DL factors.
-    pub a: DMatrix<f64>,
-    /// H(q, qd).
-    pub h: Vec<f64>,
-    pub aba: AbaWorkspace,
-}
-
-impl DirectWorkspace {
-    pub fn new(model: &DynModel<f64>) -> Self {
-        DirectWorkspace {
-            inertia: InertiaWorkspace::new(model),
-            a: DMatrix::zeros(model.nl, model.nl),
-            h: vec![0.0; model.nl],
-            aba: AbaWorkspace::new(model),
-        }
-    }
-}
-
 /// A usable pivot: finite and above the relative tolerance (false for NaN).
 #[inline]
 fn pivot_ok(d: f64, scale: f64) -> bool {
     d.is_finite() && d > PIVOT_TOL * scale
 }
 
-fn singular(j: usize, what: &str, value: f64) -> Error {
-    Error::Numerical(format!(
-        "joint {j}: {what} is {value:.3e} (zero or negative): the direct dynamic model is \
-         singular; the links carried by joint {j} have no mass or inertia along its axis \
-         (e.g. a massless chain end) or the inertial parameters are not physical"
-    ))
+fn singular(j: usize, what: &str, value: f64, scale: f64) -> Error {
+    Error::Singular {
+        what: format!("{what} of joint {j}"),
+        rcond: if scale > 0.0 { value / scale } else { 0.0 },
+        limit: PIVOT_TOL,
+        at: format!("joint {j} (pivot {value:.3e})"),
+        hint: format!(
+            "the direct dynamic model is singular: the links carried by joint {j} have no mass \
+             or inertia along its axis (e.g. a massless chain end) or the inertial parameters \
+             are not physical"
+        ),
+    }
 }
 
 /// In-place L'DL factorization of A exploiting the tree (Featherstone's LTDL): on return the
@@ -125,7 +70,7 @@ pub fn ltdl_factor(model: &DynModel<f64>, a: &mut DMatrix<f64>) -> Result<()> {
         }
         let dk = a[(k - 1, k - 1)];
         if !pivot_ok(dk, scale) {
-            return Err(singular(k, "the L'DL pivot of the inertia matrix", dk));
+            return Err(singular(k, "the inertia matrix A (L'DL pivot)", dk, scale));
         }
         let mut i = model.frame(k).ant;
         while i != 0 {
@@ -196,23 +141,34 @@ fn check_finite(qdd: &[f64]) -> Result<()> {
     }
 }
 
-/// qdd = A^-1 (Gamma - H) (§9.7 first method) with the tree L'DL factorization.
-/// Allocation-free; all slices have NL entries.
+/// qdd = A^-1 (Gamma - H) (§9.7 first method) with the tree L'DL factorization: the kernel on
+/// tree arrays (NL entries). Allocation-free.
+#[allow(clippy::too_many_arguments)]
 pub fn ddm_composite(
     model: &DynModel<f64>,
-    ws: &mut DirectWorkspace,
+    ws: &mut Data,
+    env: &Environment,
     q: &[f64],
     qd: &[f64],
     tau: &[f64],
     qdd: &mut [f64],
 ) -> Result<()> {
-    inertia_matrix_into(model, &mut ws.inertia, q, &mut ws.a);
-    h_vector_into(model, &mut ws.inertia, q, qd, &mut ws.h);
-    ltdl_factor(model, &mut ws.a)?;
-    for j in 0..model.nl {
-        qdd[j] = tau[j] - ws.h[j];
+    let mut a = std::mem::replace(&mut ws.a, DMatrix::zeros(0, 0));
+    let mut h = std::mem::take(&mut ws.h);
+    let z = std::mem::take(&mut ws.zeros);
+    composite_inertia_matrix(model, ws, q, &mut a);
+    rnea_with_environment(model, ws, env, q, qd, &z, &mut h);
+    let r = ltdl_factor(model, &mut a);
+    if r.is_ok() {
+        for j in 0..model.nl {
+            qdd[j] = tau[j] - h[j];
+        }
+        ltdl_solve(model, &a, qdd);
     }
-    ltdl_solve(model, &ws.a, qdd);
+    ws.a = a;
+    ws.h = h;
+    ws.zeros = z;
+    r?;
     check_finite(qdd)
 }
 
@@ -285,19 +241,20 @@ fn axis_index(joint: JointType) -> Option<usize> {
 /// inertia J*_j and bias beta*_j with F_j = J*_j Vd_j + beta*_j collect the children through
 /// K_k = J*_k - u_k u_k' / H_k, u_k = J*_k a_k, H_k = a_k' u_k + Ia_k; forward,
 /// qdd_j = (Gamma_j - friction - u_j' (jT_i Vd_i + gamma_j) - a_j' beta*_j) / H_j (eq 10.12).
+#[allow(clippy::too_many_arguments)]
 pub fn ddm_aba(
     model: &DynModel<f64>,
-    ws: &mut DirectWorkspace,
+    b: &mut Data,
+    env: &Environment,
     q: &[f64],
     qd: &[f64],
     tau: &[f64],
     qdd: &mut [f64],
 ) -> Result<()> {
     let n = model.nl;
-    let b = &mut ws.aba;
     let mut scale: f64 = 0.0;
     // Forward: velocities, gamma_j, link inertias and biases.
-    b.w[0] = model.w0;
+    b.w[0] = env.base.w0;
     for j in 1..=n {
         let fr = model.frame(j);
         let i = fr.ant;
@@ -328,14 +285,15 @@ pub fn ddm_aba(
         ia.fixed_view_mut::<3, 3>(0, 3).copy_from(&(-sm));
         ia.fixed_view_mut::<3, 3>(3, 0).copy_from(&sm);
         ia.fixed_view_mut::<3, 3>(3, 3).copy_from(&l.inertia);
-        let f = w.cross(&w.cross(&l.ms)) + l.fe;
-        let m = w.cross(&(l.inertia * w)) + l.me;
-        b.pa[j] = Vector6::new(f.x, f.y, f.z, m.x, m.y, m.z);
-        b.ia[j] = ia;
+        let e = env.wrench(j);
+        let f = w.cross(&w.cross(&l.ms)) + e.force;
+        let m = w.cross(&(l.inertia * w)) + e.moment;
+        b.art_bias[j] = Vector6::new(f.x, f.y, f.z, m.x, m.y, m.z);
+        b.art_inertia[j] = ia;
         b.rot[j] = rot;
         b.pos[j] = pos;
         b.w[j] = w;
-        b.tau[j] = match fr.joint {
+        b.art_tau[j] = match fr.joint {
             JointType::Fixed => 0.0,
             _ => tau[j - 1] - l.fs * s.sign() - l.fv * s,
         };
@@ -349,38 +307,44 @@ pub fn ddm_aba(
         let fr = model.frame(k);
         let (kk, alpha) = match axis_index(fr.joint) {
             Some(ax) => {
-                let u = b.ia[k].column(ax).into_owned();
+                let u = b.art_inertia[k].column(ax).into_owned();
                 let d = u[ax] + model.link(k).ia;
                 if !pivot_ok(d, scale) {
                     return Err(singular(
                         k,
                         "the articulated inertia about the joint axis",
                         d,
+                        scale,
                     ));
                 }
-                let kk = b.ia[k] - u * u.transpose() / d;
-                let alpha = kk * b.gamma[k] + b.pa[k] + u * ((b.tau[k] - b.pa[k][ax]) / d);
-                b.u[k] = u;
-                b.d[k] = d;
+                let kk = b.art_inertia[k] - u * u.transpose() / d;
+                let alpha =
+                    kk * b.gamma[k] + b.art_bias[k] + u * ((b.art_tau[k] - b.art_bias[k][ax]) / d);
+                b.art_u[k] = u;
+                b.art_d[k] = d;
                 (kk, alpha)
             }
-            None => (b.ia[k], b.ia[k] * b.gamma[k] + b.pa[k]),
+            None => (
+                b.art_inertia[k],
+                b.art_inertia[k] * b.gamma[k] + b.art_bias[k],
+            ),
         };
         let i = fr.ant;
         if i != 0 {
-            b.ia[i] += inertia_to_parent(&b.rot[k], &b.pos[k], &kk);
-            b.pa[i] += wrench_to_parent(&b.rot[k], &b.pos[k], &alpha);
+            b.art_inertia[i] += inertia_to_parent(&b.rot[k], &b.pos[k], &kk);
+            b.art_bias[i] += wrench_to_parent(&b.rot[k], &b.pos[k], &alpha);
         }
     }
     // Forward: accelerations.
-    let g = model.vp0 - model.gravity;
-    b.acc[0] = Vector6::new(g.x, g.y, g.z, model.wp0.x, model.wp0.y, model.wp0.z);
+    let g = env.base.vp0 - env.gravity;
+    let wp0 = env.base.wp0;
+    b.acc[0] = Vector6::new(g.x, g.y, g.z, wp0.x, wp0.y, wp0.z);
     for j in 1..=n {
         let fr = model.frame(j);
         let mut acc = motion_to_child(&b.rot[j], &b.pos[j], &b.acc[fr.ant]) + b.gamma[j];
         match axis_index(fr.joint) {
             Some(ax) => {
-                let a = (b.tau[j] - b.u[j].dot(&acc) - b.pa[j][ax]) / b.d[j];
+                let a = (b.art_tau[j] - b.art_u[j].dot(&acc) - b.art_bias[j][ax]) / b.art_d[j];
                 acc[ax] += a;
                 qdd[j - 1] = a;
             }
@@ -391,10 +355,12 @@ pub fn ddm_aba(
     check_finite(qdd)
 }
 
-/// Run one of the two methods.
+/// Run one of the two kernels on tree arrays.
+#[allow(clippy::too_many_arguments)]
 pub fn ddm(
     model: &DynModel<f64>,
-    ws: &mut DirectWorkspace,
+    ws: &mut Data,
+    env: &Environment,
     method: Method,
     q: &[f64],
     qd: &[f64],
@@ -402,13 +368,43 @@ pub fn ddm(
     qdd: &mut [f64],
 ) -> Result<()> {
     match method {
-        Method::Composite => ddm_composite(model, ws, q, qd, tau, qdd),
-        Method::ArticulatedBody => ddm_aba(model, ws, q, qd, tau, qdd),
+        Method::Composite => ddm_composite(model, ws, env, q, qd, tau, qdd),
+        Method::ArticulatedBody => ddm_aba(model, ws, env, q, qd, tau, qdd),
     }
 }
 
-/// Direct dynamic model of the robot's (equivalent) tree: qdd for joints 1..NL.
-/// Convenience wrapper that checks its inputs and allocates; use [`ddm`] in loops.
+/// Direct dynamic model into `qdd`: the accelerations (rad/s², m/s²) of the movable joints for
+/// positions `q`, velocities `qd` and joint torques/forces `tau` (N m, N), all over the movable
+/// joints in frame order, under `env`, by `method`. Allocation-free.
+///
+/// Errors: [`Error::Dimension`], [`Error::NotFinite`] for bad inputs; [`Error::Singular`] when
+/// the inertia matrix (or an articulated inertia) is singular.
+#[allow(clippy::too_many_arguments)]
+pub fn direct_dynamics_into(
+    robot: &Robot,
+    data: &mut Data,
+    env: &Environment,
+    q: &[f64],
+    qd: &[f64],
+    tau: &[f64],
+    method: Method,
+    qdd: &mut [f64],
+) -> Result<()> {
+    let names = ["q", "qd", "tau"];
+    tree_vector_map(
+        robot,
+        data,
+        env,
+        names,
+        [q, qd, tau],
+        "qdd",
+        qdd,
+        |m, d, q, qd, tau, a| ddm(m, d, env, method, q, qd, tau, a),
+    )?
+}
+
+/// Direct dynamic model with the robot's environment: qdd over the movable joints. Allocates;
+/// use [`direct_dynamics_into`] in loops.
 pub fn direct_dynamics(
     robot: &Robot,
     q: &[f64],
@@ -416,12 +412,17 @@ pub fn direct_dynamics(
     tau: &[f64],
     method: Method,
 ) -> Result<DVector<f64>> {
-    check_state(robot, "q", q)?;
-    check_state(robot, "qd", qd)?;
-    check_state(robot, "tau", tau)?;
-    let model = robot.numeric();
-    let mut ws = DirectWorkspace::new(model);
-    let mut qdd = DVector::zeros(model.nl);
-    ddm(model, &mut ws, method, q, qd, tau, qdd.as_mut_slice())?;
+    let mut data = Data::new(robot);
+    let mut qdd = DVector::zeros(robot.dof());
+    direct_dynamics_into(
+        robot,
+        &mut data,
+        robot.environment(),
+        q,
+        qd,
+        tau,
+        method,
+        qdd.as_mut_slice(),
+    )?;
     Ok(qdd)
 }

@@ -11,9 +11,10 @@
 //! - fe_j, me_j are exerted by link j on the environment: the joints supply their power
 //!   `P = sum_j V_j'fe_j + w_j'me_j`, whose generalized force is dP/dqd.
 
-use crate::algorithms::inverse_dynamics::check_state;
 use crate::error::{Error, Result};
-use crate::model::{DynModel, FrameConstants, JointType, LinkConstants, Robot};
+use crate::model::{
+    BaseMotion, DynModel, Environment, FrameConstants, JointType, LinkConstants, Robot,
+};
 use crate::scalar::DynScalar;
 use nalgebra::{DVector, Matrix3, Vector3};
 use num_dual::{DualNum, HyperDual64};
@@ -123,8 +124,9 @@ pub fn energies<T: DynScalar>(
         }
         // [9.25]: U_j = -g'(M 0P_j + 0A_j MS_j)
         let mc = &pos0[j] * l.mass.clone() + &rot0[j] * &l.ms;
-        potential -= model.gravity.dot(&mc);
-        wrench_power += vj.dot(&l.fe) + wj.dot(&l.me);
+        potential -= model.env.gravity.dot(&mc);
+        let e = model.env.wrench(j);
+        wrench_power += vj.dot(&e.force) + wj.dot(&e.moment);
     }
     Energies {
         kinetic,
@@ -165,24 +167,44 @@ pub fn convert_model<T: DynScalar>(m: &DynModel<f64>) -> DynModel<T> {
                 ia: f(l.ia),
                 fs: f(l.fs),
                 fv: f(l.fv),
-                fe: map3(&l.fe),
-                me: map3(&l.me),
             })
             .collect(),
-        gravity: map3(&m.gravity),
-        w0: map3(&m.w0),
-        wp0: map3(&m.wp0),
-        v0: map3(&m.v0),
-        vp0: map3(&m.vp0),
+        env: convert_environment(&m.env),
     }
 }
 
-fn check_q_qd(robot: &Robot, q: &[f64], qd: Option<&[f64]>) -> Result<()> {
-    check_state(robot, "q", q)?;
-    if let Some(qd) = qd {
-        check_state(robot, "qd", qd)?;
+fn convert_environment<T: DynScalar>(e: &Environment) -> Environment<T> {
+    let b = &e.base;
+    let mut out = Environment::new(
+        map3(&e.gravity),
+        BaseMotion {
+            w0: map3(&b.w0),
+            wp0: map3(&b.wp0),
+            v0: map3(&b.v0),
+            vp0: map3(&b.vp0),
+        },
+        e.n_links(),
+    );
+    for (k, w) in e.wrenches().iter().enumerate() {
+        out.set_wrench_by_link(k + 1, map3(&w.force), map3(&w.moment))
+            .expect("same number of links");
     }
-    Ok(())
+    out
+}
+
+/// Check joint vectors over the movable joints and scatter them into tree arrays (NL entries).
+fn tree_arrays<const K: usize>(
+    robot: &Robot,
+    names: [&str; K],
+    x: [&[f64]; K],
+) -> Result<[Vec<f64>; K]> {
+    let c = robot.coordinates();
+    let mut out: [Vec<f64>; K] = std::array::from_fn(|_| vec![0.0; robot.nl()]);
+    for k in 0..K {
+        c.check(names[k], x[k], "movable joints")?;
+        c.scatter(x[k], &mut out[k]);
+    }
+    Ok(out)
 }
 
 fn finite(x: f64, what: &str) -> Result<f64> {
@@ -193,52 +215,57 @@ fn finite(x: f64, what: &str) -> Result<f64> {
     }
 }
 
-/// Kinetic energy of the tree (links [9.16] with velocities 10.1–10.2 including the base
-/// velocities w0, v0, plus rotors 1/2 Ia qd^2).
+/// Kinetic energy of the tree (J): links [9.16] with velocities 10.1–10.2 including the base
+/// velocities w0, v0 of the robot's environment, plus rotors 1/2 Ia qd^2. `q`, `qd` over the
+/// movable joints.
 pub fn kinetic_energy(robot: &Robot, q: &[f64], qd: &[f64]) -> Result<f64> {
-    check_q_qd(robot, q, Some(qd))?;
+    let [q, qd] = tree_arrays(robot, ["q", "qd"], [q, qd])?;
     let m = robot.numeric();
+    let b = &m.env.base;
     finite(
-        energies(m, q, qd, &m.w0, &m.v0).kinetic,
+        energies(m, &q, &qd, &b.w0, &b.v0).kinetic,
         "the kinetic energy",
     )
 }
 
-/// Potential energy in the gravity field ([9.25]), zero at 0P = 0.
+/// Potential energy in the gravity field (J, [9.25]), zero at 0P = 0. `q` over the movable
+/// joints.
 pub fn potential_energy(robot: &Robot, q: &[f64]) -> Result<f64> {
-    check_q_qd(robot, q, None)?;
+    let [q] = tree_arrays(robot, ["q"], [q])?;
     let m = robot.numeric();
     let zeros = vec![0.0; q.len()];
+    let b = &m.env.base;
     finite(
-        energies(m, q, &zeros, &m.w0, &m.v0).potential,
+        energies(m, &q, &zeros, &b.w0, &b.v0).potential,
         "the potential energy",
     )
 }
 
-/// Total mechanical energy: kinetic + potential.
+/// Total mechanical energy (J): kinetic + potential.
 pub fn total_energy(robot: &Robot, q: &[f64], qd: &[f64]) -> Result<f64> {
-    check_q_qd(robot, q, Some(qd))?;
+    let [q, qd] = tree_arrays(robot, ["q", "qd"], [q, qd])?;
     let m = robot.numeric();
-    let e = energies(m, q, qd, &m.w0, &m.v0);
+    let b = &m.env.base;
+    let e = energies(m, &q, &qd, &b.w0, &b.v0);
     finite(e.kinetic + e.potential, "the total energy")
 }
 
-/// Power the links deliver to the environment through their external wrenches,
+/// Power (W) the links deliver to the environment through their external wrenches,
 /// `sum_j V_j'fe_j + w_j'me_j`.
 pub fn wrench_power(robot: &Robot, q: &[f64], qd: &[f64]) -> Result<f64> {
-    check_q_qd(robot, q, Some(qd))?;
+    let [q, qd] = tree_arrays(robot, ["q", "qd"], [q, qd])?;
     let m = robot.numeric();
+    let b = &m.env.base;
     finite(
-        energies(m, q, qd, &m.w0, &m.v0).wrench_power,
+        energies(m, &q, &qd, &b.w0, &b.v0).wrench_power,
         "the external-wrench power",
     )
 }
 
-/// dE/dt = dE/dq qd + dE/dqd qdd of the total energy E = T + U for a fixed base (w0 = v0 = 0),
-/// by forward automatic differentiation (exact to rounding).
+/// dE/dt (W) = dE/dq qd + dE/dqd qdd of the total energy E = T + U for a fixed base
+/// (w0 = v0 = 0), by forward automatic differentiation (exact to rounding).
 pub fn total_energy_rate(robot: &Robot, q: &[f64], qd: &[f64], qdd: &[f64]) -> Result<f64> {
-    check_q_qd(robot, q, Some(qd))?;
-    check_state(robot, "qdd", qdd)?;
+    let [q, qd, qdd] = tree_arrays(robot, ["q", "qd", "qdd"], [q, qd, qdd])?;
     let m: DynModel<HyperDual64> = convert_model(robot.numeric());
     let qh: Vec<_> = (0..q.len())
         .map(|i| HyperDual64::new(q[i], qd[i], 0.0, 0.0))
@@ -251,7 +278,7 @@ pub fn total_energy_rate(robot: &Robot, q: &[f64], qd: &[f64], qdd: &[f64]) -> R
     finite((e.kinetic + e.potential).eps1, "dE/dt")
 }
 
-/// Joint torques of the tree joints 1..NL by the Euler–Lagrange equations (§10.2.1):
+/// Joint torques of the movable joints by the Euler–Lagrange equations (§10.2.1):
 ///
 /// `Gamma_k = d/dt(dT/dqd_k) - dT/dq_k + dU/dq_k + Fs_k sign(qd_k) + Fv_k qd_k + dP/dqd_k`,
 ///
@@ -259,23 +286,24 @@ pub fn total_energy_rate(robot: &Robot, q: &[f64], qd: &[f64], qdd: &[f64]) -> R
 /// delivered to the environment by the external wrenches, and the base may move: T depends on
 /// time through w0 and v0 (components in R_0), whose rates are wp0 and vp0 - w0 x v0.
 /// d/dt(dT/dqd_k) is the mixed second derivative of T along e_{qd_k} and the direction
-/// (qd, qdd, wp0, vp0 - w0 x v0), computed exactly with hyper-dual numbers. Fixed frames get 0.
-/// O(NL^2); a reference, not a fast path (use [`crate::algorithms::inverse_dynamics::rnea`]).
+/// (qd, qdd, wp0, vp0 - w0 x v0), computed exactly with hyper-dual numbers.
+/// O(NL^2); a reference, not a fast path (use
+/// [`crate::algorithms::inverse_dynamics::inverse_dynamics_into`]).
 pub fn lagrangian_torques(
     robot: &Robot,
     q: &[f64],
     qd: &[f64],
     qdd: &[f64],
 ) -> Result<DVector<f64>> {
-    check_q_qd(robot, q, Some(qd))?;
-    check_state(robot, "qdd", qdd)?;
+    let [q, qd, qdd] = tree_arrays(robot, ["q", "qd", "qdd"], [q, qd, qdd])?;
     let num = robot.numeric();
     let m: DynModel<HyperDual64> = convert_model(num);
     let n = robot.nl();
     let h = HyperDual64::new;
     // d/dt of the components of w0 and v0 in the moving frame R_0.
-    let w0_rate = num.wp0;
-    let v0_rate = num.vp0 - num.w0.cross(&num.v0);
+    let base = &num.env.base;
+    let w0_rate = base.wp0;
+    let v0_rate = base.vp0 - base.w0.cross(&base.v0);
     let mut tau = DVector::zeros(n);
     let mut qh: Vec<HyperDual64> = Vec::with_capacity(n);
     let mut qdh: Vec<HyperDual64> = Vec::with_capacity(n);
@@ -290,8 +318,8 @@ pub fn lagrangian_torques(
         qh.extend((0..n).map(|i| h(q[i], 0.0, qd[i], 0.0)));
         qdh.clear();
         qdh.extend((0..n).map(|i| h(qd[i], delta(i), qdd[i], 0.0)));
-        let w0 = Vector3::from_fn(|r, _| h(num.w0[r], 0.0, w0_rate[r], 0.0));
-        let v0 = Vector3::from_fn(|r, _| h(num.v0[r], 0.0, v0_rate[r], 0.0));
+        let w0 = Vector3::from_fn(|r, _| h(base.w0[r], 0.0, w0_rate[r], 0.0));
+        let v0 = Vector3::from_fn(|r, _| h(base.v0[r], 0.0, v0_rate[r], 0.0));
         let e = energies(&m, &qh, &qdh, &w0, &v0);
         let ddt_dt_dqd = e.kinetic.eps1eps2;
         let dp_dqd = e.wrench_power.eps1;
@@ -300,8 +328,8 @@ pub fn lagrangian_torques(
         qh.extend((0..n).map(|i| h(q[i], delta(i), 0.0, 0.0)));
         qdh.clear();
         qdh.extend((0..n).map(|i| h(qd[i], 0.0, 0.0, 0.0)));
-        let w0 = map3::<HyperDual64>(&num.w0);
-        let v0 = map3::<HyperDual64>(&num.v0);
+        let w0 = map3::<HyperDual64>(&base.w0);
+        let v0 = map3::<HyperDual64>(&base.v0);
         let e = energies(&m, &qh, &qdh, &w0, &v0);
         let (dt_dq, du_dq) = (e.kinetic.eps1, e.potential.eps1);
         let l = num.link(k + 1);
@@ -314,5 +342,9 @@ pub fn lagrangian_torques(
             k + 1
         )));
     }
-    Ok(tau)
+    let c = robot.coordinates();
+    Ok(DVector::from_iterator(
+        c.len(),
+        c.frames().iter().map(|&j| tau[j - 1]),
+    ))
 }

@@ -2,61 +2,29 @@
 //! Newton–Euler with qdd = 0 (§10.2.3, which applies the two methods of the book's §9.7 to trees):
 //! Gamma = A(q) qdd + H(q, qd).
 //!
-//! Conventions: A has NL x NL entries indexed like the state vectors of
-//! [`rnea`](crate::algorithms::inverse_dynamics::rnea) (joint j at index j-1). The rows and
-//! columns of fixed frames (sigma = 2) are zero (they carry no variable) and are skipped by the
-//! solvers of [`crate::algorithms::direct_dynamics`]. A_ij = 0 whenever neither of i, j is an
-//! ancestor of the other, and the rotor inertia Ia_j is on the diagonal.
-//!
-//! Written once over [`DynScalar`]: the symbolic generator runs it on expressions.
+//! The checked functions ([`inertia_matrix`], [`h_vector`] and their `_into` forms) work over
+//! the movable joints ([`Robot::coordinates`]). The kernel [`composite_inertia_matrix`] fills
+//! the NL x NL matrix of the tree arrays (joint j at index j-1; rows and columns of fixed frames
+//! zero). A_ij = 0 whenever neither of i, j is an ancestor of the other, and the rotor inertia
+//! Ia_j is on the diagonal. Written once over [`DynScalar`]: the symbolic generator runs it on
+//! expressions.
 
-use crate::algorithms::inverse_dynamics::{check_state, rnea};
+use crate::algorithms::inverse_dynamics::{
+    check_state, on_tree_arrays, rnea_with_environment, tree_vector_map,
+};
+use crate::data::Data;
 use crate::error::Result;
-use crate::model::{DynModel, JointType, Robot};
+use crate::model::{DynModel, Environment, JointType, Robot};
 use crate::scalar::DynScalar;
-use crate::workspace::Workspace;
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 
-/// Buffers of the composite-link method and of H (index j = link j; index 0 unused).
-#[derive(Clone, Debug)]
-pub struct InertiaWorkspace<T: DynScalar = f64> {
-    /// iA_j of the current q.
-    pub rot: Vec<Matrix3<T>>,
-    /// iP_j of the current q.
-    pub pos: Vec<Vector3<T>>,
-    /// jJ_j^c: inertia about O_j of the composite link j (link j and all its successors), in R_j.
-    pub jc: Vec<Matrix3<T>>,
-    /// jMS_j^c: first moments of the composite link j.
-    pub msc: Vec<Vector3<T>>,
-    /// M_j^c: mass of the composite link j.
-    pub mc: Vec<T>,
-    /// Newton–Euler buffers (for H).
-    pub ne: Workspace<T>,
-    zeros: Vec<T>,
-}
-
-impl<T: DynScalar> InertiaWorkspace<T> {
-    pub fn new(model: &DynModel<T>) -> Self {
-        let n = model.nl + 1;
-        InertiaWorkspace {
-            rot: vec![Matrix3::identity(); n],
-            pos: vec![Vector3::zeros(); n],
-            jc: vec![Matrix3::zeros(); n],
-            msc: vec![Vector3::zeros(); n],
-            mc: vec![T::zero(); n],
-            ne: Workspace::new(model),
-            zeros: vec![T::zero(); model.nl],
-        }
-    }
-}
-
-/// Composite links (backward recursion j = NL..1): jc, msc, mc of every link about its own
-/// origin, and iA_j, iP_j in `ws.rot`, `ws.pos`.
+/// Composite links (backward recursion j = NL..1): jJ^c, jMS^c, M^c of every link about its own
+/// origin, and iA_j, iP_j, in the buffers of `ws` (kernel, tree array q).
 ///
 /// Moving the inertia (J, MS, M) of a body from R_k to R_i with R = iA_k, p = iP_k, m = R MS
 /// (parallel-axis theorem with J = integral of -skew(r)^2 dm, r = p + s):
 /// J' = R J R' + M (p'p I - p p') + 2 (p'm) I - m p' - p m',  MS' = m + M p,  M' = M.
-pub fn composite_links<T: DynScalar>(model: &DynModel<T>, ws: &mut InertiaWorkspace<T>, q: &[T]) {
+pub fn composite_links<T: DynScalar>(model: &DynModel<T>, ws: &mut Data<T>, q: &[T]) {
     for j in 1..=model.nl {
         let (rot, pos) = model.frame(j).transform(&q[j - 1]);
         ws.rot[j] = rot;
@@ -90,15 +58,16 @@ pub fn composite_links<T: DynScalar>(model: &DynModel<T>, ws: &mut InertiaWorksp
     }
 }
 
-/// Inertia matrix A(q) (NL x NL) by the composite-link method, allocation-free.
+/// Inertia matrix A(q) (NL x NL, tree arrays) by the composite-link method: the generic kernel,
+/// allocation-free.
 ///
 /// Column j: the wrench on the composite link j for qdd = e_j (qd = 0, g = 0) is
 /// f = z x MS^c, m = J^c z (revolute) or f = M^c z, m = MS^c x z (prismatic); A_jj is its
 /// projection on the joint axis plus Ia_j, and A_ij (= A_ji) for every ancestor i of j is the
 /// projection after transporting the wrench to R_i (eqs 10.10–10.12 with the link terms zero).
-pub fn inertia_matrix_into<T: DynScalar>(
+pub fn composite_inertia_matrix<T: DynScalar>(
     model: &DynModel<T>,
-    ws: &mut InertiaWorkspace<T>,
+    ws: &mut Data<T>,
     q: &[T],
     a: &mut DMatrix<T>,
 ) {
@@ -146,35 +115,93 @@ fn project<T: DynScalar>(joint: JointType, f: &Vector3<T>, m: &Vector3<T>) -> T 
     }
 }
 
-/// H(q, qd): centrifugal, Coriolis, gravity, friction and external-wrench torques, i.e. the
-/// Newton–Euler torques with qdd = 0 (§9.7 method 1). Allocation-free; `h.len() == NL`.
-pub fn h_vector_into<T: DynScalar>(
-    model: &DynModel<T>,
-    ws: &mut InertiaWorkspace<T>,
-    q: &[T],
-    qd: &[T],
-    h: &mut [T],
-) {
-    rnea(model, &mut ws.ne, q, qd, &ws.zeros, h);
+/// Inertia matrix A(q) into `a` (N x N over the movable joints, frame order; kg m², kg, and
+/// kg m for the coupling of a revolute and a prismatic joint) by composite links, rotor inertias
+/// on the diagonal. `q` over the movable joints (rad, m). Allocation-free.
+pub fn inertia_matrix_into(
+    robot: &Robot,
+    data: &mut Data,
+    q: &[f64],
+    a: &mut DMatrix<f64>,
+) -> Result<()> {
+    check_state(robot, data, ["q", "q", "q"], [q, q, q])?;
+    let c = robot.coordinates();
+    let n = c.len();
+    if a.shape() != (n, n) {
+        return Err(crate::Error::dimension(
+            "A",
+            n * n,
+            a.len(),
+            format!("{n} x {n} over {}", c.describe("movable joints")),
+        ));
+    }
+    let model = robot.numeric();
+    on_tree_arrays(robot, data, [q, q, q], |data, q, _, _| {
+        let mut full = std::mem::replace(&mut data.a, DMatrix::zeros(0, 0));
+        composite_inertia_matrix(model, data, q, &mut full);
+        gather_matrix(c.frames(), &full, a);
+        data.a = full;
+    });
+    Ok(())
 }
 
-/// A(q) of a robot's (equivalent) tree; checks its input and allocates.
+/// out[(r, c)] = full[(j_r - 1, j_c - 1)] for the joints `js`.
+pub(crate) fn gather_matrix(js: &[usize], full: &DMatrix<f64>, out: &mut DMatrix<f64>) {
+    for (c, &jc) in js.iter().enumerate() {
+        for (r, &jr) in js.iter().enumerate() {
+            out[(r, c)] = full[(jr - 1, jc - 1)];
+        }
+    }
+}
+
+/// A(q) (N x N over the movable joints); checks its input and allocates.
 pub fn inertia_matrix(robot: &Robot, q: &[f64]) -> Result<DMatrix<f64>> {
-    check_state(robot, "q", q)?;
-    let model = robot.numeric();
-    let mut ws = InertiaWorkspace::new(model);
-    let mut a = DMatrix::zeros(model.nl, model.nl);
-    inertia_matrix_into(model, &mut ws, q, &mut a);
+    let mut data = Data::new(robot);
+    let n = robot.dof();
+    let mut a = DMatrix::zeros(n, n);
+    inertia_matrix_into(robot, &mut data, q, &mut a)?;
     Ok(a)
 }
 
-/// H(q, qd) of a robot's (equivalent) tree; checks its inputs and allocates.
+/// H(q, qd) into `h` (movable joints): centrifugal, Coriolis, gravity, friction and
+/// external-wrench torques under `env`, i.e. the Newton–Euler torques with qdd = 0 (§9.7 method
+/// 1), so that Gamma = A(q) qdd + H(q, qd). Allocation-free.
+pub fn h_vector_into(
+    robot: &Robot,
+    data: &mut Data,
+    env: &Environment,
+    q: &[f64],
+    qd: &[f64],
+    h: &mut [f64],
+) -> Result<()> {
+    let names = ["q", "qd", "qd"];
+    tree_vector_map(
+        robot,
+        data,
+        env,
+        names,
+        [q, qd, qd],
+        "H",
+        h,
+        |m, d, q, qd, _, t| {
+            let z = std::mem::take(&mut d.zeros);
+            rnea_with_environment(m, d, env, q, qd, &z, t);
+            d.zeros = z;
+        },
+    )
+}
+
+/// H(q, qd) over the movable joints with the robot's environment; allocates.
 pub fn h_vector(robot: &Robot, q: &[f64], qd: &[f64]) -> Result<DVector<f64>> {
-    check_state(robot, "q", q)?;
-    check_state(robot, "qd", qd)?;
-    let model = robot.numeric();
-    let mut ws = InertiaWorkspace::new(model);
-    let mut h = DVector::zeros(model.nl);
-    h_vector_into(model, &mut ws, q, qd, h.as_mut_slice());
+    let mut data = Data::new(robot);
+    let mut h = DVector::zeros(robot.dof());
+    h_vector_into(
+        robot,
+        &mut data,
+        robot.environment(),
+        q,
+        qd,
+        h.as_mut_slice(),
+    )?;
     Ok(h)
 }

@@ -1,11 +1,17 @@
 //! Inverse dynamic model of tree structures by the recursive Newton–Euler algorithm
 //! (eqs 10.3–10.12), with gravity as a base acceleration, rotor inertia, Coulomb and viscous
 //! friction and external wrenches.
+//!
+//! - [`inverse_dynamics`] / [`inverse_dynamics_into`]: the checked API on joint vectors over the
+//!   movable joints ([`Robot::coordinates`]);
+//! - [`rnea`], [`forward_recursion`], [`backward_recursion`] (and their `_sharing` forms): the
+//!   generic kernel over any [`DynScalar`] on tree arrays (NL entries, joint j at index j-1),
+//!   unchecked, for the customized symbolic models and automatic differentiation.
 
-use crate::error::{Error, Result};
-use crate::model::{DynModel, JointType, Robot};
+use crate::data::Data;
+use crate::error::Result;
+use crate::model::{DynModel, Environment, JointType, Robot};
 use crate::scalar::DynScalar;
-use crate::workspace::Workspace;
 use nalgebra::{DVector, Matrix3, Vector3};
 
 /// `z x (s v)` is needed as `w x (qd * z)`: returns `w x [0, 0, s]`.
@@ -118,16 +124,17 @@ fn euler_moment<T: DynScalar>(
     )
 }
 
-/// Forward recursion (eqs 10.3–10.8): fills `ws.rot`, `ws.pos`, `ws.w`, `ws.wd`, `ws.vd` and the
-/// link wrenches `ws.f` = jF_j + jfe_j, `ws.m` = jM_j + jme_j for links 1..NL.
+/// Forward recursion (eqs 10.3–10.8) with the model's environment: fills the placements, link
+/// velocities and accelerations of `ws` and the link wrenches jF_j + jfe_j, jM_j + jme_j for
+/// links 1..NL. Tree arrays of NL entries.
 pub fn forward_recursion<T: DynScalar>(
     model: &DynModel<T>,
-    ws: &mut Workspace<T>,
+    ws: &mut Data<T>,
     q: &[T],
     qd: &[T],
     qdd: &[T],
 ) {
-    forward_recursion_sharing(model, ws, q, qd, qdd, &[]);
+    forward_pass(model, &model.env, ws, q, qd, qdd, &[]);
 }
 
 /// Orientation of link k taken from an earlier link m on a closed chain: 0R_k = 0R_m C with C
@@ -183,15 +190,29 @@ fn sharing_order<T: DynScalar>(
 /// to the base, never a descendant of another member.
 pub fn forward_recursion_sharing<T: DynScalar>(
     model: &DynModel<T>,
-    ws: &mut Workspace<T>,
+    ws: &mut Data<T>,
     q: &[T],
     qd: &[T],
     qdd: &[T],
     shared: &[Option<SharedOrientation<T>>],
 ) {
-    ws.w[0] = model.w0.clone();
-    ws.wd[0] = model.wp0.clone();
-    ws.vd[0] = &model.vp0 - &model.gravity;
+    forward_pass(model, &model.env, ws, q, qd, qdd, shared);
+}
+
+/// The forward recursion with an explicit environment (gravity, base motion, wrenches).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn forward_pass<T: DynScalar>(
+    model: &DynModel<T>,
+    env: &Environment<T>,
+    ws: &mut Data<T>,
+    q: &[T],
+    qd: &[T],
+    qdd: &[T],
+    shared: &[Option<SharedOrientation<T>>],
+) {
+    ws.w[0] = env.base.w0.clone();
+    ws.wd[0] = env.base.wp0.clone();
+    ws.vd[0] = &env.base.vp0 - &env.gravity;
     let (p0, sq0) = w_products(&ws.w[0]);
     ws.u[0] = u_matrix(&p0, &sq0, &ws.wd[0], 0);
     // no allocation without shared links (the numeric rnea)
@@ -240,8 +261,9 @@ pub fn forward_recursion_sharing<T: DynScalar>(
         // (10.8): M = J wd + w x (J w) + MS x vd
         let m = euler_moment(&l.inertia, &l.inertia_diff, &wd, &p, &sq, &u) + l.ms.cross(&vd);
         ws.u[j] = u;
-        ws.f[j] = name3(f + &l.fe, "F", j);
-        ws.m[j] = name3(m + &l.me, "No", j);
+        let e = env.wrench(j);
+        ws.f[j] = name3(f + &e.force, "F", j);
+        ws.m[j] = name3(m + &e.moment, "No", j);
         ws.rot[j] = rot;
         ws.pos[j] = pos;
         ws.w[j] = w;
@@ -255,7 +277,7 @@ pub fn forward_recursion_sharing<T: DynScalar>(
 /// (0 for fixed frames).
 pub fn backward_recursion<T: DynScalar>(
     model: &DynModel<T>,
-    ws: &mut Workspace<T>,
+    ws: &mut Data<T>,
     qd: &[T],
     qdd: &[T],
     tau: &mut [T],
@@ -272,7 +294,7 @@ pub fn backward_recursion<T: DynScalar>(
 /// torques of the joints between the two links are not those of the tree.
 pub fn backward_recursion_sharing<T: DynScalar>(
     model: &DynModel<T>,
-    ws: &mut Workspace<T>,
+    ws: &mut Data<T>,
     qd: &[T],
     qdd: &[T],
     tau: &mut [T],
@@ -318,48 +340,152 @@ pub fn backward_recursion_sharing<T: DynScalar>(
     }
 }
 
-/// Torques of the tree joints 1..NL (`tau.len() == NL`) by recursive Newton–Euler.
-/// Allocation-free: all intermediate values live in `ws`. Entries of fixed frames are ignored in
-/// the inputs and zero in the output.
+/// Torques of the tree joints 1..NL (tree arrays of NL entries) by recursive Newton–Euler with
+/// the model's environment: the generic kernel. Allocation-free; entries of fixed frames are
+/// ignored in the inputs and zero in the output.
+///
+/// # Panics
+/// If a slice has fewer than NL entries or `ws` was made for a smaller model.
 pub fn rnea<T: DynScalar>(
     model: &DynModel<T>,
-    ws: &mut Workspace<T>,
+    ws: &mut Data<T>,
     q: &[T],
     qd: &[T],
     qdd: &[T],
     tau: &mut [T],
 ) {
-    forward_recursion(model, ws, q, qd, qdd);
+    rnea_with_environment(model, ws, &model.env, q, qd, qdd, tau);
+}
+
+/// [`rnea`] with an explicit environment (gravity, base motion, external wrenches).
+pub fn rnea_with_environment<T: DynScalar>(
+    model: &DynModel<T>,
+    ws: &mut Data<T>,
+    env: &Environment<T>,
+    q: &[T],
+    qd: &[T],
+    qdd: &[T],
+    tau: &mut [T],
+) {
+    forward_pass(model, env, ws, q, qd, qdd, &[]);
     backward_recursion(model, ws, qd, qdd, tau);
 }
 
-/// Check that a state vector has NL entries, all finite.
-pub fn check_state(robot: &Robot, name: &str, v: &[f64]) -> Result<()> {
-    if v.len() != robot.nl() {
-        return Err(Error::Input(format!(
-            "{name} has {} entries, the robot has NL = {} tree joints",
-            v.len(),
-            robot.nl()
-        )));
-    }
-    if let Some(k) = v.iter().position(|x| !x.is_finite()) {
-        return Err(Error::Input(format!(
-            "{name}{} = {} is not a finite number",
-            k + 1,
-            v[k]
-        )));
+/// Check a tree state (q, qd, and qdd or tau) against the robot's coordinates and the data
+/// against the robot: the entry check of the checked tree functions.
+pub(crate) fn check_state(
+    robot: &Robot,
+    data: &Data,
+    names: [&str; 3],
+    x: [&[f64]; 3],
+) -> Result<()> {
+    data.check(robot)?;
+    let c = robot.coordinates();
+    for (name, v) in names.iter().zip(x) {
+        c.check(name, v, "movable joints")?;
     }
     Ok(())
 }
 
-/// Inverse dynamic model of the (equivalent) tree: Gamma_tr(q, qd, qdd) for joints 1..NL.
-/// Convenience wrapper that checks its inputs and allocates; use [`rnea`] in loops.
+/// Run `f` on tree arrays holding the joint vectors (x1, x2, x3) over the movable joints: the
+/// vectors themselves when every tree joint is movable, else copies scattered into the data's
+/// tree arrays (zeros at fixed frames). Allocation-free.
+pub(crate) fn on_tree_arrays<R>(
+    robot: &Robot,
+    data: &mut Data,
+    x: [&[f64]; 3],
+    f: impl FnOnce(&mut Data, &[f64], &[f64], &[f64]) -> R,
+) -> R {
+    let c = robot.coordinates();
+    if c.is_identity() {
+        return f(data, x[0], x[1], x[2]);
+    }
+    let mut a = std::mem::take(&mut data.q);
+    let mut b = std::mem::take(&mut data.qd);
+    let mut d = std::mem::take(&mut data.qdd);
+    c.scatter(x[0], &mut a);
+    c.scatter(x[1], &mut b);
+    c.scatter(x[2], &mut d);
+    let r = f(data, &a, &b, &d);
+    data.q = a;
+    data.qd = b;
+    data.qdd = d;
+    r
+}
+
+/// The frame of the checked tree functions that map joint vectors to a joint vector: check the
+/// inputs `x` (named `names`), the data, the environment and the output's length; run `kernel`
+/// on tree arrays (scattered from the movable joints when some frames are fixed) writing a tree
+/// array; gather it into `out`. Allocation-free.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn tree_vector_map<R>(
+    robot: &Robot,
+    data: &mut Data,
+    env: &Environment,
+    names: [&str; 3],
+    x: [&[f64]; 3],
+    out_name: &str,
+    out: &mut [f64],
+    kernel: impl FnOnce(&DynModel<f64>, &mut Data, &[f64], &[f64], &[f64], &mut [f64]) -> R,
+) -> Result<R> {
+    check_state(robot, data, names, x)?;
+    env.check(robot.nl())?;
+    let c = robot.coordinates();
+    c.check_output(out_name, out, "movable joints")?;
+    let model = robot.numeric();
+    Ok(on_tree_arrays(robot, data, x, |data, a, b, d| {
+        let mut t = std::mem::take(&mut data.tau);
+        let r = kernel(model, data, a, b, d, &mut t);
+        c.gather(&t, out);
+        data.tau = t;
+        r
+    }))
+}
+
+/// Inverse dynamic model (eqs 10.3–10.12) into `tau`: the joint torques (N m) / forces (N) of the
+/// movable joints for positions `q` (rad, m), velocities `qd` and accelerations `qdd`, all with
+/// `robot.coordinates().len()` entries in frame order, under the per-call inputs `env`
+/// (gravity, base motion, external wrenches). Allocation-free.
+///
+/// Errors: [`crate::Error::Dimension`] for a vector of the wrong length or a `data` of another
+/// robot, [`crate::Error::NotFinite`] for a NaN or infinite entry.
+#[allow(clippy::too_many_arguments)]
+pub fn inverse_dynamics_into(
+    robot: &Robot,
+    data: &mut Data,
+    env: &Environment,
+    q: &[f64],
+    qd: &[f64],
+    qdd: &[f64],
+    tau: &mut [f64],
+) -> Result<()> {
+    let names = ["q", "qd", "qdd"];
+    tree_vector_map(
+        robot,
+        data,
+        env,
+        names,
+        [q, qd, qdd],
+        "tau",
+        tau,
+        |m, d, q, qd, qdd, t| rnea_with_environment(m, d, env, q, qd, qdd, t),
+    )
+}
+
+/// Inverse dynamic model with the robot's own environment: Gamma (N m, N) of the movable joints
+/// (frame order) for q, qd, qdd over the movable joints. Allocates; use
+/// [`inverse_dynamics_into`] in loops.
 pub fn inverse_dynamics(robot: &Robot, q: &[f64], qd: &[f64], qdd: &[f64]) -> Result<DVector<f64>> {
-    check_state(robot, "q", q)?;
-    check_state(robot, "qd", qd)?;
-    check_state(robot, "qdd", qdd)?;
-    let mut ws = Workspace::new(robot.numeric());
-    let mut tau = DVector::zeros(robot.nl());
-    rnea(robot.numeric(), &mut ws, q, qd, qdd, tau.as_mut_slice());
+    let mut data = Data::new(robot);
+    let mut tau = DVector::zeros(robot.dof());
+    inverse_dynamics_into(
+        robot,
+        &mut data,
+        robot.environment(),
+        q,
+        qd,
+        qdd,
+        tau.as_mut_slice(),
+    )?;
     Ok(tau)
 }

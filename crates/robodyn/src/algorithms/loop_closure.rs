@@ -24,6 +24,11 @@
 //! time derivative of the candidates at qdd = 0, from the velocity-product accelerations of both
 //! branches (forward kinematic recursion with qdd = 0).
 
+//!
+//! This module holds the loop-closure model ([`LoopClosure`], internal to the closed-chain
+//! model [`crate::ClosedChain`]) and its equations; the public way to solve the loops is the
+//! branch tracker ([`crate::Branch`], [`crate::algorithms::closed_chain::loop_closure`]).
+
 use crate::error::{Error, Result};
 use crate::model::{ClosedLoop, JointType, Robot};
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
@@ -37,6 +42,7 @@ pub const CANDIDATES: usize = 5;
 pub struct LoopConstraint {
     /// Loop number l (1-based, in cut-joint order).
     pub number: usize,
+    /// Cut joint, twin frame, branches and root of the loop.
     pub topology: ClosedLoop,
     /// Type of the cut joint.
     pub cut_joint: JointType,
@@ -56,7 +62,7 @@ impl LoopConstraint {
 
 /// Loop-closure model of a closed-chain robot: built once from a [`Robot`], immutable.
 #[derive(Clone, Debug)]
-pub struct LoopClosure {
+pub(crate) struct LoopClosure {
     robot: Robot,
     actuated: Vec<usize>,
     passive: Vec<usize>,
@@ -73,7 +79,7 @@ pub struct LoopClosure {
 
 /// Buffers of the loop-closure computations (absolute kinematics in R_0, frames 0..NF).
 #[derive(Clone, Debug)]
-pub struct LoopWorkspace {
+pub(crate) struct LoopWorkspace {
     pub rot: Vec<Matrix3<f64>>,
     pub pos: Vec<Vector3<f64>>,
     /// Angular velocity, velocity of the origin, angular and linear acceleration of links 0..NL.
@@ -82,13 +88,14 @@ pub struct LoopWorkspace {
     pub wd: Vec<Vector3<f64>>,
     pub vd: Vec<Vector3<f64>>,
     q: Vec<f64>,
-    /// The last solution's q_p (the next solve's default guess).
-    pub last_qp: Option<Vec<f64>>,
+    /// Candidate-equation columns of the Jacobian (one per tree joint).
+    cols: Vec<[f64; CANDIDATES]>,
 }
 
-/// A solution of the closure equations.
+/// A solution of the closure equations from a guess (damped Newton; internal: the start of a
+/// branch).
 #[derive(Clone, Debug, PartialEq)]
-pub struct ClosureSolution {
+pub(crate) struct GuessSolution {
     /// q_tr: joints 1..NL at index j-1 (fixed frames 0).
     pub q_tr: Vec<f64>,
     /// q_p in [`LoopClosure::passive_joints`] order.
@@ -246,19 +253,9 @@ impl LoopClosure {
         &self.passive
     }
 
-    /// Columns of the actuated joints in vectors by joint number (j - 1).
-    pub fn actuated_columns(&self) -> Vec<usize> {
-        self.actuated.iter().map(|j| j - 1).collect()
-    }
-
     /// Columns of the passive joints in vectors by joint number (j - 1).
     pub fn passive_columns(&self) -> Vec<usize> {
         self.passive.iter().map(|j| j - 1).collect()
-    }
-
-    /// N, the degrees of freedom.
-    pub fn dof(&self) -> usize {
-        self.actuated.len()
     }
 
     /// p, the number of independent closure equations (= passive joints).
@@ -278,7 +275,7 @@ impl LoopClosure {
             wd: z(),
             vd: z(),
             q: vec![0.0; nl],
-            last_qp: None,
+            cols: vec![[0.0; CANDIDATES]; nl],
         }
     }
 
@@ -413,9 +410,8 @@ impl LoopClosure {
 
     /// d phi / d q_tr (p x NL, columns by joint number) at the placements in `ws`: at a closed
     /// configuration this is [Wa Wp] of (10.27) with the columns in joint order.
-    pub fn constraint_jacobian(&self, ws: &LoopWorkspace, out: &mut DMatrix<f64>) {
-        let nl = self.robot.nl();
-        let mut cols = vec![[0.0; CANDIDATES]; nl];
+    pub fn constraint_jacobian(&self, ws: &mut LoopWorkspace, out: &mut DMatrix<f64>) {
+        let mut cols = std::mem::take(&mut ws.cols);
         for (l, lp) in self.loops.iter().enumerate() {
             self.candidates_jacobian(ws, l, &mut cols);
             for (r, &row) in lp.rows.iter().enumerate() {
@@ -424,6 +420,7 @@ impl LoopClosure {
                 }
             }
         }
+        ws.cols = cols;
     }
 
     /// Ψ of (10.28) (p entries): d²phi/dt² at qdd = 0, after [`Self::kinematics`] with the state's
@@ -504,13 +501,13 @@ impl LoopClosure {
     }
 
     /// Solve the closure equations for q_p given q_a by damped Newton (Levenberg–Marquardt),
-    /// starting from `guess` (q_p), or the workspace's previous solution, or zeros.
-    pub fn solve(
+    /// starting from `guess` (q_p): the start of a branch (allocates).
+    pub fn solve_from_guess(
         &self,
         ws: &mut LoopWorkspace,
         q_a: &[f64],
-        guess: Option<&[f64]>,
-    ) -> Result<ClosureSolution> {
+        guess: &[f64],
+    ) -> Result<GuessSolution> {
         let (n, p) = (self.actuated.len(), self.p);
         self.check_len(
             "q_a",
@@ -518,13 +515,13 @@ impl LoopClosure {
             n,
             &format!("actuated joints {:?}", self.actuated),
         )?;
-        let mut qp: Vec<f64> = match guess {
-            Some(g) => {
-                self.check_len("guess", g, p, &format!("passive joints {:?}", self.passive))?;
-                g.to_vec()
-            }
-            None => ws.last_qp.clone().unwrap_or_else(|| vec![0.0; p]),
-        };
+        self.check_len(
+            "guess",
+            guess,
+            p,
+            &format!("passive joints {:?}", self.passive),
+        )?;
+        let mut qp: Vec<f64> = guess.to_vec();
         let initial = qp.clone();
         let nl = self.robot.nl();
         let mut q = std::mem::take(&mut ws.q);
@@ -589,17 +586,20 @@ impl LoopClosure {
         ws.q = q;
         if !converged || worst.0 > 1e3 * self.tolerance.max(1e-12) {
             let lp = &self.loops[worst.1];
-            return Err(Error::Numerical(format!(
-                "{} does not close at q_a = {} (joints {:?}): closure residual {:.3e} after {it} \
-                 damped Newton iterations from the guess q_p = {} (joints {:?}); the \
-                 configuration is unreachable or the guess is too far",
-                lp.label(),
-                fmt_vec(q_a),
-                self.actuated,
-                worst.0.max(r.amax()),
-                fmt_vec(&initial),
-                self.passive
-            )));
+            return Err(Error::LoopNotClosed {
+                loop_label: lp.label(),
+                residual: worst.0.max(r.amax()),
+                tolerance: self.tolerance,
+                at: format!(
+                    "q_a = {} (joints {:?}), after {it} damped Newton iterations from the guess \
+                     q_p = {} (joints {:?})",
+                    fmt_vec(q_a),
+                    self.actuated,
+                    fmt_vec(&initial),
+                    self.passive
+                ),
+                hint: "the configuration is unreachable or the guess is too far".into(),
+            });
         }
         // A revolute cut also vanishes with z_{k+B} = -z_k: reject that flipped assembly.
         for lp in &self.loops {
@@ -617,8 +617,7 @@ impl LoopClosure {
         }
         let q_c = self.cut_variables(ws);
         let q_tr = ws.q.clone();
-        ws.last_qp = Some(qp.clone());
-        Ok(ClosureSolution {
+        Ok(GuessSolution {
             q_tr,
             q_p: qp,
             q_c,
@@ -627,9 +626,28 @@ impl LoopClosure {
         })
     }
 
+    /// A revolute cut's equations also vanish with z_{k+B} = -z_k: the loop label of a loop
+    /// closed that way at the placements in `ws`, if any.
+    pub fn flipped_loop(&self, ws: &LoopWorkspace) -> Option<String> {
+        self.loops.iter().find_map(|lp| {
+            let (k, t) = (lp.topology.cut, lp.topology.twin);
+            (lp.cut_joint == JointType::Revolute
+                && ws.rot[k].column(2).dot(&ws.rot[t].column(2)) < 0.0)
+                .then(|| lp.label())
+        })
+    }
+
+    /// Largest absolute value of all candidate equations of every loop (the closure residual, m
+    /// or rad) at the placements in `ws`.
+    pub fn max_residual(&self, ws: &LoopWorkspace) -> f64 {
+        (0..self.loops.len())
+            .flat_map(|l| self.candidates(ws, l))
+            .fold(0.0_f64, |a, b| a.max(b.abs()))
+    }
+
     /// Cut-joint variables at the (closed) placements in `ws`: the angle about z_k from x_k(0) to
     /// x_{k+B}, or the slide along z_k.
-    fn cut_variables(&self, ws: &LoopWorkspace) -> Vec<f64> {
+    pub fn cut_variables(&self, ws: &LoopWorkspace) -> Vec<f64> {
         self.loops
             .iter()
             .map(|lp| {
@@ -644,48 +662,5 @@ impl LoopClosure {
                 }
             })
             .collect()
-    }
-
-    /// Solve along the straight path from a closed configuration (q_a0, q_p0) to q_a in `steps`
-    /// steps, each solve starting from the previous solution (continuation): robust when q_a is
-    /// far from any guess.
-    pub fn solve_continuation(
-        &self,
-        ws: &mut LoopWorkspace,
-        q_a: &[f64],
-        q_a0: &[f64],
-        q_p0: &[f64],
-        steps: usize,
-    ) -> Result<ClosureSolution> {
-        self.check_len("q_a0", q_a0, self.actuated.len(), "actuated joints")?;
-        let mut guess = q_p0.to_vec();
-        let steps = steps.max(1);
-        let mut sol = None;
-        for s in 1..=steps {
-            let t = s as f64 / steps as f64;
-            let qa: Vec<f64> = q_a0.iter().zip(q_a).map(|(a, b)| a + t * (b - a)).collect();
-            let x = self.solve(ws, &qa, Some(&guess))?;
-            guess = x.q_p.clone();
-            sol = Some(x);
-        }
-        Ok(sol.expect("steps >= 1"))
-    }
-
-    /// Singular-value check of Wp: an error naming the loops when Wp is (numerically) singular.
-    pub fn check_wp(&self, wp: &DMatrix<f64>, q_tr: &[f64]) -> Result<()> {
-        let sv = wp.clone().svd(false, false).singular_values;
-        let (smin, smax) = (sv.min(), sv.max());
-        if smin.is_nan() || smin <= 1e-9 * smax.max(1.0) {
-            let labels: Vec<String> = self.loops.iter().map(|l| l.label()).collect();
-            return Err(Error::Numerical(format!(
-                "Wp (derivative of the closure equations of {} with respect to the passive joints \
-                 {:?}) is singular at q_tr = {}: smallest singular value {smin:.3e} (largest \
-                 {smax:.3e}); the mechanism is at a singular configuration",
-                labels.join(", "),
-                self.passive,
-                fmt_vec(q_tr)
-            )));
-        }
-        Ok(())
     }
 }

@@ -14,12 +14,14 @@
 //! produce. For a closed chain, Gamma_cl = G^T Gamma_tr (10.40), so its regressor is G^T Phi
 //! ([`closed_chain_regressor`]).
 
+use crate::data::Data;
 use crate::error::{Error, Result};
-use crate::model::{DynModel, JointType, Robot, RobotDescription, STANDARD_PARAMETERS};
-use crate::workspace::Workspace;
+use crate::model::{
+    DynModel, Environment, JointType, Robot, RobotDescription, STANDARD_PARAMETERS,
+};
 use nalgebra::{DMatrix, Matrix3, SMatrix, Vector3};
 
-use super::inverse_dynamics::{check_state, forward_recursion};
+use super::inverse_dynamics::{check_state, forward_pass, on_tree_arrays, tree_vector_map};
 
 /// Number of standard parameters per link.
 pub const PARAMS_PER_LINK: usize = 13;
@@ -71,7 +73,9 @@ impl ZeroParameters {
 /// file). The ten inertial parameters of every link are in K unless absent.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct ParameterSelection {
+    /// IA_j is a parameter (index j-1).
     pub rotor: Vec<bool>,
+    /// FS_j and FV_j are parameters (index j-1).
     pub friction: Vec<bool>,
     /// K indices (13 per link) of the parameters that do not exist.
     pub absent: std::collections::BTreeSet<usize>,
@@ -176,13 +180,19 @@ fn link_wrench_map(w: &Vector3<f64>, wd: &Vector3<f64>, vd: &Vector3<f64>) -> SM
     y
 }
 
-/// Regressor of the tree, Phi (NL x 13 NL), written into `phi`, such that
-/// Phi K = Gamma_tr - Gamma_e. Allocation-free: intermediate values live in `ws` (the forward
-/// recursion of [`forward_recursion`] runs first; the parameters of `model` only affect buffers
-/// the regressor does not read). Rows of fixed frames are zero.
-pub fn regressor(
+/// Regressor of the tree on tree arrays, Phi (NL x 13 NL), written into `phi`, such that
+/// Phi K = Gamma_tr - Gamma_e under `env` (its gravity and base motion; the wrenches are Gamma_e):
+/// the kernel. Allocation-free: intermediate values live in `ws` (the forward recursion runs
+/// first; the parameters of `model` only affect buffers the regressor does not read). Rows of
+/// fixed frames are zero.
+///
+/// # Panics
+/// If `phi` is not NL x 13 NL.
+#[allow(clippy::too_many_arguments)]
+pub fn tree_regressor(
     model: &DynModel<f64>,
-    ws: &mut Workspace<f64>,
+    ws: &mut Data,
+    env: &Environment,
     q: &[f64],
     qd: &[f64],
     qdd: &[f64],
@@ -190,7 +200,7 @@ pub fn regressor(
 ) {
     let nl = model.nl;
     assert_eq!(phi.shape(), (nl, PARAMS_PER_LINK * nl), "regressor size");
-    forward_recursion(model, ws, q, qd, qdd);
+    forward_pass(model, env, ws, q, qd, qdd, &[]);
     phi.fill(0.0);
     for j in 1..=nl {
         let mut y = link_wrench_map(&ws.w[j], &ws.wd[j], &ws.vd[j]);
@@ -238,16 +248,23 @@ pub fn regressor(
     }
 }
 
-/// Gamma_e: torques of the tree joints produced by the external wrenches (fe_j, me_j) alone, at
-/// configuration q (they do not depend on qd, qdd). Overwrites the buffers of `ws`.
-pub fn wrench_torques(model: &DynModel<f64>, ws: &mut Workspace<f64>, q: &[f64], tau: &mut [f64]) {
+/// Gamma_e on tree arrays: torques of the tree joints produced by the external wrenches of
+/// `env` alone, at configuration q (they do not depend on qd, qdd): the kernel. Overwrites the
+/// buffers of `ws`.
+pub fn tree_wrench_torques(
+    model: &DynModel<f64>,
+    ws: &mut Data,
+    env: &Environment,
+    q: &[f64],
+    tau: &mut [f64],
+) {
     let nl = model.nl;
     for j in 1..=nl {
         let (rot, pos) = model.frame(j).transform(&q[j - 1]);
         ws.rot[j] = rot;
         ws.pos[j] = pos;
-        ws.f[j] = model.link(j).fe;
-        ws.m[j] = model.link(j).me;
+        ws.f[j] = env.wrench(j).force;
+        ws.m[j] = env.wrench(j).moment;
     }
     for j in (1..=nl).rev() {
         let fr = model.frame(j);
@@ -279,13 +296,160 @@ pub fn closed_chain_regressor(g: &DMatrix<f64>, phi: &DMatrix<f64>) -> Result<DM
     Ok(g.transpose() * phi)
 }
 
-/// Convenience: the regressor (NL x 13 NL) of a robot at one state, with input checks.
-pub fn regressor_at(robot: &Robot, q: &[f64], qd: &[f64], qdd: &[f64]) -> Result<DMatrix<f64>> {
-    check_state(robot, "q", q)?;
-    check_state(robot, "qd", qd)?;
-    check_state(robot, "qdd", qdd)?;
-    let mut ws = Workspace::new(robot.numeric());
-    let mut phi = DMatrix::zeros(robot.nl(), PARAMS_PER_LINK * robot.nl());
-    regressor(robot.numeric(), &mut ws, q, qd, qdd, &mut phi);
+/// Regressor Phi (N x 13 NL: rows over the movable joints, columns the standard parameters K,
+/// 13 per link, link 1 first) into `phi`, such that Gamma = Phi K + Gamma_e under `env`
+/// (gravity, base motion). `q`, `qd`, `qdd` over the movable joints. Allocation-free.
+#[allow(clippy::too_many_arguments)]
+pub fn regressor_into(
+    robot: &Robot,
+    data: &mut Data,
+    env: &Environment,
+    q: &[f64],
+    qd: &[f64],
+    qdd: &[f64],
+    phi: &mut DMatrix<f64>,
+) -> Result<()> {
+    check_state(robot, data, ["q", "qd", "qdd"], [q, qd, qdd])?;
+    env.check(robot.nl())?;
+    let c = robot.coordinates();
+    let (n, nl) = (c.len(), robot.nl());
+    if phi.shape() != (n, PARAMS_PER_LINK * nl) {
+        return Err(Error::dimension(
+            "Phi",
+            n * PARAMS_PER_LINK * nl,
+            phi.len(),
+            format!(
+                "{n} x {} (movable joints x 13 standard parameters per link)",
+                PARAMS_PER_LINK * nl
+            ),
+        ));
+    }
+    let model = robot.numeric();
+    on_tree_arrays(robot, data, [q, qd, qdd], |data, q, qd, qdd| {
+        let mut full = std::mem::replace(&mut data.phi, DMatrix::zeros(0, 0));
+        if full.shape() != (nl, PARAMS_PER_LINK * nl) {
+            full = DMatrix::zeros(nl, PARAMS_PER_LINK * nl); // first call only
+        }
+        tree_regressor(model, data, env, q, qd, qdd, &mut full);
+        for (r, &j) in c.frames().iter().enumerate() {
+            phi.row_mut(r).copy_from(&full.row(j - 1));
+        }
+        data.phi = full;
+    });
+    Ok(())
+}
+
+/// Gamma_e into `tau_e` (movable joints): the torques the external wrenches of `env` alone
+/// produce at q (N m, N). Allocation-free.
+pub fn wrench_torques_into(
+    robot: &Robot,
+    data: &mut Data,
+    env: &Environment,
+    q: &[f64],
+    tau_e: &mut [f64],
+) -> Result<()> {
+    let names = ["q", "q", "q"];
+    tree_vector_map(
+        robot,
+        data,
+        env,
+        names,
+        [q, q, q],
+        "tau_e",
+        tau_e,
+        |m, d, q, _, _, t| tree_wrench_torques(m, d, env, q, t),
+    )
+}
+
+/// The regressor (N x 13 NL) at one state with the robot's environment; allocates.
+pub fn regressor(robot: &Robot, q: &[f64], qd: &[f64], qdd: &[f64]) -> Result<DMatrix<f64>> {
+    let mut data = Data::new(robot);
+    let mut phi = DMatrix::zeros(robot.dof(), PARAMS_PER_LINK * robot.nl());
+    regressor_into(robot, &mut data, robot.environment(), q, qd, qdd, &mut phi)?;
     Ok(phi)
+}
+
+/// Gamma_e (movable joints) at q with the robot's environment; allocates.
+pub fn wrench_torques(robot: &Robot, q: &[f64]) -> Result<nalgebra::DVector<f64>> {
+    let mut data = Data::new(robot);
+    let mut t = nalgebra::DVector::zeros(robot.dof());
+    wrench_torques_into(robot, &mut data, robot.environment(), q, t.as_mut_slice())?;
+    Ok(t)
+}
+
+/// Columns of the regressor kept for a model: indices in K and their names.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RegressorColumns {
+    /// Indices in K (13 per link), in K order.
+    pub indices: Vec<usize>,
+    /// Names: `XX1`..., base parameters that group others get an `R` (`XX2R`).
+    pub names: Vec<String>,
+    /// How the set was chosen when it is not the symbolic rules' (for the user).
+    pub note: Option<String>,
+}
+
+/// The regressor columns of the standard parameters selected by `selection` (absent ones left
+/// out), named with the robot file's own parameter names.
+pub fn standard_columns(robot: &Robot, selection: &ParameterSelection) -> RegressorColumns {
+    let names = crate::algorithms::base_parameters::ParameterNames::of(robot.description());
+    let indices = selection.columns();
+    RegressorColumns {
+        names: indices.iter().map(|&i| names.name(i).to_string()).collect(),
+        indices,
+        note: None,
+    }
+}
+
+/// The regressor columns of the base parameters (Phi_b with Gamma = Phi_b K_b + Gamma_e): the
+/// symbolic rules' set (§10.3.6); for a closed chain whose loops the rules do not all handle, the
+/// numerical method's set (§10.3.4, samples seeded by `seed`), said in `note`. Names are the
+/// robot file's own (grouped ones with their `R` name).
+pub fn base_columns(
+    robot: &Robot,
+    selection: &ParameterSelection,
+    seed: u64,
+) -> Result<RegressorColumns> {
+    use crate::algorithms::base_parameters::{
+        numeric_base_parameters, symbolic_base_parameters, ClosedChainSampler, NumericOptions,
+        ParameterNames,
+    };
+    let names = ParameterNames::of(robot.description());
+    let name = |i: usize, regrouped: bool| {
+        if regrouped {
+            names.grouped(i).to_string()
+        } else {
+            names.name(i).to_string()
+        }
+    };
+    let sb = symbolic_base_parameters(robot.description(), selection)?;
+    if !robot.is_tree() && !sb.unhandled_loops.is_empty() {
+        let opt = NumericOptions {
+            selection: selection.clone(),
+            samples: None,
+            seed,
+        };
+        let mut sampler = ClosedChainSampler::new(robot)?;
+        let nb = numeric_base_parameters(robot, &mut sampler, &opt)?;
+        let (indices, names) = (0..nb.count())
+            .map(|r| (nb.base[r], name(nb.base[r], nb.is_regrouped(r))))
+            .unzip();
+        return Ok(RegressorColumns {
+            indices,
+            names,
+            note: Some(format!(
+                "{}: the symbolic rules do not handle the loop(s) cut at joint(s) {:?}; the \
+                 columns are the numerical method's base parameters (the arbiter)",
+                robot.name(),
+                sb.unhandled_loops
+            )),
+        });
+    }
+    let (indices, names) = (0..sb.count())
+        .map(|r| (sb.base[r], name(sb.base[r], sb.is_regrouped(r))))
+        .unzip();
+    Ok(RegressorColumns {
+        indices,
+        names,
+        note: None,
+    })
 }

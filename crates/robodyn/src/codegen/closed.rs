@@ -184,19 +184,20 @@ impl ClosureReference {
     /// continued to the reference actuated values) and Wp there.
     pub fn new(robot: &Robot) -> Result<ClosureReference> {
         let cc = ClosedChain::new(robot)?;
-        let mut ws = cc.workspace();
-        let qa = cc.reference_actuated();
-        let sol = cc.solve_from_reference(&mut ws, &qa, None).map_err(|e| {
+        let mut branch = cc.assembly_branch().map_err(|e| {
             Error::Numerical(format!(
                 "robot `{}`: the loops do not close at the reference configuration, which \
                  fixes the elimination order of the generated W: {e}",
                 robot.name()
             ))
         })?;
-        let c = cc.constraints(&mut ws, &sol.q_tr)?;
+        let qa = branch.q_a().to_vec();
+        let zeros = vec![0.0; qa.len()];
+        let s =
+            crate::algorithms::closed_chain::closed_state(&cc, &mut branch, &qa, &zeros, &zeros)?;
         Ok(ClosureReference {
             lc: cc.closure().clone(),
-            wp: c.wp,
+            wp: s.wp,
         })
     }
 }

@@ -18,14 +18,14 @@ pub use closed::constant_g;
 use closed::{closed_form, closed_torques, closed_w, ClosedForm};
 pub use parallel_links::parallel_links;
 
-use crate::algorithms::inertia_matrix::{inertia_matrix_into, InertiaWorkspace};
+use crate::algorithms::inertia_matrix::composite_inertia_matrix;
 use crate::algorithms::inverse_dynamics::{
     backward_recursion_sharing, forward_recursion_sharing, rnea, SharedOrientation,
 };
+use crate::data::Data;
 use crate::error::{Error, Item, Result};
 use crate::model::{DynModel, RobotDescription, STANDARD_PARAMETERS};
 use crate::scalar::DynScalar as _;
-use crate::workspace::Workspace;
 use nalgebra::DMatrix;
 use robodyn_symbolic::program::{name_value, record};
 use robodyn_symbolic::{cmp_expr, Assignment, Expr, InputGroup, Program};
@@ -250,9 +250,9 @@ fn split_param(name: &str) -> Option<(&str, usize)> {
 /// (`algorithms::inertia_matrix`, generic over the scalar), rotor inertias on the diagonal.
 pub fn inertia_columns(model: &DynModel<Expr>, joints: &[usize], q: &[Expr]) -> Vec<Vec<Expr>> {
     let n = model.nl;
-    let mut ws = InertiaWorkspace::new(model);
+    let mut ws = Data::from_model(model);
     let mut a = DMatrix::from_element(n, n, Expr::zero());
-    inertia_matrix_into(model, &mut ws, q, &mut a);
+    composite_inertia_matrix(model, &mut ws, q, &mut a);
     joints
         .iter()
         .map(|&c| joints.iter().map(|&r| a[(r - 1, c - 1)].clone()).collect())
@@ -332,7 +332,7 @@ pub fn generate(desc: &RobotDescription, opt: &GenOptions) -> Result<Program> {
         Vec::new()
     };
     let (outputs, assignments) = record(&reserved, || -> Result<Vec<Assignment>> {
-        let mut ws = Workspace::new(&model);
+        let mut ws = Data::from_model(&model);
         let mut tau = vec![Expr::zero(); nl];
         match opt.model {
             ModelKind::Idm | ModelKind::Closed => {

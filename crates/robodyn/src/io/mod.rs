@@ -46,10 +46,7 @@ impl Format {
 /// Read a text file; files that are not UTF-8 (SYMORO+ writes Latin-1 comments such as
 /// "Noë") are decoded as Latin-1.
 fn read(path: &Path) -> Result<String> {
-    let bytes = std::fs::read(path).map_err(|e| Error::Io {
-        path: path.display().to_string(),
-        reason: e.to_string(),
-    })?;
+    let bytes = std::fs::read(path).map_err(|e| Error::io(path.display().to_string(), e))?;
     Ok(match String::from_utf8(bytes) {
         Ok(s) => s,
         Err(e) => e.as_bytes().iter().map(|&b| b as char).collect(),
@@ -96,8 +93,5 @@ pub fn save_description(desc: &RobotDescription, path: &Path) -> Result<()> {
             ))
         }
     };
-    std::fs::write(path, text).map_err(|e| Error::Io {
-        path: path.display().to_string(),
-        reason: e.to_string(),
-    })
+    std::fs::write(path, text).map_err(|e| Error::io(path.display().to_string(), e))
 }

@@ -3,7 +3,7 @@
 //! `DynModel<f64>` is built once when a [`crate::Robot`] is validated; `DynModel<Expr>` is built by
 //! the symbolic model generator from the same description, so the same recursion serves both.
 
-use crate::model::{JointType, RobotDescription};
+use crate::model::{BaseMotion, Environment, JointType, RobotDescription, Wrench};
 use crate::scalar::DynScalar;
 use nalgebra::{Matrix3, Vector3};
 use robodyn_symbolic::Expr;
@@ -13,6 +13,7 @@ use robodyn_symbolic::Expr;
 pub struct FrameConstants<T: DynScalar> {
     /// a(j).
     pub ant: usize,
+    /// sigma_j.
     pub joint: JointType,
     /// Rz(gamma) Rx(alpha).
     pub pre_rot: Matrix3<T>,
@@ -68,7 +69,7 @@ impl<T: DynScalar> FrameConstants<T> {
     }
 }
 
-/// Inertial, drive and external-wrench parameters of link j in scalar `T`.
+/// Inertial and drive parameters of link j in scalar `T` (about O_j, in R_j).
 #[derive(Clone, Debug)]
 pub struct LinkConstants<T: DynScalar> {
     /// jJ_j about O_j.
@@ -78,20 +79,20 @@ pub struct LinkConstants<T: DynScalar> {
     pub inertia_diff: Vector3<T>,
     /// jMS_j.
     pub ms: Vector3<T>,
+    /// M_j (kg).
     pub mass: T,
+    /// Rotor inertia Ia_j (kg m² or kg).
     pub ia: T,
+    /// Coulomb friction Fs_j (N m or N).
     pub fs: T,
+    /// Viscous friction Fv_j (N m s/rad or N s/m).
     pub fv: T,
-    /// Force and moment exerted by the link on the environment, in R_j.
-    pub fe: Vector3<T>,
-    pub me: Vector3<T>,
 }
 
 impl<T: DynScalar> LinkConstants<T> {
-    /// From the 13 standard parameters (XX XY XZ YY YZ ZZ MX MY MZ M IA FS FV) and the wrench.
-    pub fn new(p: [T; 13], w: [T; 6]) -> Self {
+    /// From the 13 standard parameters (XX XY XZ YY YZ ZZ MX MY MZ M IA FS FV).
+    pub fn new(p: [T; 13]) -> Self {
         let [xx, xy, xz, yy, yz, zz, mx, my, mz, m, ia, fs, fv] = p;
-        let [fx, fy, fz, cx, cy, cz] = w;
         LinkConstants {
             inertia_diff: Vector3::new(
                 zz.clone() - yy.clone(),
@@ -104,26 +105,22 @@ impl<T: DynScalar> LinkConstants<T> {
             ia,
             fs,
             fv,
-            fe: Vector3::new(fx, fy, fz),
-            me: Vector3::new(cx, cy, cz),
         }
     }
 }
 
-/// All constants of a robot in scalar `T`.
+/// All constants of a robot in scalar `T`: the generic layer the recursions run on.
 #[derive(Clone, Debug)]
 pub struct DynModel<T: DynScalar> {
+    /// NL, the links of the (equivalent) tree.
     pub nl: usize,
     /// Frames 1..NF at index j-1.
     pub frames: Vec<FrameConstants<T>>,
     /// Links 1..NL at index j-1.
     pub links: Vec<LinkConstants<T>>,
-    /// Gravity g in R_0.
-    pub gravity: Vector3<T>,
-    pub w0: Vector3<T>,
-    pub wp0: Vector3<T>,
-    pub v0: Vector3<T>,
-    pub vp0: Vector3<T>,
+    /// The description's gravity, base motion and external wrenches (the default per-call
+    /// inputs).
+    pub env: Environment<T>,
 }
 
 impl<T: DynScalar> DynModel<T> {
@@ -143,24 +140,40 @@ impl<T: DynScalar> DynModel<T> {
             .links
             .iter()
             .enumerate()
-            .map(|(i, l)| {
-                let p = std::array::from_fn(|k| link(i + 1, k, &l.params[k]));
-                let w = std::array::from_fn(|k| link(i + 1, 13 + k, &l.wrench[k]));
-                LinkConstants::new(p, w)
-            })
+            .map(|(i, l)| LinkConstants::new(std::array::from_fn(|k| link(i + 1, k, &l.params[k]))))
             .collect();
+        let wrenches = desc
+            .links
+            .iter()
+            .enumerate()
+            .map(|(i, l)| {
+                let mut c = |k: usize| link(i + 1, 13 + k, &l.wrench[k]);
+                Wrench {
+                    force: Vector3::new(c(0), c(1), c(2)),
+                    moment: Vector3::new(c(3), c(4), c(5)),
+                }
+            })
+            .collect::<Vec<_>>();
         let v3 = |a: &[Expr; 3], geo: &mut dyn FnMut(&Expr) -> T| {
             Vector3::new(geo(&a[0]), geo(&a[1]), geo(&a[2]))
         };
-        DynModel {
-            nl: desc.nl,
-            frames,
-            links,
-            gravity: v3(&desc.gravity, &mut geo),
+        let gravity = v3(&desc.gravity, &mut geo);
+        let base = BaseMotion {
             w0: v3(&desc.w0, &mut geo),
             wp0: v3(&desc.wp0, &mut geo),
             v0: v3(&desc.v0, &mut geo),
             vp0: v3(&desc.vp0, &mut geo),
+        };
+        let mut env = Environment::new(gravity, base, desc.nl);
+        for (j, w) in wrenches.into_iter().enumerate() {
+            env.set_wrench_by_link(j + 1, w.force, w.moment)
+                .expect("one wrench per link");
+        }
+        DynModel {
+            nl: desc.nl,
+            frames,
+            links,
+            env,
         }
     }
 

@@ -8,8 +8,11 @@ use std::collections::BTreeMap;
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum JointType {
+    /// sigma = 0: a rotation about z_j by the variable q_j = theta_j (rad).
     Revolute,
+    /// sigma = 1: a translation along z_j by q_j = r_j (m).
     Prismatic,
+    /// sigma = 2: no joint variable.
     Fixed,
 }
 
@@ -23,6 +26,7 @@ impl JointType {
         }
     }
 
+    /// From sigma_j (0, 1, 2); None otherwise.
     pub fn from_sigma(s: i64) -> Option<JointType> {
         match s {
             0 => Some(JointType::Revolute),
@@ -37,10 +41,12 @@ impl JointType {
         self == JointType::Revolute
     }
 
+    /// sigma_j = 1.
     pub fn is_prismatic(self) -> bool {
         self == JointType::Prismatic
     }
 
+    /// sigma_j != 2: the frame carries a joint variable.
     pub fn is_movable(self) -> bool {
         self != JointType::Fixed
     }
@@ -60,14 +66,21 @@ pub struct FrameDesc {
     pub name: String,
     /// Antecedent a(j): 0 for the base.
     pub ant: usize,
+    /// sigma_j.
     pub joint: JointType,
     /// mu_j: true when the joint is actuated.
     pub actuated: bool,
+    /// gamma_j (rad).
     pub gamma: Expr,
+    /// b_j (m).
     pub b: Expr,
+    /// alpha_j (rad).
     pub alpha: Expr,
+    /// d_j (m).
     pub d: Expr,
+    /// Constant part of theta_j (rad).
     pub theta: Expr,
+    /// Constant part of r_j (m).
     pub r: Expr,
 }
 
@@ -100,6 +113,7 @@ impl FrameDesc {
         ]
     }
 
+    /// The six parameters, mutable, in [`GEOMETRIC_PARAMETERS`] order.
     pub fn geometric_mut(&mut self) -> [&mut Expr; 6] {
         [
             &mut self.gamma,
@@ -119,18 +133,31 @@ pub const STANDARD_PARAMETERS: [&str; 13] = [
 
 /// Index of each standard parameter in [`STANDARD_PARAMETERS`].
 pub mod param {
+    /// XX: inertia about x_j (kg m²).
     pub const XX: usize = 0;
+    /// XY: product of inertia (kg m²).
     pub const XY: usize = 1;
+    /// XZ: product of inertia (kg m²).
     pub const XZ: usize = 2;
+    /// YY: inertia about y_j (kg m²).
     pub const YY: usize = 3;
+    /// YZ: product of inertia (kg m²).
     pub const YZ: usize = 4;
+    /// ZZ: inertia about z_j (kg m²).
     pub const ZZ: usize = 5;
+    /// MX: first moment along x_j (kg m).
     pub const MX: usize = 6;
+    /// MY: first moment along y_j (kg m).
     pub const MY: usize = 7;
+    /// MZ: first moment along z_j (kg m).
     pub const MZ: usize = 8;
+    /// M: mass (kg).
     pub const M: usize = 9;
+    /// IA: rotor inertia (kg m² or kg).
     pub const IA: usize = 10;
+    /// FS: Coulomb friction (N m or N).
     pub const FS: usize = 11;
+    /// FV: viscous friction (N m s/rad or N s/m).
     pub const FV: usize = 12;
 }
 
@@ -140,6 +167,7 @@ pub const WRENCH_COMPONENTS: [&str; 6] = ["FX", "FY", "FZ", "CX", "CY", "CZ"];
 /// Link j: 13 standard inertial/drive parameters and the external wrench.
 #[derive(Clone, Debug, PartialEq)]
 pub struct LinkDesc {
+    /// Link name.
     pub name: String,
     /// XX XY XZ YY YZ ZZ MX MY MZ M IA FS FV, about O_j in R_j.
     pub params: [Expr; 13],
@@ -170,6 +198,7 @@ impl LinkDesc {
 /// A complete robot description: what a file says. Validate it with [`crate::Robot::new`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct RobotDescription {
+    /// Robot name.
     pub name: String,
     /// NL: number of links (the equivalent tree has joints 1..NL).
     pub nl: usize,
@@ -183,8 +212,11 @@ pub struct RobotDescription {
     pub gravity: [Expr; 3],
     /// Base angular velocity, angular acceleration, linear velocity and acceleration, in R_0.
     pub w0: [Expr; 3],
+    /// Base angular acceleration (rad/s²).
     pub wp0: [Expr; 3],
+    /// Base linear velocity (m/s).
     pub v0: [Expr; 3],
+    /// Base linear acceleration (m/s²).
     pub vp0: [Expr; 3],
     /// Whether the base is mobile (SYMORO's `is_mobile`).
     pub mobile_base: bool,
@@ -244,6 +276,7 @@ impl RobotDescription {
         &self.frames[j - 1]
     }
 
+    /// Frame j (1-based), mutable.
     pub fn frame_mut(&mut self, j: usize) -> &mut FrameDesc {
         &mut self.frames[j - 1]
     }
@@ -253,6 +286,7 @@ impl RobotDescription {
         &self.links[j - 1]
     }
 
+    /// Link j (1-based), mutable.
     pub fn link_mut(&mut self, j: usize) -> &mut LinkDesc {
         &mut self.links[j - 1]
     }

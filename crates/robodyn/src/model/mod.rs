@@ -1,26 +1,34 @@
-//! What a robot IS: the description (frames, links, symbols), its validated topology and its
-//! numeric constants. Immutable once built; per-evaluation buffers live in [`crate::workspace`].
+//! What a robot IS: the description (frames, links, symbols), its validated topology, its
+//! numeric constants, the coordinate map of its joint vectors and its default per-call inputs.
+//! Immutable once built; per-evaluation buffers live in [`crate::data`].
 
 mod constants;
+mod coordinates;
 mod description;
+mod environment;
 mod structure;
 
 pub use constants::{DynModel, FrameConstants, LinkConstants};
+pub use coordinates::Coordinates;
 pub use description::{
     param, FrameDesc, JointType, LinkDesc, RobotDescription, GEOMETRIC_PARAMETERS,
     STANDARD_PARAMETERS, WRENCH_COMPONENTS,
 };
+pub use environment::{BaseMotion, Environment, Wrench};
 pub use structure::{path_from_base, ClosedLoop, Structure, StructureType};
 
 use crate::error::{Error, Item, Result};
 use robodyn_symbolic::Expr;
 
-/// A validated robot: description, topology and numeric model (every symbol has a value).
+/// A validated tree robot (the equivalent tree of a closed chain): description, topology,
+/// numeric model (every symbol has a value) and the coordinate map of its joint vectors (the
+/// movable joints, in frame order).
 #[derive(Clone, Debug)]
 pub struct Robot {
     desc: RobotDescription,
     structure: Structure,
     numeric: DynModel<f64>,
+    coords: Coordinates,
 }
 
 /// Check counts and antecedents and derive the topology. Needs no numeric values, so it also
@@ -160,8 +168,8 @@ impl Robot {
                     item,
                     match err {
                         robodyn_symbolic::EvalError::UnknownSymbol(s) => format!(
-                            "symbol `{s}` in `{e}` has no numeric value (define it in the \
-                             file's symbol values or with --set {s}=VALUE)"
+                            "symbol `{s}` in `{e}` has no numeric value (give `{s}` a value \
+                             in the description's symbols)"
                         ),
                         other => other.to_string(),
                     },
@@ -181,7 +189,7 @@ impl Robot {
             for (k, e) in l.params.iter().enumerate() {
                 let v = eval(e, Item::Link(idx + 1, Some(STANDARD_PARAMETERS[k].into())))?;
                 if matches!(k, param::M | param::IA | param::FS | param::FV) && v < 0.0 {
-                    return Err(Error::invalid(
+                    return Err(Error::physical(
                         Item::Link(idx + 1, Some(STANDARD_PARAMETERS[k].into())),
                         format!("{} = {v} is negative", STANDARD_PARAMETERS[k]),
                     ));
@@ -204,21 +212,58 @@ impl Robot {
         }
         let value = |e: &Expr| e.eval(&env).expect("checked above");
         let numeric = DynModel::build(&desc, value, |_, _, e| value(e));
+        let movable = desc.movable_joints();
+        let names = movable
+            .iter()
+            .map(|&j| desc.frame(j).name.clone())
+            .collect();
+        let coords = Coordinates::new(movable, names, desc.nl);
         Ok(Robot {
             desc,
             structure,
             numeric,
+            coords,
         })
     }
 
+    /// The coordinate map of joint vectors: the movable joints (fixed frames carry no
+    /// variable), in frame order. `q`, `qd`, `qdd`, `tau` of the tree functions have
+    /// `coordinates().len()` entries.
+    #[inline]
+    pub fn coordinates(&self) -> &Coordinates {
+        &self.coords
+    }
+
+    /// N, the number of entries of a joint vector (movable joints).
+    #[inline]
+    pub fn dof(&self) -> usize {
+        self.coords.len()
+    }
+
+    /// The description's gravity, base motion and external wrenches: the default per-call
+    /// inputs (clone it to change them for a call).
+    #[inline]
+    pub fn environment(&self) -> &Environment<f64> {
+        &self.numeric.env
+    }
+
+    /// Joint values (movable joints, frame order) of the description's `assembly`, if any.
+    pub fn assembly(&self) -> Option<Vec<f64>> {
+        let a = self.desc.assembly.as_ref()?;
+        Some(self.coords.frames().iter().map(|&j| a[j - 1]).collect())
+    }
+
+    /// The validated description.
     pub fn description(&self) -> &RobotDescription {
         &self.desc
     }
 
+    /// The description (consumes the robot).
     pub fn into_description(self) -> RobotDescription {
         self.desc
     }
 
+    /// The topology: antecedents, children, main branches, loops.
     pub fn structure(&self) -> &Structure {
         &self.structure
     }
@@ -229,6 +274,7 @@ impl Robot {
         &self.numeric
     }
 
+    /// The robot's name.
     pub fn name(&self) -> &str {
         &self.desc.name
     }
@@ -239,10 +285,12 @@ impl Robot {
         self.desc.nl
     }
 
+    /// NJ: joints (tree joints and cut joints).
     pub fn nj(&self) -> usize {
         self.desc.nj
     }
 
+    /// NF = 2 NJ - NL: frames.
     pub fn nf(&self) -> usize {
         self.desc.nf()
     }
@@ -252,6 +300,7 @@ impl Robot {
         self.desc.nj - self.desc.nl
     }
 
+    /// True when the robot has no closed loop (NJ = NL).
     pub fn is_tree(&self) -> bool {
         self.desc.nj == self.desc.nl
     }
@@ -262,18 +311,14 @@ impl Robot {
         self.structure.ant[j]
     }
 
+    /// Frame j's description (1-based).
     pub fn frame(&self, j: usize) -> &FrameDesc {
         self.desc.frame(j)
     }
 
+    /// Link j's description (1-based).
     pub fn link(&self, j: usize) -> &LinkDesc {
         self.desc.link(j)
-    }
-
-    /// Numeric value of an expression with this robot's symbols.
-    pub fn value(&self, e: &Expr) -> Result<f64> {
-        e.eval(&|s| self.desc.symbols.get(s).copied())
-            .map_err(|err| Error::Input(err.to_string()))
     }
 
     /// Tree joints 1..NL that are movable (not fixed).
@@ -296,19 +341,20 @@ impl Robot {
         self.desc
             .links
             .iter()
-            .flat_map(|l| l.params.iter().map(|e| self.value(e).expect("validated")))
+            .flat_map(|l| {
+                l.params.iter().map(|e| {
+                    e.eval(&|s| self.desc.symbols.get(s).copied())
+                        .expect("validated")
+                })
+            })
             .collect()
     }
 
-    /// The same robot with the given numeric standard parameters (13 per link).
+    /// The same robot with the given numeric standard parameters (13 per link, link 1 first).
     pub fn with_standard_parameters(&self, k: &[f64]) -> Result<Robot> {
-        if k.len() != 13 * self.nl() {
-            return Err(Error::Input(format!(
-                "{} standard parameters given, {} expected (13 per link)",
-                k.len(),
-                13 * self.nl()
-            )));
-        }
+        crate::error::check_vector("standard parameters", k, 13 * self.nl(), || {
+            "13 per link: XX XY XZ YY YZ ZZ MX MY MZ M IA FS FV".into()
+        })?;
         let mut desc = self.desc.clone();
         for (j, l) in desc.links.iter_mut().enumerate() {
             for (p, e) in l.params.iter_mut().enumerate() {

@@ -32,8 +32,11 @@ impl ClosedLoop {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum StructureType {
+    /// One chain, no branching.
     Serial,
+    /// A tree with branches, no loop.
     Tree,
+    /// At least one closed loop.
     Closed,
 }
 
@@ -56,7 +59,9 @@ pub struct Structure {
     pub children: Vec<Vec<usize>>,
     /// Main branches: paths (link numbers from the base) to each terminal link.
     pub main_branches: Vec<Vec<usize>>,
+    /// The closed loops (one per cut joint).
     pub loops: Vec<ClosedLoop>,
+    /// Serial, tree or closed.
     pub kind: StructureType,
 }
 

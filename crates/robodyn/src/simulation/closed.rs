@@ -1,105 +1,82 @@
 //! Closed-chain robots in the simulator: the coordinates are the actuated joints q_a; at every
-//! evaluation the passive joints q_p are re-solved by loop closure from the previous solution
-//! (drift control: the loops never drift open), and qdd_a comes from A_cl, H_cl (10.46–10.48).
-//! The energy is the kinetic + potential energy of the whole equivalent tree at the consistent
-//! state (q_tr, qd_tr = G qd_a, 10.29); extra columns: `closure_residual` (max over the loops)
-//! and the passive joints' q<j>.
+//! evaluation the branch tracker moves to the stage's q_a (drift control: the loops never drift
+//! open, and the motion stays on the branch it started on), and qdd_a comes from A_cl, H_cl
+//! (10.46–10.48). The energy is the kinetic + potential energy of the whole equivalent tree at
+//! the consistent state (q_tr, qd_tr = G qd_a, 10.29); extra columns: `closure_residual` (max
+//! over the loops) and the passive joints' q<j>.
 
-use super::energy::{total_energy, EnergyWorkspace};
+use super::energy::mechanical_energy;
 use super::Dynamics;
-use crate::algorithms::closed_chain::{ClosedChain, ClosedDynamics};
+use crate::algorithms::closed_chain::{
+    closed_direct_dynamics_smoothed, last_residual, last_tree_state, loop_closure_into, Branch,
+    ClosedChain, ClosedData,
+};
 use crate::error::{Error, Result};
-use crate::model::Robot;
+use crate::model::Environment;
 
-/// A closed-chain robot as the simulator sees it (actuated coordinates).
+/// A closed-chain robot as the simulator sees it (actuated coordinates), on a branch.
 #[derive(Clone, Debug)]
 pub struct ClosedChainDynamics {
-    sys: ClosedDynamics,
-    energy_ws: EnergyWorkspace,
-    zeros: Vec<f64>,
+    chain: ClosedChain,
+    data: ClosedData,
+    branch: Branch,
+    env: Environment,
+    qdd: Vec<f64>,
+    q_p: Vec<f64>,
     coulomb_smoothing: Option<f64>,
-    /// q_tr of the last successful evaluation (for the diagnosis of a failure).
-    last_q_tr: Option<Vec<f64>>,
 }
 
 impl ClosedChainDynamics {
-    /// Error if the robot has no loop or its loops are malformed (see `LoopClosure::new`).
-    pub fn new(robot: &Robot) -> Result<Self> {
-        let sys = ClosedDynamics::new(robot)?;
-        let n = sys.dof();
-        Ok(ClosedChainDynamics {
-            energy_ws: EnergyWorkspace::new(robot),
-            sys,
-            zeros: vec![0.0; n],
+    /// The simulated system of `chain` under its robot's environment, starting on `branch`
+    /// (e.g. [`ClosedChain::assembly_branch`]).
+    pub fn new(chain: ClosedChain, branch: Branch) -> Self {
+        let n = chain.dof();
+        ClosedChainDynamics {
+            data: ClosedData::new(&chain),
+            env: chain.robot().environment().clone(),
+            q_p: vec![0.0; chain.n_equations()],
+            chain,
+            branch,
+            qdd: vec![0.0; n],
             coulomb_smoothing: None,
-            last_q_tr: None,
-        })
+        }
     }
 
-    /// Coulomb friction of every tree joint as Fs tanh(qd / v) (v > 0), see
-    /// [`ClosedChain::direct_dynamics_smoothed`].
+    /// Coulomb friction of every tree joint as Fs tanh(qd / v) (v > 0, rad/s or m/s) instead of
+    /// Fs sign(qd): the exact sign makes the right-hand side discontinuous.
     pub fn with_coulomb_smoothing(mut self, v: Option<f64>) -> Self {
         self.coulomb_smoothing = v.filter(|v| *v > 0.0);
         self
     }
 
-    /// Start the first loop closure from this q_p instead of the reference assembly.
-    pub fn set_guess(&mut self, q_p: &[f64]) {
-        self.sys.set_guess(q_p);
+    /// The closed-chain model.
+    pub fn chain(&self) -> &ClosedChain {
+        &self.chain
     }
 
-    pub fn model(&self) -> &ClosedChain {
-        &self.sys.model
+    /// The branch tracker (at the last evaluated q_a).
+    pub fn branch(&self) -> &Branch {
+        &self.branch
     }
 
-    /// The actuated joints: coordinate k is joint `actuated_joints()[k]`.
-    pub fn actuated_joints(&self) -> &[usize] {
-        self.sys.model.actuated_joints()
-    }
-
-    /// The passive tree joints (extra columns q<j>).
-    pub fn passive_joints(&self) -> &[usize] {
-        self.sys.model.passive_joints()
-    }
-
-    /// A failed loop closure during a simulation is most often the approach of a singular
-    /// configuration (Wp singular: the passive joints are no longer determined by the actuated
-    /// ones); say so when Wp was already ill-conditioned at the last closed configuration.
-    fn diagnose(&mut self, e: Error) -> Error {
-        let Error::Numerical(m) = e else {
-            return e;
-        };
-        let Some(q) = self.last_q_tr.clone() else {
-            return Error::Numerical(m);
-        };
-        let ratio = match self.sys.model.constraints(&mut self.sys.ws, &q) {
-            Ok(c) => {
-                let sv = c.wp.svd(false, false).singular_values;
-                sv.min() / sv.max()
-            }
-            Err(_) => 0.0,
-        };
-        if ratio < 1e-2 {
-            Error::Numerical(format!(
-                "{m}\n  at the last closed configuration q_tr = {q:.6?} Wp was ill-conditioned \
-                 (smallest / largest singular value {ratio:.1e}): the motion reached a singular \
-                 configuration of the mechanism"
-            ))
-        } else {
-            Error::Numerical(m)
+    fn hint(&self, e: Error) -> Error {
+        match e {
+            Error::BranchLost { .. } | Error::Singular { .. } => Error::Numerical(format!(
+                "{e}\n  the motion reached a singular configuration of the mechanism (Wp \
+                 singular: the passive joints are no longer determined by the actuated ones)"
+            )),
+            e => e,
         }
     }
 }
 
 impl Dynamics for ClosedChainDynamics {
     fn dof(&self) -> usize {
-        self.sys.dof()
+        self.chain.dof()
     }
     fn labels(&self) -> Vec<String> {
-        self.actuated_joints()
-            .iter()
-            .map(|j| j.to_string())
-            .collect()
+        let c = self.chain.coordinates();
+        c.frames().iter().map(|j| j.to_string()).collect()
     }
     fn accel(
         &mut self,
@@ -109,49 +86,57 @@ impl Dynamics for ClosedChainDynamics {
         tau: &[f64],
         qdd: &mut [f64],
     ) -> Result<()> {
-        if self.sys.ws.closure.last_qp.is_none() {
-            self.sys.solve(q)?;
-        }
-        // guess None: the previous solution (drift control)
-        let d = self.sys.model.direct_dynamics_smoothed(
-            &mut self.sys.ws,
-            q,
-            qd,
-            tau,
-            None,
+        closed_direct_dynamics_smoothed(
+            &self.chain,
+            &mut self.data,
+            &mut self.branch,
+            &self.env,
+            [q, qd, tau],
             self.coulomb_smoothing,
-        );
-        match d {
-            Ok(d) => {
-                qdd.copy_from_slice(d.qdd_a.as_slice());
-                self.last_q_tr = Some(d.state.q);
-                Ok(())
-            }
-            Err(e) => Err(self.diagnose(e)),
-        }
+            &mut self.qdd,
+        )
+        .map_err(|e| self.hint(e))?;
+        qdd.copy_from_slice(&self.qdd);
+        Ok(())
     }
     fn energy(&mut self, q: &[f64], qd: &[f64]) -> Result<f64> {
-        let sol = self.sys.solve(q)?;
-        let s = self
-            .sys
-            .model
-            .state(&mut self.sys.ws, q, qd, &self.zeros, Some(&sol.q_p))?;
-        Ok(total_energy(
-            self.sys.model.robot(),
-            &mut self.energy_ws,
-            &s.q,
-            &s.qd,
+        let z = vec![0.0; q.len()];
+        closed_direct_dynamics_smoothed(
+            &self.chain,
+            &mut self.data,
+            &mut self.branch,
+            &self.env,
+            [q, qd, &z],
+            None,
+            &mut self.qdd,
+        )
+        .map_err(|e| self.hint(e))?;
+        let (q_tr, qd_tr) = last_tree_state(&self.data);
+        let (q_tr, qd_tr) = (q_tr.to_vec(), qd_tr.to_vec());
+        Ok(mechanical_energy(
+            self.chain.robot(),
+            self.data.tree_mut(),
+            &q_tr,
+            &qd_tr,
         ))
     }
     fn extra_columns(&self) -> Vec<String> {
         let mut c = vec!["closure_residual".to_string()];
-        c.extend(self.passive_joints().iter().map(|j| format!("q{j}")));
+        let p = self.chain.passive_coordinates();
+        c.extend(p.frames().iter().map(|j| format!("q{j}")));
         c
     }
     fn extra_values(&mut self, q: &[f64], _qd: &[f64], out: &mut [f64]) -> Result<()> {
-        let sol = self.sys.solve(q)?;
-        out[0] = sol.residual;
-        out[1..].copy_from_slice(&sol.q_p);
+        loop_closure_into(
+            &self.chain,
+            &mut self.data,
+            &mut self.branch,
+            q,
+            &mut self.q_p,
+        )
+        .map_err(|e| self.hint(e))?;
+        out[0] = last_residual(&self.chain, &self.data);
+        out[1..].copy_from_slice(&self.q_p);
         Ok(())
     }
 }

@@ -6,47 +6,34 @@
 //!   g_eff = g - VP0 (a base translating with constant acceleration VP0 adds a uniform inertial
 //!   field). The base is assumed not to rotate (W0 = WP0 = 0) for T + U to be conserved.
 
-use crate::algorithms::inertia_matrix::{inertia_matrix_into, InertiaWorkspace};
+use crate::algorithms::inertia_matrix::composite_inertia_matrix;
+use crate::data::Data;
 use crate::geometry::frame_transforms;
 use crate::model::Robot;
 use nalgebra::{DMatrix, Vector3};
 
-/// Buffers for the energy (A(q)).
-#[derive(Clone, Debug)]
-pub struct EnergyWorkspace {
-    inertia: InertiaWorkspace<f64>,
-    a: DMatrix<f64>,
-}
-
-impl EnergyWorkspace {
-    pub fn new(robot: &Robot) -> Self {
-        let model = robot.numeric();
-        EnergyWorkspace {
-            inertia: InertiaWorkspace::new(model),
-            a: DMatrix::zeros(model.nl, model.nl),
-        }
-    }
-}
-
-/// T = 1/2 qd' A(q) qd (NL-sized q, qd; entries of fixed frames ignored).
-pub fn kinetic_energy(robot: &Robot, ws: &mut EnergyWorkspace, q: &[f64], qd: &[f64]) -> f64 {
+/// T = 1/2 qd' A(q) qd (tree arrays q, qd; entries of fixed frames ignored).
+fn kinetic(robot: &Robot, ws: &mut Data, q: &[f64], qd: &[f64]) -> f64 {
     let model = robot.numeric();
-    inertia_matrix_into(model, &mut ws.inertia, q, &mut ws.a);
+    let mut a = std::mem::replace(&mut ws.a, DMatrix::zeros(0, 0));
+    composite_inertia_matrix(model, ws, q, &mut a);
     let n = model.nl;
     let mut t = 0.0;
     for i in 0..n {
         for j in 0..n {
             // rows/columns of fixed frames are zero in A
-            t += qd[i] * ws.a[(i, j)] * qd[j];
+            t += qd[i] * a[(i, j)] * qd[j];
         }
     }
+    ws.a = a;
     0.5 * t
 }
 
 /// U = -sum_j g_eff' (M_j 0P_j + 0A_j jMS_j), g_eff = g - VP0.
-pub fn potential_energy(robot: &Robot, q: &[f64]) -> f64 {
+fn potential(robot: &Robot, q: &[f64]) -> f64 {
     let model = robot.numeric();
-    let g: Vector3<f64> = model.gravity - model.vp0;
+    let env = &model.env;
+    let g: Vector3<f64> = env.gravity - env.base.vp0;
     let t = frame_transforms(robot, q);
     (1..=model.nl)
         .map(|j| {
@@ -57,7 +44,7 @@ pub fn potential_energy(robot: &Robot, q: &[f64]) -> f64 {
         .sum()
 }
 
-/// T + U.
-pub fn total_energy(robot: &Robot, ws: &mut EnergyWorkspace, q: &[f64], qd: &[f64]) -> f64 {
-    kinetic_energy(robot, ws, q, qd) + potential_energy(robot, q)
+/// T + U of the simulation output (tree arrays q, qd).
+pub(crate) fn mechanical_energy(robot: &Robot, ws: &mut Data, q: &[f64], qd: &[f64]) -> f64 {
+    kinetic(robot, ws, q, qd) + potential(robot, q)
 }

@@ -52,6 +52,7 @@ impl TimeSeries {
         })
     }
 
+    /// Number of columns.
     pub fn width(&self) -> usize {
         self.width
     }
@@ -113,9 +114,13 @@ pub enum TorqueInput {
     /// The reference holds q_ref in its first `dof` columns and, when `with_velocity`, qd_ref
     /// in the next `dof`; otherwise qd_ref is the slope of the interpolated q_ref.
     Pd {
+        /// q_ref (and qd_ref) over time.
         reference: TimeSeries,
+        /// Whether the reference has qd_ref columns.
         with_velocity: bool,
+        /// Proportional gains (N m/rad or N/m), one per coordinate.
         kp: Vec<f64>,
+        /// Derivative gains (N m s/rad or N s/m), one per coordinate.
         kd: Vec<f64>,
     },
 }

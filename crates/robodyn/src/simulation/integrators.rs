@@ -7,6 +7,7 @@ use crate::error::{Error, Result};
 
 /// A first-order ODE y' = f(t, y).
 pub trait Ode {
+    /// Dimension of y.
     fn dim(&self) -> usize;
     /// Write f(t, y) into `dy`.
     fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<()>;
@@ -16,13 +17,21 @@ pub trait Ode {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Integrator {
     /// Classical RK4 with step `dt` (shortened so as to land on the output times).
-    Rk4 { dt: f64 },
+    /// Fixed-step RK4.
+    Rk4 {
+        /// Step (s).
+        dt: f64,
+    },
     /// Dormand–Prince 5(4) with error control |err_i| <= atol + rtol max(|y_i|, |y_new_i|)
     /// (RMS norm); `h0` the first step (automatic when None), `h_max` the largest step.
     Dopri5 {
+        /// Relative tolerance.
         rtol: f64,
+        /// Absolute tolerance.
         atol: f64,
+        /// First step (s); automatic when None.
         h0: Option<f64>,
+        /// Largest step (s).
         h_max: Option<f64>,
     },
 }
@@ -55,8 +64,11 @@ impl Integrator {
 /// Counters of an integration.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Stats {
+    /// Accepted steps.
     pub accepted: usize,
+    /// Rejected steps.
     pub rejected: usize,
+    /// Right-hand side evaluations.
     pub evaluations: usize,
 }
 
@@ -106,6 +118,7 @@ const E: [f64; 7] = [
 /// Stage buffers of the integrators, sized once.
 #[derive(Clone, Debug)]
 pub struct Stepper {
+    /// The scheme.
     pub integrator: Integrator,
     /// Stop with an error after this many steps (accepted + rejected) in total.
     pub max_steps: Option<usize>,
@@ -116,6 +129,7 @@ pub struct Stepper {
     /// k[0] holds f(t, y) of the current state (first same as last).
     fsal: bool,
     h: Option<f64>,
+    /// Counters.
     pub stats: Stats,
 }
 
@@ -131,6 +145,7 @@ fn finite_or_err(y: &[f64]) -> Result<()> {
 }
 
 impl Stepper {
+    /// Stage buffers of `integrator` for a state of dimension `dim`.
     pub fn new(integrator: Integrator, dim: usize) -> Self {
         Stepper {
             integrator,

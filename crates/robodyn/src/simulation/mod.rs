@@ -6,7 +6,7 @@
 //! every evaluation, extra columns `closure_residual` and the passive q<j>).
 
 pub mod closed;
-pub mod energy;
+pub(crate) mod energy;
 pub mod input;
 pub mod integrators;
 pub mod output;
@@ -14,13 +14,16 @@ pub mod output;
 pub use closed::ClosedChainDynamics;
 pub use input::{TimeSeries, TorqueInput};
 pub use integrators::{Integrator, Ode, Stats, Stepper};
-pub use output::{plot_svg, CsvSink, Recorder, Tee, TrajectorySink};
+#[cfg(feature = "plot")]
+pub use output::plot_svg;
+pub use output::{CsvSink, Recorder, Tee, TrajectorySink};
 
-use crate::algorithms::direct_dynamics::{ddm, DirectWorkspace, Method};
+use crate::algorithms::direct_dynamics::{ddm, Method};
+use crate::data::Data;
 use crate::error::{Error, Result};
-use crate::model::Robot;
+use crate::model::{Environment, Robot};
 use crate::scalar::DynScalar;
-use energy::{total_energy, EnergyWorkspace};
+use energy::mechanical_energy;
 
 /// A mechanical system with `dof` coordinates as the simulator sees it.
 pub trait Dynamics {
@@ -47,8 +50,8 @@ pub struct TreeDynamics<'a> {
     robot: &'a Robot,
     method: Method,
     joints: Vec<usize>,
-    ws: DirectWorkspace,
-    energy_ws: EnergyWorkspace,
+    ws: Data,
+    env: Environment,
     q: Vec<f64>,
     qd: Vec<f64>,
     tau: Vec<f64>,
@@ -57,14 +60,16 @@ pub struct TreeDynamics<'a> {
 }
 
 impl<'a> TreeDynamics<'a> {
+    /// The simulated system of a tree robot under its own environment (gravity, base motion,
+    /// wrenches), with direct model `method`.
     pub fn new(robot: &'a Robot, method: Method) -> Self {
         let nl = robot.nl();
         TreeDynamics {
             robot,
             method,
-            joints: robot.movable_joints(),
-            ws: DirectWorkspace::new(robot.numeric()),
-            energy_ws: EnergyWorkspace::new(robot),
+            joints: robot.coordinates().frames().to_vec(),
+            ws: Data::new(robot),
+            env: robot.environment().clone(),
             q: vec![0.0; nl],
             qd: vec![0.0; nl],
             tau: vec![0.0; nl],
@@ -122,6 +127,7 @@ impl Dynamics for TreeDynamics<'_> {
         ddm(
             model,
             &mut self.ws,
+            &self.env,
             self.method,
             &self.q,
             &self.qd,
@@ -135,9 +141,9 @@ impl Dynamics for TreeDynamics<'_> {
     }
     fn energy(&mut self, q: &[f64], qd: &[f64]) -> Result<f64> {
         self.scatter(q, qd);
-        Ok(total_energy(
+        Ok(mechanical_energy(
             self.robot,
-            &mut self.energy_ws,
+            &mut self.ws,
             &self.q,
             &self.qd,
         ))
@@ -149,6 +155,7 @@ impl Dynamics for TreeDynamics<'_> {
 pub struct SimOptions {
     /// Simulated time span [0, duration].
     pub duration: f64,
+    /// The integration scheme.
     pub integrator: Integrator,
     /// Time between output rows (the integrators land exactly on these times).
     pub output_dt: f64,
@@ -159,8 +166,11 @@ pub struct SimOptions {
 /// What happened.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct SimSummary {
+    /// Time reached (s).
     pub t_end: f64,
+    /// Rows written.
     pub rows: usize,
+    /// Integrator counters.
     pub stats: Stats,
 }
 
@@ -265,8 +275,8 @@ fn run(
     let mut summary = SimSummary::default();
     let stop = |t: f64, e: Error| -> Error {
         match e {
-            Error::Numerical(m) => Error::Numerical(format!("simulation stopped at t = {t}: {m}")),
-            other => other,
+            Error::Io { .. } | Error::Input(_) | Error::Dimension { .. } => e,
+            other => Error::Numerical(format!("simulation stopped at t = {t}: {other}")),
         }
     };
     loop {

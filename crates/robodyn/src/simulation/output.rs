@@ -7,7 +7,9 @@ use std::path::Path;
 
 /// Receives the trajectory: the column names once, then one row per output time.
 pub trait TrajectorySink {
+    /// Receive the column names.
     fn begin(&mut self, headers: &[String]) -> Result<()>;
+    /// Receive one row.
     fn row(&mut self, values: &[f64]) -> Result<()>;
     /// Flush; called at the end and when the simulation stops on an error.
     fn finish(&mut self) -> Result<()> {
@@ -24,10 +26,8 @@ pub struct CsvSink<W: Write> {
 impl CsvSink<std::io::BufWriter<std::fs::File>> {
     /// Create (truncate) a CSV file.
     pub fn create(path: &Path) -> Result<Self> {
-        let f = std::fs::File::create(path).map_err(|e| Error::Io {
-            path: path.display().to_string(),
-            reason: e.to_string(),
-        })?;
+        let f =
+            std::fs::File::create(path).map_err(|e| Error::io(path.display().to_string(), e))?;
         Ok(CsvSink::new(
             std::io::BufWriter::new(f),
             path.display().to_string(),
@@ -44,15 +44,13 @@ impl<W: Write> CsvSink<W> {
         }
     }
 
+    /// The writer.
     pub fn into_inner(self) -> W {
         self.out
     }
 
     fn io(&self, e: std::io::Error) -> Error {
-        Error::Io {
-            path: self.name.clone(),
-            reason: e.to_string(),
-        }
+        Error::io(self.name.clone(), e)
     }
 }
 
@@ -83,7 +81,9 @@ impl<W: Write> TrajectorySink for CsvSink<W> {
 /// Keeps the trajectory in memory.
 #[derive(Clone, Debug, Default)]
 pub struct Recorder {
+    /// Column names.
     pub headers: Vec<String>,
+    /// Rows.
     pub rows: Vec<Vec<f64>>,
 }
 
@@ -133,14 +133,12 @@ impl TrajectorySink for Tee<'_> {
     }
 }
 
+#[cfg(feature = "plot")]
 /// SVG plot of a recorded trajectory: the joint positions `q<j>` (top) and the total energy
 /// (bottom) against time.
 pub fn plot_svg(path: &Path, rec: &Recorder) -> Result<()> {
     use plotters::prelude::*;
-    let err = |e: String| Error::Io {
-        path: path.display().to_string(),
-        reason: e,
-    };
+    let err = |e: String| Error::io(path.display().to_string(), std::io::Error::other(e));
     let t = rec
         .series("t")
         .ok_or_else(|| err("the trajectory has no column t".into()))?;

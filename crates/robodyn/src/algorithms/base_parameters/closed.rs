@@ -1,8 +1,7 @@
 //! Random consistent states of a closed chain for the numerical method (§10.3.4).
 //!
 //! [`ClosedChainSampler`] draws q_a uniformly in a box around the assembly configuration (the
-//! file's `assembly`, else q = 0) and solves q_p by continuation along the straight path from the
-//! assembly (as `robodyn closure` does): every sample is on the branch the assembly defines. (A
+//! file's `assembly`, else q = 0) and solves q_p with the branch tracker from the start (as `robodyn closure` does): every sample is on the branch the assembly defines. (A
 //! random walk continuing from the previous sample was tried first: on the SR400, whose assembly
 //! is a flattened parallelogram, the walk crosses the bifurcation set q7 = q2 and mixes the
 //! parallelogram and crossed branches, giving 50 base parameters instead of 42.) A sample is
@@ -21,15 +20,16 @@
 //! Every sample then keeps the start's sign of det Wp (the branch invariant: a path that keeps
 //! Wp regular keeps its sign) and, for parallelograms, the parallelogram relation.
 //!
-//! A general branch tracker (closed-chain continuation with branch checks, planned in the
-//! library for `idm`, `ddm`, `simulate`) should replace [`ClosedChainSampler::new`]'s start
-//! search and the continuation of `try_move`: the sampler would hold the tracker's branch
-//! state and ask it for q_p at each target q_a.
+//! Every sample is reached by the library's branch tracker ([`crate::Branch`]) from the start:
+//! continuation along the straight path in q_a with the sign of det Wp and the conditioning
+//! checked at each step, as `idm`, `ddm` and `simulate` do.
 
 use super::numeric::{ConsistentSample, Sampler};
 use super::summary::short;
 use super::symbolic::parallelograms;
-use crate::algorithms::closed_chain::{ClosedChain, ClosedChainWorkspace, ClosedState};
+use crate::algorithms::closed_chain::{
+    closed_state, refine_closure, Branch, ClosedChain, ClosedState, ConditioningLimits,
+};
 use crate::error::{Error, Result};
 use crate::geometry::frame_transforms;
 use crate::model::{JointType, Robot};
@@ -110,39 +110,9 @@ impl StartReport {
     }
 }
 
-fn det_sign(s: &ClosedState) -> f64 {
-    s.constraints.wp.clone().lu().determinant().signum()
-}
-
-/// Loop-closure sampler of a closed-chain robot (see the module documentation).
-#[derive(Clone, Debug)]
-pub struct ClosedChainSampler {
-    chain: ClosedChain,
-    ws: ClosedChainWorkspace,
-    /// Assembly configuration (closed): actuated and passive parts.
-    qa0: Vec<f64>,
-    qp0: Vec<f64>,
-    /// Half-width of the random q_a box around the assembly, per actuated joint (rad for
-    /// revolute, m for prismatic joints).
-    pub range: Vec<f64>,
-    /// Continuation steps from the assembly to each sample.
-    pub continuation: usize,
-    /// Smallest accepted sigma_min / sigma_max of Wp.
-    pub min_wp_ratio: f64,
-    /// Rejected moves allowed per sample before giving up.
-    pub max_attempts: usize,
-    /// qd_a uniform in [-qd_max, qd_max], qdd_a in [-qdd_max, qdd_max].
-    pub qd_max: f64,
-    pub qdd_max: f64,
-    /// Moves rejected so far (diagnostics).
-    pub rejected: usize,
-    start: StartReport,
-    /// Parallel link pairs of the parallelogram loops: (low, high, lowA_high).
-    pairs: Vec<(usize, usize, Matrix3<f64>)>,
-}
-
+/// sigma_min / sigma_max of Wp at a state (0 when degenerate).
 fn ratio(s: &ClosedState) -> f64 {
-    let sv = s.constraints.wp.clone().svd(false, false).singular_values;
+    let sv = s.wp.clone().svd(false, false).singular_values;
     let (lo, hi) = (sv.min(), sv.max());
     if hi > 0.0 && lo.is_finite() {
         lo / hi
@@ -151,123 +121,67 @@ fn ratio(s: &ClosedState) -> f64 {
     }
 }
 
-impl ClosedChainSampler {
-    /// Sampler of `robot` (a closed chain) starting from its assembly configuration: the file's
-    /// `assembly` when given, else q = 0 (solved for q_p from that guess when not closed there),
-    /// moved to a regular start when q = 0 is singular (see the module documentation).
-    /// Box: +-1.5 rad for revolute actuated joints, +-0.1 m for prismatic ones.
-    pub fn new(robot: &Robot) -> Result<ClosedChainSampler> {
-        if robot.is_tree() {
-            return Err(Error::Input(format!(
-                "{} is a tree: use the tree sampler (random independent joint values)",
-                robot.name()
-            )));
-        }
-        let chain = ClosedChain::new(robot)?;
-        let ws = chain.workspace();
-        let given = robot.description().assembly.clone();
-        let reference = given.clone().unwrap_or_else(|| vec![0.0; robot.nl()]);
-        let pick = |js: &[usize], q: &[f64]| -> Vec<f64> {
-            js.iter()
-                .map(|&j| q.get(j - 1).copied().unwrap_or(0.0))
-                .collect()
-        };
-        let pairs = parallel_pairs(robot)?;
-        let range = chain
-            .actuated_joints()
-            .iter()
-            .map(|&j| match robot.frame(j).joint {
-                JointType::Prismatic => 0.1,
-                _ => 1.5,
-            })
-            .collect();
-        let mut sampler = ClosedChainSampler {
-            qa0: pick(chain.actuated_joints(), &reference),
-            qp0: pick(chain.passive_joints(), &reference),
-            range,
-            chain,
-            ws,
-            continuation: 24,
-            min_wp_ratio: 1e-2,
-            max_attempts: 200,
-            qd_max: 2.0,
-            qdd_max: 5.0,
-            rejected: 0,
-            start: StartReport {
-                origin: StartOrigin::Zero,
-                q: reference.clone(),
-                wp_ratio: 0.0,
-                det_sign: 1.0,
-                parallelograms: Vec::new(),
-            },
-            pairs,
-        };
-        let (qa0, guess) = (sampler.qa0.clone(), sampler.qp0.clone());
-        let first = sampler.regular_start(&qa0, &guess);
-        let origin = match (&first, &given) {
-            (Ok(_), Some(_)) => StartOrigin::Assembly,
-            (Ok(_), None) => StartOrigin::Zero,
-            (Err((_, e)), Some(_)) => {
-                return Err(Error::Numerical(format!(
-                    "{}: the assembly configuration cannot start the samples: {e}; give a \
-                     regular `assembly` in the robot file",
-                    robot.name()
-                )))
-            }
-            (Err((ratio, _)), None) => StartOrigin::Moved {
-                ratio_at_zero: *ratio,
-            },
-        };
-        let (qa, qp, ratio, sign) = match first {
-            Ok(v) => v,
-            Err(_) => sampler.search_start(&qa0, &guess).ok_or_else(|| {
-                Error::Numerical(format!(
-                    "{}: the file has no assembly, q = 0 is singular (or does not close) and no \
-                     regular closed configuration was found near it; give `assembly` in the \
-                     robot file",
-                    robot.name()
-                ))
-            })?,
-        };
-        let mut q = vec![0.0; robot.nl()];
-        sampler.chain.closure().assemble(&qa, &qp, &mut q);
-        sampler.start = StartReport {
-            origin,
-            q,
-            wp_ratio: ratio,
-            det_sign: sign,
-            parallelograms: parallelograms(robot.description())?
-                .iter()
-                .map(|p| p.cut)
-                .collect(),
-        };
-        sampler.qa0 = qa;
-        sampler.qp0 = qp;
-        Ok(sampler)
-    }
+fn det_sign(s: &ClosedState) -> f64 {
+    s.wp.clone().lu().determinant().signum()
+}
 
-    /// How the start was chosen, and its branch.
-    pub fn start(&self) -> &StartReport {
-        &self.start
-    }
+/// Loop-closure sampler of a closed-chain robot (see the module documentation).
+#[derive(Clone, Debug)]
+pub struct ClosedChainSampler {
+    chain: ClosedChain,
+    /// The branch tracker at the start: every sample is reached from it.
+    branch: Branch,
+    /// Half-width of the random q_a box around the start, per actuated joint (rad for
+    /// revolute, m for prismatic joints).
+    pub range: Vec<f64>,
+    /// Smallest accepted sigma_min / sigma_max of Wp at the sample and along the path.
+    pub min_wp_ratio: f64,
+    /// Rejected moves allowed per sample before giving up.
+    pub max_attempts: usize,
+    /// qd_a uniform in [-qd_max, qd_max], qdd_a in [-qdd_max, qdd_max].
+    pub qd_max: f64,
+    /// See `qd_max`.
+    pub qdd_max: f64,
+    /// Moves rejected so far (diagnostics).
+    pub rejected: usize,
+    start: StartReport,
+    /// Parallel link pairs of the parallelogram loops: (low, high, lowA_high).
+    pairs: Vec<(usize, usize, Matrix3<f64>)>,
+}
 
-    /// Close the loops at `qa` from `guess`; Ok((qa, qp, ratio, det sign)) when the result is
-    /// regular and on the parallelogram branch, Err((ratio, reason)) otherwise.
-    #[allow(clippy::type_complexity)]
+/// Default smallest accepted sigma_min / sigma_max of Wp.
+const MIN_WP_RATIO: f64 = 1e-2;
+
+/// A regular start: its tracker, sigma_min/sigma_max of Wp and the tree configuration (NL).
+type Start = (Branch, f64, Vec<f64>);
+
+/// What the start search and the sample checks need.
+struct Probe<'a> {
+    chain: &'a ClosedChain,
+    pairs: &'a [(usize, usize, Matrix3<f64>)],
+    range: &'a [f64],
+    min_wp_ratio: f64,
+}
+
+impl Probe<'_> {
+    /// Close the loops at `qa` from `guess` and check the result: Ok when regular and on the
+    /// parallelogram branch, Err((sigma_min/sigma_max of Wp, reason)) otherwise.
     fn regular_start(
-        &mut self,
+        &self,
         qa: &[f64],
         guess: &[f64],
-    ) -> std::result::Result<(Vec<f64>, Vec<f64>, f64, f64), (f64, String)> {
-        let sol = self
+    ) -> std::result::Result<Start, (f64, String)> {
+        let b = self
             .chain
-            .solve_positions(&mut self.ws, qa, Some(guess))
-            .map_err(|e| (0.0, format!("the loops do not close there: {e}")))?;
-        let qp = self.polish(qa, sol.q_p);
+            .branch_from(qa, guess)
+            .map_err(|e| (0.0, format!("the loops do not close regularly there: {e}")))?;
+        let qp = refine_closure(self.chain, qa, b.q_p());
+        let mut b = self
+            .chain
+            .branch_from(qa, &qp)
+            .map_err(|e| (0.0, e.to_string()))?;
         let zeros = vec![0.0; qa.len()];
-        let st = self
-            .chain
-            .state(&mut self.ws, qa, &zeros, &zeros, Some(&qp))
+        let st = closed_state(self.chain, &mut b, qa, &zeros, &zeros)
             .map_err(|e| (0.0, e.to_string()))?;
         let r = ratio(&st);
         if r < self.min_wp_ratio {
@@ -279,27 +193,23 @@ impl ClosedChainSampler {
                 ),
             ));
         }
-        if !self.on_parallelograms(&st.q) {
+        let q = self.tree_q(&st);
+        if !self.on_parallelograms(&q) {
             return Err((r, "it is not on the parallelogram branch (eq 10.54)".into()));
         }
-        Ok((qa.to_vec(), qp, r, det_sign(&st)))
+        Ok((b, r, q))
     }
 
     /// Small deterministic moves of q_a around a singular start (0.05 to 0.8 rad, or a tenth
     /// of that in m), each closed from the singular start's q_p: the first regular result on the
     /// parallelogram branch.
-    #[allow(clippy::type_complexity)]
-    fn search_start(
-        &mut self,
-        qa0: &[f64],
-        guess: &[f64],
-    ) -> Option<(Vec<f64>, Vec<f64>, f64, f64)> {
+    fn search_start(&self, qa0: &[f64], guess: &[f64]) -> Option<Start> {
         let mut rng = crate::testing::rng(0x57a7);
         for attempt in 0..60 {
             let size = 0.05 * (1.0 + attempt as f64 / 4.0).min(16.0);
             let qa: Vec<f64> = qa0
                 .iter()
-                .zip(&self.range)
+                .zip(self.range)
                 .map(|(&x, &r)| x + size * (r / 1.5) * rng.random_range(-1.0..1.0))
                 .collect();
             if let Ok(v) = self.regular_start(&qa, guess) {
@@ -307,6 +217,14 @@ impl ClosedChainSampler {
             }
         }
         None
+    }
+
+    /// Tree joint values 1..NL of a closed state (fixed frames 0).
+    fn tree_q(&self, s: &ClosedState) -> Vec<f64> {
+        let robot = self.chain.robot();
+        let mut q = vec![0.0; robot.nl()];
+        robot.coordinates().scatter(s.q.as_slice(), &mut q);
+        q
     }
 
     /// Whether every parallel pair of the parallelogram loops keeps its relative orientation
@@ -327,6 +245,101 @@ impl ClosedChainSampler {
             .iter()
             .all(|(lo, hi, a)| (rot(*lo).transpose() * rot(*hi) - a).amax() < 1e-6)
     }
+}
+
+impl ClosedChainSampler {
+    /// Sampler of `robot` (a closed chain) starting from its assembly configuration: the file's
+    /// `assembly` when given, else q = 0, moved to a regular start nearby when q = 0 is singular
+    /// or off the parallelogram branch (see the module documentation). Box: +-1.5 rad for
+    /// revolute actuated joints, +-0.1 m for prismatic ones.
+    pub fn new(robot: &Robot) -> Result<ClosedChainSampler> {
+        if robot.is_tree() {
+            return Err(Error::Input(format!(
+                "{} is a tree: use the tree sampler (random independent joint values)",
+                robot.name()
+            )));
+        }
+        let chain = ClosedChain::new(robot)?;
+        let given = robot.description().assembly.is_some();
+        let reference = robot
+            .description()
+            .assembly
+            .clone()
+            .unwrap_or_else(|| vec![0.0; robot.nl()]);
+        let pick = |c: &crate::Coordinates| -> Vec<f64> {
+            c.frames().iter().map(|&j| reference[j - 1]).collect()
+        };
+        let (qa0, qp0) = (pick(chain.coordinates()), pick(chain.passive_coordinates()));
+        let range: Vec<f64> = chain
+            .coordinates()
+            .frames()
+            .iter()
+            .map(|&j| match robot.frame(j).joint {
+                JointType::Prismatic => 0.1,
+                _ => 1.5,
+            })
+            .collect();
+        let pairs = parallel_pairs(robot)?;
+        let probe = Probe {
+            chain: &chain,
+            pairs: &pairs,
+            range: &range,
+            min_wp_ratio: MIN_WP_RATIO,
+        };
+        let first = probe.regular_start(&qa0, &qp0);
+        let origin = match (&first, given) {
+            (Ok(_), true) => StartOrigin::Assembly,
+            (Ok(_), false) => StartOrigin::Zero,
+            (Err((_, e)), true) => {
+                return Err(Error::Numerical(format!(
+                    "{}: the assembly configuration cannot start the samples: {e}; give a \
+                     regular `assembly` in the robot file",
+                    robot.name()
+                )))
+            }
+            (Err((ratio, _)), false) => StartOrigin::Moved {
+                ratio_at_zero: *ratio,
+            },
+        };
+        let (branch, ratio, q) = match first {
+            Ok(v) => v,
+            Err(_) => probe.search_start(&qa0, &qp0).ok_or_else(|| {
+                Error::Numerical(format!(
+                    "{}: the file has no assembly, q = 0 is singular (or does not close) and no \
+                     regular closed configuration was found near it; give `assembly` in the \
+                     robot file",
+                    robot.name()
+                ))
+            })?,
+        };
+        let start = StartReport {
+            origin,
+            q,
+            wp_ratio: ratio,
+            det_sign: branch.det_sign(),
+            parallelograms: parallelograms(robot.description())?
+                .iter()
+                .map(|p| p.cut)
+                .collect(),
+        };
+        Ok(ClosedChainSampler {
+            chain,
+            branch,
+            range,
+            min_wp_ratio: MIN_WP_RATIO,
+            max_attempts: 200,
+            qd_max: 2.0,
+            qdd_max: 5.0,
+            rejected: 0,
+            start,
+            pairs,
+        })
+    }
+
+    /// How the start was chosen, and its branch.
+    pub fn start(&self) -> &StartReport {
+        &self.start
+    }
 
     /// The closed-chain model used for the samples.
     pub fn chain(&self) -> &ClosedChain {
@@ -335,112 +348,43 @@ impl ClosedChainSampler {
 
     /// Try one random configuration; `None` when rejected.
     fn try_move(&mut self, rng: &mut dyn RngCore) -> Option<ClosedState> {
-        let n = self.qa0.len();
+        let qa0 = self.branch.q_a().to_vec();
+        let n = qa0.len();
         let target: Vec<f64> = (0..n)
-            .map(|k| self.qa0[k] + rng.random_range(-self.range[k]..self.range[k]))
+            .map(|k| qa0[k] + rng.random_range(-self.range[k]..self.range[k]))
             .collect();
-        // Continuation from the assembly, staying in its regular region: a path through a
-        // singular configuration (Wp rank-deficient) may switch assembly branch (the SR400's
-        // parallelogram flattens at q7 = q2 and q7 = q2 + pi), so such a path is rejected.
-        // Predictor-corrector: the guess of each step is q_p + W dq_a (eq 10.29); a corrected
-        // q_p far from the prediction means Newton jumped to another branch: rejected.
-        let steps = self.continuation.max(1);
+        // The tracker continues from the start along the straight path, refusing a path
+        // through a singular configuration (where it may switch assembly branch: the SR400's
+        // parallelogram flattens at q7 = q2 and q7 = q2 + pi) and any point whose Wp is below
+        // `min_wp_ratio` (near one, G = [I; W] is inaccurate).
+        // (the tracker's limit is on the 1-norm reciprocal condition number, which can be p
+        // times smaller than sigma_min / sigma_max: the sample itself is checked on the latter)
+        let p = self.chain.n_equations().max(1) as f64;
+        let limits = ConditioningLimits {
+            wp_hard: self.min_wp_ratio / p,
+            ..*self.chain.limits()
+        };
+        let chain = self.chain.clone().with_limits(limits);
+        let mut branch = self.branch.clone();
         let zeros = vec![0.0; n];
-        let mut q_p = self.qp0.clone();
-        let mut w: Option<nalgebra::DMatrix<f64>> = None;
-        let dqa: Vec<f64> = (0..n)
-            .map(|k| (target[k] - self.qa0[k]) / steps as f64)
-            .collect();
-        for s in 1..=steps {
-            let t = s as f64 / steps as f64;
-            let qa: Vec<f64> = (0..n)
-                .map(|k| self.qa0[k] + t * (target[k] - self.qa0[k]))
-                .collect();
-            let predicted: Vec<f64> = match &w {
-                Some(w) => {
-                    let d = w * nalgebra::DVector::from_column_slice(&dqa);
-                    q_p.iter().zip(d.iter()).map(|(a, b)| a + b).collect()
-                }
-                None => q_p.clone(),
-            };
-            let step_norm = predicted
-                .iter()
-                .zip(&q_p)
-                .map(|(a, b)| (a - b).abs())
-                .fold(0.0, f64::max);
-            q_p = self
-                .chain
-                .closure()
-                .solve(&mut self.ws.closure, &qa, Some(&predicted))
-                .ok()?
-                .q_p;
-            let jump = q_p
-                .iter()
-                .zip(&predicted)
-                .map(|(a, b)| (a - b).abs())
-                .fold(0.0, f64::max);
-            if w.is_some() && jump > 0.05 + 0.5 * step_norm {
-                return None;
-            }
-            let on_path = self
-                .chain
-                .state(&mut self.ws, &qa, &zeros, &zeros, Some(&q_p))
-                .ok()?;
-            if ratio(&on_path) < self.min_wp_ratio || det_sign(&on_path) != self.start.det_sign {
-                return None;
-            }
-            w = Some(on_path.constraints.w.clone());
-        }
-        let sol_q_p = q_p;
-        let qp = self.polish(&target, sol_q_p);
+        let s = closed_state(&chain, &mut branch, &target, &zeros, &zeros).ok()?;
+        // Newton steps beyond the closure tolerance: the error on q_p (amplified by Wp^-1) would
+        // show in the rank decision of the numerical method.
+        let qp = refine_closure(&chain, &target, s.q_p.as_slice());
+        let mut branch = chain.branch_from(&target, &qp).ok()?;
         let mut v = |s: f64| -> Vec<f64> { (0..n).map(|_| rng.random_range(-s..s)).collect() };
         let (qd, qdd) = (v(self.qd_max), v(self.qdd_max));
-        let state = self
-            .chain
-            .state(&mut self.ws, &target, &qd, &qdd, Some(&qp))
-            .ok()?;
-        if ratio(&state) < self.min_wp_ratio
-            || det_sign(&state) != self.start.det_sign
-            || !self.on_parallelograms(&state.q)
-        {
-            return None;
-        }
-        Some(state)
-    }
-
-    /// Newton steps on the kept closure equations (q_p -= Wp^-1 phi) until the residual stops
-    /// decreasing: the solver stops at 1e-12, and its error on q_p (amplified by Wp^-1) would
-    /// show in the rank decision of the numerical method.
-    fn polish(&mut self, q_a: &[f64], mut q_p: Vec<f64>) -> Vec<f64> {
-        let lc = self.chain.closure();
-        let (p, nl) = (lc.n_equations(), self.chain.robot().nl());
-        let mut q = vec![0.0; nl];
-        let mut r = nalgebra::DVector::zeros(p);
-        let mut jac = nalgebra::DMatrix::zeros(p, nl);
-        let pcols = lc.passive_columns();
-        lc.assemble(q_a, &q_p, &mut q);
-        lc.kinematics(&mut self.ws.closure, &q, None, None);
-        lc.residual(&self.ws.closure, &mut r);
-        let mut norm = r.amax();
-        for _ in 0..6 {
-            if norm == 0.0 {
-                break;
-            }
-            lc.constraint_jacobian(&self.ws.closure, &mut jac);
-            let wp = jac.select_columns(pcols.iter());
-            let Some(step) = wp.lu().solve(&r) else { break };
-            let trial: Vec<f64> = q_p.iter().zip(step.iter()).map(|(a, b)| a - b).collect();
-            lc.assemble(q_a, &trial, &mut q);
-            lc.kinematics(&mut self.ws.closure, &q, None, None);
-            lc.residual(&self.ws.closure, &mut r);
-            let nt = r.amax();
-            if nt >= norm {
-                break;
-            }
-            q_p = trial;
-            norm = nt;
-        }
-        q_p
+        let state = closed_state(&chain, &mut branch, &target, &qd, &qdd).ok()?;
+        let probe = Probe {
+            chain: &self.chain,
+            pairs: &self.pairs,
+            range: &self.range,
+            min_wp_ratio: self.min_wp_ratio,
+        };
+        (ratio(&state) >= self.min_wp_ratio
+            && det_sign(&state) == self.start.det_sign
+            && probe.on_parallelograms(&probe.tree_q(&state)))
+        .then_some(state)
     }
 
     /// The next consistent state (also returned by [`Sampler::sample`]).
@@ -454,11 +398,11 @@ impl ClosedChainSampler {
         Err(Error::Numerical(format!(
             "{}: no acceptable closed configuration in {} random configurations around the assembly q_a = {:?} \
              (actuated joints {:?}) within {:?}: the loops fail to close or Wp is ill-conditioned \
-             (sigma_min/sigma_max < {:e}) around it",
+             (reciprocal condition number < {:e}) around it",
             self.chain.robot().name(),
             self.max_attempts,
-            self.qa0,
-            self.chain.actuated_joints(),
+            self.branch.q_a(),
+            self.chain.coordinates().frames(),
             self.range,
             self.min_wp_ratio
         )))
@@ -475,11 +419,22 @@ impl Sampler for ClosedChainSampler {
             )));
         }
         let s = self.next_state(rng)?;
+        // tree arrays (NL entries) from the vectors over the tree's movable joints
+        let c = robot.coordinates();
+        let tree = |v: &nalgebra::DVector<f64>| {
+            let mut t = vec![0.0; robot.nl()];
+            c.scatter(v.as_slice(), &mut t);
+            t
+        };
+        let mut g = nalgebra::DMatrix::zeros(robot.nl(), s.g.ncols());
+        for (r, &j) in c.frames().iter().enumerate() {
+            g.row_mut(j - 1).copy_from(&s.g.row(r));
+        }
         Ok(ConsistentSample {
-            q: s.q,
-            qd: s.qd,
-            qdd: s.qdd,
-            g: Some(s.constraints.g),
+            q: tree(&s.q),
+            qd: tree(&s.qd),
+            qdd: tree(&s.qdd),
+            g: Some(g),
         })
     }
 }

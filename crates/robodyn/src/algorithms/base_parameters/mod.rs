@@ -90,7 +90,7 @@ pub fn numeric_base_parameters_auto(
 /// (prismatic) joints of the equivalent tree, n_r0 (n_p0) those connected to the base, n_g0 the
 /// revolute joints connected to the base whose axes are parallel to gravity.
 pub fn inertial_bound(robot: &Robot, n_parallelograms: usize) -> usize {
-    let g = robot.numeric().gravity;
+    let g = robot.numeric().env.gravity;
     let (mut nr, mut np, mut nr0, mut np0, mut ng0) = (0i64, 0i64, 0i64, 0i64, 0i64);
     for j in 1..=robot.nl() {
         let at_base = robot.ant(j) == 0;

@@ -31,12 +31,12 @@
 //! <= tol), so both methods name the same base parameters.
 
 use super::super::regressor::{
-    closed_chain_regressor, regressor, ParameterSelection, PARAMS_PER_LINK,
+    closed_chain_regressor, tree_regressor, ParameterSelection, PARAMS_PER_LINK,
 };
 use super::names::ParameterNames;
+use crate::data::Data;
 use crate::error::{Error, Result};
 use crate::model::Robot;
-use crate::workspace::Workspace;
 use faer::reborrow::{Reborrow, ReborrowMut};
 use faer::{Mat, MatRef, Par};
 use nalgebra::DMatrix;
@@ -490,7 +490,7 @@ pub fn numeric_base_parameters(
     }
     let mut rng = crate::testing::rng(opt.seed);
     let model = robot.numeric();
-    let mut ws = Workspace::new(model);
+    let mut ws = Data::new(robot);
     let mut phi = DMatrix::zeros(nl, PARAMS_PER_LINK * nl);
     // the first sample fixes N (rows per sample)
     let first = sampler.sample(robot, &mut rng)?;
@@ -509,7 +509,7 @@ pub fn numeric_base_parameters(
                 "the sampler returned a state of the wrong size (NL = {nl} expected)"
             )));
         }
-        regressor(model, &mut ws, &s.q, &s.qd, &s.qdd, &mut phi);
+        tree_regressor(model, &mut ws, &model.env, &s.q, &s.qd, &s.qdd, &mut phi);
         let block = match &s.g {
             Some(g) => closed_chain_regressor(g, &phi)?,
             None => phi.clone(),

@@ -1,0 +1,130 @@
+//! Per-evaluation data of a tree robot (Pinocchio's `Data`): every buffer the tree algorithms
+//! use, sized once from the model and reused across calls, so that the `_into` functions
+//! allocate nothing. A `Data` holds no result a later call depends on: every call overwrites
+//! what it reads.
+
+use crate::error::{Error, Result};
+use crate::model::{DynModel, Robot};
+use crate::scalar::DynScalar;
+use nalgebra::{DMatrix, Matrix3, Matrix6, Vector3, Vector6};
+
+/// Buffers of the tree algorithms (Newton–Euler, composite links, inertia matrix, H,
+/// articulated bodies, regressor) for one model. Index j of a per-link buffer holds link/frame
+/// j; index 0 is the base. Make one per thread with [`Data::new`].
+#[derive(Clone, Debug)]
+pub struct Data<T: DynScalar = f64> {
+    nl: usize,
+    nf: usize,
+    /// iA_j, orientation of frame j in its antecedent frame (frames 0..NF).
+    pub(crate) rot: Vec<Matrix3<T>>,
+    /// iP_j, origin of frame j in its antecedent frame.
+    pub(crate) pos: Vec<Vector3<T>>,
+    /// jw_j, angular velocity of link j in R_j.
+    pub(crate) w: Vec<Vector3<T>>,
+    /// jwd_j.
+    pub(crate) wd: Vec<Vector3<T>>,
+    /// jVd_j, linear acceleration of O_j (gravity included as a base acceleration).
+    pub(crate) vd: Vec<Vector3<T>>,
+    /// jU_j = skew(jwd_j) + skew(jw_j)^2 (eq 10.6–10.7).
+    pub(crate) u: Vec<Matrix3<T>>,
+    /// jf_j, force exerted on link j by link a(j).
+    pub(crate) f: Vec<Vector3<T>>,
+    /// jm_j, moment about O_j exerted on link j by link a(j).
+    pub(crate) m: Vec<Vector3<T>>,
+    /// jJ_j^c, jMS_j^c, M_j^c of the composite link j (link j and its successors).
+    pub(crate) jc: Vec<Matrix3<T>>,
+    pub(crate) msc: Vec<Vector3<T>>,
+    pub(crate) mc: Vec<T>,
+    /// A(q) (NL x NL), then its L'DL factors.
+    pub(crate) a: DMatrix<T>,
+    /// Articulated bodies: gamma_j, J*_j, beta*_j, u_j = J*_j a_j, H_j, Gamma_j minus friction,
+    /// classical accelerations [Vd_j; wd_j].
+    pub(crate) gamma: Vec<Vector6<T>>,
+    pub(crate) art_inertia: Vec<Matrix6<T>>,
+    pub(crate) art_bias: Vec<Vector6<T>>,
+    pub(crate) art_u: Vec<Vector6<T>>,
+    pub(crate) art_d: Vec<T>,
+    pub(crate) art_tau: Vec<T>,
+    pub(crate) acc: Vec<Vector6<T>>,
+    /// The regressor of the tree (NL x 13 NL), sized at the first regressor call.
+    pub(crate) phi: DMatrix<T>,
+    /// Tree arrays (NL entries, joint j at j-1) the public joint vectors scatter into.
+    pub(crate) q: Vec<T>,
+    pub(crate) qd: Vec<T>,
+    pub(crate) qdd: Vec<T>,
+    pub(crate) tau: Vec<T>,
+    pub(crate) h: Vec<T>,
+    pub(crate) zeros: Vec<T>,
+}
+
+impl Data<f64> {
+    /// The buffers of `robot`'s algorithms.
+    pub fn new(robot: &Robot) -> Data<f64> {
+        Data::from_model(robot.numeric())
+    }
+
+    /// Error unless this data was made for a model of `robot`'s size ([`Error::Dimension`]).
+    pub fn check(&self, robot: &Robot) -> Result<()> {
+        if self.nl != robot.nl() || self.nf != robot.nf() {
+            return Err(Error::dimension(
+                "data",
+                robot.nl(),
+                self.nl,
+                format!(
+                    "links: the Data was made for another robot than `{}` (NL = {}, NF = {})",
+                    robot.name(),
+                    robot.nl(),
+                    robot.nf()
+                ),
+            ));
+        }
+        Ok(())
+    }
+}
+
+impl<T: DynScalar> Data<T> {
+    /// The buffers of the generic layer for a model in scalar `T` (e.g. `Expr` for the
+    /// customized symbolic models).
+    pub fn from_model(model: &DynModel<T>) -> Self {
+        let nf = model.frames.len();
+        let nl = model.nl;
+        let v = || vec![Vector3::zeros(); nl + 1];
+        let z = || vec![T::zero(); nl];
+        let v6 = || vec![Vector6::zeros(); nl + 1];
+        Data {
+            nl,
+            nf,
+            rot: vec![Matrix3::identity(); nf + 1],
+            pos: vec![Vector3::zeros(); nf + 1],
+            w: v(),
+            wd: v(),
+            vd: v(),
+            u: vec![Matrix3::zeros(); nl + 1],
+            f: v(),
+            m: v(),
+            jc: vec![Matrix3::zeros(); nl + 1],
+            msc: v(),
+            mc: vec![T::zero(); nl + 1],
+            a: DMatrix::from_element(nl, nl, T::zero()),
+            gamma: v6(),
+            art_inertia: vec![Matrix6::zeros(); nl + 1],
+            art_bias: v6(),
+            art_u: v6(),
+            art_d: vec![T::zero(); nl + 1],
+            art_tau: vec![T::zero(); nl + 1],
+            acc: v6(),
+            phi: DMatrix::from_element(0, 0, T::zero()),
+            q: z(),
+            qd: z(),
+            qdd: z(),
+            tau: z(),
+            h: z(),
+            zeros: z(),
+        }
+    }
+
+    /// NL of the model this data was made for.
+    pub fn nl(&self) -> usize {
+        self.nl
+    }
+}
