@@ -4,7 +4,7 @@
 //! Output is deterministic (assignment order, no hash-map iteration) and documents the inputs and
 //! the operation counts in a header comment.
 
-use crate::expr::{Expr, Func, Node};
+use crate::expr::{grow, Expr, Func, Node};
 use crate::print::{product_parts, term_is_negative};
 use crate::program::Program;
 use num_traits::Signed;
@@ -149,6 +149,10 @@ fn latex_name(n: &str) -> String {
 }
 
 fn latex(e: &Expr, prec: u8) -> String {
+    grow(|| latex_node(e, prec))
+}
+
+fn latex_node(e: &Expr, prec: u8) -> String {
     match e.node() {
         Node::Rational(r) => {
             let body = if r.is_integer() {
@@ -237,6 +241,11 @@ fn latex(e: &Expr, prec: u8) -> String {
             };
             format!("{name}\\left({}\\right)", latex(a, 0))
         }
+        Node::Atan2(y, x) => format!(
+            "\\operatorname{{atan2}}\\left({}, {}\\right)",
+            latex(y, 0),
+            latex(x, 0)
+        ),
     }
 }
 
@@ -248,7 +257,9 @@ fn latex_terms(v: &[Expr]) -> Vec<String> {
             if i == 0 {
                 latex(t, 0)
             } else if term_is_negative(t) {
-                format!(" - {}", latex(&-t.clone(), 0))
+                let neg = -t.clone();
+                let prec = u8::from(matches!(neg.node(), Node::Add(_)));
+                format!(" - {}", latex(&neg, prec))
             } else {
                 format!(" + {}", latex(t, 0))
             }
@@ -315,6 +326,10 @@ fn emit_latex(p: &Program) -> String {
 
 /// Infix code for C-like languages: powers written as products, rationals as float literals.
 fn code(e: &Expr, lang: Lang, prec: u8, names: &Names) -> String {
+    grow(|| code_node(e, lang, prec, names))
+}
+
+fn code_node(e: &Expr, lang: Lang, prec: u8, names: &Names) -> String {
     let lit = |x: f64| -> String {
         let s = format!("{x:?}");
         let s = if s.contains('.') || s.contains('e') || s.contains("inf") || s.contains("NaN") {
@@ -415,6 +430,15 @@ fn code(e: &Expr, lang: Lang, prec: u8, names: &Names) -> String {
                 (Lang::C, _) => format!("{}({arg})", f.name()),
                 (Lang::Python, _) => format!("np.{}({arg})", f.name()),
                 (_, _) => format!("{}({arg})", f.name()),
+            }
+        }
+        Node::Atan2(y, x) => {
+            let (y, x) = (code(y, lang, 0, names), code(x, lang, 0, names));
+            match lang {
+                Lang::Rust => format!("f64::atan2({y}, {x})"),
+                Lang::Python => format!("np.arctan2({y}, {x})"),
+                Lang::Julia => format!("atan({y}, {x})"),
+                _ => format!("atan2({y}, {x})"),
             }
         }
     }

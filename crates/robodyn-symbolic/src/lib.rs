@@ -6,6 +6,7 @@
 
 pub mod emit;
 mod expr;
+mod optimize;
 mod parse;
 mod print;
 pub mod program;

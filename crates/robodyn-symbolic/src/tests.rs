@@ -76,3 +76,21 @@ fn trig_of_shifted_arguments_folds() {
         }
     }
 }
+
+#[test]
+fn fuzz_timeout_product_power_expands() {
+    let e = p("((a+b)*(c-d))^3");
+    let x = e.expand();
+    assert!(x.to_string().len() > 10);
+}
+
+#[test]
+fn dbg_steps() {
+    let e = p("((a+b)*(c-d))^3");
+    eprintln!("parsed {e}");
+    let s = p("(a+b)^3");
+    eprintln!("pow {s}");
+    eprintln!("exp {}", s.expand());
+    let t = p("(a+b)*(c-d)");
+    eprintln!("exp2 {}", t.expand());
+}
