@@ -687,8 +687,8 @@ impl Program {
 }
 
 /// Replace `target` by `sym` in every slot that may hold it; returns the slots changed. The
-/// slots searched are those where the target was counted, and for a sum or product of three or
-/// more items (which may also sit inside a larger one, uncounted) those using all its symbols.
+/// slots searched are those where the target was counted, and for a sum or a product (which may
+/// also sit inside a larger one, uncounted) those using its rarest symbol.
 fn replace_in_slots(
     s: &mut Slots,
     cands: &mut Candidates,
@@ -700,7 +700,9 @@ fn replace_in_slots(
         .get(target)
         .map(|(_, m)| m.keys().copied().collect())
         .unwrap_or_default();
-    let wide = matches!(target.node(), Node::Add(v) | Node::Mul(v) if v.len() > 2);
+    // a sum or product may also match inside a larger one (`a*b` in `2*a*b`, `a + b + c` in
+    // `a + b + c + d`), where it was not counted
+    let wide = matches!(target.node(), Node::Add(_) | Node::Mul(_));
     if wide {
         let symbols = target.symbols();
         match symbols
