@@ -7,7 +7,10 @@ use std::path::{Path, PathBuf};
 
 /// `<workspace>/../shared/cases/external` (CI clones the repository with `shared/` beside it).
 fn external() -> PathBuf {
-    let dir = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/cases/external"));
+    let dir = Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../../shared/cases/external"
+    ));
     assert!(
         dir.is_dir(),
         "{}: the external SYMORO cases are expected beside the repository",
@@ -19,8 +22,14 @@ fn external() -> PathBuf {
 /// The files refused, with a part of the reason the error must give.
 const REFUSED: [(&str, &str); 5] = [
     // the files themselves are inconsistent (NF = 6 but 14 / 10 frames listed)
-    ("freecad-symoro/AKR3000.par", "Ant has 14 entries, NF = 6 expected"),
-    ("freecad-symoro/sr400.par", "Ant has 10 entries, NF = 6 expected"),
+    (
+        "freecad-symoro/AKR3000.par",
+        "Ant has 14 entries, NF = 6 expected",
+    ),
+    (
+        "freecad-symoro/sr400.par",
+        "Ant has 10 entries, NF = 6 expected",
+    ),
     // a twin frame whose antecedent is another fixed frame (frame 12 on frame 11): a change of
     // the structure model, not of the reader
     (
@@ -32,7 +41,10 @@ const REFUSED: [(&str, &str); 5] = [
         "antecedent a(12) = 11 of a cut-joint frame must be a link",
     ),
     // a free-floating base
-    ("symoro-robots/rx90float.par", "floating (free) base is not supported"),
+    (
+        "symoro-robots/rx90float.par",
+        "floating (free) base is not supported",
+    ),
 ];
 
 fn all_par(dir: &Path, out: &mut Vec<PathBuf>) {
@@ -55,7 +67,11 @@ fn every_external_file_loads_or_is_refused_for_its_reason() {
     assert!(files.len() >= 33, "{} files", files.len());
     let mut loaded = 0;
     for f in &files {
-        let rel = f.strip_prefix(&dir).unwrap().to_string_lossy().replace('\\', "/");
+        let rel = f
+            .strip_prefix(&dir)
+            .unwrap()
+            .to_string_lossy()
+            .replace('\\', "/");
         let expected = REFUSED.iter().find(|(n, _)| *n == rel).map(|(_, why)| *why);
         match (robodyn::io::load_description_mapped(f), expected) {
             (Ok((d, _)), None) => {
@@ -86,8 +102,10 @@ fn every_external_file_loads_or_is_refused_for_its_reason() {
 fn python_booleans_and_atan2_are_read_as_opensymoro_reads_them() {
     let dir = external();
     // `is_mobile = False`
-    let (d, _) = robodyn::io::load_description_mapped(&dir.join("symoro-robots/planar2r.par")).unwrap();
-    let (d0, _) = robodyn::io::load_description_mapped(&dir.join("derived/planar2r_is_mobile0.par")).unwrap();
+    let (d, _) =
+        robodyn::io::load_description_mapped(&dir.join("symoro-robots/planar2r.par")).unwrap();
+    let (d0, _) =
+        robodyn::io::load_description_mapped(&dir.join("derived/planar2r_is_mobile0.par")).unwrap();
     assert!(!d.mobile_base);
     assert_eq!(d, d0);
     // `gamma = {..., -atan2(b, d6) + pi}`: the twin frame 12 points back along the link
@@ -114,6 +132,7 @@ fn the_assembly_comment_round_trips() {
     assert!(text.contains("(* robodyn assembly"), "{text}");
     let (back, _) = par::parse_description(&text, Some("back.par")).unwrap();
     assert_eq!(back.assembly, Some(q.clone()));
-    let (back, _) = toml_format::parse_description(&toml_format::write_description(&d), None).unwrap();
+    let (back, _) =
+        toml_format::parse_description(&toml_format::write_description(&d), None).unwrap();
     assert_eq!(back.assembly, Some(q));
 }
