@@ -14,17 +14,24 @@ use std::fmt::Write;
 /// Target language.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Lang {
+    /// SYMORO-style equations `NAME = expr`, one per line.
     Text,
+    /// A LaTeX `align*` environment.
     Latex,
+    /// A Rust function over slices.
     Rust,
+    /// A C99 function over `double` arrays.
     C,
+    /// A Python function over NumPy arrays.
     Python,
+    /// A Julia function filling its output in place (`NAME!`).
     Julia,
     /// MATLAB / GNU Octave: a function file `NAME.m` (1-based indexing).
     Matlab,
 }
 
 impl Lang {
+    /// The language of a name or file extension (`c`, `rust`/`rs`, `python`/`py`, `m`...).
     pub fn from_name(s: &str) -> Option<Lang> {
         Some(match s {
             "text" | "txt" => Lang::Text,

@@ -1170,7 +1170,7 @@ fn node_hash_depth(node: &Node) -> (u64, u32) {
 const SHALLOW: u32 = 64;
 
 /// Deep trees are taken apart iteratively: the last owner of a node moves its children onto a
-/// work list before the node goes, so dropping never recurses deeper than [`SHALLOW`].
+/// work list before the node goes, so dropping never recurses deeper than `SHALLOW` (64) levels.
 impl Drop for Expr {
     fn drop(&mut self) {
         if self.0.depth < SHALLOW {

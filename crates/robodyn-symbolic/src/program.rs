@@ -16,7 +16,9 @@ use std::collections::{HashMap, HashSet};
 /// One assignment `name = expr`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Assignment {
+    /// The name assigned.
     pub name: String,
+    /// Its value.
     pub expr: Expr,
 }
 
@@ -38,7 +40,9 @@ pub struct Program {
     pub name: String,
     /// Header lines (what the model is, its options).
     pub description: Vec<String>,
+    /// Input arrays, in argument order.
     pub inputs: Vec<InputGroup>,
+    /// Intermediate values, in evaluation order.
     pub assignments: Vec<Assignment>,
     /// Outputs, written to the output array in this order.
     pub outputs: Vec<Assignment>,
@@ -48,8 +52,11 @@ pub struct Program {
 /// elementary function calls (sin, cos, sign, sqrt; not counted as multiplications).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct OpCount {
+    /// Multiplications and divisions.
     pub mul: usize,
+    /// Additions and subtractions.
     pub add: usize,
+    /// Elementary function calls.
     pub func: usize,
 }
 

@@ -20,7 +20,7 @@ fn external() -> PathBuf {
 }
 
 /// The files refused, with a part of the reason the error must give.
-const REFUSED: [(&str, &str); 5] = [
+const REFUSED: [(&str, &str); 6] = [
     // the files themselves are inconsistent (NF = 6 but 14 / 10 frames listed)
     (
         "freecad-symoro/AKR3000.par",
@@ -44,6 +44,10 @@ const REFUSED: [(&str, &str); 5] = [
     (
         "symoro-robots/rx90float.par",
         "floating (free) base is not supported",
+    ),
+    (
+        "symoro-robots/floatplanar2r.par",
+        "is_floating = True: a floating (free) base",
     ),
 ];
 

@@ -692,8 +692,11 @@ pub fn parse_description(text: &str, file: Option<&str>) -> Result<(RobotDescrip
     if let Some((true, at)) = keys.flag("is_floating")? {
         return Err(ctx.err_line(
             at,
-            "is_floating = 1: a floating (free) base is not supported; robodyn's base is fixed \
-             or moves as given by W0 WP0 V0 VP0 (is_mobile = 1)",
+            format!(
+                "is_floating = {}: a floating (free) base is not supported; robodyn's base is \
+                 fixed or moves as given by W0 WP0 V0 VP0 (is_mobile = 1)",
+                keys.by_key["is_floating"].entries[0].0
+            ),
         ));
     }
     let mut ex = Extras::default();
