@@ -76,6 +76,9 @@ fn remove_all(hay: &mut Vec<Expr>, needles: &[Expr]) {
     }
 }
 
+/// Sums and products of more items than this contribute no pairs of items as candidates.
+const MAX_PAIR_ITEMS: usize = 24;
+
 /// Candidate common subexpressions of `e`: whole sub-nodes and pairs of factors / terms (the
 /// root itself when `root` is false).
 fn collect_candidates(e: &Expr, root: bool, out: &mut Vec<Expr>) {
@@ -86,7 +89,9 @@ fn collect_candidates(e: &Expr, root: bool, out: &mut Vec<Expr>) {
             }
             let is_mul = matches!(e.node(), Node::Mul(_));
             let items: Vec<&Expr> = v.iter().filter(|t| !(is_mul && t.is_number())).collect();
-            if items.len() > 2 {
+            // pairs of a long sum (a row of the direct model's L D L' factorization has as many
+            // terms as joints) would be quadratic in its length, and rarely recur elsewhere
+            if items.len() > 2 && items.len() <= MAX_PAIR_ITEMS {
                 for a in 0..items.len() {
                     for b in a + 1..items.len() {
                         out.push(if is_mul {

@@ -87,7 +87,7 @@ fn main() {
             (t, ops, code.len())
         };
         let (idm, idm_ops, _) = gen(ModelKind::Idm);
-        let ddm = (n <= 200).then(|| gen(ModelKind::Ddm));
+        let ddm = (n <= 100).then(|| gen(ModelKind::Ddm));
         let ratio = |now: f64, before: Option<f64>| {
             before.map_or("".to_string(), |b| format!("x{:.1}", now / b))
         };
