@@ -194,7 +194,14 @@ fn latex_node(e: &Expr, prec: u8) -> String {
                 s
             }
         }
-        Node::Pow(b, n) if *n > 0 => format!("{}^{{{n}}}", latex(b, 3)),
+        Node::Pow(b, n) if *n > 0 => {
+            let base = latex(b, 3);
+            if matches!(b.node(), Node::Pow(..)) {
+                format!("\\left({base}\\right)^{{{n}}}")
+            } else {
+                format!("{base}^{{{n}}}")
+            }
+        }
         Node::Mul(_) | Node::Pow(..) => {
             let (coef, num, den) = product_parts(e);
             let mut neg = false;
@@ -451,13 +458,25 @@ fn code_node(e: &Expr, lang: Lang, prec: u8, names: &Names) -> String {
     }
 }
 
-/// x^n written as n factors so that the code performs the counted multiplications.
+/// x^n written as n factors so that the code performs the counted multiplications; a power of
+/// a compound base beyond the square (`(x^40)^2`, `(a + b)^3`: never in a generated model) as
+/// the language's power, so that nested powers cannot multiply the length of the code.
 fn push_power(f: &Expr, lang: Lang, parts: &mut Vec<String>, names: &Names) {
     match f.node() {
         Node::Pow(b, n) if *n > 0 => {
             let s = code(b, lang, 2, names);
-            for _ in 0..*n {
-                parts.push(s.clone());
+            let leaf = matches!(b.node(), Node::Symbol(_) | Node::Pi) || b.is_number();
+            if leaf || *n <= 2 {
+                for _ in 0..*n {
+                    parts.push(s.clone());
+                }
+            } else {
+                parts.push(match lang {
+                    Lang::C => format!("pow({s}, {n})"),
+                    Lang::Rust => format!("{s}.powi({n})"),
+                    Lang::Python => format!("{s}**{n}"),
+                    _ => format!("{s}^{n}"),
+                });
             }
         }
         _ => parts.push(code(f, lang, 2, names)),

@@ -493,7 +493,12 @@ impl Expr {
                         index.get(&b).copied()
                     };
                     // an exponent that would overflow stays a separate factor
-                    match found.and_then(|i| bases[i].1.checked_add(n).map(|s| (i, s))) {
+                    // an exponent beyond MAX_POWER stays a separate factor
+                    let merged = found.and_then(|i| {
+                        let s = bases[i].1.checked_add(n)?;
+                        (s.abs() <= MAX_POWER).then_some((i, s))
+                    });
+                    match merged {
                         Some((i, s)) => bases[i].1 = s,
                         None => {
                             if !index.is_empty() || bases.len() + 1 >= LINEAR_SEARCH {
@@ -550,7 +555,8 @@ impl Expr {
                 }
             }
             Node::Float(x) => Expr::num(x.powi(n)),
-            Node::Pow(b, m) => match i32::checked_mul(*m, n) {
+            // (x^m)^n = x^(mn) while |mn| <= MAX_POWER, else kept nested
+            Node::Pow(b, m) => match i32::checked_mul(*m, n).filter(|k| k.abs() <= MAX_POWER) {
                 Some(k) => b.powi(k),
                 None => Expr::new(Node::Pow(self.clone(), n)),
             },
@@ -770,6 +776,11 @@ fn distribute(a: &Expr, b: &Expr) -> Expr {
             .map(move |y| Expr::product([x.clone(), y.clone()]))
     }))
 }
+
+/// Largest exponent (in absolute value) a power merges to: `x^40*x^40` stays two factors and
+/// `(x^40)^2` a power of a power, so that what prints reads back (the parser takes written
+/// exponents up to this bound).
+pub const MAX_POWER: i32 = 64;
 
 /// Below this many terms (factors), a sum (product) finds like terms by a linear search.
 const LINEAR_SEARCH: usize = 16;

@@ -9,8 +9,8 @@ use crate::expr::{Expr, Func, Node};
 /// Deepest nesting of parentheses, function calls, unary signs and exponents accepted.
 pub const MAX_DEPTH: usize = 200;
 
-/// Largest exponent (in absolute value) an expression may carry (`x^64`; `(x^8)^8` too).
-pub const MAX_EXPONENT: i32 = 64;
+/// Largest exponent (in absolute value) written in an expression (`x^64`).
+pub const MAX_EXPONENT: i32 = crate::expr::MAX_POWER;
 
 /// A parse error with the byte offset (0-based) of the offending character in the input.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -178,34 +178,19 @@ impl Parser<'_> {
         }
         let at = self.pos;
         let exp = self.unary()?;
-        let e = match exp.as_rational() {
+        match exp.as_rational() {
             Some(r) if r.is_integer() && r.numer().abs() <= MAX_EXPONENT as i64 => {
-                base.powi(*r.numer() as i32)
+                Ok(base.powi(*r.numer() as i32))
             }
-            Some(r) if *r.denom() == 2 && *r.numer() == 1 => base.sqrt(),
-            _ => {
-                return Err(ParseError {
-                    offset: at,
-                    message: format!(
-                        "only integer exponents from -{MAX_EXPONENT} to {MAX_EXPONENT} (or 1/2) \
-                         are supported"
-                    ),
-                })
-            }
-        };
-        // powers of powers multiply their exponents: x^64^64 would be written out as 4096 factors
-        let too_large = |f: &Expr| matches!(f.node(), Node::Pow(_, n) if n.unsigned_abs() > MAX_EXPONENT as u32);
-        let large = match e.node() {
-            Node::Mul(v) => v.iter().any(too_large),
-            _ => too_large(&e),
-        };
-        if large {
-            return Err(ParseError {
+            Some(r) if *r.denom() == 2 && *r.numer() == 1 => Ok(base.sqrt()),
+            _ => Err(ParseError {
                 offset: at,
-                message: format!("the resulting exponent exceeds {MAX_EXPONENT}"),
-            });
+                message: format!(
+                    "only integer exponents from -{MAX_EXPONENT} to {MAX_EXPONENT} (or 1/2) are \
+                     supported"
+                ),
+            }),
         }
-        Ok(e)
     }
 
     fn atom(&mut self) -> Result<Expr, ParseError> {

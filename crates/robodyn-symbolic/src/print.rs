@@ -130,8 +130,17 @@ pub(crate) fn product_parts(e: &Expr) -> (Option<Expr>, Vec<Expr>, Vec<Expr>) {
 fn write_product(f: &mut fmt::Formatter<'_>, e: &Expr, prec: u8) -> fmt::Result {
     if let Node::Pow(b, n) = e.node() {
         if *n > 0 {
+            // a power as the base of a power keeps its parentheses: (x^40)^2
+            let wrap = prec > PREC_POWER;
+            if wrap {
+                write!(f, "(")?;
+            }
             write_expr(f, b, PREC_POWER + 1)?;
-            return write!(f, "^{n}");
+            write!(f, "^{n}")?;
+            if wrap {
+                write!(f, ")")?;
+            }
+            return Ok(());
         }
     }
     let (coef, num, den) = product_parts(e);

@@ -1,7 +1,7 @@
 //! How the cost of loading and of code generation grows with the size of a robot (issue 13's
 //! cost table): a serial chain of n revolute links (alternating twists, numeric geometry,
 //! symbolic inertial parameters), written as a TOML file, read back, and its inverse (and, up to
-//! 200 links, direct) dynamic model generated as C.
+//! 100 links, direct) dynamic model generated as C.
 //!
 //!     cargo run --release -p robodyn --example scaling [-- 10 50 100 200 500 2000]
 //!
