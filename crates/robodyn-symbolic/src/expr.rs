@@ -996,13 +996,13 @@ fn cmp_terms(a: &Expr, b: &Expr) -> Ordering {
 
 /// Compare names so that `M2 < M10` and `XX1 < XX2`.
 fn natural_cmp(a: &str, b: &str) -> Ordering {
-    let split = |s: &str| {
+    fn split(s: &str) -> (&[u8], Option<u64>) {
         let i = s.trim_end_matches(|c: char| c.is_ascii_digit()).len();
-        (s[..i].to_string(), s[i..].parse::<u64>().ok())
-    };
+        (&s.as_bytes()[..i], s[i..].parse::<u64>().ok())
+    }
     let (pa, na) = split(a);
     let (pb, nb) = split(b);
-    pa.cmp(&pb).then(na.cmp(&nb)).then(a.cmp(b))
+    pa.cmp(pb).then(na.cmp(&nb)).then(a.cmp(b))
 }
 
 impl std::ops::Add for Expr {

@@ -8,7 +8,7 @@
 //! Prints one row per size: file size, load time, generation times and operation counts, and the
 //! ratio of each time to the previous row's (linear growth gives the ratio of the sizes).
 
-use robodyn::codegen::{generate, GenOptions, ModelKind};
+use robodyn::codegen::{generate_with_progress, GenOptions, ModelKind};
 use robodyn::io::toml_format;
 use robodyn_symbolic::{emit, Lang};
 use std::time::Instant;
@@ -80,9 +80,22 @@ fn main() {
                     model,
                     ..GenOptions::default()
                 };
-                let p = generate(&desc, &opt).unwrap();
+                // SCALING_STAGES=1: the time of each stage on standard error
+                let stages = std::env::var_os("SCALING_STAGES").is_some();
+                let start = Instant::now();
+                let mut report = |what: &str| {
+                    if stages {
+                        eprintln!(
+                            "  {n} links, {:>7.3} s: {what}",
+                            start.elapsed().as_secs_f64()
+                        );
+                    }
+                };
+                let p = generate_with_progress(&desc, &opt, &mut report).unwrap();
                 ops = p.count();
+                report("emitting C");
                 code = emit(&p, Lang::C);
+                report("done");
             });
             (t, ops, code.len())
         };
