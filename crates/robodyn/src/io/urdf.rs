@@ -294,7 +294,7 @@ fn read_links<'a>(
         let inertial = match child(n, "inertial") {
             None => None,
             Some(i) => {
-                let com = origin(&ctx, i, &what)?;
+                let com = origin(ctx, i, &what)?;
                 let mass_node = child(i, "mass")
                     .ok_or_else(|| ctx.err(i, format!("{what}: missing <mass>")))?;
                 let m = ctx.number(
@@ -424,7 +424,7 @@ fn read_joints<'a>(
         }
         joint_names.insert(name.clone(), joints.len());
         joints.push(UJoint {
-            origin: origin(&ctx, n, &what)?,
+            origin: origin(ctx, n, &what)?,
             name,
             node: n,
             joint,
