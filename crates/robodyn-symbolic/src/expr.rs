@@ -1192,6 +1192,7 @@ impl Drop for Expr {
             if e.0.depth >= SHALLOW {
                 if let Some(inner) = Arc::get_mut(&mut e.0) {
                     work.push(std::mem::replace(&mut inner.node, Node::Pi));
+                    inner.depth = 1;
                 }
             }
         };
