@@ -64,46 +64,14 @@ pub struct Table {
 }
 
 impl Table {
+    /// Read a state table (the library's reader: a repeated column, a short row or a field
+    /// that is not a finite number is an error with its line).
     pub fn read(path: &Path) -> CliResult<Table> {
-        let file = path.display().to_string();
-        let mut rdr = csv::ReaderBuilder::new()
-            .trim(csv::Trim::All)
-            .comment(Some(b'#'))
-            .from_path(path)
-            .map_err(|e| format!("{file}: {e}"))?;
-        let headers: Vec<String> = rdr
-            .headers()
-            .map_err(|e| format!("{file}: {e}"))?
-            .iter()
-            .map(str::to_string)
-            .collect();
-        let mut rows = Vec::new();
-        for (i, rec) in rdr.records().enumerate() {
-            let rec = rec.map_err(|e| format!("{file}: {e}"))?;
-            let line = rec.position().map(|p| p.line()).unwrap_or(i as u64 + 2);
-            let mut row = Vec::with_capacity(rec.len());
-            for (k, field) in rec.iter().enumerate() {
-                let x: f64 = field.parse().map_err(|_| {
-                    format!(
-                        "{file}:{line}: column `{}`: `{field}` is not a number",
-                        headers[k]
-                    )
-                })?;
-                if !x.is_finite() {
-                    return Err(format!(
-                        "{file}:{line}: column `{}`: {x} is not finite",
-                        headers[k]
-                    )
-                    .into());
-                }
-                row.push(x);
-            }
-            rows.push(row);
-        }
+        let t = robodyn::io::table::Table::read(path)?;
         Ok(Table {
-            headers,
-            rows,
-            file,
+            headers: t.headers,
+            rows: t.rows,
+            file: t.file,
         })
     }
 

@@ -4,7 +4,7 @@
 //! Output is deterministic (assignment order, no hash-map iteration) and documents the inputs and
 //! the operation counts in a header comment.
 
-use crate::expr::{Expr, Func, Node};
+use crate::expr::{grow, Expr, Func, Node};
 use crate::print::{product_parts, term_is_negative};
 use crate::program::Program;
 use num_traits::Signed;
@@ -14,17 +14,24 @@ use std::fmt::Write;
 /// Target language.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Lang {
+    /// SYMORO-style equations `NAME = expr`, one per line.
     Text,
+    /// A LaTeX `align*` environment.
     Latex,
+    /// A Rust function over slices.
     Rust,
+    /// A C99 function over `double` arrays.
     C,
+    /// A Python function over NumPy arrays.
     Python,
+    /// A Julia function filling its output in place (`NAME!`).
     Julia,
     /// MATLAB / GNU Octave: a function file `NAME.m` (1-based indexing).
     Matlab,
 }
 
 impl Lang {
+    /// The language of a name or file extension (`c`, `rust`/`rs`, `python`/`py`, `m`...).
     pub fn from_name(s: &str) -> Option<Lang> {
         Some(match s {
             "text" | "txt" => Lang::Text,
@@ -149,6 +156,10 @@ fn latex_name(n: &str) -> String {
 }
 
 fn latex(e: &Expr, prec: u8) -> String {
+    grow(|| latex_node(e, prec))
+}
+
+fn latex_node(e: &Expr, prec: u8) -> String {
     match e.node() {
         Node::Rational(r) => {
             let body = if r.is_integer() {
@@ -183,7 +194,14 @@ fn latex(e: &Expr, prec: u8) -> String {
                 s
             }
         }
-        Node::Pow(b, n) if *n > 0 => format!("{}^{{{n}}}", latex(b, 3)),
+        Node::Pow(b, n) if *n > 0 => {
+            let base = latex(b, 3);
+            if matches!(b.node(), Node::Pow(..)) {
+                format!("\\left({base}\\right)^{{{n}}}")
+            } else {
+                format!("{base}^{{{n}}}")
+            }
+        }
         Node::Mul(_) | Node::Pow(..) => {
             let (coef, num, den) = product_parts(e);
             let mut neg = false;
@@ -237,6 +255,11 @@ fn latex(e: &Expr, prec: u8) -> String {
             };
             format!("{name}\\left({}\\right)", latex(a, 0))
         }
+        Node::Atan2(y, x) => format!(
+            "\\operatorname{{atan2}}\\left({}, {}\\right)",
+            latex(y, 0),
+            latex(x, 0)
+        ),
     }
 }
 
@@ -248,7 +271,9 @@ fn latex_terms(v: &[Expr]) -> Vec<String> {
             if i == 0 {
                 latex(t, 0)
             } else if term_is_negative(t) {
-                format!(" - {}", latex(&-t.clone(), 0))
+                let neg = -t.clone();
+                let prec = u8::from(matches!(neg.node(), Node::Add(_)));
+                format!(" - {}", latex(&neg, prec))
             } else {
                 format!(" + {}", latex(t, 0))
             }
@@ -315,6 +340,10 @@ fn emit_latex(p: &Program) -> String {
 
 /// Infix code for C-like languages: powers written as products, rationals as float literals.
 fn code(e: &Expr, lang: Lang, prec: u8, names: &Names) -> String {
+    grow(|| code_node(e, lang, prec, names))
+}
+
+fn code_node(e: &Expr, lang: Lang, prec: u8, names: &Names) -> String {
     let lit = |x: f64| -> String {
         let s = format!("{x:?}");
         let s = if s.contains('.') || s.contains('e') || s.contains("inf") || s.contains("NaN") {
@@ -417,16 +446,37 @@ fn code(e: &Expr, lang: Lang, prec: u8, names: &Names) -> String {
                 (_, _) => format!("{}({arg})", f.name()),
             }
         }
+        Node::Atan2(y, x) => {
+            let (y, x) = (code(y, lang, 0, names), code(x, lang, 0, names));
+            match lang {
+                Lang::Rust => format!("f64::atan2({y}, {x})"),
+                Lang::Python => format!("np.arctan2({y}, {x})"),
+                Lang::Julia => format!("atan({y}, {x})"),
+                _ => format!("atan2({y}, {x})"),
+            }
+        }
     }
 }
 
-/// x^n written as n factors so that the code performs the counted multiplications.
+/// x^n written as n factors so that the code performs the counted multiplications; a power of
+/// a compound base beyond the square (`(x^40)^2`, `(a + b)^3`: never in a generated model) as
+/// the language's power, so that nested powers cannot multiply the length of the code.
 fn push_power(f: &Expr, lang: Lang, parts: &mut Vec<String>, names: &Names) {
     match f.node() {
         Node::Pow(b, n) if *n > 0 => {
             let s = code(b, lang, 2, names);
-            for _ in 0..*n {
-                parts.push(s.clone());
+            let leaf = matches!(b.node(), Node::Symbol(_) | Node::Pi) || b.is_number();
+            if leaf || *n <= 2 {
+                for _ in 0..*n {
+                    parts.push(s.clone());
+                }
+            } else {
+                parts.push(match lang {
+                    Lang::C => format!("pow({s}, {n})"),
+                    Lang::Rust => format!("{s}.powi({n})"),
+                    Lang::Python => format!("{s}**{n}"),
+                    _ => format!("{s}^{n}"),
+                });
             }
         }
         _ => parts.push(code(f, lang, 2, names)),

@@ -8,22 +8,29 @@
 use num_rational::Rational64;
 use num_traits::{CheckedAdd, CheckedMul, One, Signed, ToPrimitive, Zero};
 use std::cmp::Ordering;
+use std::collections::HashMap;
 use std::fmt;
 use std::sync::Arc;
 
 /// Elementary functions an expression may contain.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum Func {
+    /// Sine.
     Sin,
+    /// Cosine.
     Cos,
+    /// Tangent.
     Tan,
+    /// Square root.
     Sqrt,
+    /// Absolute value.
     Abs,
     /// sign(x): -1, 0 or 1 (used for Coulomb friction).
     Sign,
 }
 
 impl Func {
+    /// The name in expressions and generated code (`sin`, `sqrt`...).
     pub fn name(self) -> &'static str {
         match self {
             Func::Sin => "sin",
@@ -35,6 +42,7 @@ impl Func {
         }
     }
 
+    /// The function of a name (`sin`, `Sin` or `SIN`...), if it is one.
     pub fn from_name(name: &str) -> Option<Func> {
         Some(match name {
             "sin" | "Sin" | "SIN" => Func::Sin,
@@ -47,6 +55,7 @@ impl Func {
         })
     }
 
+    /// The function's value at `x`.
     pub fn apply(self, x: f64) -> f64 {
         match self {
             Func::Sin => x.sin(),
@@ -87,17 +96,40 @@ pub enum Node {
     Pow(Expr, i32),
     /// An elementary function.
     Func(Func, Expr),
+    /// atan2(y, x): the angle of the point (x, y), in (-pi, pi].
+    Atan2(Expr, Expr),
 }
 
 /// A shared, immutable symbolic expression.
-#[derive(Clone, PartialEq)]
-pub struct Expr(Arc<Node>);
+///
+/// Each node memoizes its structural hash and its depth when it is built, so that hashing (the
+/// common-subexpression passes hash every sub-node) costs O(1) and deep trees can be handled
+/// without recursion: drop is iterative and the recursive walks grow their stack on demand.
+#[derive(Clone)]
+pub struct Expr(Arc<Inner>);
+
+/// A node with its memoized structural hash and depth (a leaf has depth 1).
+struct Inner {
+    node: Node,
+    hash: u64,
+    depth: u32,
+}
+
+/// Run a recursive step of a walk over an expression, on a fresh heap-allocated stack segment
+/// when the current one runs low: the depth of an expression is not bounded (a long serial
+/// chain's unnamed expressions nest as deep as the chain is long), a thread's stack is.
+#[inline]
+pub(crate) fn grow<R>(f: impl FnOnce() -> R) -> R {
+    stacker::maybe_grow(128 * 1024, 4 * 1024 * 1024, f)
+}
 
 /// Error while evaluating an expression numerically.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum EvalError {
+    /// A symbol has no value.
     #[error("unknown symbol `{0}`")]
     UnknownSymbol(String),
+    /// The value is NaN or infinite (the expression, printed, is given).
     #[error("expression `{0}` does not evaluate to a finite number")]
     NotFinite(String),
 }
@@ -116,34 +148,50 @@ impl Default for Expr {
 
 impl Expr {
     fn new(node: Node) -> Expr {
-        Expr(Arc::new(node))
+        let (hash, depth) = node_hash_depth(&node);
+        Expr(Arc::new(Inner { node, hash, depth }))
     }
 
     /// The node behind this expression.
     pub fn node(&self) -> &Node {
-        &self.0
+        &self.0.node
     }
 
+    /// Depth of the expression tree (1 for a number or a symbol).
+    pub fn depth(&self) -> u32 {
+        self.0.depth
+    }
+
+    /// The number 0.
     pub fn zero() -> Expr {
         Expr::rational(Rational64::zero())
     }
 
+    /// The number 1.
     pub fn one() -> Expr {
         Expr::rational(Rational64::one())
     }
 
+    /// An integer.
     pub fn int(n: i64) -> Expr {
         Expr::rational(Rational64::from_integer(n))
     }
 
+    /// An exact rational number.
     pub fn rational(r: Rational64) -> Expr {
+        // a numerator or denominator of i64::MIN could not be negated: keep its value as a float
+        if *r.numer() == i64::MIN || *r.denom() == i64::MIN {
+            return Expr::new(Node::Float(r.to_f64().unwrap_or(f64::NAN)));
+        }
         Expr::new(Node::Rational(r))
     }
 
+    /// The constant pi.
     pub fn pi() -> Expr {
         Expr::new(Node::Pi)
     }
 
+    /// A named symbol.
     pub fn symbol(name: impl Into<String>) -> Expr {
         Expr::new(Node::Symbol(name.into()))
     }
@@ -165,6 +213,7 @@ impl Expr {
         }
     }
 
+    /// The exact value if this expression is a rational number.
     pub fn as_rational(&self) -> Option<Rational64> {
         match self.node() {
             Node::Rational(r) => Some(*r),
@@ -172,6 +221,7 @@ impl Expr {
         }
     }
 
+    /// The name if this expression is a symbol.
     pub fn as_symbol(&self) -> Option<&str> {
         match self.node() {
             Node::Symbol(s) => Some(s),
@@ -179,6 +229,7 @@ impl Expr {
         }
     }
 
+    /// True for the number 0.
     pub fn is_zero(&self) -> bool {
         match self.node() {
             Node::Rational(r) => r.is_zero(),
@@ -187,6 +238,7 @@ impl Expr {
         }
     }
 
+    /// True for the number 1.
     pub fn is_one(&self) -> bool {
         match self.node() {
             Node::Rational(r) => r.is_one(),
@@ -195,19 +247,21 @@ impl Expr {
         }
     }
 
+    /// True for a number (rational or float).
     pub fn is_number(&self) -> bool {
         matches!(self.node(), Node::Rational(_) | Node::Float(_))
     }
 
     /// True when the expression contains no symbol (numbers, pi and functions of them).
     pub fn is_constant(&self) -> bool {
-        match self.node() {
+        grow(|| match self.node() {
             Node::Rational(_) | Node::Float(_) | Node::Pi => true,
             Node::Symbol(_) => false,
             Node::Add(v) | Node::Mul(v) => v.iter().all(Expr::is_constant),
             Node::Pow(b, _) => b.is_constant(),
             Node::Func(_, a) => a.is_constant(),
-        }
+            Node::Atan2(y, x) => y.is_constant() && x.is_constant(),
+        })
     }
 
     /// Names of all symbols, sorted and without repetition.
@@ -220,24 +274,32 @@ impl Expr {
     }
 
     fn collect_symbols(&self, out: &mut Vec<String>) {
-        match self.node() {
-            Node::Symbol(s) => out.push(s.clone()),
-            Node::Add(v) | Node::Mul(v) => v.iter().for_each(|e| e.collect_symbols(out)),
-            Node::Pow(b, _) => b.collect_symbols(out),
-            Node::Func(_, a) => a.collect_symbols(out),
+        self.for_each_symbol(&mut |s| out.push(s.to_string()));
+    }
+
+    /// Call `f` on every occurrence of a symbol, left to right.
+    pub fn for_each_symbol(&self, f: &mut dyn FnMut(&str)) {
+        grow(|| match self.node() {
+            Node::Symbol(s) => f(s),
+            Node::Add(v) | Node::Mul(v) => v.iter().for_each(|e| e.for_each_symbol(f)),
+            Node::Pow(b, _) | Node::Func(_, b) => b.for_each_symbol(f),
+            Node::Atan2(y, x) => {
+                y.for_each_symbol(f);
+                x.for_each_symbol(f)
+            }
             _ => {}
-        }
+        })
     }
 
     /// Whether symbol `name` occurs in the expression.
     pub fn depends_on(&self, name: &str) -> bool {
-        match self.node() {
+        grow(|| match self.node() {
             Node::Symbol(s) => s == name,
             Node::Add(v) | Node::Mul(v) => v.iter().any(|e| e.depends_on(name)),
-            Node::Pow(b, _) => b.depends_on(name),
-            Node::Func(_, a) => a.depends_on(name),
+            Node::Pow(b, _) | Node::Func(_, b) => b.depends_on(name),
+            Node::Atan2(y, x) => y.depends_on(name) || x.depends_on(name),
             _ => false,
-        }
+        })
     }
 
     /// Numeric value, with symbol values from `env`.
@@ -251,6 +313,10 @@ impl Expr {
     }
 
     fn eval_inner(&self, env: &dyn Fn(&str) -> Option<f64>) -> Result<f64, EvalError> {
+        grow(|| self.eval_node(env))
+    }
+
+    fn eval_node(&self, env: &dyn Fn(&str) -> Option<f64>) -> Result<f64, EvalError> {
         Ok(match self.node() {
             Node::Rational(r) => r.to_f64().unwrap_or(f64::NAN),
             Node::Float(x) => *x,
@@ -272,19 +338,32 @@ impl Expr {
             }
             Node::Pow(b, n) => b.eval_inner(env)?.powi(*n),
             Node::Func(f, a) => f.apply(a.eval_inner(env)?),
+            Node::Atan2(y, x) => y.eval_inner(env)?.atan2(x.eval_inner(env)?),
         })
     }
 
     /// Replace symbols by expressions (symbols `f` maps to `None` are kept).
     pub fn substitute(&self, f: &dyn Fn(&str) -> Option<Expr>) -> Expr {
-        match self.node() {
-            Node::Symbol(s) => f(s).unwrap_or_else(|| self.clone()),
-            Node::Add(v) => Expr::sum(v.iter().map(|e| e.substitute(f))),
-            Node::Mul(v) => Expr::product(v.iter().map(|e| e.substitute(f))),
-            Node::Pow(b, n) => b.substitute(f).powi(*n),
-            Node::Func(fun, a) => Expr::func(*fun, a.substitute(f)),
+        self.map_children(&|e| e.substitute(f), &|s| f(s))
+    }
+
+    /// Rebuild the expression with `child` applied to every direct sub-expression (through the
+    /// canonicalising constructors) and `leaf` to every symbol (`None` keeps it). The walk of
+    /// the passes that rewrite a tree (substitution, factoring, replacement).
+    pub fn map_children(
+        &self,
+        child: &dyn Fn(&Expr) -> Expr,
+        leaf: &dyn Fn(&str) -> Option<Expr>,
+    ) -> Expr {
+        grow(|| match self.node() {
+            Node::Symbol(s) => leaf(s).unwrap_or_else(|| self.clone()),
+            Node::Add(v) => Expr::sum(v.iter().map(child)),
+            Node::Mul(v) => Expr::product(v.iter().map(child)),
+            Node::Pow(b, n) => child(b).powi(*n),
+            Node::Func(fun, a) => Expr::func(*fun, child(a)),
+            Node::Atan2(y, x) => Expr::atan2(child(y), child(x)),
             _ => self.clone(),
-        }
+        })
     }
 
     /// Sum of terms, canonicalised.
@@ -294,12 +373,26 @@ impl Expr {
         let mut float_constant = 0.0f64;
         let mut has_float = false;
         let mut parts: Vec<(Expr, Coef)> = Vec::new();
-        let push = |e: &Expr, parts: &mut Vec<(Expr, Coef)>| {
+        // like terms: a linear search while the sum is short, an index beyond
+        let mut index: HashMap<Expr, usize> = HashMap::new();
+        let push = |e: &Expr, parts: &mut Vec<(Expr, Coef)>, index: &mut HashMap<Expr, usize>| {
             let (c, rest) = e.split_coefficient();
-            if let Some(slot) = parts.iter_mut().find(|(r, _)| *r == rest) {
-                slot.1 = slot.1.add(c);
+            let found = if parts.len() < LINEAR_SEARCH {
+                parts.iter().position(|(r, _)| *r == rest)
             } else {
-                parts.push((rest, c));
+                if index.is_empty() {
+                    index.extend(parts.iter().enumerate().map(|(i, (r, _))| (r.clone(), i)));
+                }
+                index.get(&rest).copied()
+            };
+            match found {
+                Some(i) => parts[i].1 = parts[i].1.add(c),
+                None => {
+                    if !index.is_empty() || parts.len() + 1 >= LINEAR_SEARCH {
+                        index.insert(rest.clone(), parts.len());
+                    }
+                    parts.push((rest, c));
+                }
             }
         };
         let mut stack: Vec<Expr> = terms.into_iter().collect();
@@ -311,12 +404,30 @@ impl Expr {
                         stack.push(e.clone());
                     }
                 }
-                Node::Rational(r) => constant += *r,
+                // -(a + b) as a term: its terms, negated (free: subtractions)
+                Node::Mul(f)
+                    if f.len() == 2
+                        && f[0].as_rational() == Some(-Rational64::one())
+                        && matches!(f[1].node(), Node::Add(_)) =>
+                {
+                    if let Node::Add(v) = f[1].node() {
+                        for e in v.iter().rev() {
+                            stack.push(-e.clone());
+                        }
+                    }
+                }
+                Node::Rational(r) => match constant.checked_add(r) {
+                    Some(c) => constant = c,
+                    None => {
+                        float_constant += r.to_f64().unwrap_or(f64::NAN);
+                        has_float = true;
+                    }
+                },
                 Node::Float(x) => {
                     float_constant += *x;
                     has_float = true;
                 }
-                _ => push(&t, &mut parts),
+                _ => push(&t, &mut parts, &mut index),
             }
         }
         let mut out: Vec<Expr> = parts
@@ -340,6 +451,10 @@ impl Expr {
         if let Some(n) = num {
             out.insert(0, n);
         }
+        // a sum whose collected coefficient became 1 (`2*(a+b) - (a+b)`) is spliced in
+        if out.iter().any(|t| matches!(t.node(), Node::Add(_))) {
+            return Expr::sum(out);
+        }
         match out.len() {
             0 => Expr::zero(),
             1 => out.pop().unwrap(),
@@ -351,6 +466,7 @@ impl Expr {
     pub fn product(factors: impl IntoIterator<Item = Expr>) -> Expr {
         let mut coef = Coef::Rat(Rational64::one());
         let mut bases: Vec<(Expr, i32)> = Vec::new();
+        let mut index: HashMap<Expr, usize> = HashMap::new();
         let mut stack: Vec<Expr> = factors.into_iter().collect();
         stack.reverse();
         while let Some(f) = stack.pop() {
@@ -367,10 +483,29 @@ impl Expr {
                         Node::Pow(b, n) => (b.clone(), *n),
                         _ => (f.clone(), 1),
                     };
-                    if let Some(slot) = bases.iter_mut().find(|(x, _)| *x == b) {
-                        slot.1 += n;
+                    let found = if bases.len() < LINEAR_SEARCH {
+                        bases.iter().position(|(x, _)| *x == b)
                     } else {
-                        bases.push((b, n));
+                        if index.is_empty() {
+                            index
+                                .extend(bases.iter().enumerate().map(|(i, (x, _))| (x.clone(), i)));
+                        }
+                        index.get(&b).copied()
+                    };
+                    // an exponent that would overflow stays a separate factor
+                    // an exponent beyond MAX_POWER stays a separate factor
+                    let merged = found.and_then(|i| {
+                        let s = bases[i].1.checked_add(n)?;
+                        (s.abs() <= MAX_POWER).then_some((i, s))
+                    });
+                    match merged {
+                        Some((i, s)) => bases[i].1 = s,
+                        None => {
+                            if !index.is_empty() || bases.len() + 1 >= LINEAR_SEARCH {
+                                index.entry(b.clone()).or_insert(bases.len());
+                            }
+                            bases.push((b, n));
+                        }
                     }
                 }
             }
@@ -420,7 +555,11 @@ impl Expr {
                 }
             }
             Node::Float(x) => Expr::num(x.powi(n)),
-            Node::Pow(b, m) => b.powi(m * n),
+            // (x^m)^n = x^(mn) while |mn| <= MAX_POWER, else kept nested
+            Node::Pow(b, m) => match i32::checked_mul(*m, n).filter(|k| k.abs() <= MAX_POWER) {
+                Some(k) => b.powi(k),
+                None => Expr::new(Node::Pow(self.clone(), n)),
+            },
             Node::Mul(v) => Expr::product(v.iter().map(|f| f.powi(n))),
             Node::Func(Func::Sqrt, a) if n % 2 == 0 => a.powi(n / 2),
             _ => Expr::new(Node::Pow(self.clone(), n)),
@@ -506,14 +645,41 @@ impl Expr {
         }
     }
 
+    /// atan2(y, x), with exact values on the axes (y or x zero, the other a rational number) and
+    /// a number when both arguments are floats.
+    pub fn atan2(y: Expr, x: Expr) -> Expr {
+        if let (Node::Float(_), Node::Float(_))
+        | (Node::Float(_), Node::Rational(_))
+        | (Node::Rational(_), Node::Float(_)) = (y.node(), x.node())
+        {
+            if let (Some(a), Some(b)) = (y.as_f64(), x.as_f64()) {
+                return Expr::num(a.atan2(b));
+            }
+        }
+        if let (Some(a), Some(b)) = (y.as_rational(), x.as_rational()) {
+            let half_pi = || Expr::pi() / Expr::int(2);
+            match (a.signum().to_integer(), b.signum().to_integer()) {
+                (0, 1) => return Expr::zero(),
+                (0, -1) => return Expr::pi(),
+                (1, 0) => return half_pi(),
+                (-1, 0) => return -half_pi(),
+                _ => {}
+            }
+        }
+        Expr::new(Node::Atan2(y, x))
+    }
+
+    /// sin of this expression.
     pub fn sin(&self) -> Expr {
         Expr::func(Func::Sin, self.clone())
     }
 
+    /// cos of this expression.
     pub fn cos(&self) -> Expr {
         Expr::func(Func::Cos, self.clone())
     }
 
+    /// Square root of this expression.
     pub fn sqrt(&self) -> Expr {
         Expr::func(Func::Sqrt, self.clone())
     }
@@ -529,7 +695,7 @@ impl Expr {
         }
         match c {
             Coef::Rat(r) => {
-                let twice = r * Rational64::from_integer(2);
+                let twice = r.checked_mul(&Rational64::from_integer(2))?;
                 twice.is_integer().then(|| twice.to_integer())
             }
             Coef::Float(_) => None,
@@ -561,33 +727,27 @@ impl Expr {
     /// Expand products of sums (distributes multiplication over addition, positive integer powers
     /// of sums included).
     pub fn expand(&self) -> Expr {
+        grow(|| self.expand_node())
+    }
+
+    fn expand_node(&self) -> Expr {
         match self.node() {
             Node::Add(v) => Expr::sum(v.iter().map(Expr::expand)),
             Node::Mul(v) => {
-                let mut acc = vec![Expr::one()];
+                let mut acc = Expr::one();
                 for f in v {
-                    let f = f.expand();
-                    let terms: Vec<Expr> = match f.node() {
-                        Node::Add(t) => t.clone(),
-                        _ => vec![f.clone()],
-                    };
-                    acc = acc
-                        .iter()
-                        .flat_map(|a| {
-                            terms
-                                .iter()
-                                .map(move |t| Expr::product([a.clone(), t.clone()]))
-                        })
-                        .collect();
+                    acc = distribute(&acc, &f.expand());
                 }
-                Expr::sum(acc)
+                acc
             }
             Node::Pow(b, n) if *n > 1 => {
                 let b = b.expand();
                 if matches!(b.node(), Node::Add(_)) {
-                    let mut r = Expr::one();
-                    for _ in 0..*n {
-                        r = Expr::product([r, b.clone()]).expand();
+                    // multiplied out term by term: a product of equal sums would fold back
+                    // into the power
+                    let mut r = b.clone();
+                    for _ in 1..*n {
+                        r = distribute(&r, &b);
                     }
                     r
                 } else {
@@ -595,10 +755,35 @@ impl Expr {
                 }
             }
             Node::Func(f, a) => Expr::func(*f, a.expand()),
+            Node::Atan2(y, x) => Expr::atan2(y.expand(), x.expand()),
             _ => self.clone(),
         }
     }
 }
+
+/// The product of two expanded expressions, multiplied out: the sum of the products of their
+/// terms.
+fn distribute(a: &Expr, b: &Expr) -> Expr {
+    let terms = |e: &Expr| -> Vec<Expr> {
+        match e.node() {
+            Node::Add(t) => t.clone(),
+            _ => vec![e.clone()],
+        }
+    };
+    let (ta, tb) = (terms(a), terms(b));
+    Expr::sum(ta.iter().flat_map(|x| {
+        tb.iter()
+            .map(move |y| Expr::product([x.clone(), y.clone()]))
+    }))
+}
+
+/// Largest exponent (in absolute value) a power merges to: `x^40*x^40` stays two factors and
+/// `(x^40)^2` a power of a power, so that what prints reads back (the parser takes written
+/// exponents up to this bound).
+pub const MAX_POWER: i32 = 64;
+
+/// Below this many terms (factors), a sum (product) finds like terms by a linear search.
+const LINEAR_SEARCH: usize = 16;
 
 /// Numeric coefficient of a term: exact when possible.
 #[derive(Clone, Copy, Debug)]
@@ -628,7 +813,10 @@ impl Coef {
     }
     fn neg(self) -> Coef {
         match self {
-            Coef::Rat(r) => Coef::Rat(-r),
+            Coef::Rat(r) => match r.numer().checked_neg() {
+                Some(n) => Coef::Rat(Rational64::new_raw(n, *r.denom())),
+                None => Coef::Float(-r.to_f64().unwrap_or(f64::NAN)),
+            },
             Coef::Float(x) => Coef::Float(-x),
         }
     }
@@ -700,7 +888,7 @@ fn isqrt(n: i64) -> Option<i64> {
         return None;
     }
     let s = (n as f64).sqrt().round() as i64;
-    (s * s == n).then_some(s)
+    (s.checked_mul(s) == Some(n)).then_some(s)
 }
 
 /// Exact rational for integers and decimals with few digits (as read from files).
@@ -740,18 +928,29 @@ fn kind_rank(e: &Expr) -> u8 {
         Node::Pow(..) => 3,
         Node::Mul(_) => 4,
         Node::Func(..) => 5,
-        Node::Add(_) => 6,
+        Node::Atan2(..) => 6,
+        Node::Add(_) => 7,
     }
 }
 
 /// Total structural order, used for canonical ordering of sums and products.
 pub fn cmp_expr(a: &Expr, b: &Expr) -> Ordering {
+    if Arc::ptr_eq(&a.0, &b.0) {
+        return Ordering::Equal;
+    }
+    grow(|| cmp_nodes(a, b))
+}
+
+fn cmp_nodes(a: &Expr, b: &Expr) -> Ordering {
     match (a.node(), b.node()) {
         (Node::Rational(x), Node::Rational(y)) => x.cmp(y),
         (Node::Float(x), Node::Float(y)) => x.total_cmp(y),
         (Node::Symbol(x), Node::Symbol(y)) => natural_cmp(x, y),
         (Node::Pow(b1, n1), Node::Pow(b2, n2)) => cmp_expr(b1, b2).then(n1.cmp(n2)),
         (Node::Func(f1, a1), Node::Func(f2, a2)) => cmp_expr(a1, a2).then(f1.cmp(f2)),
+        (Node::Atan2(y1, x1), Node::Atan2(y2, x2)) => {
+            cmp_expr(y1, y2).then_with(|| cmp_expr(x1, x2))
+        }
         (Node::Add(x), Node::Add(y)) | (Node::Mul(x), Node::Mul(y)) => {
             for (p, q) in x.iter().zip(y) {
                 let o = cmp_expr(p, q);
@@ -797,13 +996,13 @@ fn cmp_terms(a: &Expr, b: &Expr) -> Ordering {
 
 /// Compare names so that `M2 < M10` and `XX1 < XX2`.
 fn natural_cmp(a: &str, b: &str) -> Ordering {
-    let split = |s: &str| {
+    fn split(s: &str) -> (&[u8], Option<u64>) {
         let i = s.trim_end_matches(|c: char| c.is_ascii_digit()).len();
-        (s[..i].to_string(), s[i..].parse::<u64>().ok())
-    };
+        (&s.as_bytes()[..i], s[i..].parse::<u64>().ok())
+    }
     let (pa, na) = split(a);
     let (pb, nb) = split(b);
-    pa.cmp(&pb).then(na.cmp(&nb)).then(a.cmp(b))
+    pa.cmp(pb).then(na.cmp(&nb)).then(a.cmp(b))
 }
 
 impl std::ops::Add for Expr {
@@ -923,32 +1122,94 @@ impl num_traits::One for Expr {
 }
 
 /// Structural hash (floats by their bits), consistent with `PartialEq` for non-NaN values; used
-/// by the program builder for common-subexpression sharing.
+/// by the program builder for common-subexpression sharing. Memoized: O(1).
 impl std::hash::Hash for Expr {
     fn hash<H: std::hash::Hasher>(&self, h: &mut H) {
-        self.node().hash(h)
+        h.write_u64(self.0.hash)
+    }
+}
+
+/// Structural equality; shared nodes and different memoized hashes answer at once.
+impl PartialEq for Expr {
+    fn eq(&self, o: &Expr) -> bool {
+        Arc::ptr_eq(&self.0, &o.0)
+            || (self.0.hash == o.0.hash
+                && self.0.depth == o.0.depth
+                && grow(|| self.0.node == o.0.node))
     }
 }
 
 impl Eq for Expr {}
 
-impl std::hash::Hash for Node {
-    fn hash<H: std::hash::Hasher>(&self, h: &mut H) {
-        std::mem::discriminant(self).hash(h);
-        match self {
-            Node::Rational(r) => r.hash(h),
-            // -0.0 == 0.0: hash them alike
-            Node::Float(x) => (if *x == 0.0 { 0.0f64 } else { *x }).to_bits().hash(h),
-            Node::Pi => {}
-            Node::Symbol(s) => s.hash(h),
-            Node::Add(v) | Node::Mul(v) => v.hash(h),
-            Node::Pow(b, n) => {
-                b.hash(h);
-                n.hash(h)
+/// The memoized hash and depth of a new node, from its children's.
+fn node_hash_depth(node: &Node) -> (u64, u32) {
+    use std::hash::{Hash, Hasher};
+    let mut h = std::hash::DefaultHasher::new();
+    std::mem::discriminant(node).hash(&mut h);
+    let mut depth = 0u32;
+    let mut child = |e: &Expr, h: &mut std::hash::DefaultHasher| {
+        h.write_u64(e.0.hash);
+        depth = depth.max(e.0.depth);
+    };
+    match node {
+        Node::Rational(r) => r.hash(&mut h),
+        // -0.0 == 0.0: hash them alike
+        Node::Float(x) => (if *x == 0.0 { 0.0f64 } else { *x }).to_bits().hash(&mut h),
+        Node::Pi => {}
+        Node::Symbol(s) => s.hash(&mut h),
+        Node::Add(v) | Node::Mul(v) => {
+            v.len().hash(&mut h);
+            v.iter().for_each(|e| child(e, &mut h));
+        }
+        Node::Pow(b, n) => {
+            child(b, &mut h);
+            n.hash(&mut h)
+        }
+        Node::Func(f, a) => {
+            f.hash(&mut h);
+            child(a, &mut h)
+        }
+        Node::Atan2(y, x) => {
+            child(y, &mut h);
+            child(x, &mut h)
+        }
+    }
+    (h.finish(), depth.saturating_add(1))
+}
+
+/// Trees shallower than this are dropped by the compiler's (recursive) drop glue.
+const SHALLOW: u32 = 64;
+
+/// Deep trees are taken apart iteratively: the last owner of a node moves its children onto a
+/// work list before the node goes, so dropping never recurses deeper than `SHALLOW` (64) levels.
+impl Drop for Expr {
+    fn drop(&mut self) {
+        if self.0.depth < SHALLOW {
+            return;
+        }
+        let mut work: Vec<Node> = Vec::new();
+        let take = |e: &mut Expr, work: &mut Vec<Node>| {
+            if e.0.depth >= SHALLOW {
+                if let Some(inner) = Arc::get_mut(&mut e.0) {
+                    work.push(std::mem::replace(&mut inner.node, Node::Pi));
+                    inner.depth = 1;
+                }
             }
-            Node::Func(f, a) => {
-                f.hash(h);
-                a.hash(h)
+        };
+        take(self, &mut work);
+        while let Some(node) = work.pop() {
+            match node {
+                Node::Add(v) | Node::Mul(v) => {
+                    for mut e in v {
+                        take(&mut e, &mut work);
+                    }
+                }
+                Node::Pow(mut b, _) | Node::Func(_, mut b) => take(&mut b, &mut work),
+                Node::Atan2(mut y, mut x) => {
+                    take(&mut y, &mut work);
+                    take(&mut x, &mut work);
+                }
+                _ => {}
             }
         }
     }

@@ -4,8 +4,11 @@
 //! exact rational constants, `pi`, `sin`/`cos`, canonicalising constructors that fold trivial
 //! algebra on construction, expansion, substitution, numeric evaluation, parsing and printing.
 
+#![warn(missing_docs)]
+
 pub mod emit;
 mod expr;
+mod optimize;
 mod parse;
 mod print;
 pub mod program;

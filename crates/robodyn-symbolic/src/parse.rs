@@ -1,13 +1,24 @@
 //! Parser for the expressions found in robot files: numbers, symbols, `pi`, `+ - * / ^ **`,
-//! parentheses and the functions `sin cos tan sqrt abs sign`.
+//! parentheses, the functions `sin cos tan sqrt abs sign` and `atan2(y, x)`.
+//!
+//! Nesting (parentheses, function calls, signs, exponents) is limited to [`MAX_DEPTH`] levels:
+//! the parser is recursive descent, and a file must not be able to exhaust its stack.
 
-use crate::expr::{Expr, Func};
+use crate::expr::{Expr, Func, Node};
+
+/// Deepest nesting of parentheses, function calls, unary signs and exponents accepted.
+pub const MAX_DEPTH: usize = 200;
+
+/// Largest exponent (in absolute value) written in an expression (`x^64`).
+pub const MAX_EXPONENT: i32 = crate::expr::MAX_POWER;
 
 /// A parse error with the byte offset (0-based) of the offending character in the input.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error("column {}: {message}", .offset + 1)]
 pub struct ParseError {
+    /// Byte offset of the offending character.
     pub offset: usize,
+    /// What is wrong.
     pub message: String,
 }
 
@@ -17,6 +28,7 @@ impl Expr {
         let mut p = Parser {
             s: text.as_bytes(),
             pos: 0,
+            depth: 0,
         };
         p.skip_ws();
         if p.pos >= p.s.len() {
@@ -27,13 +39,34 @@ impl Expr {
         if p.pos < p.s.len() {
             return Err(p.err(&format!("unexpected `{}`", p.s[p.pos] as char)));
         }
+        if has_non_finite(&e) {
+            return Err(ParseError {
+                offset: 0,
+                message: "the expression is infinite or undefined (a division by zero, \
+                          tan(pi/2)...)"
+                    .into(),
+            });
+        }
         Ok(e)
     }
+}
+
+/// Whether a number of the expression is infinite or NaN.
+fn has_non_finite(e: &Expr) -> bool {
+    crate::expr::grow(|| match e.node() {
+        Node::Float(x) => !x.is_finite(),
+        Node::Add(v) | Node::Mul(v) => v.iter().any(has_non_finite),
+        Node::Pow(b, _) | Node::Func(_, b) => has_non_finite(b),
+        Node::Atan2(y, x) => has_non_finite(y) || has_non_finite(x),
+        _ => false,
+    })
 }
 
 struct Parser<'a> {
     s: &'a [u8],
     pos: usize,
+    /// Current nesting depth (see [`MAX_DEPTH`]).
+    depth: usize,
 }
 
 impl Parser<'_> {
@@ -99,7 +132,21 @@ impl Parser<'_> {
         Ok(acc)
     }
 
+    /// Every recursion of the grammar goes through here: the nesting depth is counted once.
     fn unary(&mut self) -> Result<Expr, ParseError> {
+        if self.depth >= MAX_DEPTH {
+            return Err(self.err(&format!(
+                "the expression is nested more than {MAX_DEPTH} levels deep (parentheses, \
+                 functions, signs or exponents)"
+            )));
+        }
+        self.depth += 1;
+        let e = self.unary_inner();
+        self.depth -= 1;
+        e
+    }
+
+    fn unary_inner(&mut self) -> Result<Expr, ParseError> {
         match self.peek() {
             Some(b'-') => {
                 self.pos += 1;
@@ -132,11 +179,16 @@ impl Parser<'_> {
         let at = self.pos;
         let exp = self.unary()?;
         match exp.as_rational() {
-            Some(r) if r.is_integer() && r.numer().abs() <= 64 => Ok(base.powi(*r.numer() as i32)),
+            Some(r) if r.is_integer() && r.numer().abs() <= MAX_EXPONENT as i64 => {
+                Ok(base.powi(*r.numer() as i32))
+            }
             Some(r) if *r.denom() == 2 && *r.numer() == 1 => Ok(base.sqrt()),
             _ => Err(ParseError {
                 offset: at,
-                message: "only integer exponents (or 1/2) are supported".into(),
+                message: format!(
+                    "only integer exponents from -{MAX_EXPONENT} to {MAX_EXPONENT} (or 1/2) are \
+                     supported"
+                ),
             }),
         }
     }
@@ -167,6 +219,20 @@ impl Parser<'_> {
             }
             let name = std::str::from_utf8(&self.s[start..self.pos]).unwrap_or("");
             if self.peek() == Some(b'(') {
+                if name.eq_ignore_ascii_case("atan2") {
+                    self.pos += 1;
+                    let y = self.sum()?;
+                    if self.peek() != Some(b',') {
+                        return Err(self.err("expected `,` between the arguments of atan2(y, x)"));
+                    }
+                    self.pos += 1;
+                    let x = self.sum()?;
+                    if self.peek() != Some(b')') {
+                        return Err(self.err("expected `)`"));
+                    }
+                    self.pos += 1;
+                    return Ok(Expr::atan2(y, x));
+                }
                 let f = Func::from_name(name).ok_or(ParseError {
                     offset: start,
                     message: format!("unknown function `{name}`"),
@@ -208,9 +274,22 @@ impl Parser<'_> {
         }
         let text = std::str::from_utf8(&s[start..i]).unwrap_or("");
         self.pos = i;
-        text.parse::<f64>().map(Expr::num).map_err(|_| ParseError {
-            offset: start,
-            message: format!("bad number `{text}`"),
-        })
+        // an integer literal is exact (`1234440111544321` is not rounded to a float)
+        if text.bytes().all(|c| c.is_ascii_digit()) {
+            if let Ok(n) = text.parse::<i64>() {
+                return Ok(Expr::int(n));
+            }
+        }
+        match text.parse::<f64>() {
+            Ok(x) if x.is_finite() => Ok(Expr::num(x)),
+            Ok(_) => Err(ParseError {
+                offset: start,
+                message: format!("number `{text}` is not a finite number (out of range)"),
+            }),
+            Err(_) => Err(ParseError {
+                offset: start,
+                message: format!("bad number `{text}`"),
+            }),
+        }
     }
 }

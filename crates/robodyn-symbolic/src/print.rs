@@ -1,6 +1,6 @@
 //! Plain-text printing of expressions (`d3^2*(M3 + M4) - MX8/d3`), with minimal parentheses.
 
-use crate::expr::{Expr, Node};
+use crate::expr::{grow, Expr, Node};
 use num_rational::Rational64;
 use num_traits::{One, Signed};
 use std::fmt;
@@ -32,13 +32,19 @@ fn write_rational(f: &mut fmt::Formatter<'_>, r: &Rational64, prec: u8) -> fmt::
 }
 
 fn write_expr(f: &mut fmt::Formatter<'_>, e: &Expr, prec: u8) -> fmt::Result {
+    grow(|| write_node(f, e, prec))
+}
+
+fn write_node(f: &mut fmt::Formatter<'_>, e: &Expr, prec: u8) -> fmt::Result {
     match e.node() {
         Node::Rational(r) => write_rational(f, r, prec),
+        // Debug format: shortest digits that read back to the same float, always with a `.` or
+        // an exponent, so that the parser reads it back as a float (not an exact integer)
         Node::Float(x) => {
             if *x < 0.0 && prec > PREC_SUM {
-                write!(f, "({x})")
+                write!(f, "({x:?})")
             } else {
-                write!(f, "{x}")
+                write!(f, "{x:?}")
             }
         }
         Node::Pi => write!(f, "pi"),
@@ -54,7 +60,14 @@ fn write_expr(f: &mut fmt::Formatter<'_>, e: &Expr, prec: u8) -> fmt::Result {
                     // a leading product with a negative coefficient prints its own minus sign
                 } else if negative {
                     write!(f, " - ")?;
-                    write_expr(f, &-t.clone(), PREC_SUM)?;
+                    let neg = -t.clone();
+                    // a negated sum keeps its parentheses: a - (b + c)
+                    let prec = if matches!(neg.node(), Node::Add(_)) {
+                        PREC_PRODUCT
+                    } else {
+                        PREC_SUM
+                    };
+                    write_expr(f, &neg, prec)?;
                 } else {
                     write!(f, " + ")?;
                     write_expr(f, t, PREC_SUM)?;
@@ -69,6 +82,13 @@ fn write_expr(f: &mut fmt::Formatter<'_>, e: &Expr, prec: u8) -> fmt::Result {
         Node::Func(func, a) => {
             write!(f, "{}(", func.name())?;
             write_expr(f, a, PREC_SUM)?;
+            write!(f, ")")
+        }
+        Node::Atan2(y, x) => {
+            write!(f, "atan2(")?;
+            write_expr(f, y, PREC_SUM)?;
+            write!(f, ", ")?;
+            write_expr(f, x, PREC_SUM)?;
             write!(f, ")")
         }
     }
@@ -110,8 +130,17 @@ pub(crate) fn product_parts(e: &Expr) -> (Option<Expr>, Vec<Expr>, Vec<Expr>) {
 fn write_product(f: &mut fmt::Formatter<'_>, e: &Expr, prec: u8) -> fmt::Result {
     if let Node::Pow(b, n) = e.node() {
         if *n > 0 {
+            // a power as the base of a power keeps its parentheses: (x^40)^2
+            let wrap = prec > PREC_POWER;
+            if wrap {
+                write!(f, "(")?;
+            }
             write_expr(f, b, PREC_POWER + 1)?;
-            return write!(f, "^{n}");
+            write!(f, "^{n}")?;
+            if wrap {
+                write!(f, ")")?;
+            }
+            return Ok(());
         }
     }
     let (coef, num, den) = product_parts(e);

@@ -16,7 +16,9 @@ use std::collections::{HashMap, HashSet};
 /// One assignment `name = expr`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Assignment {
+    /// The name assigned.
     pub name: String,
+    /// Its value.
     pub expr: Expr,
 }
 
@@ -38,7 +40,9 @@ pub struct Program {
     pub name: String,
     /// Header lines (what the model is, its options).
     pub description: Vec<String>,
+    /// Input arrays, in argument order.
     pub inputs: Vec<InputGroup>,
+    /// Intermediate values, in evaluation order.
     pub assignments: Vec<Assignment>,
     /// Outputs, written to the output array in this order.
     pub outputs: Vec<Assignment>,
@@ -48,8 +52,11 @@ pub struct Program {
 /// elementary function calls (sin, cos, sign, sqrt; not counted as multiplications).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct OpCount {
+    /// Multiplications and divisions.
     pub mul: usize,
+    /// Additions and subtractions.
     pub add: usize,
+    /// Elementary function calls.
     pub func: usize,
 }
 
@@ -87,6 +94,10 @@ pub fn count_ops(e: &Expr) -> OpCount {
 }
 
 fn count_into(e: &Expr, c: &mut OpCount) {
+    crate::expr::grow(|| count_node(e, c))
+}
+
+fn count_node(e: &Expr, c: &mut OpCount) {
     match e.node() {
         Node::Rational(_) | Node::Float(_) | Node::Pi | Node::Symbol(_) => {}
         Node::Add(v) => {
@@ -137,6 +148,11 @@ fn count_into(e: &Expr, c: &mut OpCount) {
         Node::Func(_, a) => {
             c.func += 1;
             count_into(a, c);
+        }
+        Node::Atan2(y, x) => {
+            c.func += 1;
+            count_into(y, c);
+            count_into(x, c);
         }
     }
 }
@@ -283,166 +299,6 @@ pub fn name_trig(e: Expr) -> Expr {
     }
 }
 
-/// Replace every occurrence of `target` (as a whole node, as a sub-product of a product's
-/// factors or as a sub-sum of a sum's terms) by `by`.
-fn replace(e: &Expr, target: &Expr, by: &Expr) -> Expr {
-    if e == target {
-        return by.clone();
-    }
-    match e.node() {
-        Node::Add(v) => {
-            let mut terms: Vec<Expr> = v.iter().map(|t| replace(t, target, by)).collect();
-            if let Node::Add(tt) = target.node() {
-                if contains_all(&terms, tt) {
-                    remove_all(&mut terms, tt);
-                    terms.push(by.clone());
-                }
-            }
-            Expr::sum(terms)
-        }
-        Node::Mul(v) => {
-            let mut fs: Vec<Expr> = v.iter().map(|t| replace(t, target, by)).collect();
-            if let Node::Mul(tt) = target.node() {
-                if !tt[0].is_number() && contains_all(&fs, tt) {
-                    remove_all(&mut fs, tt);
-                    fs.push(by.clone());
-                }
-            }
-            Expr::product(fs)
-        }
-        Node::Pow(b, n) => replace(b, target, by).powi(*n),
-        Node::Func(f, a) => Expr::func(*f, replace(a, target, by)),
-        _ => e.clone(),
-    }
-}
-
-fn contains_all(hay: &[Expr], needles: &[Expr]) -> bool {
-    let mut used = vec![false; hay.len()];
-    needles.iter().all(
-        |n| match hay.iter().enumerate().position(|(i, h)| !used[i] && h == n) {
-            Some(i) => {
-                used[i] = true;
-                true
-            }
-            None => false,
-        },
-    )
-}
-
-fn remove_all(hay: &mut Vec<Expr>, needles: &[Expr]) {
-    for n in needles {
-        if let Some(i) = hay.iter().position(|h| h == n) {
-            hay.remove(i);
-        }
-    }
-}
-
-/// Does symbol `name` occur in `e`?
-fn uses(e: &Expr, name: &str) -> usize {
-    match e.node() {
-        Node::Symbol(s) => usize::from(s == name),
-        Node::Add(v) | Node::Mul(v) => v.iter().map(|t| uses(t, name)).sum(),
-        Node::Pow(b, _) => uses(b, name),
-        Node::Func(_, a) => uses(a, name),
-        _ => 0,
-    }
-}
-
-fn symbol_uses(e: &Expr, out: &mut HashMap<String, usize>) {
-    match e.node() {
-        Node::Symbol(s) => *out.entry(s.clone()).or_default() += 1,
-        Node::Add(v) | Node::Mul(v) => v.iter().for_each(|t| symbol_uses(t, out)),
-        Node::Pow(b, _) => symbol_uses(b, out),
-        Node::Func(_, a) => symbol_uses(a, out),
-        _ => {}
-    }
-}
-
-/// Candidate common subexpressions: whole sub-nodes and pairs of factors / terms.
-fn collect_candidates(e: &Expr, root: bool, out: &mut HashMap<Expr, usize>) {
-    match e.node() {
-        Node::Add(v) | Node::Mul(v) => {
-            if !root {
-                *out.entry(e.clone()).or_default() += 1;
-            }
-            let is_mul = matches!(e.node(), Node::Mul(_));
-            let items: Vec<&Expr> = v.iter().filter(|t| !(is_mul && t.is_number())).collect();
-            if items.len() > 2 {
-                for a in 0..items.len() {
-                    for b in a + 1..items.len() {
-                        let pair = if is_mul {
-                            Expr::product([items[a].clone(), items[b].clone()])
-                        } else {
-                            Expr::sum([items[a].clone(), items[b].clone()])
-                        };
-                        *out.entry(pair).or_default() += 1;
-                    }
-                }
-            }
-            v.iter().for_each(|t| collect_candidates(t, false, out));
-        }
-        Node::Pow(b, n) => {
-            if !root && *n > 1 {
-                *out.entry(e.clone()).or_default() += 1;
-            }
-            collect_candidates(b, false, out)
-        }
-        Node::Func(_, a) => {
-            if !root {
-                *out.entry(e.clone()).or_default() += 1;
-            }
-            collect_candidates(a, false, out)
-        }
-        _ => {}
-    }
-}
-
-/// Recursive greedy factoring of symbols common to terms of sums (see [`Program::factor_sums`]).
-fn factor(e: &Expr) -> Expr {
-    match e.node() {
-        Node::Add(v) => {
-            let terms: Vec<Expr> = v.iter().map(factor).collect();
-            // symbol factors of each term
-            let mut freq: HashMap<Expr, usize> = HashMap::new();
-            for t in &terms {
-                if let Node::Mul(fs) = t.node() {
-                    let mut seen: Vec<&Expr> = Vec::new();
-                    for f in fs {
-                        if matches!(f.node(), Node::Symbol(_)) && !seen.contains(&f) {
-                            seen.push(f);
-                            *freq.entry(f.clone()).or_default() += 1;
-                        }
-                    }
-                }
-            }
-            let best = freq
-                .into_iter()
-                .filter(|(_, n)| *n >= 2)
-                .max_by(|a, b| a.1.cmp(&b.1).then_with(|| crate::cmp_expr(&b.0, &a.0)));
-            let Some((f, _)) = best else {
-                return Expr::sum(terms);
-            };
-            let mut inner = Vec::new();
-            let mut rest = Vec::new();
-            for t in terms {
-                let has = matches!(t.node(), Node::Mul(fs) if fs.contains(&f));
-                if has {
-                    inner.push(t / f.clone());
-                } else {
-                    rest.push(t);
-                }
-            }
-            let factored = Expr::product([f, factor(&Expr::sum(inner))]);
-            rest.push(factored);
-            Expr::sum(rest)
-        }
-        Node::Mul(v) => Expr::product(v.iter().map(factor)),
-        Node::Pow(b, n) => factor(b).powi(*n),
-        Node::Func(f, a) => Expr::func(*f, factor(a)),
-        _ => e.clone(),
-    }
-}
-
 impl Program {
     /// Total operations of the assignments and outputs.
     pub fn count(&self) -> OpCount {
@@ -475,278 +331,6 @@ impl Program {
             .iter()
             .map(|o| o.expr.eval(&|s| vals.get(s).copied().or_else(|| env(s))))
             .collect()
-    }
-
-    /// Remove assignments no output depends on.
-    pub fn remove_dead(&mut self) {
-        let mut live: HashSet<String> = HashSet::new();
-        let add = |e: &Expr, live: &mut HashSet<String>| {
-            for s in e.symbols() {
-                live.insert(s);
-            }
-        };
-        for o in &self.outputs {
-            add(&o.expr, &mut live);
-        }
-        let mut keep = vec![false; self.assignments.len()];
-        for (i, a) in self.assignments.iter().enumerate().rev() {
-            if live.contains(&a.name) {
-                keep[i] = true;
-                add(&a.expr, &mut live);
-            }
-        }
-        let mut k = keep.into_iter();
-        self.assignments.retain(|_| k.next().unwrap());
-    }
-
-    /// Replace assignments whose value is trivial (a symbol, a number, a negated symbol) by
-    /// their value where they are used.
-    pub fn remove_aliases(&mut self) {
-        let mut map: HashMap<String, Expr> = HashMap::new();
-        let mut out = Vec::with_capacity(self.assignments.len());
-        for a in self.assignments.drain(..) {
-            let e = if map.is_empty() {
-                a.expr
-            } else {
-                a.expr.substitute(&|s| map.get(s).cloned())
-            };
-            if is_trivial(&e) {
-                map.insert(a.name, e);
-            } else {
-                out.push(Assignment {
-                    name: a.name,
-                    expr: e,
-                });
-            }
-        }
-        self.assignments = out;
-        if !map.is_empty() {
-            for o in &mut self.outputs {
-                o.expr = o.expr.substitute(&|s| map.get(s).cloned());
-            }
-        }
-    }
-
-    /// Where `name` is used: the first assignment using it, else the first output (`true`).
-    fn user_of(&self, name: &str) -> Option<(bool, usize)> {
-        let find = |v: &[Assignment]| v.iter().position(|a| uses(&a.expr, name) > 0);
-        find(&self.assignments)
-            .map(|k| (false, k))
-            .or_else(|| find(&self.outputs).map(|k| (true, k)))
-    }
-
-    fn slot_mut(&mut self, (is_out, k): (bool, usize)) -> &mut Assignment {
-        if is_out {
-            &mut self.outputs[k]
-        } else {
-            &mut self.assignments[k]
-        }
-    }
-
-    fn count_uses(&self) -> HashMap<String, usize> {
-        let mut uses_count = HashMap::new();
-        for a in self.assignments.iter().chain(&self.outputs) {
-            symbol_uses(&a.expr, &mut uses_count);
-        }
-        uses_count
-    }
-
-    /// Inline assignments used exactly once when that lowers the operation count (constants
-    /// fold, like terms merge), or when the single user is a plain copy of it (`GAMCL4 = GAM4`).
-    /// One step further too: when the user is itself an assignment used once, inlining both into
-    /// its user may pay (terms cancel: `GAMCL2 = N32 - N33`, `N32 = NDI33 + No32`,
-    /// `NDI33 = N33 + ...`).
-    pub fn inline_single_use(&mut self) {
-        let mut uses_count = self.count_uses();
-        let mut i = 0;
-        while i < self.assignments.len() {
-            let name = self.assignments[i].name.clone();
-            let user = (uses_count.get(&name) == Some(&1))
-                .then(|| self.user_of(&name))
-                .flatten();
-            let Some(user) = user else {
-                i += 1;
-                continue;
-            };
-            let def = self.assignments[i].expr.clone();
-            let slot = self.slot_mut(user);
-            let before = count_ops(&slot.expr) + count_ops(&def);
-            let after_expr = slot.expr.substitute(&|s| (s == name).then(|| def.clone()));
-            let after = count_ops(&after_expr);
-            let copy = slot.expr.as_symbol() == Some(name.as_str());
-            if copy || after.mul + after.add < before.mul + before.add {
-                slot.expr = after_expr;
-                self.assignments.remove(i);
-                uses_count = self.count_uses();
-                continue;
-            }
-            if let (false, k) = user {
-                let uname = self.assignments[k].name.clone();
-                let user2 = (uses_count.get(&uname) == Some(&1))
-                    .then(|| self.user_of(&uname))
-                    .flatten();
-                if let Some(user2) = user2 {
-                    let slot2 = self.slot_mut(user2);
-                    let before2 = before + count_ops(&slot2.expr);
-                    let after2_expr = slot2
-                        .expr
-                        .substitute(&|s| (s == uname).then(|| after_expr.clone()));
-                    let after2 = count_ops(&after2_expr);
-                    if after2.mul + after2.add < before2.mul + before2.add {
-                        slot2.expr = after2_expr;
-                        // remove the user (k) and the definition (i)
-                        self.assignments.remove(i.max(k));
-                        self.assignments.remove(i.min(k));
-                        uses_count = self.count_uses();
-                        i = i.min(k);
-                        continue;
-                    }
-                }
-            }
-            i += 1;
-        }
-    }
-
-    /// Share common subexpressions (whole sub-nodes, pairs of factors of products and pairs of
-    /// terms of sums) greedily, the largest saving first, as new assignments `T1, T2, ...`.
-    pub fn share_common_subexpressions(&mut self) {
-        let reserved: HashSet<String> = self
-            .assignments
-            .iter()
-            .chain(&self.outputs)
-            .map(|a| a.name.clone())
-            .chain(self.input_symbols())
-            .collect();
-        let mut counter = 0;
-        // targets already extracted: never extracted twice (guards against a candidate whose
-        // occurrences do not all match as counted)
-        let mut done: HashSet<Expr> = HashSet::new();
-        loop {
-            let mut cands: HashMap<Expr, usize> = HashMap::new();
-            for a in self.assignments.iter().chain(&self.outputs) {
-                collect_candidates(&a.expr, true, &mut cands);
-                // roots also count as occurrences
-                if !is_trivial(&a.expr) {
-                    *cands.entry(a.expr.clone()).or_default() += 1;
-                }
-            }
-            let best = cands
-                .into_iter()
-                .filter(|(e, n)| *n >= 2 && !done.contains(e))
-                .map(|(e, n)| {
-                    let c = count_ops(&e);
-                    let saving = (n - 1) * (c.mul + c.add + c.func);
-                    (saving, e)
-                })
-                .filter(|(s, _)| *s > 0)
-                .max_by(|a, b| {
-                    // deterministic choice among equal savings (never the hash order)
-                    a.0.cmp(&b.0)
-                        .then_with(|| crate::cmp_expr(&b.1, &a.1))
-                        .then_with(|| b.1.to_string().cmp(&a.1.to_string()))
-                });
-            let Some((_, target)) = best else { break };
-            done.insert(target.clone());
-            let name = loop {
-                counter += 1;
-                let n = format!("T{counter}");
-                if !reserved.contains(&n) {
-                    break n;
-                }
-            };
-            let sym = Expr::symbol(name.clone());
-            let mut first_use = None;
-            let mut changed = false;
-            for (k, a) in self.assignments.iter_mut().enumerate() {
-                let r = replace(&a.expr, &target, &sym);
-                if r != a.expr {
-                    changed = true;
-                    if first_use.is_none() {
-                        first_use = Some(k);
-                    }
-                    a.expr = r;
-                }
-            }
-            for o in &mut self.outputs {
-                let r = replace(&o.expr, &target, &sym);
-                if r != o.expr {
-                    changed = true;
-                    o.expr = r;
-                }
-            }
-            if !changed {
-                // the candidate did not match as counted (canonical re-ordering); stop here
-                break;
-            }
-            let at = first_use.unwrap_or(self.assignments.len());
-            self.assignments
-                .insert(at, Assignment { name, expr: target });
-            // an assignment whose value became exactly T: alias
-            self.remove_aliases();
-        }
-    }
-
-    /// Factor a symbol common to several terms of a sum: `a*x + b*x + c` -> `x*(a + b) + c`
-    /// (saves one multiplication per extra term), greedily, the most frequent factor first.
-    pub fn factor_sums(&mut self) {
-        for a in self.assignments.iter_mut().chain(self.outputs.iter_mut()) {
-            a.expr = factor(&a.expr);
-        }
-    }
-
-    /// All passes: dead assignments, aliases, single-use inlining, then the better (fewer
-    /// operations) of common-subexpression sharing alone or after factoring sums.
-    pub fn optimize(&mut self) {
-        self.remove_dead();
-        self.remove_aliases();
-        self.inline_single_use();
-        let mut factored = self.clone();
-        self.share_common_subexpressions();
-        self.inline_single_use();
-        self.remove_dead();
-        factored.factor_sums();
-        factored.share_common_subexpressions();
-        factored.inline_single_use();
-        factored.remove_dead();
-        let (a, b) = (self.count(), factored.count());
-        if b.mul + b.add < a.mul + a.add {
-            *self = factored;
-        }
-        self.name_outputs();
-    }
-
-    /// An output that is a copy of an intermediate (`W3_1 = X2_1`, `QDP2 = X2`) gives that
-    /// intermediate its own name, so that the equations read `W3_1 = ...` once. Inputs, and
-    /// intermediates copied by several outputs beyond the first, keep theirs. No operation changes.
-    pub fn name_outputs(&mut self) {
-        let taken: HashSet<String> = self
-            .input_symbols()
-            .into_iter()
-            .chain(self.assignments.iter().map(|a| a.name.clone()))
-            .collect();
-        let mut map: HashMap<String, Expr> = HashMap::new();
-        for o in &self.outputs {
-            let Some(s) = o.expr.as_symbol() else {
-                continue;
-            };
-            let is_assignment = self.assignments.iter().any(|a| a.name == s);
-            if is_assignment && !map.contains_key(s) && !taken.contains(&o.name) {
-                map.insert(s.to_string(), Expr::symbol(o.name.clone()));
-            }
-        }
-        if map.is_empty() {
-            return;
-        }
-        let rename = |e: &Expr| e.substitute(&|s| map.get(s).cloned());
-        for a in &mut self.assignments {
-            if let Some(n) = map.get(&a.name).and_then(Expr::as_symbol) {
-                a.name = n.to_string();
-            }
-            a.expr = rename(&a.expr);
-        }
-        for o in &mut self.outputs {
-            o.expr = rename(&o.expr);
-        }
     }
 
     /// True when output `o` is just the intermediate of the same name (see [`Self::name_outputs`]).

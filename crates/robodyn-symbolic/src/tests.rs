@@ -76,3 +76,44 @@ fn trig_of_shifted_arguments_folds() {
         }
     }
 }
+
+#[test]
+fn powers_of_sums_expand_term_by_term() {
+    // a product of equal sums folds back into their power: expansion multiplies out instead
+    assert_eq!(p("(a+b)^3").expand(), p("a^3 + 3*a^2*b + 3*a*b^2 + b^3"));
+    let e = p("((a+b)*(c-d))^2").expand();
+    let v = |e: &Expr| {
+        e.eval(&|s| Some(s.len() as f64 + s.as_bytes()[0] as f64 / 50.0))
+            .unwrap()
+    };
+    assert!((v(&e) - v(&p("((a+b)*(c-d))^2"))).abs() < 1e-12);
+    assert!(
+        !e.to_string().contains('^') || !e.to_string().contains('('),
+        "{e}"
+    );
+}
+
+#[test]
+fn canonical_forms_print_and_read_back() {
+    // fuzzer findings: a negated sum inside a sum, a float that reads back as a rational, large
+    // integers, merged powers beyond the parser's exponent bound
+    for (text, printed) in [
+        ("s - (a - b + c)", "-a + b - c + s"),
+        ("2*(a+b) - (a+b)", "-a - b + 2*(a + b)"),
+        ("1234440111544321*x", "1234440111544321*x"),
+        ("22*222*B2*222*222222222222", "240943999999759056*B2"),
+        ("x^55*x^55", "x^55*x^55"),
+        ("(x^40)^2", "(x^40)^2"),
+    ] {
+        let e = p(text);
+        assert_eq!(e.to_string(), printed, "{text}");
+        assert_eq!(p(printed).to_string(), printed, "{text}");
+    }
+    // a coefficient overflowing i64 becomes a float, printed so that it reads back as one
+    let e = p("22*222*B2*222*222222222222*1000");
+    assert!(e.to_string().contains("e20*B2"), "{e}");
+    assert_eq!(p(&e.to_string()).to_string(), e.to_string());
+    assert!(Expr::parse("0^-6").is_err());
+    assert!(Expr::parse("tan(pi/2)").is_err());
+    assert!(Expr::parse("1e999").is_err());
+}

@@ -62,7 +62,6 @@ fn values(file: &str) -> BTreeMap<String, f64> {
     v.iter().map(|(k, x)| (k.to_string(), *x)).collect()
 }
 
-const IS_MOBILE: &str = "OpenSYMORO writes `is_mobile = False` (Python booleans)";
 const TWOLOOPS_WHY: &str = "both loops are parallelograms (the second with its fixed side on \
     link 1 and a zero side O3 = O8) and are grouped by 10.51c, 10.55, 10.56 (classes of equal \
     angular velocity {1, 4, 8}, {2, 6}, {3, 7}); through them link 4 keeps link 1's orientation, \
@@ -73,13 +72,7 @@ const TWOLOOPS_WHY: &str = "both loops are parallelograms (the second with its f
 fn expectation(file: &str) -> Expect {
     use Expect::*;
     match file {
-        "symoro-robots/akr3000.par"
-        | "symoro-robots/eloise-hand.par"
-        | "symoro-robots/floatplanar2r.par"
-        | "symoro-robots/non-planar-2r.par"
-        | "symoro-robots/planar2r.par"
-        | "opensymoro-symoro-history/RX90_23db8e5.par" => NotLoading("is_mobile", IS_MOBILE),
-        "symoro-robots/rx90float.par" => NotLoading(
+        "symoro-robots/rx90float.par" | "symoro-robots/floatplanar2r.par" => NotLoading(
             "floating",
             "a floating base is refused (documented; a later issue adds it)",
         ),
@@ -87,9 +80,6 @@ fn expectation(file: &str) -> Expect {
             "antecedent",
             "a twin frame on another fixed frame (frame 12 on frame 11)",
         ),
-        "opensymoro-symoro-history/TwoLoops_0e10e3e.par" => {
-            NotLoading("atan2", "`atan2` in an expression")
-        }
         "freecad-symoro/AKR3000.par" | "freecad-symoro/sr400.par" => NotLoading(
             "entries",
             "the file is inconsistent (NF = 6 with 10 or 14 frames): a correct rejection",
@@ -101,12 +91,13 @@ fn expectation(file: &str) -> Expect {
             "mu marks more actuated joints than the mechanism has degrees of freedom: the \
              closed-chain model (and so the numerical method) refuses it; the rules still run",
         ),
-        "opensymoro-symoro/AKR3000.par" => NumericRefused(
+        "opensymoro-symoro/AKR3000.par" | "symoro-robots/akr3000.par" => NumericRefused(
             "no regular closed configuration",
             "no symbol values and no assembly: with generic geometry the loops do not close \
              near q = 0 (derived/AKR3000_assembly.par with the values of SOURCES.md does)",
         ),
-        "opensymoro-symoro-history/TwoLoops_8153937.par" => RulesKeep(
+        "opensymoro-symoro-history/TwoLoops_8153937.par"
+        | "opensymoro-symoro-history/TwoLoops_0e10e3e.par" => RulesKeep(
             &["MY4", "XX5", "XY5", "XZ5", "YZ5", "MX7", "MY7"],
             TWOLOOPS_WHY,
         ),
@@ -125,13 +116,15 @@ fn expectation(file: &str) -> Expect {
 }
 
 /// Counts with an external reference: (file, friction, count).
-const REFERENCES: [(&str, bool, usize); 6] = [
+const REFERENCES: [(&str, bool, usize); 7] = [
     ("opensymoro-symoro/SR400.par", false, 42), // Table 10.2
     ("symoro-robots/sr400.par", false, 42),     // Table 10.2
     ("derived/SR400_assembly.par", false, 42),  // Table 10.2
     ("opensymoro-symoro/RX90.par", true, 52),   // OpenSYMORO RX90_regp.txt
     ("derived/RX90_zeros.par", true, 44),       // OpenSYMORO on the same file
     ("symoro-robots/rx90.par", true, 52),       // OpenSYMORO rx90_regp.txt
+    // the same RX90 with Python booleans (`is_mobile = False`): OpenSYMORO RX90_regp.txt
+    ("opensymoro-symoro-history/RX90_23db8e5.par", true, 52),
 ];
 
 fn par_files(dir: &Path) -> Vec<String> {

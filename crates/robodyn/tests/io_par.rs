@@ -313,3 +313,48 @@ fn latin1_symoro_files_load() {
     assert_eq!(tau[0], 2.0);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn joint_variables_are_read_as_symoro_reads_them() {
+    // SYMORO's theta entry of a revolute joint IS the joint variable: a number there is the
+    // variable's value (the configuration the file describes), not an offset; a bare symbol
+    // without a value is the variable whatever its name
+    let text = format!("{HEAD}theta = {{0.3, th2 + a2, x3}}\n");
+    let (d, map) = par::parse_description(&text, Some("test.par")).unwrap();
+    assert!(d.frames[0].theta.is_zero(), "{}", d.frames[0].theta);
+    assert_eq!(d.frames[1].theta.to_string(), "a2");
+    assert!(d.frames[2].theta.is_zero());
+    let w: Vec<String> = map.warnings.iter().map(|w| w.to_string()).collect();
+    assert_eq!(w.len(), 1, "{w:?}");
+    assert!(
+        w[0].starts_with("test.par:5: frame 1, theta:")
+            && w[0].contains("q1 = 3/10")
+            && w[0].contains("th1 + 3/10"),
+        "{w:?}"
+    );
+    // a zero is the same under both readings: no warning
+    let (_, map) = par::parse_description(&format!("{HEAD}theta = {{0, 0, 0}}\n"), None).unwrap();
+    assert!(map.warnings.is_empty());
+    // two symbols without values, neither named like a variable: which one moves is ambiguous
+    let m = err(&format!("{HEAD}theta = {{a + b, 0, 0}}\n"));
+    assert!(
+        m.contains("several candidates") && m.contains("a, b"),
+        "{m}"
+    );
+    // OpenSYMORO's Python booleans
+    for (v, mobile) in [
+        ("True", true),
+        ("true", true),
+        ("False", false),
+        ("false", false),
+        ("1", true),
+        ("0", false),
+    ] {
+        let d = parse(&format!("{HEAD}is_mobile = {v}\nis_floating = False\n")).unwrap();
+        assert_eq!(d.mobile_base, mobile, "{v}");
+    }
+    let m = err(&format!("{HEAD}is_mobile = yes\n"));
+    assert!(m.starts_with("test.par:5:") && m.contains("0 or 1"), "{m}");
+    let m = err(&format!("{HEAD}is_floating = True\n"));
+    assert!(m.contains("floating (free) base is not supported"), "{m}");
+}

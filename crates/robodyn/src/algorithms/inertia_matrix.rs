@@ -34,7 +34,9 @@ pub fn composite_links<T: DynScalar>(model: &DynModel<T>, ws: &mut Data<T>, q: &
         ws.msc[j] = l.ms.clone();
         ws.mc[j] = l.mass.clone();
     }
-    for k in (2..=model.nl).rev() {
+    for k in (1..=model.nl).rev() {
+        // composite link k is complete (its successors, numbered after it, are in)
+        name_composite(ws, k);
         let i = model.frame(k).ant;
         if i == 0 {
             continue;
@@ -96,6 +98,12 @@ pub fn composite_inertia_matrix<T: DynScalar>(
             m = &ws.rot[k] * &m + ws.pos[k].cross(&fi);
             f = fi;
             k = model.frame(k).ant;
+            if T::NAMED {
+                // the wrench of column j carried to link k: named, or it would grow with the
+                // depth of the tree
+                f = f.map_with_location(|c, _, x| x.named(|| format!("AF{}_{k}_{j}", c + 1)));
+                m = m.map_with_location(|c, _, x| x.named(|| format!("AN{}_{k}_{j}", c + 1)));
+            }
             let joint = model.frame(k).joint;
             if joint.is_movable() {
                 let v = project(joint, &f, &m);
@@ -104,6 +112,26 @@ pub fn composite_inertia_matrix<T: DynScalar>(
             }
         }
     }
+}
+
+/// Naming hook of the customized symbolic model: the composite inertia of link k (`JP<r><c><k>`,
+/// `MSP<c><k>`, `MP<k>`), so that its expression does not grow with the size of the subtree. A
+/// no-op for `f64`.
+#[inline(always)]
+fn name_composite<T: DynScalar>(ws: &mut Data<T>, k: usize) {
+    if !T::NAMED {
+        return;
+    }
+    let j = ws.jc[k].clone();
+    ws.jc[k] = Matrix3::from_fn(|r, c| {
+        let (r, c) = (r.min(c), r.max(c));
+        j[(r, c)]
+            .clone()
+            .named(|| format!("JP{}{}{k}", r + 1, c + 1))
+    });
+    let ms = ws.msc[k].clone();
+    ws.msc[k] = Vector3::from_fn(|c, _| ms[c].clone().named(|| format!("MSP{}{k}", c + 1)));
+    ws.mc[k] = ws.mc[k].clone().named(|| format!("MP{k}"));
 }
 
 #[inline]

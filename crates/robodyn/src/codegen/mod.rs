@@ -269,43 +269,22 @@ pub(crate) fn pair_name(prefix: &str, i: usize, j: usize) -> String {
 
 /// Generate a customized model of a robot description.
 pub fn generate(desc: &RobotDescription, opt: &GenOptions) -> Result<Program> {
+    generate_with_progress(desc, opt, &mut |_| {})
+}
+
+/// [`generate`], calling `progress` with what it is doing as each stage starts (building the
+/// symbolic model, recording the recursions, each optimisation pass): a long generation (a
+/// humanoid's direct model takes seconds) can show it.
+pub fn generate_with_progress(
+    desc: &RobotDescription,
+    opt: &GenOptions,
+    progress: &mut dyn FnMut(&str),
+) -> Result<Program> {
     crate::model::validate_structure(desc)?;
+    progress("building the symbolic model");
     let model = symbolic_model(desc, opt)?;
     let nl = desc.nl;
     let joints = desc.movable_joints();
-    let sym = |k: &str, j: usize| Expr::symbol(joint_symbol(k, j));
-    let q: Vec<Expr> = (1..=nl).map(|j| sym("q", j)).collect();
-    let qd: Vec<Expr> = (1..=nl).map(|j| sym("QP", j)).collect();
-    let qdd: Vec<Expr> = (1..=nl).map(|j| sym("QDP", j)).collect();
-    let group = |name: &str, kind: &str, doc: &str| InputGroup {
-        name: name.into(),
-        doc: doc.into(),
-        symbols: (1..=nl)
-            .map(|j| joints.contains(&j).then(|| joint_symbol(kind, j)))
-            .collect(),
-    };
-    let mut inputs = vec![group("q", "q", "joint positions q_j, j = 1..NL")];
-    let mut reserved: Vec<String> = Vec::new();
-    // GAM<j> are inputs of the direct model only; elsewhere they name the tree torques
-    let kinds: &[&str] = if opt.model == ModelKind::Ddm {
-        &["q", "QP", "QDP", "GAM"]
-    } else {
-        &["q", "QP", "QDP"]
-    };
-    for k in kinds {
-        reserved.extend((1..=nl).map(|j| joint_symbol(k, j)));
-    }
-    for s in desc.symbols.keys() {
-        reserved.push(s.clone());
-    }
-    for l in 1..=nl {
-        for p in STANDARD_PARAMETERS {
-            reserved.push(format!("{p}{l}"));
-        }
-    }
-    if let Some(b) = &opt.base {
-        reserved.extend(b.grouped.iter().map(|g| g.name.clone()));
-    }
     let closed = matches!(opt.model, ModelKind::Closed | ModelKind::W);
     // the numeric robot of the closed models (loop closure, constant G, parallel links)
     let robot = closed.then(|| crate::Robot::new(desc.clone()));
@@ -331,102 +310,14 @@ pub fn generate(desc: &RobotDescription, opt: &GenOptions) -> Result<Program> {
     } else {
         Vec::new()
     };
-    let (outputs, assignments) = record(&reserved, || -> Result<Vec<Assignment>> {
-        let mut ws = Data::from_model(&model);
-        let mut tau = vec![Expr::zero(); nl];
-        match opt.model {
-            ModelKind::Idm | ModelKind::Closed => {
-                forward_recursion_sharing(&model, &mut ws, &q, &qd, &qdd, &shared);
-                // the closed model only needs G^T Gamma_tr: moments of shared links move too
-                backward_recursion_sharing(&model, &mut ws, &qd, &qdd, &mut tau, &shared);
-                if opt.model == ModelKind::Idm {
-                    Ok(joints
-                        .iter()
-                        .map(|&j| Assignment {
-                            name: joint_symbol("GAM", j),
-                            expr: tau[j - 1].clone(),
-                        })
-                        .collect())
-                } else {
-                    let gam: Vec<Expr> =
-                        (1..=nl).map(|j| tau[j - 1].clone().named_gam(j)).collect();
-                    closed_torques(&model, &form, &q, &gam)
-                }
-            }
-            ModelKind::W => closed_w(&model, &form, &q),
-            ModelKind::H => {
-                let zero = vec![Expr::zero(); nl];
-                rnea(&model, &mut ws, &q, &qd, &zero, &mut tau);
-                Ok(joints
-                    .iter()
-                    .map(|&j| Assignment {
-                        name: joint_symbol("H", j),
-                        expr: tau[j - 1].clone(),
-                    })
-                    .collect())
-            }
-            ModelKind::Inertia => {
-                let cols = inertia_columns(&model, &joints, &q);
-                let mut out = Vec::new();
-                for (a, &i) in joints.iter().enumerate() {
-                    for (b, &j) in joints.iter().enumerate().take(a + 1) {
-                        out.push(Assignment {
-                            name: pair_name("A", i, j),
-                            expr: cols[b][a].clone(),
-                        });
-                    }
-                }
-                Ok(out)
-            }
-            ModelKind::Ddm => {
-                let zero = vec![Expr::zero(); nl];
-                rnea(&model, &mut ws, &q, &qd, &zero, &mut tau);
-                let n = joints.len();
-                // right-hand side Gamma - H
-                let rhs: Vec<Expr> = joints
-                    .iter()
-                    .map(|&j| {
-                        let h = tau[j - 1].clone().named(|| joint_symbol("H", j));
-                        (sym("GAM", j) - h).named(|| format!("BB{j}"))
-                    })
-                    .collect();
-                let cols = inertia_columns(&model, &joints, &q);
-                let a: Vec<Vec<Expr>> = (0..n)
-                    .map(|r| {
-                        (0..n)
-                            .map(|c| {
-                                let (r2, c2) = if r >= c { (r, c) } else { (c, r) };
-                                cols[c2][r2]
-                                    .clone()
-                                    .named(|| pair_name("A", joints[r2], joints[c2]))
-                            })
-                            .collect()
-                    })
-                    .collect();
-                Ok(linear::ldl_solve(&a, &rhs, &joints)
-                    .into_iter()
-                    .zip(&joints)
-                    .map(|(x, &j)| Assignment {
-                        name: joint_symbol("QDP", j),
-                        expr: x,
-                    })
-                    .collect())
-            }
-        }
+    progress(&format!(
+        "recording the {} model ({nl} links)",
+        opt.model.name()
+    ));
+    let (outputs, assignments) = record(&reserved_names(desc, opt), || {
+        record_model(&model, opt, &form, &shared, &joints)
     });
     let outputs = outputs?;
-    match opt.model {
-        ModelKind::Idm | ModelKind::Closed => {
-            inputs.push(group("qd", "QP", "joint velocities, j = 1..NL"));
-            inputs.push(group("qdd", "QDP", "joint accelerations, j = 1..NL"));
-        }
-        ModelKind::H => inputs.push(group("qd", "QP", "joint velocities, j = 1..NL")),
-        ModelKind::Inertia | ModelKind::W => {}
-        ModelKind::Ddm => {
-            inputs.push(group("qd", "QP", "joint velocities, j = 1..NL"));
-            inputs.push(group("gam", "GAM", "joint torques, j = 1..NL"));
-        }
-    }
     let mut description = describe(desc, opt);
     if closed {
         description.extend(form.describe(nl));
@@ -443,16 +334,171 @@ pub fn generate(desc: &RobotDescription, opt: &GenOptions) -> Result<Program> {
             .clone()
             .unwrap_or_else(|| format!("{}_{}", ident(&desc.name), opt.model.name())),
         description,
-        inputs,
+        inputs: joint_inputs(nl, &joints, opt.model),
         assignments,
         outputs,
     };
     if opt.optimize {
-        prog.optimize();
+        let n = prog.assignments.len();
+        prog.optimize_with_progress(&mut |pass| {
+            progress(&format!("optimizing {n} assignments: {pass}"))
+        });
     } else {
         prog.remove_dead();
     }
-    // every other symbol is a parameter
+    add_parameter_inputs(&mut prog);
+    Ok(prog)
+}
+
+/// Names intermediates may not take: the joint variables, the robot's symbols, the standard
+/// and grouped parameters.
+fn reserved_names(desc: &RobotDescription, opt: &GenOptions) -> Vec<String> {
+    let nl = desc.nl;
+    let mut reserved: Vec<String> = Vec::new();
+    // GAM<j> are inputs of the direct model only; elsewhere they name the tree torques
+    let kinds: &[&str] = if opt.model == ModelKind::Ddm {
+        &["q", "QP", "QDP", "GAM"]
+    } else {
+        &["q", "QP", "QDP"]
+    };
+    for k in kinds {
+        reserved.extend((1..=nl).map(|j| joint_symbol(k, j)));
+    }
+    reserved.extend(desc.symbols.keys().cloned());
+    for l in 1..=nl {
+        for p in STANDARD_PARAMETERS {
+            reserved.push(format!("{p}{l}"));
+        }
+    }
+    if let Some(b) = &opt.base {
+        reserved.extend(b.grouped.iter().map(|g| g.name.clone()));
+    }
+    reserved
+}
+
+/// The joint-variable input arrays of a model (NL entries each; fixed frames unused).
+fn joint_inputs(nl: usize, joints: &[usize], model: ModelKind) -> Vec<InputGroup> {
+    let movable: BTreeSet<usize> = joints.iter().copied().collect();
+    let group = |name: &str, kind: &str, doc: &str| InputGroup {
+        name: name.into(),
+        doc: doc.into(),
+        symbols: (1..=nl)
+            .map(|j| movable.contains(&j).then(|| joint_symbol(kind, j)))
+            .collect(),
+    };
+    let mut inputs = vec![group("q", "q", "joint positions q_j, j = 1..NL")];
+    match model {
+        ModelKind::Idm | ModelKind::Closed => {
+            inputs.push(group("qd", "QP", "joint velocities, j = 1..NL"));
+            inputs.push(group("qdd", "QDP", "joint accelerations, j = 1..NL"));
+        }
+        ModelKind::H => inputs.push(group("qd", "QP", "joint velocities, j = 1..NL")),
+        ModelKind::Inertia | ModelKind::W => {}
+        ModelKind::Ddm => {
+            inputs.push(group("qd", "QP", "joint velocities, j = 1..NL"));
+            inputs.push(group("gam", "GAM", "joint torques, j = 1..NL"));
+        }
+    }
+    inputs
+}
+
+/// Run the model's recursions on symbols (inside a recording): its outputs.
+fn record_model(
+    model: &DynModel<Expr>,
+    opt: &GenOptions,
+    form: &ClosedForm,
+    shared: &[Option<SharedOrientation<Expr>>],
+    joints: &[usize],
+) -> Result<Vec<Assignment>> {
+    let nl = model.nl;
+    let sym = |k: &str, j: usize| Expr::symbol(joint_symbol(k, j));
+    let q: Vec<Expr> = (1..=nl).map(|j| sym("q", j)).collect();
+    let qd: Vec<Expr> = (1..=nl).map(|j| sym("QP", j)).collect();
+    let qdd: Vec<Expr> = (1..=nl).map(|j| sym("QDP", j)).collect();
+    let outputs = |prefix: &str, tau: &[Expr]| -> Vec<Assignment> {
+        joints
+            .iter()
+            .map(|&j| Assignment {
+                name: joint_symbol(prefix, j),
+                expr: tau[j - 1].clone(),
+            })
+            .collect()
+    };
+    let mut ws = Data::from_model(model);
+    let mut tau = vec![Expr::zero(); nl];
+    match opt.model {
+        ModelKind::Idm | ModelKind::Closed => {
+            forward_recursion_sharing(model, &mut ws, &q, &qd, &qdd, shared);
+            // the closed model only needs G^T Gamma_tr: moments of shared links move too
+            backward_recursion_sharing(model, &mut ws, &qd, &qdd, &mut tau, shared);
+            if opt.model == ModelKind::Idm {
+                Ok(outputs("GAM", &tau))
+            } else {
+                let gam: Vec<Expr> = (1..=nl).map(|j| tau[j - 1].clone().named_gam(j)).collect();
+                closed_torques(model, form, &q, &gam)
+            }
+        }
+        ModelKind::W => closed_w(model, form, &q),
+        ModelKind::H => {
+            let zero = vec![Expr::zero(); nl];
+            rnea(model, &mut ws, &q, &qd, &zero, &mut tau);
+            Ok(outputs("H", &tau))
+        }
+        ModelKind::Inertia => {
+            let cols = inertia_columns(model, joints, &q);
+            let mut out = Vec::new();
+            for (a, &i) in joints.iter().enumerate() {
+                for (b, &j) in joints.iter().enumerate().take(a + 1) {
+                    out.push(Assignment {
+                        name: pair_name("A", i, j),
+                        expr: cols[b][a].clone(),
+                    });
+                }
+            }
+            Ok(out)
+        }
+        ModelKind::Ddm => {
+            let zero = vec![Expr::zero(); nl];
+            rnea(model, &mut ws, &q, &qd, &zero, &mut tau);
+            let n = joints.len();
+            // right-hand side Gamma - H
+            let rhs: Vec<Expr> = joints
+                .iter()
+                .map(|&j| {
+                    let h = tau[j - 1].clone().named(|| joint_symbol("H", j));
+                    (sym("GAM", j) - h).named(|| format!("BB{j}"))
+                })
+                .collect();
+            let cols = inertia_columns(model, joints, &q);
+            let a: Vec<Vec<Expr>> = (0..n)
+                .map(|r| {
+                    (0..n)
+                        .map(|c| {
+                            let (r2, c2) = if r >= c { (r, c) } else { (c, r) };
+                            cols[c2][r2]
+                                .clone()
+                                .named(|| pair_name("A", joints[r2], joints[c2]))
+                        })
+                        .collect()
+                })
+                .collect();
+            let x = linear::ldl_solve(&a, &rhs, joints);
+            Ok(outputs("QDP", &scatter(joints, nl, x)))
+        }
+    }
+}
+
+/// Values of `joints` at their indices j - 1 of an NL-vector (zeros elsewhere).
+fn scatter(joints: &[usize], nl: usize, x: Vec<Expr>) -> Vec<Expr> {
+    let mut v = vec![Expr::zero(); nl];
+    for (&j, e) in joints.iter().zip(x) {
+        v[j - 1] = e;
+    }
+    v
+}
+
+/// The parameter input `p`: every symbol that is neither an input nor an intermediate.
+fn add_parameter_inputs(prog: &mut Program) {
     let known: BTreeSet<String> = prog
         .input_symbols()
         .into_iter()
@@ -477,7 +523,6 @@ pub fn generate(desc: &RobotDescription, opt: &GenOptions) -> Result<Program> {
             .map(|e| e.as_symbol().map(str::to_string))
             .collect(),
     });
-    Ok(prog)
 }
 
 /// Helper so that the closed-chain model names the tree torques GAM<j>.

@@ -3,17 +3,59 @@
 //! [`load_description`] reads any of them (chosen by extension) into a [`RobotDescription`];
 //! [`load`] also validates it into a [`Robot`], which needs a numeric value for every symbol.
 
+mod consistency;
+pub mod fuzz_checks;
 pub mod par;
+pub mod source;
+pub mod table;
 pub mod toml_format;
 pub mod urdf;
 
-pub use toml_format::SourceMap;
+pub use consistency::{body_inconsistency, physical_consistency};
+pub use source::{LineIndex, SourceMap};
 
-use crate::error::{Error, Result};
+use crate::error::{Error, Item, Location, Result};
 use crate::model::RobotDescription;
 use crate::Robot;
 use std::collections::BTreeMap;
 use std::path::Path;
+
+/// Something a reader noticed that is not an error: the file loads, but may not mean what its
+/// author meant (a SYMORO reading that differs from robodyn's, inertial parameters no rigid body
+/// has, a name a writer had to escape).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Warning {
+    /// File and line, when known.
+    pub location: Location,
+    /// The frame, link, key... concerned.
+    pub item: Option<Item>,
+    /// What was noticed.
+    pub message: String,
+}
+
+impl Warning {
+    /// A warning about `item`, without a position yet.
+    pub fn new(item: Item, message: impl Into<String>) -> Warning {
+        Warning {
+            location: Location::default(),
+            item: Some(item),
+            message: message.into(),
+        }
+    }
+}
+
+impl std::fmt::Display for Warning {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let loc = self.location.to_string();
+        if !loc.is_empty() {
+            write!(f, "{loc}: ")?;
+        }
+        if let Some(item) = &self.item {
+            write!(f, "{item}: ")?;
+        }
+        f.write_str(&self.message)
+    }
+}
 
 /// The file formats robodyn reads and writes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -43,25 +85,48 @@ impl Format {
     }
 }
 
-/// Read a text file; files that are not UTF-8 (SYMORO+ writes Latin-1 comments such as
-/// "Noë") are decoded as Latin-1.
+/// Read a text file (see [`decode_text`]).
 fn read(path: &Path) -> Result<String> {
     let bytes = std::fs::read(path).map_err(|e| Error::io(path.display().to_string(), e))?;
-    Ok(match String::from_utf8(bytes) {
-        Ok(s) => s,
-        Err(e) => e.as_bytes().iter().map(|&b| b as char).collect(),
-    })
+    Ok(decode_text(bytes))
 }
 
-/// Read a robot description from a file, with the positions of its entries.
+/// The text of a robot file: UTF-8, or else Latin-1 (SYMORO+ writes Latin-1 comments such as
+/// "Noë").
+pub fn decode_text(bytes: Vec<u8>) -> String {
+    match String::from_utf8(bytes) {
+        Ok(s) => s,
+        Err(e) => e.as_bytes().iter().map(|&b| b as char).collect(),
+    }
+}
+
+/// Read a robot description from a file, with the positions of its entries. The map's
+/// [`SourceMap::warnings`] hold what the reader noticed and the physical-consistency check
+/// ([`physical_consistency`]) found, with their lines.
 pub fn load_description_mapped(path: &Path) -> Result<(RobotDescription, SourceMap)> {
     let text = read(path)?;
     let file = path.display().to_string();
-    match Format::from_path(path)? {
+    let (desc, mut map) = match Format::from_path(path)? {
         Format::Toml => toml_format::parse_description(&text, Some(&file)),
         Format::Par => par::parse_description(&text, Some(&file)),
         Format::Urdf => urdf::parse_description(&text, Some(&file)),
+    }?;
+    for w in physical_consistency(&desc) {
+        map.warn(w);
     }
+    Ok((desc, map))
+}
+
+/// Read and validate a robot, with the warnings of [`load_description_mapped`].
+pub fn load_with_warnings(
+    path: &Path,
+    overrides: &BTreeMap<String, f64>,
+) -> Result<(Robot, Vec<Warning>)> {
+    let (mut desc, map) = load_description_mapped(path)?;
+    desc.symbols
+        .extend(overrides.iter().map(|(k, v)| (k.clone(), *v)));
+    let robot = Robot::new(desc).map_err(|e| map.locate(e))?;
+    Ok((robot, map.warnings))
 }
 
 /// Read a robot description from a file.

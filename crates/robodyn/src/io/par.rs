@@ -2,7 +2,8 @@
 //!
 //! The dialect accepted (see `docs/robot-format.md`):
 //! - `(* comments *)`, possibly spanning lines;
-//! - `NL NJ NF Type is_mobile` scalars (`NF` must equal 2 NJ - NL);
+//! - `NL NJ NF Type is_mobile is_floating` scalars (`NF` must equal 2 NJ - NL; `is_mobile` and
+//!   `is_floating` are 0/1 or OpenSYMORO's Python booleans `True`/`False`);
 //! - lists `{a, b, ...}` of NF entries: `ant sigma b d r gamma alpha mu theta` (SYMORO+'s
 //!   capitalised `Ant Mu Sigma B Alpha Theta R` too; keys are case-insensitive);
 //! - lists of NL entries: `XX XY XZ YY YZ ZZ MX MY MZ M IA FV FS FX FY FZ CX CY CZ`;
@@ -10,23 +11,39 @@
 //! - `W0 WP0 V0 VP0 G` of 3 entries (`G` is the gravity acceleration g in frame 0), `Z` of 16;
 //! - `Robotname = 'name'` or `name = ...`, also inside a comment as SYMORO writes it.
 //!
-//! In `theta` of a revolute joint and `r` of a prismatic joint, a name such as `th3`, `q3`, `t3`
-//! (resp. `r3`, `q3`) without a numeric value is the joint variable; it must enter with
-//! coefficient 1 (`th3 + pi/2`); what remains is the constant offset we store.
+//! **Joint variables, as SYMORO reads them.** The `theta` entry of a revolute joint (the `r`
+//! entry of a prismatic one) *is* the joint variable in SYMORO. robodyn splits it into the
+//! variable q_j and a constant offset: the variable is the entry's symbol without a value (a
+//! name such as `th3`, `q3`, `t3` when there are several); it must enter with coefficient 1
+//! (`th3 + pi/2`); what remains is the offset we store. An entry with no symbol left (a number,
+//! a constant expression) is the value SYMORO gives the joint variable, i.e. the configuration
+//! the file describes, not an offset: the offset is 0, and a warning says so when the value is
+//! not 0.
 //!
 //! SYMORO files carry no numeric values for their symbols. Our writer stores them in a comment
 //! SYMORO ignores, `(* robodyn values: d2 = 0.15; d3 = 0.6 *)`, which our reader reads back (as
-//! it does `(* robodyn frame names: ... *)`, `(* robodyn link names: ... *)` and
-//! `(* robodyn note: ... *)`), so that `.par -> .toml -> .par` round-trips.
+//! it does `(* robodyn frame names: ... *)`, `(* robodyn link names: ... *)`,
+//! `(* robodyn note: ... *)`, `(* robodyn name: ... *)` and `(* robodyn assembly: ... *)`), so
+//! that `.par -> .toml -> .par` round-trips. A name or note that `;`, a new line, `*` or a quote
+//! would break is written as a quoted string with backslash escapes.
+//!
+//! Reading is linear in the file size: positions come from a [`LineIndex`], and the counts are
+//! checked against the lists the file has before anything is sized from them.
 
-use crate::error::{Error, Location, Result};
-use crate::io::SourceMap;
+use crate::error::{Error, Item, Location, Result};
+use crate::io::source::LineIndex;
+use crate::io::toml_format::is_symbol_name;
+use crate::io::{SourceMap, Warning};
 use crate::model::{
     validate_structure, JointType, RobotDescription, GEOMETRIC_PARAMETERS, STANDARD_PARAMETERS,
     WRENCH_COMPONENTS,
 };
 use robodyn_symbolic::Expr;
 use std::collections::{BTreeMap, BTreeSet};
+
+/// Without lists giving that many entries, a file may not declare more frames than this (a
+/// description of NF frames is built before the lists are read).
+const FRAMES_WITHOUT_LISTS: usize = 1000;
 
 /// One `KEY = value` statement.
 struct Statement {
@@ -41,20 +58,15 @@ struct Statement {
 struct Ctx<'a> {
     text: &'a str,
     file: Option<&'a str>,
+    lines: LineIndex,
 }
 
 impl Ctx<'_> {
-    fn pos(&self, offset: usize) -> (usize, usize) {
-        let before = &self.text[..offset.min(self.text.len())];
-        let line = before.matches('\n').count() + 1;
-        let col = before.len() - before.rfind('\n').map(|p| p + 1).unwrap_or(0) + 1;
-        (line, col)
-    }
     fn line(&self, offset: usize) -> usize {
-        self.pos(offset).0
+        self.lines.line(offset)
     }
     fn err(&self, offset: usize, reason: impl Into<String>) -> Error {
-        let (line, col) = self.pos(offset);
+        let (line, col) = self.lines.position(offset);
         Error::Parse {
             location: Location {
                 file: self.file.map(str::to_string),
@@ -224,11 +236,11 @@ fn split_statements(ctx: &Ctx, s: &str) -> Result<Vec<Statement>> {
 enum KeyKind {
     Count,    // nl nj nf
     Type,     // type
-    Mobile,   // is_mobile
+    Flag,     // is_mobile is_floating
     Name,     // robotname, name
     PerFrame, // ant sigma b d r gamma alpha mu theta
     PerLink,  // XX ... CZ
-    PerJoint, // QP QDP GAM
+    PerJoint, // QP QDP GAM eta k
     Base,     // W0 WP0 V0 VP0 G
     ZMatrix,  // Z
 }
@@ -237,7 +249,7 @@ fn key_kind(k: &str) -> Option<KeyKind> {
     Some(match k.to_ascii_lowercase().as_str() {
         "nl" | "nj" | "nf" => KeyKind::Count,
         "type" => KeyKind::Type,
-        "is_mobile" | "is_floating" => KeyKind::Mobile,
+        "is_mobile" | "is_floating" => KeyKind::Flag,
         "robotname" | "name" => KeyKind::Name,
         "ant" | "sigma" | "b" | "d" | "r" | "gamma" | "alpha" | "mu" | "theta" => KeyKind::PerFrame,
         "xx" | "xy" | "xz" | "yy" | "yz" | "zz" | "mx" | "my" | "mz" | "m" | "ia" | "fv" | "fs"
@@ -265,6 +277,82 @@ fn is_variable_name(name: &str, joint: JointType) -> bool {
     })
 }
 
+/// A text for a robodyn comment: as it is when nothing in it can break the comment or its
+/// `;`-separated list, else a quoted string with backslash escapes (`\"`, `\\`, `\n`, `\r`,
+/// `\t`, and `\x2a` for every `*`, so that neither `(*` nor `*)` appears).
+fn comment_text(s: &str) -> String {
+    let plain = !s.is_empty()
+        && s.trim() == s
+        && !s.starts_with('"')
+        && !s.contains([';', '\n', '\r', '*', '\\']);
+    if plain {
+        return s.to_string();
+    }
+    let mut out = String::with_capacity(s.len() + 2);
+    out.push('"');
+    for c in s.chars() {
+        match c {
+            '"' => out.push_str("\\\""),
+            '\\' => out.push_str("\\\\"),
+            '\n' => out.push_str("\\n"),
+            '\r' => out.push_str("\\r"),
+            '\t' => out.push_str("\\t"),
+            '*' => out.push_str("\\x2a"),
+            c => out.push(c),
+        }
+    }
+    out.push('"');
+    out
+}
+
+/// The text of a value written by [`comment_text`] (`None` for a broken quoted string).
+fn uncomment_text(s: &str) -> Option<String> {
+    let Some(body) = s.strip_prefix('"') else {
+        return Some(s.to_string());
+    };
+    let body = body.strip_suffix('"')?;
+    let mut out = String::with_capacity(body.len());
+    let mut chars = body.chars();
+    while let Some(c) = chars.next() {
+        match c {
+            '\\' => out.push(match chars.next()? {
+                'n' => '\n',
+                'r' => '\r',
+                't' => '\t',
+                'x' => {
+                    let hex: String = chars.by_ref().take(2).collect();
+                    char::from(u8::from_str_radix(&hex, 16).ok().filter(|b| b.is_ascii())?)
+                }
+                other => other,
+            }),
+            '"' => return None,
+            c => out.push(c),
+        }
+    }
+    Some(out)
+}
+
+/// Split the body of a robodyn comment into items at `;` and new lines outside quoted strings,
+/// with their byte offsets in `body`.
+fn split_items(body: &str) -> Vec<(&str, usize)> {
+    let mut out = Vec::new();
+    let (mut start, mut quoted, mut escaped) = (0, false, false);
+    for (i, c) in body.char_indices() {
+        match c {
+            _ if escaped => escaped = false,
+            '\\' if quoted => escaped = true,
+            '"' => quoted = !quoted,
+            ';' | '\n' if !quoted => {
+                out.push((&body[start..i], start));
+                start = i + 1;
+            }
+            _ => {}
+        }
+    }
+    out.push((&body[start..], start));
+    out
+}
+
 /// What our own comments carry.
 #[derive(Default)]
 struct Extras {
@@ -273,7 +361,9 @@ struct Extras {
     link_names: BTreeMap<usize, String>,
     notes: Vec<String>,
     robot_name: Option<String>,
-    assembly: BTreeMap<usize, f64>,
+    /// `(* robodyn name: ... *)`, which wins over SYMORO's `Robotname` comment.
+    robodyn_name: Option<String>,
+    assembly: BTreeMap<usize, (f64, usize)>,
 }
 
 /// Parse SYMORO's `Robotname = '...'` comment and the `robodyn ...:` blocks of our own comments.
@@ -301,16 +391,30 @@ fn parse_robodyn_comment(
     };
     let body_at = body_at + head.len() + 1;
     let h = head.trim();
-    let kind = ["values", "frame names", "link names", "note", "assembly"]
-        .into_iter()
-        .find(|k| h.starts_with(k));
+    let kind = [
+        "values",
+        "frame names",
+        "link names",
+        "note",
+        "assembly",
+        "name",
+    ]
+    .into_iter()
+    .find(|k| h.starts_with(k));
+    let text_of = |v: &str, v_at: usize, what: &str| -> Result<String> {
+        uncomment_text(v).ok_or_else(|| {
+            ctx.err(
+                v_at,
+                format!("robodyn {what}: `{v}` is not a well-formed quoted string"),
+            )
+        })
+    };
     match kind {
-        Some("note") => ex.notes.push(body.trim().to_string()),
+        Some("note") => ex.notes.push(text_of(body.trim(), body_at, "note")?),
+        Some("name") => ex.robodyn_name = Some(text_of(body.trim(), body_at, "name")?),
         Some(kind) => {
-            let mut off = 0;
-            for item in body.split([';', '\n']) {
+            for (item, off) in split_items(body) {
                 let item_at = body_at + off;
-                off += item.len() + 1;
                 if item.trim().is_empty() {
                     continue;
                 }
@@ -338,8 +442,14 @@ fn parse_robodyn_comment(
                         .expr(&format!("assembly value of q{k}"), v, v_at)?
                         .eval(&|_| None)
                         .map_err(|e| ctx.err(v_at, format!("assembly value of q{k}: {e}")))?;
-                    ex.assembly.insert(j, x);
+                    ex.assembly.insert(j, (x, item_at));
                 } else if kind == "values" {
+                    if !is_symbol_name(k) {
+                        return Err(ctx.err(
+                            item_at,
+                            format!("robodyn values: `{k}` is not a symbol name"),
+                        ));
+                    }
                     let e = ctx.expr(&format!("value of {k}"), v, v_at)?;
                     let x = e.eval(&|_| None).map_err(|e| {
                         ctx.err(
@@ -356,12 +466,13 @@ fn parse_robodyn_comment(
                             format!("robodyn {kind}: `{k}` is not a frame/link number"),
                         )
                     })?;
+                    let name = text_of(v, v_at, kind)?;
                     let dst = if kind == "frame names" {
                         &mut ex.frame_names
                     } else {
                         &mut ex.link_names
                     };
-                    dst.insert(j, v.to_string());
+                    dst.insert(j, name);
                 }
             }
         }
@@ -370,31 +481,28 @@ fn parse_robodyn_comment(
     Ok(())
 }
 
-/// Parse a `.par` file. `file` names the source in error messages.
-pub fn parse_description(text: &str, file: Option<&str>) -> Result<(RobotDescription, SourceMap)> {
-    let ctx = Ctx { text, file };
-    let (stripped, comments) = strip_comments(&ctx)?;
-    let statements = split_statements(&ctx, &stripped)?;
-    let mut map = SourceMap::default();
-    map.file = file.map(str::to_string);
-
-    // keys: known, not repeated
+/// The statements by lowercase key (`Robotname` as `name`): known keys, each once, lists where
+/// lists are expected.
+fn index_keys<'s>(
+    ctx: &Ctx,
+    statements: &'s [Statement],
+) -> Result<BTreeMap<String, &'s Statement>> {
     let mut by_key: BTreeMap<String, &Statement> = BTreeMap::new();
-    for st in &statements {
+    for st in statements {
         let kind = key_kind(&st.key).ok_or_else(|| {
             ctx.err_line(
                 st.at,
                 format!(
-                    "unknown key `{}` (expected NL NJ NF Type is_mobile, ant sigma b d r gamma \
-                     alpha mu theta, XX XY XZ YY YZ ZZ MX MY MZ M IA FV FS FX FY FZ CX CY CZ, \
-                     QP QDP GAM, W0 WP0 V0 VP0 G, Z or Robotname)",
+                    "unknown key `{}` (expected NL NJ NF Type is_mobile is_floating, ant sigma b \
+                     d r gamma alpha mu theta, XX XY XZ YY YZ ZZ MX MY MZ M IA FV FS FX FY FZ CX \
+                     CY CZ, QP QDP GAM eta k, W0 WP0 V0 VP0 G, Z or Robotname)",
                     st.key
                 ),
             )
         })?;
         let list_expected = !matches!(
             kind,
-            KeyKind::Count | KeyKind::Type | KeyKind::Mobile | KeyKind::Name
+            KeyKind::Count | KeyKind::Type | KeyKind::Flag | KeyKind::Name
         );
         if list_expected != st.is_list {
             return Err(ctx.err_line(
@@ -423,38 +531,153 @@ pub fn parse_description(text: &str, file: Option<&str>) -> Result<(RobotDescrip
             ));
         }
     }
-    let int_of = |k: &str| -> Result<Option<(i64, usize)>> {
-        match by_key.get(k) {
-            None => Ok(None),
-            Some(st) => {
-                let (v, at) = &st.entries[0];
-                let x: i64 = v.parse().map_err(|_| {
-                    ctx.err(*at, format!("{}: `{v}` is not a whole number", st.key))
-                })?;
-                Ok(Some((x, st.at)))
+    Ok(by_key)
+}
+
+/// The statements of a file with the checks every value goes through.
+struct Keys<'a, 's> {
+    ctx: &'a Ctx<'a>,
+    by_key: BTreeMap<String, &'s Statement>,
+}
+
+impl<'s> Keys<'_, 's> {
+    /// A whole number, with the offset of its key.
+    fn int(&self, k: &str) -> Result<Option<(i64, usize)>> {
+        let Some(st) = self.by_key.get(k) else {
+            return Ok(None);
+        };
+        let (v, at) = &st.entries[0];
+        let x: i64 = v.parse().map_err(|_| {
+            self.ctx
+                .err(*at, format!("{}: `{v}` is not a whole number", st.key))
+        })?;
+        Ok(Some((x, st.at)))
+    }
+
+    /// A flag: 0/1 or the Python booleans OpenSYMORO writes (`True`, `False`, `true`, `false`).
+    fn flag(&self, k: &str) -> Result<Option<(bool, usize)>> {
+        let Some(st) = self.by_key.get(k) else {
+            return Ok(None);
+        };
+        let (v, at) = &st.entries[0];
+        let b = match v.as_str() {
+            "1" | "True" | "true" => true,
+            "0" | "False" | "false" => false,
+            _ => {
+                return Err(self.ctx.err(
+                    *at,
+                    format!("{} = {v}: expected 0 or 1 (or True, False)", st.key),
+                ))
             }
-        }
-    };
-    let (nl, nl_at) =
-        int_of("nl")?.ok_or_else(|| ctx.err_line(0, "the key NL (number of links) is missing"))?;
-    let (nj, nj_at) = int_of("nj")?.unwrap_or((nl, nl_at));
-    if nl < 1 {
-        return Err(ctx.err_line(nl_at, format!("NL = {nl}: a robot has at least one link")));
+        };
+        Ok(Some((b, st.at)))
     }
-    if nj < nl {
-        return Err(ctx.err_line(nj_at, format!("NJ = {nj} is smaller than NL = {nl}")));
-    }
-    let (nl, nj) = (nl as usize, nj as usize);
-    let nf = 2 * nj - nl;
-    if let Some((f, at)) = int_of("nf")? {
-        if f != nf as i64 {
-            return Err(ctx.err_line(
-                at,
-                format!("NF = {f}, but NF must equal 2 NJ - NL = {nf} (NL = {nl}, NJ = {nj})"),
+
+    /// A list that must have `n` entries (`what` names n: `NF`, `NL`, `NJ` or a number).
+    fn list(&self, k: &str, n: usize, what: &str) -> Result<Option<&'s Statement>> {
+        let Some(st) = self.by_key.get(k).copied() else {
+            return Ok(None);
+        };
+        if st.entries.len() != n {
+            return Err(self.ctx.err_line(
+                st.at,
+                if what.parse::<usize>().is_ok() {
+                    format!("{} has {} entries, {n} expected", st.key, st.entries.len())
+                } else {
+                    format!(
+                        "{} has {} entries, {what} = {n} expected",
+                        st.key,
+                        st.entries.len()
+                    )
+                },
             ));
         }
+        Ok(Some(st))
     }
-    if let Some((t, at)) = int_of("type")? {
+
+    /// The entries of a list as whole numbers, each one of `allowed` when it is not empty.
+    fn ints(&self, st: &Statement, allowed: &[i64]) -> Result<Vec<i64>> {
+        st.entries
+            .iter()
+            .map(|(v, at)| {
+                let x: i64 = v.trim().parse().map_err(|_| {
+                    self.ctx
+                        .err(*at, format!("{}: `{v}` is not a whole number", st.key))
+                })?;
+                if !allowed.is_empty() && !allowed.contains(&x) {
+                    return Err(self
+                        .ctx
+                        .err(*at, format!("{}: {x} is not one of {allowed:?}", st.key)));
+                }
+                Ok(x)
+            })
+            .collect()
+    }
+
+    /// NL, NJ and NF = 2 NJ - NL, checked (NF as written, overflow, the lists' lengths) before
+    /// anything is sized from them.
+    fn counts(&self, statements: &[Statement]) -> Result<(usize, usize, usize)> {
+        let ctx = self.ctx;
+        let (nl, nl_at) = self
+            .int("nl")?
+            .ok_or_else(|| ctx.err_line(0, "the key NL (number of links) is missing"))?;
+        let (nj, nj_at) = self.int("nj")?.unwrap_or((nl, nl_at));
+        if nl < 1 {
+            return Err(ctx.err_line(nl_at, format!("NL = {nl}: a robot has at least one link")));
+        }
+        if nj < nl {
+            return Err(ctx.err_line(nj_at, format!("NJ = {nj} is smaller than NL = {nl}")));
+        }
+        let nf = nj
+            .checked_mul(2)
+            .and_then(|x| x.checked_sub(nl))
+            .ok_or_else(|| ctx.err_line(nj_at, format!("NJ = {nj} is too large")))?;
+        if let Some((f, at)) = self.int("nf")? {
+            if f != nf {
+                return Err(ctx.err_line(
+                    at,
+                    format!("NF = {f}, but NF must equal 2 NJ - NL = {nf} (NL = {nl}, NJ = {nj})"),
+                ));
+            }
+        }
+        let longest = statements
+            .iter()
+            .filter(|s| s.is_list)
+            .map(|s| s.entries.len())
+            .max()
+            .unwrap_or(0);
+        let limit = longest.max(FRAMES_WITHOUT_LISTS) as i64;
+        if nf > limit {
+            return Err(ctx.err_line(
+                nj_at,
+                format!(
+                    "NL = {nl}, NJ = {nj} make NF = {nf} frames, but no list of the file has more \
+                     than {longest} entries: a file without lists may declare at most \
+                     {FRAMES_WITHOUT_LISTS} frames"
+                ),
+            ));
+        }
+        // nf <= limit, which the file's size or a small constant bounds
+        Ok((nl as usize, nj as usize, nf as usize))
+    }
+}
+
+/// Parse a `.par` file. `file` names the source in error messages; warnings go to the map.
+pub fn parse_description(text: &str, file: Option<&str>) -> Result<(RobotDescription, SourceMap)> {
+    let ctx = Ctx {
+        text,
+        file,
+        lines: LineIndex::new(text),
+    };
+    let (stripped, comments) = strip_comments(&ctx)?;
+    let statements = split_statements(&ctx, &stripped)?;
+    let mut map = SourceMap::new(file);
+    let keys = Keys {
+        ctx: &ctx,
+        by_key: index_keys(&ctx, &statements)?,
+    };
+    let (nl, nj, nf) = keys.counts(&statements)?;
+    if let Some((t, at)) = keys.int("type")? {
         if !(0..=2).contains(&t) {
             return Err(ctx.err_line(
                 at,
@@ -462,80 +685,76 @@ pub fn parse_description(text: &str, file: Option<&str>) -> Result<(RobotDescrip
             ));
         }
     }
-
-    let mut robot_name = by_key
-        .get("name")
-        .map(|st| st.entries[0].0.trim_matches(['\'', '"']).to_string());
     let mut desc = RobotDescription::new("robot", nl, nj);
-    if let Some((m, at)) = int_of("is_mobile")? {
-        desc.mobile_base = match m {
-            0 => false,
-            1 => true,
-            _ => return Err(ctx.err_line(at, format!("is_mobile = {m} (0 or 1)"))),
-        };
+    if let Some((m, _)) = keys.flag("is_mobile")? {
+        desc.mobile_base = m;
     }
-    if let Some((m, at)) = int_of("is_floating")? {
-        if m != 0 {
-            return Err(ctx.err_line(
-                at,
-                format!(
-                    "is_floating = {m}: a floating (free) base is not supported; robodyn's base \
-                     is fixed or moves as given by W0 WP0 V0 VP0 (is_mobile = 1)"
-                ),
-            ));
-        }
+    if let Some((true, at)) = keys.flag("is_floating")? {
+        return Err(ctx.err_line(
+            at,
+            format!(
+                "is_floating = {}: a floating (free) base is not supported; robodyn's base is \
+                 fixed or moves as given by W0 WP0 V0 VP0 (is_mobile = 1)",
+                keys.by_key["is_floating"].entries[0].0
+            ),
+        ));
     }
     let mut ex = Extras::default();
     for (c, at) in &comments {
         parse_robodyn_comment(&ctx, c, *at, &mut ex, &mut map)?;
     }
-    if robot_name.is_none() {
-        robot_name = ex.robot_name.take();
-    }
-    desc.name = robot_name.unwrap_or_else(|| "robot".into());
+    let statement_name = keys
+        .by_key
+        .get("name")
+        .map(|st| st.entries[0].0.trim_matches(['\'', '"']).to_string());
+    desc.name = ex
+        .robodyn_name
+        .take()
+        .or(statement_name)
+        .or(ex.robot_name.take())
+        .unwrap_or_else(|| "robot".into());
     desc.symbols = std::mem::take(&mut ex.symbols);
     desc.notes = std::mem::take(&mut ex.notes);
-
-    let list = |k: &str, n: usize, what: &str| -> Result<Option<&Statement>> {
-        match by_key.get(k) {
-            None => Ok(None),
-            Some(st) => {
-                if st.entries.len() != n {
-                    return Err(ctx.err_line(
-                        st.at,
-                        if what.parse::<usize>().is_ok() {
-                            format!("{} has {} entries, {n} expected", st.key, st.entries.len())
-                        } else {
-                            format!(
-                                "{} has {} entries, {what} = {n} expected",
-                                st.key,
-                                st.entries.len()
-                            )
-                        },
-                    ));
-                }
-                Ok(Some(st))
-            }
+    frame_lists(&keys, &mut desc, &mut map)?;
+    for (j, n) in std::mem::take(&mut ex.frame_names) {
+        if (1..=nf).contains(&j) {
+            desc.frames[j - 1].name = n;
         }
-    };
-    let ints = |st: &Statement, allowed: &[i64]| -> Result<Vec<i64>> {
-        st.entries
-            .iter()
-            .map(|(v, at)| {
-                let x: i64 = v.trim().parse().map_err(|_| {
-                    ctx.err(*at, format!("{}: `{v}` is not a whole number", st.key))
-                })?;
-                if !allowed.is_empty() && !allowed.contains(&x) {
-                    return Err(ctx.err(*at, format!("{}: {x} is not one of {allowed:?}", st.key)));
-                }
-                Ok(x)
-            })
-            .collect()
-    };
+    }
+    link_lists(&keys, &mut desc, &mut map)?;
+    for (j, n) in std::mem::take(&mut ex.link_names) {
+        if (1..=nl).contains(&j) {
+            desc.links[j - 1].name = n;
+        }
+    }
+    if !ex.assembly.is_empty() {
+        let mut q = vec![0.0; nl];
+        for (&j, &(x, at)) in &ex.assembly {
+            if !(1..=nl).contains(&j) {
+                return Err(ctx.err(
+                    at,
+                    format!("robodyn assembly: joint {j} is not a tree joint 1..{nl}"),
+                ));
+            }
+            q[j - 1] = x;
+        }
+        map.set_base(
+            "assembly",
+            ctx.line(ex.assembly.values().next().expect("one").1),
+        );
+        desc.assembly = Some(q);
+    }
+    other_lists(&keys, &mut desc, &mut map)?;
+    validate_structure(&desc).map_err(|e| map.locate(e))?;
+    Ok((desc, map))
+}
 
-    // frame lists
-    if let Some(st) = list("ant", nf, "NF")? {
-        for (j, a) in ints(st, &[])?.into_iter().enumerate() {
+/// The NF-entry lists: structure, joint types, actuation, geometry (joint variables removed).
+fn frame_lists(keys: &Keys, desc: &mut RobotDescription, map: &mut SourceMap) -> Result<()> {
+    let ctx = keys.ctx;
+    let (nl, nj, nf) = (desc.nl, desc.nj, desc.nf());
+    if let Some(st) = keys.list("ant", nf, "NF")? {
+        for (j, a) in keys.ints(st, &[])?.into_iter().enumerate() {
             if a < 0 {
                 return Err(ctx.err(
                     st.entries[j].1,
@@ -543,24 +762,20 @@ pub fn parse_description(text: &str, file: Option<&str>) -> Result<(RobotDescrip
                 ));
             }
             desc.frames[j].ant = a as usize;
-            map.set_frame(j + 1, Some("ant"), ctx.line(st.entries[j].1));
+            let line = ctx.line(st.entries[j].1);
+            map.set_frame(j + 1, Some("ant"), line);
+            map.set_frame(j + 1, None, line);
         }
     }
-    for j in 1..=nf {
-        let line = by_key.get("ant").map(|s| ctx.line(s.entries[j - 1].1));
-        if let Some(l) = line {
-            map.set_frame(j, None, l);
-        }
-    }
-    if let Some(st) = list("sigma", nf, "NF")? {
-        for (j, s) in ints(st, &[0, 1, 2])?.into_iter().enumerate() {
+    if let Some(st) = keys.list("sigma", nf, "NF")? {
+        for (j, s) in keys.ints(st, &[0, 1, 2])?.into_iter().enumerate() {
             desc.frames[j].joint = JointType::from_sigma(s).expect("checked");
             map.set_frame(j + 1, Some("sigma"), ctx.line(st.entries[j].1));
         }
     }
-    match list("mu", nf, "NF")? {
+    match keys.list("mu", nf, "NF")? {
         Some(st) => {
-            for (j, m) in ints(st, &[0, 1])?.into_iter().enumerate() {
+            for (j, m) in keys.ints(st, &[0, 1])?.into_iter().enumerate() {
                 desc.frames[j].actuated = m == 1;
                 map.set_frame(j + 1, Some("mu"), ctx.line(st.entries[j].1));
             }
@@ -572,29 +787,34 @@ pub fn parse_description(text: &str, file: Option<&str>) -> Result<(RobotDescrip
         }
     }
     for (k, pname) in GEOMETRIC_PARAMETERS.iter().enumerate() {
-        let Some(st) = list(pname, nf, "NF")? else {
+        let Some(st) = keys.list(pname, nf, "NF")? else {
             continue;
         };
         for j in 1..=nf {
             let (v, at) = &st.entries[j - 1];
-            let mut e = ctx.expr(&format!("{} of frame {j}", st.key), v, *at)?;
+            let mut e = ctx.expr(&format!("frame {j}, {}", st.key), v, *at)?;
             map.set_frame(j, Some(pname), ctx.line(*at));
             let joint = desc.frames[j - 1].joint;
             let var_slot = (*pname == "theta" && joint == JointType::Revolute)
                 || (*pname == "r" && joint == JointType::Prismatic);
             if var_slot && j <= nj {
-                e = remove_joint_variable(&ctx, st, j, joint, e, &desc.symbols, *at)?;
+                let (offset, warning) =
+                    remove_joint_variable(ctx, st, j, joint, e, &desc.symbols, *at)?;
+                if let Some(w) = warning {
+                    map.warn(w);
+                }
+                e = offset;
             }
             *desc.frames[j - 1].geometric_mut()[k] = e;
         }
     }
-    for (j, n) in std::mem::take(&mut ex.frame_names) {
-        if (1..=nf).contains(&j) {
-            desc.frames[j - 1].name = n;
-        }
-    }
+    Ok(())
+}
 
-    // link lists
+/// The NL-entry lists: inertial and drive parameters, external wrenches.
+fn link_lists(keys: &Keys, desc: &mut RobotDescription, map: &mut SourceMap) -> Result<()> {
+    let ctx = keys.ctx;
+    let nl = desc.nl;
     for (k, pname) in STANDARD_PARAMETERS
         .iter()
         .chain(WRENCH_COMPONENTS.iter())
@@ -602,11 +822,11 @@ pub fn parse_description(text: &str, file: Option<&str>) -> Result<(RobotDescrip
     {
         // with a mobile base, OpenSYMORO lists link 0 (the base) first: NL + 1 entries
         let key = pname.to_ascii_lowercase();
-        let skip = match by_key.get(key.as_str()) {
+        let skip = match keys.by_key.get(key.as_str()) {
             Some(st) if desc.mobile_base && st.entries.len() == nl + 1 => 1,
             _ => 0,
         };
-        let Some(st) = list(&key, nl + skip, "NL")? else {
+        let Some(st) = keys.list(&key, nl + skip, "NL")? else {
             continue;
         };
         if skip == 1 && !st.entries[0].0.trim().eq("0") {
@@ -618,7 +838,7 @@ pub fn parse_description(text: &str, file: Option<&str>) -> Result<(RobotDescrip
         }
         for j in 1..=nl {
             let (v, at) = &st.entries[j - 1 + skip];
-            let e = ctx.expr(&format!("{} of link {j}", st.key), v, *at)?;
+            let e = ctx.expr(&format!("link {j}, {}", st.key), v, *at)?;
             map.set_link(j, Some(pname), ctx.line(*at));
             if k < 13 {
                 desc.links[j - 1].params[k] = e;
@@ -627,27 +847,15 @@ pub fn parse_description(text: &str, file: Option<&str>) -> Result<(RobotDescrip
             }
         }
     }
-    if !ex.assembly.is_empty() {
-        let mut q = vec![0.0; nl];
-        for (&j, &x) in &ex.assembly {
-            if !(1..=nl).contains(&j) {
-                return Err(Error::parse(
-                    file,
-                    1,
-                    format!("robodyn assembly: joint {j} is not a tree joint 1..{nl}"),
-                ));
-            }
-            q[j - 1] = x;
-        }
-        desc.assembly = Some(q);
-    }
-    for (j, n) in std::mem::take(&mut ex.link_names) {
-        if (1..=nl).contains(&j) {
-            desc.links[j - 1].name = n;
-        }
-    }
+    Ok(())
+}
+
+/// The NJ-entry lists (checked, flexibility noted), the base matrix Z (noted when it is not the
+/// identity), gravity and the base velocities and accelerations.
+fn other_lists(keys: &Keys, desc: &mut RobotDescription, map: &mut SourceMap) -> Result<()> {
+    let ctx = keys.ctx;
     for k in ["qp", "qdp", "gam", "eta", "k"] {
-        if let Some(st) = list(k, nj, "NJ")? {
+        if let Some(st) = keys.list(k, desc.nj, "NJ")? {
             for (v, at) in &st.entries {
                 let e = ctx.expr(&st.key, v, *at)?;
                 if k == "eta" && !e.is_zero() {
@@ -661,7 +869,7 @@ pub fn parse_description(text: &str, file: Option<&str>) -> Result<(RobotDescrip
             }
         }
     }
-    if let Some(st) = list("z", 16, "16")? {
+    if let Some(st) = keys.list("z", 16, "16")? {
         let mut z = [0.0; 16];
         for (i, (v, at)) in st.entries.iter().enumerate() {
             let e = ctx.expr("Z", v, *at)?;
@@ -689,7 +897,7 @@ pub fn parse_description(text: &str, file: Option<&str>) -> Result<(RobotDescrip
         ("v0", "V0"),
         ("vp0", "VP0"),
     ] {
-        if let Some(st) = list(k, 3, "3")? {
+        if let Some(st) = keys.list(k, 3, "3")? {
             map.set_base(name, ctx.line(st.at));
             let mut v: [Expr; 3] = std::array::from_fn(|_| Expr::zero());
             for (i, (s, at)) in st.entries.iter().enumerate() {
@@ -704,13 +912,18 @@ pub fn parse_description(text: &str, file: Option<&str>) -> Result<(RobotDescrip
             }
         }
     }
-    validate_structure(&desc).map_err(|e| map.locate(e))?;
-    Ok((desc, map))
+    Ok(())
 }
 
-/// Strip the joint variable from a `theta` (revolute) or `r` (prismatic) entry: the variable must
-/// enter with coefficient 1 (checked by evaluating at two points with the other symbols at
-/// arbitrary values); the rest is the constant offset.
+/// Split a `theta` (revolute) or `r` (prismatic) entry into the joint variable and the constant
+/// offset, as SYMORO reads it (the entry is the joint variable):
+/// - the variable is the entry's symbol without a value; among several, the one named like a
+///   joint variable (`th3`, `q3`, `t3`, `theta3`; `r3`, `q3`); it must enter with coefficient 1
+///   (checked by evaluating at three points with the other symbols at arbitrary values), and what
+///   remains is the offset;
+/// - an entry without such a symbol (a number, a constant expression) is the value SYMORO gives
+///   the variable, not an offset: the offset is 0 and, when the value is not 0, a warning says
+///   how SYMORO's models relate to robodyn's.
 fn remove_joint_variable(
     ctx: &Ctx,
     st: &Statement,
@@ -719,20 +932,56 @@ fn remove_joint_variable(
     e: Expr,
     values: &BTreeMap<String, f64>,
     at: usize,
-) -> Result<Expr> {
-    let vars: Vec<String> = e
+) -> Result<(Expr, Option<Warning>)> {
+    let unknown: Vec<String> = e
         .symbols()
         .into_iter()
-        .filter(|s| !values.contains_key(s) && is_variable_name(s, joint))
+        .filter(|s| !values.contains_key(s))
         .collect();
-    let var = match vars.as_slice() {
-        [] => return Ok(e), // a number or constant expression: the offset alone
-        [v] => v.clone(),
-        many => {
+    let named: Vec<&String> = unknown
+        .iter()
+        .filter(|s| is_variable_name(s, joint))
+        .collect();
+    let var = match (unknown.as_slice(), named.as_slice()) {
+        ([], _) => {
+            let v = e.eval(&|s| values.get(s).copied()).ok();
+            let param = if joint == JointType::Revolute {
+                "theta"
+            } else {
+                "r"
+            };
+            let prefix = if joint == JointType::Revolute {
+                "th"
+            } else {
+                "r"
+            };
+            let warning = (v != Some(0.0)).then(|| {
+                Warning::new(
+                    Item::Frame(j, Some(param.into())),
+                    format!(
+                        "{} = {e} on a {} joint: SYMORO reads this entry as the joint variable \
+                         itself, so the file describes the robot at q{j} = {e}; robodyn reads it \
+                         the same way (the joint's {param} is q{j}, with no constant offset). \
+                         Write `{prefix}{j} + {e}` if {e} is meant as an offset",
+                        st.key,
+                        if joint == JointType::Revolute {
+                            "revolute"
+                        } else {
+                            "prismatic"
+                        },
+                    ),
+                )
+            });
+            return Ok((Expr::zero(), warning));
+        }
+        ([v], _) => v.clone(),
+        (_, [v]) => (*v).clone(),
+        (many, _) => {
             return Err(ctx.err(
                 at,
                 format!(
-                    "{} of frame {j}: several joint variables ({})",
+                    "{} of frame {j}: several candidates for the joint variable ({}): name it \
+                     th{j} (or q{j}) and give the others a value",
                     st.key,
                     many.join(", ")
                 ),
@@ -772,10 +1021,9 @@ fn remove_joint_variable(
             ));
         }
     }
-    Ok(offset)
+    Ok((offset, None))
 }
 
-/// The Type of a description: 0 simple chain, 1 tree, 2 closed loops.
 fn structure_type(desc: &RobotDescription) -> u8 {
     if desc.nj > desc.nl {
         2
@@ -786,20 +1034,26 @@ fn structure_type(desc: &RobotDescription) -> u8 {
     }
 }
 
-/// A name safe inside a comment and a `;`-separated list.
-fn clean_name(s: &str) -> String {
-    s.replace([';', '\n'], "_")
-        .replace("(*", "( *")
-        .replace("*)", "* )")
+/// The robot name as SYMORO's `Robotname` comment can hold it (robodyn's own name comment
+/// keeps the exact name when this changes it).
+fn symoro_name(s: &str) -> String {
+    s.replace(['\n', '\r', '\'', '*'], "_")
 }
 
 /// Write a description as a SYMORO `.par` file (plus our values/names in comments).
 pub fn write_description(desc: &RobotDescription) -> String {
     let nf = desc.nf();
     let mut s = String::new();
-    s.push_str(&format!("(* Robotname = '{}' *)\n", clean_name(&desc.name)));
+    let name = symoro_name(&desc.name);
+    s.push_str(&format!("(* Robotname = '{name}' *)\n"));
+    if name != desc.name || name.trim() != name || name.is_empty() {
+        s.push_str(&format!(
+            "(* robodyn name: {} *)\n",
+            comment_text(&desc.name)
+        ));
+    }
     for n in &desc.notes {
-        s.push_str(&format!("(* robodyn note: {} *)\n", n.replace("*)", "* )")));
+        s.push_str(&format!("(* robodyn note: {} *)\n", comment_text(n)));
     }
     s.push_str(&format!(
         "NL = {}\nNJ = {}\nNF = {nf}\nType = {}\nis_mobile = {}\n",
@@ -932,7 +1186,7 @@ pub fn write_description(desc: &RobotDescription) -> String {
             .frames
             .iter()
             .enumerate()
-            .map(|(i, f)| format!("{} = {}", i + 1, clean_name(&f.name)))
+            .map(|(i, f)| format!("{} = {}", i + 1, comment_text(&f.name)))
             .collect();
         s.push_str(&format!(
             "\n(* robodyn frame names: {} *)\n",
@@ -949,7 +1203,7 @@ pub fn write_description(desc: &RobotDescription) -> String {
             .links
             .iter()
             .enumerate()
-            .map(|(i, l)| format!("{} = {}", i + 1, clean_name(&l.name)))
+            .map(|(i, l)| format!("{} = {}", i + 1, comment_text(&l.name)))
             .collect();
         s.push_str(&format!("(* robodyn link names: {} *)\n", items.join("; ")));
     }

@@ -1,9 +1,15 @@
 //! The native TOML robot format (documented in `docs/robot-format.md`).
 //!
 //! Every value may be a number or a string holding an expression over the symbols of the
-//! `[symbols]` table. Errors carry the file and line of the offending entry.
+//! `[symbols]` table. Errors carry the file and line of the offending entry, and the key.
+//!
+//! Reading is linear in the file size: positions come from a [`LineIndex`], and the counts
+//! `nl`/`nj` are checked against the tables the file actually has before anything is sized
+//! from them.
 
-use crate::error::{Error, Item, Location, Result};
+use crate::error::{Error, Location, Result};
+use crate::io::source::LineIndex;
+pub use crate::io::SourceMap;
 use crate::model::{
     validate_structure, JointType, LinkDesc, RobotDescription, GEOMETRIC_PARAMETERS,
     STANDARD_PARAMETERS, WRENCH_COMPONENTS,
@@ -11,7 +17,7 @@ use crate::model::{
 use crate::Robot;
 use robodyn_symbolic::Expr;
 use serde::Deserialize;
-use std::collections::{BTreeMap, HashMap};
+use std::collections::BTreeMap;
 use std::ops::Range;
 use toml::Spanned;
 
@@ -104,333 +110,393 @@ impl LinkTable {
     }
 }
 
-/// Line numbers of the items of a file, to place errors found after parsing.
-#[derive(Default, Debug, Clone)]
-pub struct SourceMap {
-    pub file: Option<String>,
-    lines: HashMap<ItemKey, usize>,
+/// Whether `s` can name a symbol in an expression: a letter or `_`, then letters, digits, `_`.
+pub(crate) fn is_symbol_name(s: &str) -> bool {
+    let mut c = s.chars();
+    c.next()
+        .is_some_and(|f| f.is_ascii_alphabetic() || f == '_')
+        && c.all(|x| x.is_ascii_alphanumeric() || x == '_')
 }
 
-#[derive(Hash, PartialEq, Eq, Debug, Clone)]
-enum ItemKey {
-    Frame(usize, Option<String>),
-    Link(usize, Option<String>),
-    Base(String),
-    Symbol(String),
+/// The reading of one file: its text, lines and the map being built.
+struct Reader<'a> {
+    text: &'a str,
+    file: Option<&'a str>,
+    lines: LineIndex,
+    map: SourceMap,
 }
 
-impl SourceMap {
-    /// Record the line of an item (frame j or link j, optionally one of its parameters).
-    pub fn set_frame(&mut self, j: usize, param: Option<&str>, line: usize) {
-        self.lines
-            .insert(ItemKey::Frame(j, param.map(str::to_string)), line);
-    }
-    pub fn set_link(&mut self, j: usize, param: Option<&str>, line: usize) {
-        self.lines
-            .insert(ItemKey::Link(j, param.map(str::to_string)), line);
-    }
-    pub fn set_base(&mut self, name: &str, line: usize) {
-        self.lines.insert(ItemKey::Base(name.to_string()), line);
-    }
-    pub fn set_symbol(&mut self, name: &str, line: usize) {
-        self.lines.insert(ItemKey::Symbol(name.to_string()), line);
-    }
-
-    /// The line of an item, falling back to its frame/link as a whole.
-    pub fn line_of(&self, item: &Item) -> Option<usize> {
-        let get = |k: ItemKey| self.lines.get(&k).copied();
-        match item {
-            Item::Frame(j, p) => {
-                get(ItemKey::Frame(*j, p.clone())).or(get(ItemKey::Frame(*j, None)))
-            }
-            Item::Link(j, p) => get(ItemKey::Link(*j, p.clone())).or(get(ItemKey::Link(*j, None))),
-            Item::Base(n) => {
-                let base = n.split('[').next().unwrap_or(n).to_string();
-                get(ItemKey::Base(base))
-            }
-            Item::Symbol(s) => get(ItemKey::Symbol(s.clone())),
-            Item::Robot | Item::Loop(_) => None,
+impl<'a> Reader<'a> {
+    fn new(text: &'a str, file: Option<&'a str>) -> Reader<'a> {
+        Reader {
+            text,
+            file,
+            lines: LineIndex::new(text),
+            map: SourceMap::new(file),
         }
     }
 
-    /// Attach file and line to an error.
-    pub fn locate(&self, e: Error) -> Error {
-        let line = e.item().and_then(|i| self.line_of(i));
-        e.at(self.file.as_deref(), line)
+    fn line(&self, span: Range<usize>) -> usize {
+        self.lines.line(span.start)
     }
-}
 
-fn line_of(text: &str, span: Range<usize>) -> usize {
-    text[..span.start.min(text.len())].matches('\n').count() + 1
-}
+    fn err(&self, span: Range<usize>, reason: impl Into<String>) -> Error {
+        Error::parse(self.file, self.line(span), reason)
+    }
 
-fn to_expr(text: &str, file: Option<&str>, v: &SV) -> Result<Expr> {
-    let line = line_of(text, v.span());
-    match v.get_ref() {
-        Value::Int(i) => Ok(Expr::int(*i)),
-        Value::Float(x) => {
-            if x.is_finite() {
-                Ok(Expr::num(*x))
-            } else {
-                Err(Error::parse(
-                    file,
+    /// The file as TOML: a syntax or type error names its line, the table and the key.
+    fn deserialize(&self) -> Result<FileTop> {
+        toml::from_str(self.text).map_err(|e| {
+            let (line, column, key) = match e.span() {
+                Some(s) => {
+                    let (l, c) = self.lines.position(s.start);
+                    (Some(l), Some(c), self.key_at(s.start))
+                }
+                None => (None, None, None),
+            };
+            let reason = friendly_toml_message(e.message());
+            Error::Parse {
+                location: Location {
+                    file: self.file.map(str::to_string),
                     line,
-                    format!("{x} is not a finite number"),
-                ))
+                    column,
+                },
+                reason: match key {
+                    Some(k) => format!("{k}: {reason}"),
+                    None => reason,
+                },
             }
-        }
-        Value::Str(s) => Expr::parse(s)
-            .map_err(|e| Error::parse(file, line, format!("bad expression `{s}`: {e}"))),
+        })
     }
-}
 
-/// Parse a TOML robot description. `file` names the source in error messages.
-pub fn parse_description(text: &str, file: Option<&str>) -> Result<(RobotDescription, SourceMap)> {
-    let top: FileTop = toml::from_str(text).map_err(|e| {
-        let line = e.span().map(|s| line_of(text, s)).unwrap_or(1);
-        Error::Parse {
-            location: Location {
-                file: file.map(str::to_string),
-                line: Some(line),
-                column: None,
-            },
-            reason: e.message().to_string(),
-        }
-    })?;
-    let mut map = SourceMap {
-        file: file.map(str::to_string),
-        ..Default::default()
-    };
-    let nl = top
-        .nl
-        .as_ref()
-        .map(|s| *s.get_ref())
-        .unwrap_or(top.link.len());
-    let nj = top.nj.as_ref().map(|s| *s.get_ref()).unwrap_or(nl);
-    if nj < nl || 2 * nj < nl {
-        let line = top
-            .nj
-            .as_ref()
-            .map(|s| line_of(text, s.span()))
-            .unwrap_or(1);
-        return Err(Error::parse(
-            file,
-            line,
-            format!("nj = {nj} is smaller than nl = {nl}"),
-        ));
-    }
-    let mut desc =
-        RobotDescription::new(top.name.clone().unwrap_or_else(|| "robot".into()), nl, nj);
-    desc.notes = top.notes.clone().unwrap_or_default();
-    desc.mobile_base = top.mobile_base.unwrap_or(false);
-    let nf = desc.nf();
-    if top.frame.len() != nf {
-        return Err(Error::parse(
-            file,
-            top.frame
-                .last()
-                .map(|f| line_of(text, f.span()))
-                .unwrap_or(1),
-            format!(
-                "{} [[frame]] tables given, NF = 2 nj - nl = {nf} expected (nl = {nl}, nj = {nj})",
-                top.frame.len()
-            ),
-        ));
-    }
-    if top.link.len() != nl {
-        return Err(Error::parse(
-            file,
-            top.link
-                .last()
-                .map(|f| line_of(text, f.span()))
-                .unwrap_or(1),
-            format!(
-                "{} [[link]] tables given, nl = {nl} expected",
-                top.link.len()
-            ),
-        ));
-    }
-    for (name, v) in &top.symbols {
-        let line = line_of(text, v.span());
-        map.set_symbol(name, line);
-        let x = match v.get_ref() {
-            Value::Int(i) => *i as f64,
-            Value::Float(x) => *x,
-            Value::Str(s) => {
-                // a symbol may be defined by an expression of the constants (e.g. "pi/6")
-                let e = Expr::parse(s)
-                    .map_err(|e| Error::parse(file, line, format!("symbol {name}: {e}")))?;
-                e.eval(&|_| None).map_err(|e| {
-                    Error::parse(
-                        file,
-                        line,
-                        format!("symbol {name}: {e} (symbol values must be constants)"),
-                    )
-                })?
+    /// The key written on the line of `offset` (`ant`, `gravity`...) with its table (`[[frame]]`
+    /// number 3, `[symbols]`), for error messages.
+    fn key_at(&self, offset: usize) -> Option<String> {
+        let line = self.lines.line(offset);
+        let start = self.lines.line_start(line);
+        let text = &self.text[start..];
+        let text = &text[..text.find('\n').unwrap_or(text.len())];
+        let key = text
+            .split_once('=')
+            .map(|(k, _)| k.trim().trim_matches(['"', '\'']).to_string())
+            .filter(|k| !k.is_empty() && !k.starts_with('['));
+        // the enclosing table: the last header line before, and how many like it precede
+        let before = &self.text[..start];
+        let header = before
+            .lines()
+            .rev()
+            .map(str::trim)
+            .find(|l| l.starts_with('['))
+            .map(|h| h.split('#').next().unwrap_or(h).trim().to_string());
+        let table = header.map(|h| {
+            if h.starts_with("[[") {
+                let n = before.lines().filter(|l| l.trim().starts_with(&h)).count();
+                let name = h.trim_matches(['[', ']']).trim();
+                format!("[[{name}]] number {n}")
+            } else {
+                h
             }
+        });
+        match (table, key) {
+            (Some(t), Some(k)) => Some(format!("{t}, key `{k}`")),
+            (None, Some(k)) => Some(format!("key `{k}`")),
+            (Some(t), None) => Some(t),
+            (None, None) => None,
+        }
+    }
+
+    /// A value as an expression: a finite number or a string that parses.
+    fn expr(&self, key: &str, v: &SV) -> Result<Expr> {
+        match v.get_ref() {
+            Value::Int(i) => Ok(Expr::int(*i)),
+            Value::Float(x) if x.is_finite() => Ok(Expr::num(*x)),
+            Value::Float(x) => {
+                Err(self.err(v.span(), format!("{key}: {x} is not a finite number")))
+            }
+            Value::Str(s) => Expr::parse(s)
+                .map_err(|e| self.err(v.span(), format!("{key}: bad expression `{s}`: {e}"))),
+        }
+    }
+
+    /// NL and NJ, checked against the tables the file has before anything is sized from them.
+    fn counts(&self, top: &FileTop) -> Result<(usize, usize)> {
+        let nl = top
+            .nl
+            .as_ref()
+            .map(|s| *s.get_ref())
+            .unwrap_or(top.link.len());
+        let nj = top.nj.as_ref().map(|s| *s.get_ref()).unwrap_or(nl);
+        let nj_line = || top.nj.as_ref().map(|s| self.line(s.span())).unwrap_or(1);
+        let last_line = |spans: &mut dyn Iterator<Item = Range<usize>>| {
+            spans.last().map(|s| self.lines.line(s.start)).unwrap_or(1)
         };
-        if !x.is_finite() {
+        if top.link.len() != nl {
             return Err(Error::parse(
-                file,
-                line,
-                format!("symbol {name} = {x} is not a finite number"),
+                self.file,
+                last_line(&mut top.link.iter().map(|l| l.span())),
+                format!(
+                    "{} [[link]] tables given, nl = {nl} expected",
+                    top.link.len()
+                ),
             ));
         }
-        desc.symbols.insert(name.clone(), x);
-    }
-    for (idx, ft) in top.frame.iter().enumerate() {
-        let j = idx + 1;
-        let line = line_of(text, ft.span());
-        map.set_frame(j, None, line);
-        let f = ft.get_ref();
-        if let Some(jj) = &f.j {
-            if *jj.get_ref() != j {
-                return Err(Error::parse(
-                    file,
-                    line_of(text, jj.span()),
-                    format!(
-                        "[[frame]] number {j} says j = {}: frames must be listed in order",
-                        jj.get_ref()
-                    ),
-                ));
-            }
+        if nj < nl {
+            return Err(Error::parse(
+                self.file,
+                nj_line(),
+                format!("nj = {nj} is smaller than nl = {nl}"),
+            ));
         }
-        let fr = desc.frame_mut(j);
-        if let Some(n) = &f.name {
-            fr.name = n.clone();
-        }
-        fr.ant = *f.ant.get_ref();
-        map.set_frame(j, Some("ant"), line_of(text, f.ant.span()));
-        let joint = match (&f.sigma, &f.kind) {
-            (Some(s), _) => JointType::from_sigma(*s.get_ref()).ok_or_else(|| {
-                Error::parse(
-                    file,
-                    line_of(text, s.span()),
-                    format!(
-                        "frame {j}: sigma = {} (0 revolute, 1 prismatic, 2 fixed)",
-                        s.get_ref()
-                    ),
-                )
-            })?,
-            (None, Some(k)) => match k.get_ref().as_str() {
-                "revolute" => JointType::Revolute,
-                "prismatic" => JointType::Prismatic,
-                "fixed" => JointType::Fixed,
-                other => {
-                    return Err(Error::parse(
-                        file,
-                        line_of(text, k.span()),
-                        format!("frame {j}: type `{other}` (revolute, prismatic or fixed)"),
-                    ))
-                }
-            },
-            (None, None) => {
-                if j > nj {
-                    JointType::Fixed
-                } else {
-                    JointType::Revolute
-                }
-            }
+        let Some(nf) = nj.checked_mul(2).and_then(|x| x.checked_sub(nl)) else {
+            return Err(Error::parse(
+                self.file,
+                nj_line(),
+                format!("nj = {nj} is too large (NF = 2 nj - nl overflows)"),
+            ));
         };
-        fr.joint = joint;
-        fr.actuated = match &f.mu {
-            Some(m) => match m.get_ref() {
-                0 => false,
-                1 => true,
-                other => {
-                    return Err(Error::parse(
-                        file,
-                        line_of(text, m.span()),
-                        format!("frame {j}: mu = {other} (1 actuated, 0 passive)"),
-                    ))
-                }
-            },
-            None => j <= nl && joint.is_movable(),
-        };
-        let vals = [&f.gamma, &f.b, &f.alpha, &f.d, &f.theta, &f.r];
-        for (k, v) in vals.iter().enumerate() {
-            if let Some(v) = v {
-                map.set_frame(j, Some(GEOMETRIC_PARAMETERS[k]), line_of(text, v.span()));
-                *desc.frame_mut(j).geometric_mut()[k] = to_expr(text, file, v)?;
-            }
+        if top.frame.len() != nf {
+            return Err(Error::parse(
+                self.file,
+                last_line(&mut top.frame.iter().map(|f| f.span())),
+                format!(
+                    "{} [[frame]] tables given, NF = 2 nj - nl = {nf} expected (nl = {nl}, nj = {nj})",
+                    top.frame.len()
+                ),
+            ));
         }
+        Ok((nl, nj))
     }
-    for (idx, lt) in top.link.iter().enumerate() {
-        let j = idx + 1;
-        let line = line_of(text, lt.span());
-        map.set_link(j, None, line);
-        let l = lt.get_ref();
-        if let Some(jj) = &l.j {
-            if *jj.get_ref() != j {
+
+    /// `[symbols]`: constant values (numbers or constant expressions such as `"pi/6"`).
+    fn symbols(&mut self, top: &FileTop, desc: &mut RobotDescription) -> Result<()> {
+        for (name, v) in &top.symbols {
+            let line = self.line(v.span());
+            self.map.set_symbol(name, line);
+            if !is_symbol_name(name) {
                 return Err(Error::parse(
-                    file,
-                    line_of(text, jj.span()),
-                    format!(
-                        "[[link]] number {j} says j = {}: links must be listed in order",
-                        jj.get_ref()
-                    ),
-                ));
-            }
-        }
-        let mut ld = LinkDesc::zero(l.name.clone().unwrap_or_else(|| format!("link{j}")));
-        for (k, v) in l.params().iter().enumerate() {
-            if let Some(v) = v {
-                map.set_link(j, Some(STANDARD_PARAMETERS[k]), line_of(text, v.span()));
-                ld.params[k] = to_expr(text, file, v)?;
-            }
-        }
-        for (k, v) in l.wrench().iter().enumerate() {
-            if let Some(v) = v {
-                map.set_link(j, Some(WRENCH_COMPONENTS[k]), line_of(text, v.span()));
-                ld.wrench[k] = to_expr(text, file, v)?;
-            }
-        }
-        desc.links[idx] = ld;
-    }
-    for (name, v, dst) in [
-        ("G", &top.gravity, &mut desc.gravity),
-        ("W0", &top.w0, &mut desc.w0),
-        ("WP0", &top.wp0, &mut desc.wp0),
-        ("V0", &top.v0, &mut desc.v0),
-        ("VP0", &top.vp0, &mut desc.vp0),
-    ] {
-        if let Some(v) = v {
-            let line = line_of(text, v.span());
-            map.set_base(name, line);
-            if v.get_ref().len() != 3 {
-                return Err(Error::parse(
-                    file,
+                    self.file,
                     line,
                     format!(
-                        "{} has {} entries, 3 expected",
-                        name.to_lowercase(),
-                        v.get_ref().len()
+                        "[symbols]: `{name}` is not a symbol name (a letter or `_`, then \
+                         letters, digits or `_`)"
                     ),
+                ));
+            }
+            let x = match v.get_ref() {
+                Value::Int(i) => *i as f64,
+                Value::Float(x) => *x,
+                Value::Str(s) => {
+                    // a symbol may be defined by an expression of the constants (e.g. "pi/6")
+                    let e = Expr::parse(s).map_err(|e| {
+                        Error::parse(self.file, line, format!("symbol {name}: {e}"))
+                    })?;
+                    e.eval(&|_| None).map_err(|e| {
+                        Error::parse(
+                            self.file,
+                            line,
+                            format!("symbol {name}: {e} (symbol values must be constants)"),
+                        )
+                    })?
+                }
+            };
+            if !x.is_finite() {
+                return Err(Error::parse(
+                    self.file,
+                    line,
+                    format!("symbol {name} = {x} is not a finite number"),
+                ));
+            }
+            desc.symbols.insert(name.clone(), x);
+        }
+        Ok(())
+    }
+
+    /// Check that a table's `j`, when given, is its position.
+    fn check_number(&self, kind: &str, j: usize, given: &Option<Spanned<usize>>) -> Result<()> {
+        match given {
+            Some(jj) if *jj.get_ref() != j => Err(self.err(
+                jj.span(),
+                format!(
+                    "[[{kind}]] number {j} says j = {}: {kind}s must be listed in order",
+                    jj.get_ref()
+                ),
+            )),
+            _ => Ok(()),
+        }
+    }
+
+    fn frames(&mut self, top: &FileTop, desc: &mut RobotDescription) -> Result<()> {
+        let (nl, nj) = (desc.nl, desc.nj);
+        for (idx, ft) in top.frame.iter().enumerate() {
+            let j = idx + 1;
+            self.map.set_frame(j, None, self.line(ft.span()));
+            let f = ft.get_ref();
+            self.check_number("frame", j, &f.j)?;
+            let joint = match (&f.sigma, &f.kind) {
+                (Some(s), _) => JointType::from_sigma(*s.get_ref()).ok_or_else(|| {
+                    self.err(
+                        s.span(),
+                        format!(
+                            "frame {j}: sigma = {} (0 revolute, 1 prismatic, 2 fixed)",
+                            s.get_ref()
+                        ),
+                    )
+                })?,
+                (None, Some(k)) => match k.get_ref().as_str() {
+                    "revolute" => JointType::Revolute,
+                    "prismatic" => JointType::Prismatic,
+                    "fixed" => JointType::Fixed,
+                    other => {
+                        return Err(self.err(
+                            k.span(),
+                            format!("frame {j}: type `{other}` (revolute, prismatic or fixed)"),
+                        ))
+                    }
+                },
+                (None, None) if j > nj => JointType::Fixed,
+                (None, None) => JointType::Revolute,
+            };
+            let actuated = match &f.mu {
+                Some(m) => match m.get_ref() {
+                    0 => false,
+                    1 => true,
+                    other => {
+                        return Err(self.err(
+                            m.span(),
+                            format!("frame {j}: mu = {other} (1 actuated, 0 passive)"),
+                        ))
+                    }
+                },
+                None => j <= nl && joint.is_movable(),
+            };
+            self.map.set_frame(j, Some("ant"), self.line(f.ant.span()));
+            let fr = desc.frame_mut(j);
+            if let Some(n) = &f.name {
+                fr.name = n.clone();
+            }
+            fr.ant = *f.ant.get_ref();
+            fr.joint = joint;
+            fr.actuated = actuated;
+            let vals = [&f.gamma, &f.b, &f.alpha, &f.d, &f.theta, &f.r];
+            for (k, v) in vals.iter().enumerate() {
+                if let Some(v) = v {
+                    let pname = GEOMETRIC_PARAMETERS[k];
+                    self.map.set_frame(j, Some(pname), self.line(v.span()));
+                    *desc.frame_mut(j).geometric_mut()[k] =
+                        self.expr(&format!("frame {j}, {pname}"), v)?;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn links(&mut self, top: &FileTop, desc: &mut RobotDescription) -> Result<()> {
+        for (idx, lt) in top.link.iter().enumerate() {
+            let j = idx + 1;
+            self.map.set_link(j, None, self.line(lt.span()));
+            let l = lt.get_ref();
+            self.check_number("link", j, &l.j)?;
+            let mut ld = LinkDesc::zero(l.name.clone().unwrap_or_else(|| format!("link{j}")));
+            let entries = l
+                .params()
+                .into_iter()
+                .zip(STANDARD_PARAMETERS)
+                .chain(l.wrench().into_iter().zip(WRENCH_COMPONENTS));
+            for (k, (v, pname)) in entries.enumerate() {
+                if let Some(v) = v {
+                    self.map.set_link(j, Some(pname), self.line(v.span()));
+                    let e = self.expr(&format!("link {j}, {pname}"), v)?;
+                    if k < 13 {
+                        ld.params[k] = e;
+                    } else {
+                        ld.wrench[k - 13] = e;
+                    }
+                }
+            }
+            desc.links[idx] = ld;
+        }
+        Ok(())
+    }
+
+    /// Gravity and the base velocities and accelerations: three entries each.
+    fn base(&mut self, top: &FileTop, desc: &mut RobotDescription) -> Result<()> {
+        for (name, v, dst) in [
+            ("G", &top.gravity, &mut desc.gravity),
+            ("W0", &top.w0, &mut desc.w0),
+            ("WP0", &top.wp0, &mut desc.wp0),
+            ("V0", &top.v0, &mut desc.v0),
+            ("VP0", &top.vp0, &mut desc.vp0),
+        ] {
+            let Some(v) = v else { continue };
+            let key = if name == "G" {
+                "gravity".to_string()
+            } else {
+                name.to_lowercase()
+            };
+            self.map.set_base(name, self.line(v.span()));
+            if v.get_ref().len() != 3 {
+                return Err(self.err(
+                    v.span(),
+                    format!("{key} has {} entries, 3 expected", v.get_ref().len()),
                 ));
             }
             for (k, e) in v.get_ref().iter().enumerate() {
-                dst[k] = to_expr(text, file, e)?;
+                dst[k] = self.expr(&format!("{key}[{}]", k + 1), e)?;
             }
         }
+        Ok(())
     }
-    if let Some(v) = &top.assembly {
-        let line = line_of(text, v.span());
-        map.set_base("assembly", line);
+
+    /// `assembly`: constant joint values of the tree joints (their number is checked with the
+    /// structure).
+    fn assembly(&mut self, top: &FileTop, desc: &mut RobotDescription) -> Result<()> {
+        let Some(v) = &top.assembly else {
+            return Ok(());
+        };
+        self.map.set_base("assembly", self.line(v.span()));
         let mut q = Vec::with_capacity(v.get_ref().len());
-        for e in v.get_ref() {
-            let x = to_expr(text, file, e)?.eval(&|_| None).map_err(|err| {
-                Error::parse(
-                    file,
-                    line,
-                    format!("assembly: {err} (joint values must be constants)"),
+        for (k, e) in v.get_ref().iter().enumerate() {
+            let what = format!("assembly[{}]", k + 1);
+            let x = self.expr(&what, e)?.eval(&|_| None).map_err(|err| {
+                self.err(
+                    e.span(),
+                    format!("{what}: {err} (joint values must be constants)"),
                 )
             })?;
             q.push(x);
         }
         desc.assembly = Some(q);
+        Ok(())
     }
-    validate_structure(&desc).map_err(|e| map.locate(e))?;
-    Ok((desc, map))
+}
+
+/// serde's wording of a type error, in the words of the format.
+fn friendly_toml_message(m: &str) -> String {
+    m.replace(
+        "data did not match any variant of untagged enum Value",
+        "expected a number or a string holding an expression",
+    )
+    .replace("expected usize", "expected a non-negative whole number")
+    .replace("expected i64", "expected a whole number")
+    .replace("expected a boolean", "expected true or false")
+}
+
+/// Parse a TOML robot description. `file` names the source in error messages.
+pub fn parse_description(text: &str, file: Option<&str>) -> Result<(RobotDescription, SourceMap)> {
+    let mut r = Reader::new(text, file);
+    let top = r.deserialize()?;
+    let (nl, nj) = r.counts(&top)?;
+    let mut desc =
+        RobotDescription::new(top.name.clone().unwrap_or_else(|| "robot".into()), nl, nj);
+    desc.notes = top.notes.clone().unwrap_or_default();
+    desc.mobile_base = top.mobile_base.unwrap_or(false);
+    r.symbols(&top, &mut desc)?;
+    r.frames(&top, &mut desc)?;
+    r.links(&top, &mut desc)?;
+    r.base(&top, &mut desc)?;
+    r.assembly(&top, &mut desc)?;
+    validate_structure(&desc).map_err(|e| r.map.locate(e))?;
+    Ok((desc, r.map))
 }
 
 /// Read a TOML robot and validate it into a [`Robot`] (every symbol needs a value).
@@ -439,22 +505,29 @@ pub fn parse_robot(text: &str, file: Option<&str>) -> Result<Robot> {
     Robot::new(desc).map_err(|e| map.locate(e))
 }
 
+/// A TOML string literal (quotes and escapes as TOML wants them, any character kept).
+fn toml_string(s: &str) -> String {
+    toml::Value::String(s.to_string()).to_string()
+}
+
+/// A value: a number as a TOML number (exact integers as integers), otherwise the expression
+/// as a string.
 fn fmt_value(e: &Expr) -> String {
     match e.as_f64() {
         Some(x) if e.as_rational().is_some_and(|r| r.is_integer()) => format!("{x}"),
         Some(x) => format!("{x:?}"),
-        None => format!("\"{e}\""),
+        None => toml_string(&e.to_string()),
     }
 }
 
 /// Write a description in the TOML format.
 pub fn write_description(desc: &RobotDescription) -> String {
     let mut s = String::new();
-    s.push_str(&format!("name = {:?}\n", desc.name));
+    s.push_str(&format!("name = {}\n", toml_string(&desc.name)));
     if !desc.notes.is_empty() {
         s.push_str("notes = [\n");
         for n in &desc.notes {
-            s.push_str(&format!("  {n:?},\n"));
+            s.push_str(&format!("  {},\n", toml_string(n)));
         }
         s.push_str("]\n");
     }
@@ -486,14 +559,19 @@ pub fn write_description(desc: &RobotDescription) -> String {
     if !desc.symbols.is_empty() {
         s.push_str("\n[symbols]\n");
         for (k, v) in &desc.symbols {
-            s.push_str(&format!("{k} = {v:?}\n"));
+            let key = if is_symbol_name(k) {
+                k.clone()
+            } else {
+                toml_string(k)
+            };
+            s.push_str(&format!("{key} = {v:?}\n"));
         }
     }
     for (idx, f) in desc.frames.iter().enumerate() {
         s.push_str(&format!(
-            "\n[[frame]]\nj = {}\nname = {:?}\nant = {}\nsigma = {}\nmu = {}\n",
+            "\n[[frame]]\nj = {}\nname = {}\nant = {}\nsigma = {}\nmu = {}\n",
             idx + 1,
-            f.name,
+            toml_string(&f.name),
             f.ant,
             f.joint.sigma(),
             u8::from(f.actuated)
@@ -506,9 +584,9 @@ pub fn write_description(desc: &RobotDescription) -> String {
     }
     for (idx, l) in desc.links.iter().enumerate() {
         s.push_str(&format!(
-            "\n[[link]]\nj = {}\nname = {:?}\n",
+            "\n[[link]]\nj = {}\nname = {}\n",
             idx + 1,
-            l.name
+            toml_string(&l.name)
         ));
         for (k, e) in l.params.iter().enumerate() {
             if !e.is_zero() {

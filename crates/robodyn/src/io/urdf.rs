@@ -23,8 +23,9 @@
 //! - `mimic` joints are imported as independent joints and flagged in the notes;
 //! - the root link is the fixed base (link 0); gravity is [0, 0, -9.81].
 
-use crate::error::{Error, Location, Result};
-use crate::io::SourceMap;
+use crate::error::{Error, Item, Location, Result};
+use crate::io::source::LineIndex;
+use crate::io::{SourceMap, Warning};
 use crate::model::{param, FrameDesc, JointType, LinkDesc, RobotDescription};
 use nalgebra::{Matrix3, Rotation3, Translation3, UnitQuaternion, Vector3};
 use robodyn_symbolic::Expr;
@@ -122,13 +123,13 @@ fn num_expr(x: f64, angle: bool) -> Expr {
 }
 
 struct Ctx<'a> {
-    doc: &'a roxmltree::Document<'a>,
     file: Option<&'a str>,
+    lines: LineIndex,
 }
 
 impl Ctx<'_> {
     fn line(&self, node: roxmltree::Node) -> usize {
-        self.doc.text_pos_at(node.range().start).row as usize
+        self.lines.line(node.range().start)
     }
     fn err(&self, node: roxmltree::Node, reason: impl Into<String>) -> Error {
         Error::parse(self.file, self.line(node), reason)
@@ -201,9 +202,17 @@ struct UJoint<'a> {
     child: usize,
     origin: Iso,
     axis: Vector3<f64>,
-    mimic: Option<String>,
+    mimic: Option<UMimic<'a>>,
     damping: f64,
     friction: f64,
+}
+
+/// `<mimic joint multiplier offset>`: q = multiplier * q_joint + offset.
+struct UMimic<'a> {
+    joint: String,
+    node: roxmltree::Node<'a, 'a>,
+    multiplier: f64,
+    offset: f64,
 }
 
 struct ULink<'a> {
@@ -239,7 +248,10 @@ pub fn parse_description(text: &str, file: Option<&str>) -> Result<(RobotDescrip
         },
         reason: format!("invalid XML: {e}"),
     })?;
-    let ctx = Ctx { doc: &doc, file };
+    let ctx = Ctx {
+        file,
+        lines: LineIndex::new(text),
+    };
     let robot = doc.root_element();
     if !robot.has_tag_name("robot") {
         return Err(ctx.err(
@@ -251,8 +263,17 @@ pub fn parse_description(text: &str, file: Option<&str>) -> Result<(RobotDescrip
         ));
     }
     let robot_name = robot.attribute("name").unwrap_or("robot").to_string();
+    let (links, link_index) = read_links(&ctx, robot)?;
+    let joints = read_joints(&ctx, robot, &links, &link_index)?;
+    let (root, order) = tree_order(&ctx, robot, &links, &joints)?;
+    build(&ctx, robot_name, &links, &joints, root, &order)
+}
 
-    // links
+/// The `<link>`s, each defined once, with their inertials.
+fn read_links<'a>(
+    ctx: &Ctx,
+    robot: roxmltree::Node<'a, 'a>,
+) -> Result<(Vec<ULink<'a>>, HashMap<String, usize>)> {
     let mut links: Vec<ULink> = Vec::new();
     let mut link_index: HashMap<String, usize> = HashMap::new();
     for n in robot
@@ -273,7 +294,7 @@ pub fn parse_description(text: &str, file: Option<&str>) -> Result<(RobotDescrip
         let inertial = match child(n, "inertial") {
             None => None,
             Some(i) => {
-                let com = origin(&ctx, i, &what)?;
+                let com = origin(ctx, i, &what)?;
                 let mass_node = child(i, "mass")
                     .ok_or_else(|| ctx.err(i, format!("{what}: missing <mass>")))?;
                 let m = ctx.number(
@@ -305,7 +326,16 @@ pub fn parse_description(text: &str, file: Option<&str>) -> Result<(RobotDescrip
         });
     }
 
-    // joints
+    Ok((links, link_index))
+}
+
+/// The `<joint>`s: type, parent and child links, origin, axis, mimic, dynamics.
+fn read_joints<'a>(
+    ctx: &Ctx,
+    robot: roxmltree::Node<'a, 'a>,
+    links: &[ULink<'a>],
+    link_index: &HashMap<String, usize>,
+) -> Result<Vec<UJoint<'a>>> {
     let mut joints: Vec<UJoint> = Vec::new();
     let mut joint_names: HashMap<String, usize> = HashMap::new();
     for n in robot
@@ -370,10 +400,17 @@ pub fn parse_description(text: &str, file: Option<&str>) -> Result<(RobotDescrip
         let mimic = match child(n, "mimic") {
             None => None,
             Some(m) => {
-                let other = ctx.attr(m, "joint", &format!("{what}, <mimic>"))?;
-                let mult = m.attribute("multiplier").unwrap_or("1");
-                let off = m.attribute("offset").unwrap_or("0");
-                Some(format!("joint {name} mimics {other} (q = {mult} * q_{other} + {off}); imported as an independent joint"))
+                let w = format!("{what}, <mimic>");
+                let number = |a: &str, default: f64| -> Result<f64> {
+                    m.attribute(a)
+                        .map_or(Ok(default), |t| ctx.number(m, t, &format!("{w}: {a}")))
+                };
+                Some(UMimic {
+                    joint: ctx.attr(m, "joint", &w)?.to_string(),
+                    node: m,
+                    multiplier: number("multiplier", 1.0)?,
+                    offset: number("offset", 0.0)?,
+                })
             }
         };
         let (mut damping, mut friction) = (0.0, 0.0);
@@ -387,7 +424,7 @@ pub fn parse_description(text: &str, file: Option<&str>) -> Result<(RobotDescrip
         }
         joint_names.insert(name.clone(), joints.len());
         joints.push(UJoint {
-            origin: origin(&ctx, n, &what)?,
+            origin: origin(ctx, n, &what)?,
             name,
             node: n,
             joint,
@@ -400,6 +437,18 @@ pub fn parse_description(text: &str, file: Option<&str>) -> Result<(RobotDescrip
         });
     }
 
+    Ok(joints)
+}
+
+/// The root link and the joints in depth-first order from it (children in file order), after
+/// checking that the joints form one tree: each link at most one parent joint, exactly one root,
+/// every joint reachable.
+fn tree_order(
+    ctx: &Ctx,
+    robot: roxmltree::Node,
+    links: &[ULink],
+    joints: &[UJoint],
+) -> Result<(usize, Vec<usize>)> {
     // tree check: each link at most one parent joint, exactly one root, everything reachable
     let mut parent_joint: Vec<Option<usize>> = vec![None; links.len()];
     for (k, jt) in joints.iter().enumerate() {
@@ -489,12 +538,23 @@ pub fn parse_description(text: &str, file: Option<&str>) -> Result<(RobotDescrip
         return Err(ctx.err(robot, "the robot has no joint (NL = 0)"));
     }
 
-    // frames and links (frame j carries link j; auxiliary fixed frames carry massless links)
+    Ok((root, order))
+}
+
+/// The description: frame j carries link j (auxiliary fixed frames carry massless links).
+fn build(
+    ctx: &Ctx,
+    robot_name: String,
+    links: &[ULink],
+    joints: &[UJoint],
+    root: usize,
+    order: &[usize],
+) -> Result<(RobotDescription, SourceMap)> {
     let mut frames: Vec<FrameDesc> = Vec::with_capacity(order.len());
     let mut dlinks: Vec<LinkDesc> = Vec::with_capacity(order.len());
     let mut notes = Vec::new();
     let mut map = SourceMap::default();
-    map.file = file.map(str::to_string);
+    map.file = ctx.file.map(str::to_string);
     let mut number_of_link: Vec<usize> = vec![0; links.len()]; // URDF link -> our link number
                                                                // c_of[j]: orientation of the URDF link frame in R_j (index 0: the base)
     let mut c_of: Vec<UnitQuaternion<f64>> = vec![UnitQuaternion::identity()];
@@ -506,7 +566,9 @@ pub fn parse_description(text: &str, file: Option<&str>) -> Result<(RobotDescrip
         }
         f
     };
-    for &k in &order {
+    let joint_set: std::collections::HashSet<&str> =
+        joints.iter().map(|j| j.name.as_str()).collect();
+    for &k in order {
         let jt = &joints[k];
         let mut i = number_of_link[jt.parent];
         let s = if jt.joint.is_movable() {
@@ -547,7 +609,25 @@ pub fn parse_description(text: &str, file: Option<&str>) -> Result<(RobotDescrip
         number_of_link[jt.child] = j;
         map.set_frame(j, None, ctx.line(jt.node));
         if let Some(m) = &jt.mimic {
-            notes.push(m.clone());
+            // a mimic of an unknown joint does not change the model (mimic joints are imported
+            // as independent joints), but the file is wrong: example-robot-data's
+            // alex_psyonic_hands.urdf has such references, and Pinocchio loads it
+            if !joint_set.contains(m.joint.as_str()) {
+                let mut w = Warning::new(
+                    Item::Frame(frames.len(), None),
+                    format!(
+                        "joint `{}`, <mimic>: joint `{}` is not defined (the joint is imported \
+                         as an independent joint)",
+                        jt.name, m.joint
+                    ),
+                );
+                w.location.line = Some(ctx.line(m.node));
+                map.warn(w);
+            }
+            notes.push(format!(
+                "joint {} mimics {} (q = {:?} * q_{} + {:?}); imported as an independent joint",
+                jt.name, m.joint, m.multiplier, m.joint, m.offset
+            ));
         }
 
         let ul = &links[jt.child];
