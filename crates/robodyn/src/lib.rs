@@ -16,6 +16,7 @@ pub mod algorithms;
 pub mod codegen;
 pub mod error;
 pub mod geometry;
+pub mod identification;
 pub mod io;
 pub mod model;
 pub mod scalar;

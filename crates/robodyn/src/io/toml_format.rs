@@ -5,7 +5,8 @@
 
 use crate::error::{Error, Item, Location, Result};
 use crate::model::{
-    validate_structure, JointType, LinkDesc, RobotDescription, GEOMETRIC_PARAMETERS,
+    validate_structure, JointLimits, JointType, LinkDesc, RobotDescription, Transmission,
+    GEOMETRIC_PARAMETERS,
     STANDARD_PARAMETERS, WRENCH_COMPONENTS,
 };
 use crate::Robot;
@@ -45,6 +46,25 @@ struct FileTop {
     frame: Vec<Spanned<FrameTable>>,
     #[serde(default)]
     link: Vec<Spanned<LinkTable>>,
+    transmission: Option<Spanned<TransmissionTable>>,
+}
+
+/// `[transmission]`: m = R q over the actuated joints (see `docs/robot-format.md`).
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct TransmissionTable {
+    joints: Option<Vec<usize>>,
+    matrix: Vec<Vec<SV>>,
+}
+
+/// `limits = { q = [min, max], qd = .., qdd = .., tau = .. }` of a `[[frame]]`.
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct LimitsTable {
+    q: Option<Vec<SV>>,
+    qd: Option<SV>,
+    qdd: Option<SV>,
+    tau: Option<SV>,
 }
 
 #[derive(Deserialize, Debug)]
@@ -63,6 +83,7 @@ struct FrameTable {
     d: Option<SV>,
     theta: Option<SV>,
     r: Option<SV>,
+    limits: Option<Spanned<LimitsTable>>,
 }
 
 #[derive(Deserialize, Debug)]
@@ -354,6 +375,10 @@ pub fn parse_description(text: &str, file: Option<&str>) -> Result<(RobotDescrip
                 *desc.frame_mut(j).geometric_mut()[k] = to_expr(text, file, v)?;
             }
         }
+        if let Some(l) = &f.limits {
+            let lim = parse_limits(text, file, &desc.symbols, l)?;
+            desc.limits.insert(j, lim);
+        }
     }
     for (idx, lt) in top.link.iter().enumerate() {
         let j = idx + 1;
@@ -429,8 +454,119 @@ pub fn parse_description(text: &str, file: Option<&str>) -> Result<(RobotDescrip
         }
         desc.assembly = Some(q);
     }
+    if let Some(t) = &top.transmission {
+        desc.transmission = Some(parse_transmission(text, file, &desc, t)?);
+    }
     validate_structure(&desc).map_err(|e| map.locate(e))?;
     Ok((desc, map))
+}
+
+/// A constant (number or expression over the file's symbols).
+fn constant(text: &str, file: Option<&str>, symbols: &BTreeMap<String, f64>, v: &SV) -> Result<f64> {
+    to_expr(text, file, v)?
+        .eval(&|s| symbols.get(s).copied())
+        .map_err(|e| Error::parse(file, line_of(text, v.span()), e.to_string()))
+}
+
+fn parse_limits(
+    text: &str,
+    file: Option<&str>,
+    symbols: &BTreeMap<String, f64>,
+    l: &Spanned<LimitsTable>,
+) -> Result<JointLimits> {
+    let line = line_of(text, l.span());
+    let t = l.get_ref();
+    let c = |v: &SV| constant(text, file, symbols, v);
+    let positive = |name: &str, v: &Option<SV>| -> Result<Option<f64>> {
+        match v {
+            Some(v) => {
+                let x = c(v)?;
+                if x > 0.0 {
+                    Ok(Some(x))
+                } else {
+                    Err(Error::parse(
+                        file,
+                        line_of(text, v.span()),
+                        format!("limits: {name} = {x} must be positive"),
+                    ))
+                }
+            }
+            None => Ok(None),
+        }
+    };
+    let (q_min, q_max) = match &t.q {
+        Some(q) if q.len() == 2 => {
+            let (a, b) = (c(&q[0])?, c(&q[1])?);
+            if a >= b {
+                return Err(Error::parse(
+                    file,
+                    line,
+                    format!("limits: q = [{a}, {b}] is not an interval [min, max]"),
+                ));
+            }
+            (Some(a), Some(b))
+        }
+        Some(q) => {
+            return Err(Error::parse(
+                file,
+                line,
+                format!("limits: q has {} entries, [min, max] expected", q.len()),
+            ))
+        }
+        None => (None, None),
+    };
+    Ok(JointLimits {
+        q_min,
+        q_max,
+        qd: positive("qd", &t.qd)?,
+        qdd: positive("qdd", &t.qdd)?,
+        tau: positive("tau", &t.tau)?,
+    })
+}
+
+fn parse_transmission(
+    text: &str,
+    file: Option<&str>,
+    desc: &RobotDescription,
+    t: &Spanned<TransmissionTable>,
+) -> Result<Transmission> {
+    let line = line_of(text, t.span());
+    let tt = t.get_ref();
+    let joints = tt.joints.clone().unwrap_or_else(|| desc.actuated_joints());
+    let n = joints.len();
+    if let Some(&j) = joints.iter().find(|&&j| j == 0 || j > desc.nl || !desc.frame(j).actuated) {
+        return Err(Error::parse(
+            file,
+            line,
+            format!("transmission: joint {j} is not an actuated joint of the tree (1..{})", desc.nl),
+        ));
+    }
+    if tt.matrix.len() != n {
+        return Err(Error::parse(
+            file,
+            line,
+            format!(
+                "transmission: matrix has {} rows, {n} expected (one per motor, as many as joints {joints:?})",
+                tt.matrix.len()
+            ),
+        ));
+    }
+    let mut matrix = Vec::with_capacity(n);
+    for (k, row) in tt.matrix.iter().enumerate() {
+        if row.len() != n {
+            return Err(Error::parse(
+                file,
+                line,
+                format!("transmission: row {} has {} entries, {n} expected", k + 1, row.len()),
+            ));
+        }
+        matrix.push(
+            row.iter()
+                .map(|v| constant(text, file, &desc.symbols, v))
+                .collect::<Result<Vec<f64>>>()?,
+        );
+    }
+    Ok(Transmission { joints, matrix })
 }
 
 /// Read a TOML robot and validate it into a [`Robot`] (every symbol needs a value).
@@ -503,6 +639,18 @@ pub fn write_description(desc: &RobotDescription) -> String {
                 s.push_str(&format!("{} = {}\n", GEOMETRIC_PARAMETERS[k], fmt_value(e)));
             }
         }
+        if let Some(l) = desc.limits.get(&(idx + 1)) {
+            let mut parts = Vec::new();
+            if let (Some(a), Some(b)) = (l.q_min, l.q_max) {
+                parts.push(format!("q = [{a:?}, {b:?}]"));
+            }
+            for (name, v) in [("qd", l.qd), ("qdd", l.qdd), ("tau", l.tau)] {
+                if let Some(v) = v {
+                    parts.push(format!("{name} = {v:?}"));
+                }
+            }
+            s.push_str(&format!("limits = {{ {} }}\n", parts.join(", ")));
+        }
     }
     for (idx, l) in desc.links.iter().enumerate() {
         s.push_str(&format!(
@@ -520,6 +668,21 @@ pub fn write_description(desc: &RobotDescription) -> String {
                 s.push_str(&format!("{} = {}\n", WRENCH_COMPONENTS[k], fmt_value(e)));
             }
         }
+    }
+    if let Some(t) = &desc.transmission {
+        let rows: Vec<String> = t
+            .matrix
+            .iter()
+            .map(|r| {
+                let v: Vec<String> = r.iter().map(|x| format!("{x:?}")).collect();
+                format!("  [{}],", v.join(", "))
+            })
+            .collect();
+        s.push_str(&format!(
+            "\n[transmission]\njoints = {:?}\nmatrix = [\n{}\n]\n",
+            t.joints,
+            rows.join("\n")
+        ));
     }
     s
 }
