@@ -80,3 +80,10 @@ fn noise_free_rx90_equals_true_base_parameters() {
         assert!(err < 1e-8, "{}: {} vs true {} ({err:e})", p.name, id.x[k], truth[k]);
     }
 }
+
+#[test]
+fn debug_tx40_params() {
+    let mut acc = access("tx40.toml");
+    let m = robodyn::identification::parameters::ParameterModel::build(&mut acc, &Default::default()).unwrap();
+    for p in &m.params { eprintln!("{} = {}", p.name, p.equation); }
+}

@@ -96,7 +96,7 @@ pub struct Args {
     #[arg(long, default_value_t = 0.0)]
     pub min_speed: f64,
     /// IDIM-IV: iterations.
-    #[arg(long, default_value_t = 6)]
+    #[arg(long, default_value_t = 8)]
     pub iv_iterations: usize,
     /// IDIM-IV: bandwidth of the tracking loop of the simulation (Hz; default bandwidth / 4).
     #[arg(long)]
@@ -196,12 +196,13 @@ pub fn run(a: Args) -> CliResult {
         let mut desc = access.description_with(&id.standard_parameters())?;
         desc.name = format!("{} (identified)", desc.name);
         desc.notes.push(format!(
-            "Identified by robodyn identify from {} ({}); physically consistent standard \
-             parameters whose base parameters are within {:.3} standard deviations of the \
+            "Identified by robodyn identify from {} ({}): physically consistent standard \
+             parameters (pseudo-inertia PSD per link, drive parameters >= 0), the constrained \
+             least-squares fit, at squared Mahalanobis distance {:.3} from the unconstrained \
              estimate.",
             a.data.display(),
             id.estimator,
-            id.consistent.as_ref().map_or(0.0, |c| c.max_deviation)
+            id.consistent.as_ref().map_or(0.0, |c| c.distance2)
         ));
         save_description(&desc, p)?;
         eprintln!("wrote {}", p.display());

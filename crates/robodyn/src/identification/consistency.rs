@@ -10,13 +10,12 @@
 //! and friction coefficients >= 0 these are linear matrix inequalities in K, solved as a
 //! semidefinite program with Clarabel's PSD cone:
 //!
-//! - [`nearest_consistent`]: the standard parameters whose base parameters are nearest to the
-//!   estimate, in standard deviations: min sum_r ((M K - x)_r / std_r)^2 + eps ||K - K0||_S^2
-//!   (K0 the robot file's values, S a per-parameter scale: eps = 1e-6 only chooses among the
-//!   K with the same base parameters, as moving K by one scale unit costs as much as moving a
-//!   base parameter by 1e-3 standard deviations);
-//! - [`constrained_least_squares`]: identification under the constraints,
-//!   min ||Y - W x(K, offsets)||^2_weights / sigma^2 + eps ||K - K0||_S^2.
+//! [`consistent_parameters`]: identification under the constraints,
+//! min ||Y - W x(K, offsets)||^2_weights / sigma^2 + eps ||K - K0||_S^2 — equivalently the
+//! consistent set nearest to the unconstrained estimate in the metric of its covariance. K0 are
+//! the robot file's values and S a per-parameter scale: eps = 1e-6 only chooses among the K
+//! with the same base parameters (moving K by one scale unit costs as much as moving the
+//! estimate by 1e-3 standard deviations).
 
 use super::estimators::LsSolution;
 use super::model_access::{ModelAccess, FS, FV, IA, PER_LINK};
@@ -117,9 +116,10 @@ impl Variables {
     }
 }
 
-/// Scale of each standard variable for the prior term: the magnitude of its kind of parameter
-/// in the robot file (at least 1e-3 of the largest of that kind, and 1e-6).
-fn prior_scales(vars: &Variables, prior: &[f64]) -> Vec<f64> {
+/// Weight of each standard variable in the prior term: 1 / s^2 with s the magnitude of its kind
+/// of parameter in the robot file (its own value, at least 1e-3 of the largest of that kind);
+/// 0 for a kind the file leaves at zero on every link (no prior: e.g. friction to identify).
+fn prior_weights(vars: &Variables, prior: &[f64]) -> Vec<f64> {
     let kind_max = |p: usize| -> f64 {
         (0..vars.nl)
             .map(|j| prior[PER_LINK * j + p].abs())
@@ -128,8 +128,13 @@ fn prior_scales(vars: &Variables, prior: &[f64]) -> Vec<f64> {
     vars.standard
         .iter()
         .map(|&i| {
-            let p = i % PER_LINK;
-            prior[i].abs().max(1e-3 * kind_max(p)).max(1e-6)
+            let m = kind_max(i % PER_LINK);
+            if m > 0.0 {
+                let s = prior[i].abs().max(1e-3 * m);
+                1.0 / (s * s)
+            } else {
+                0.0
+            }
         })
         .collect()
 }
@@ -285,9 +290,9 @@ fn solve_sdp(vars: &Variables, p_dense: &Mat<f64>, q: &[f64]) -> Result<(Vec<f64
 
 /// Add eps sum_i ((v_i - K0_i) / s_i)^2 to (P, q) (with 1/2 v^T P v + q^T v conventions).
 fn add_prior(vars: &Variables, prior: &[f64], weight: f64, p: &mut Mat<f64>, q: &mut [f64]) {
-    let scales = prior_scales(vars, prior);
+    let weights = prior_weights(vars, prior);
     for (s, &i) in vars.standard.iter().enumerate() {
-        let w = weight / (scales[s] * scales[s]);
+        let w = weight * weights[s];
         p[(s, s)] += 2.0 * w;
         q[s] -= 2.0 * w * prior[i];
     }
@@ -320,47 +325,19 @@ fn finish(
             standard,
             deviation,
             max_deviation,
+            distance2: 0.0,
             solver,
         },
         x_full,
     })
 }
 
-/// Standard parameters satisfying the constraints whose identified vector is nearest to the
-/// estimate, in its standard deviations (offsets are kept as estimated).
-pub fn nearest_consistent(
-    access: &ModelAccess,
-    model: &ParameterModel,
-    estimate: &LsSolution,
-) -> Result<ConsistentSolution> {
-    let vars = Variables::new(model);
-    let e = vars.x_map(model);
-    let nv = vars.count();
-    let p = model.count();
-    let mut pm = Mat::<f64>::zeros(nv, nv);
-    let mut q = vec![0.0; nv];
-    for r in 0..p {
-        // a noise-free estimate has std ~ 0: floored at 1e-7 relative
-        let s = estimate.std[r].max(1e-7 * estimate.x[r].abs()).max(1e-12);
-        let w = 1.0 / (s * s);
-        for a in 0..nv {
-            if e[(r, a)] == 0.0 {
-                continue;
-            }
-            q[a] -= 2.0 * w * e[(r, a)] * estimate.x[r];
-            for b in 0..nv {
-                pm[(a, b)] += 2.0 * w * e[(r, a)] * e[(r, b)];
-            }
-        }
-    }
-    add_prior(&vars, &access.standard_parameters(), PRIOR_WEIGHT, &mut pm, &mut q);
-    let (v, text) = solve(&vars, &pm, &q)?;
-    finish(access, model, &vars, &v, estimate, text)
-}
-
 /// Identification under the constraints: min ||T_w [x(v); -1]||^2 (the weighted rows of the
-/// fit) over consistent standard parameters and the offsets.
-pub fn constrained_least_squares(
+/// fit) over consistent standard parameters and the offsets. Since
+/// ||T_w [x; -1]||^2 = ||T_w [x_hat; -1]||^2 + (x - x_hat)^T W_w^T W_w (x - x_hat), this is
+/// also the consistent set nearest to the unconstrained estimate x_hat in the metric of its
+/// covariance sigma^2 (W_w^T W_w)^-1 (the Mahalanobis distance, correlations included).
+pub fn consistent_parameters(
     access: &ModelAccess,
     model: &ParameterModel,
     tw: &Mat<f64>,
@@ -388,5 +365,9 @@ pub fn constrained_least_squares(
     }
     add_prior(&vars, &access.standard_parameters(), PRIOR_WEIGHT, &mut pm, &mut q);
     let (v, text) = solve(&vars, &pm, &q)?;
-    finish(access, model, &vars, &v, estimate, text)
+    let mut sol = finish(access, model, &vars, &v, estimate, text)?;
+    // increase of the weighted residual, in units of sigma^2: the squared Mahalanobis distance
+    let base = super::estimators::residual_sq(tw, &estimate.x);
+    sol.result.distance2 = (super::estimators::residual_sq(tw, &sol.x_full) - base).max(0.0) / s2;
+    Ok(sol)
 }

@@ -114,7 +114,7 @@ impl Default for Options {
             use_log_derivatives: true,
             gains: None,
             min_speed: 0.0,
-            iv_iterations: 6,
+            iv_iterations: 8,
             iv_bandwidth: None,
             keep_validation_rows: false,
         }
@@ -202,6 +202,10 @@ pub struct Consistent {
     /// (x_consistent - x_estimate) / std per parameter, and the largest.
     pub deviation: Vec<f64>,
     pub max_deviation: f64,
+    /// Squared Mahalanobis distance of the consistent set from the unconstrained estimate
+    /// (x_c - x)^T Cov^-1 (x_c - x): chi-square with p degrees of freedom when the true
+    /// parameters are consistent.
+    pub distance2: f64,
     /// Smallest eigenvalue of a link's pseudo-inertia matrix (kg m^2 scale) and of A(q).
     pub min_pseudo_inertia_eigenvalue: f64,
     pub min_inertia_eigenvalue: f64,
@@ -468,7 +472,7 @@ pub fn identify(access: &mut ModelAccess, log: &dyn LogSource, opt: &Options) ->
             sol.x = x.clone();
             sol.std = std;
             sol.sigma2 = s2;
-            if last_change < 0.01 {
+            if last_change < 0.02 {
                 converged = true;
                 break;
             }
@@ -493,35 +497,36 @@ pub fn identify(access: &mut ModelAccess, log: &dyn LogSource, opt: &Options) ->
         Some(sig) => combine(&ts.iter().zip(sig).map(|(t, s)| (t, 1.0 / s)).collect::<Vec<_>>()),
         None => combine(&ts.iter().map(|t| (t, 1.0)).collect::<Vec<_>>()),
     };
-    // physically consistent parameters
+    // physically consistent parameters: the constrained least squares, which is also the
+    // consistent set nearest to the unconstrained estimate in the metric of its covariance
     let mut consistent = None;
-    if opt.consistent {
-        let c = consistency::constrained_least_squares(access, &model, &tw, &sol)?;
-        sol.x = c.x_full.clone();
-        estimator.push_str(" under physical-consistency constraints (SDP)");
-        notes.push(
-            "the standard deviations are those of the unconstrained estimate; parameters whose \
-             constraint is active are at the boundary of the consistent set"
-                .into(),
-        );
-        consistent = Some(c.result);
-    } else if opt.standard {
-        let c = consistency::nearest_consistent(access, &model, &sol)?;
-        if c.result.max_deviation > 2.0 {
+    if opt.consistent || opt.standard {
+        let c = consistency::consistent_parameters(access, &model, &tw, &sol)?;
+        let bound = p as f64 + 3.0 * (2.0 * p as f64).sqrt();
+        if c.result.distance2 > bound {
+            let worst = c
+                .result
+                .deviation
+                .iter()
+                .enumerate()
+                .max_by(|a, b| a.1.abs().partial_cmp(&b.1.abs()).unwrap())
+                .map_or(0, |(i, _)| i);
             warnings.push(format!(
-                "the identified parameters are not physically consistent: the nearest consistent \
-                 set differs by up to {:.1} standard deviations (parameter {}); the robot file \
-                 holds the consistent set",
-                c.result.max_deviation,
-                names[c
-                    .result
-                    .deviation
-                    .iter()
-                    .enumerate()
-                    .max_by(|a, b| a.1.abs().partial_cmp(&b.1.abs()).unwrap())
-                    .map(|(i, _)| i)
-                    .unwrap_or(0)]
+                "the unconstrained estimate is not physically consistent: the nearest consistent \
+                 set is at a squared Mahalanobis distance {:.1} (above {bound:.1}, the 99.8 % \
+                 quantile of chi-square with {p} degrees of freedom); largest change {:.1} standard \
+                 deviations ({})",
+                c.result.distance2, c.result.max_deviation, names[worst]
             ));
+        }
+        if opt.consistent {
+            sol.x = c.x_full.clone();
+            estimator.push_str(" under physical-consistency constraints (SDP)");
+            notes.push(
+                "the standard deviations are those of the unconstrained estimate; parameters whose \
+                 constraint is active are at the boundary of the consistent set"
+                    .into(),
+            );
         }
         consistent = Some(c.result);
     }

@@ -161,9 +161,6 @@ impl ParameterModel {
             for ((k, which), coefs) in grouped {
                 let index = PER_LINK * (joints[k] - 1) + which;
                 for (r, c) in coefs {
-                    if c.abs() < 1e-12 {
-                        continue;
-                    }
                     map[r].push((index, c));
                     let mag = format_coefficient(c.abs());
                     let sign = if c < 0.0 { " - " } else { " + " };
@@ -298,43 +295,47 @@ impl ParameterModel {
                 }
             }
         }
-        let norms: Vec<f64> = (0..total)
-            .map(|c| (0..rows).map(|i| w[(i, c)] * w[(i, c)]).sum::<f64>().sqrt())
-            .collect();
-        let scaled = Mat::from_fn(rows, total, |i, c| {
-            if norms[c] > 0.0 {
-                w[(i, c)] / norms[c]
-            } else {
-                0.0
-            }
-        });
-        let qr = scaled.qr();
-        let rr = qr.thin_R();
+        // a motor column is kept when its distance from the span of the columns kept before it
+        // (relative to its norm) is above the tolerance: the definition of |R_kk| of an
+        // unpivoted QR, computed by projection because a QR's diagonal stops meaning that once
+        // one exactly dependent column has been met
+        let column = |c: usize| Mat::from_fn(rows, 1, |i, _| w[(i, c)]);
         let mut kept_cols: Vec<usize> = (0..nb).collect();
         let mut kept = Vec::new();
-        let mut dependent = Vec::new();
+        let mut grouped = Vec::new();
         for (c, &m) in wanted.iter().enumerate() {
-            if norms[nb + c] > 0.0 && rr[(nb + c, nb + c)].abs() > GROUP_TOLERANCE {
+            let b = column(nb + c);
+            let norm = (0..rows).map(|i| b[(i, 0)] * b[(i, 0)]).sum::<f64>().sqrt();
+            if norm == 0.0 {
+                grouped.push((m, Vec::new()));
+                continue;
+            }
+            let a = Mat::from_fn(rows, kept_cols.len(), |i, k| w[(i, kept_cols[k])]);
+            let x = a.qr().solve_lstsq(&b);
+            let residual = (0..rows)
+                .map(|i| {
+                    let fit: f64 = (0..kept_cols.len()).map(|k| a[(i, k)] * x[(k, 0)]).sum();
+                    (b[(i, 0)] - fit).powi(2)
+                })
+                .sum::<f64>()
+                .sqrt();
+            if std::env::var("ROBODYN_DEBUG").is_ok() {
+                eprintln!("motor column {m:?}: relative distance {:e}", residual / norm);
+            }
+            if residual > GROUP_TOLERANCE * norm {
                 kept_cols.push(nb + c);
                 kept.push(m);
             } else {
-                dependent.push((c, m));
-            }
-        }
-        let mut grouped = Vec::new();
-        if !dependent.is_empty() {
-            let a = Mat::from_fn(rows, kept_cols.len(), |i, c| w[(i, kept_cols[c])]);
-            let qr = a.qr();
-            for (c, m) in dependent {
-                let b = Mat::from_fn(rows, 1, |i, _| w[(i, nb + c)]);
-                let x = qr.solve_lstsq(&b);
-                let coefs = (0..kept_cols.len())
-                    .map(|k| {
-                        // kept motor columns come after the base parameters, in `kept` order
-                        (k, x[(k, 0)])
-                    })
-                    .collect();
-                grouped.push((m, coefs));
+                // kept motor columns come after the base parameters, in `kept` order
+                // coefficients whose contribution is at rounding level are dropped
+                let col_norm = |k: usize| (0..rows).map(|i| a[(i, k)] * a[(i, k)]).sum::<f64>().sqrt();
+                grouped.push((
+                    m,
+                    (0..kept_cols.len())
+                        .map(|k| (k, x[(k, 0)]))
+                        .filter(|&(k, v)| (v * col_norm(k)).abs() > 1e-10 * norm)
+                        .collect(),
+                ));
             }
         }
         Ok((kept, grouped))

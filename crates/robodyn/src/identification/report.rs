@@ -176,9 +176,14 @@ pub fn to_text(id: &Identification) -> String {
     if let Some(c) = &id.consistent {
         s.push_str(&format!(
             "\nPhysically consistent standard parameters ({}): pseudo-inertia eigenvalues >= \
-             {:.3e}, inertia matrix eigenvalues >= {:.3e} (30 random configurations); their base \
-             parameters differ from the estimate by at most {:.3} standard deviations\n",
-            c.solver, c.min_pseudo_inertia_eigenvalue, c.min_inertia_eigenvalue, c.max_deviation
+             {:.3e}, inertia matrix eigenvalues >= {:.3e} (30 random configurations); the \
+             consistent values differ from the unconstrained estimate by at most {:.3} standard \
+             deviations (squared Mahalanobis distance {:.3})\n",
+            c.solver,
+            c.min_pseudo_inertia_eigenvalue,
+            c.min_inertia_eigenvalue,
+            c.max_deviation,
+            c.distance2
         ));
     }
     for n in &id.notes {
@@ -291,6 +296,7 @@ pub fn to_json(id: &Identification) -> serde_json::Value {
             "values": c.x,
             "deviation": c.deviation,
             "max_deviation": c.max_deviation,
+            "mahalanobis_distance2": c.distance2,
             "min_pseudo_inertia_eigenvalue": c.min_pseudo_inertia_eigenvalue,
             "min_inertia_eigenvalue": c.min_inertia_eigenvalue,
         });
@@ -432,6 +438,6 @@ pub fn plot_fit(path: &Path, id: &Identification) -> Result<()> {
         ),
         &rows.t,
         &panels,
-        "torque",
+        "torque [N m] / force [N]",
     )
 }
