@@ -210,6 +210,7 @@ pub fn run(a: Args) -> CliResult {
             &times,
             &panels,
             "rad, rad/s, rad/s^2",
+            false,
         )?;
         eprintln!("wrote {}", p.display());
     }

@@ -331,6 +331,7 @@ pub fn plot_panels(
     t: &[f64],
     panels: &[(String, Vec<(String, Vec<f64>)>)],
     y_label: &str,
+    bold_first: bool,
 ) -> Result<()> {
     use plotters::prelude::*;
     let err = |e: String| Error::Io {
@@ -348,7 +349,16 @@ pub fn plot_panels(
         .titled(title, ("sans-serif", 22))
         .map_err(|e| ds(&e))?;
     let areas = root.split_evenly((panels.len(), 1));
-    let colors = [RGBColor(30, 30, 30), RGBColor(220, 50, 40), RGBColor(40, 90, 200)];
+    let colors = [
+        RGBColor(20, 20, 20),
+        RGBColor(220, 50, 40),
+        RGBColor(40, 90, 200),
+        RGBColor(30, 150, 60),
+        RGBColor(230, 140, 0),
+        RGBColor(150, 60, 170),
+        RGBColor(0, 160, 170),
+        RGBColor(140, 100, 60),
+    ];
     let (t0, t1) = (t[0], *t.last().unwrap());
     for (area, (name, curves)) in areas.iter().zip(panels) {
         let (lo, hi) = curves
@@ -382,7 +392,7 @@ pub fn plot_panels(
             chart
                 .draw_series(LineSeries::new(
                     t.iter().copied().zip(v.iter().copied()),
-                    color.stroke_width(if k == 0 { 2 } else { 1 }),
+                    color.stroke_width(if bold_first && k == 0 { 2 } else { 1 }),
                 ))
                 .map_err(|e| ds(&e))?
                 .label(label.as_str())
@@ -439,5 +449,6 @@ pub fn plot_fit(path: &Path, id: &Identification) -> Result<()> {
         &rows.t,
         &panels,
         "torque [N m] / force [N]",
+        true,
     )
 }
