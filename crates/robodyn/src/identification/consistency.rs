@@ -269,6 +269,10 @@ fn solve_sdp(vars: &Variables, p_dense: &Mat<f64>, q: &[f64]) -> Result<(Vec<f64
     let settings = DefaultSettingsBuilder::default()
         .verbose(false)
         .max_iter(400)
+        .tol_gap_abs(1e-11)
+        .tol_gap_rel(1e-11)
+        .tol_feas(1e-11)
+        .tol_ktratio(1e-9)
         .build()
         .map_err(|e| Error::Numerical(format!("SDP settings: {e:?}")))?;
     let mut solver = DefaultSolver::new(&p, q, &a, &b, &cones, settings)

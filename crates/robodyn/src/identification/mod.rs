@@ -503,7 +503,15 @@ pub fn identify(access: &mut ModelAccess, log: &dyn LogSource, opt: &Options) ->
     if opt.consistent || opt.standard {
         let c = consistency::consistent_parameters(access, &model, &tw, &sol)?;
         let bound = p as f64 + 3.0 * (2.0 * p as f64).sqrt();
-        if c.result.distance2 > bound {
+        // changes at rounding level (a noise-free fit whose true values lie on the boundary,
+        // e.g. zero friction) are not reported
+        let scale = sol.x.iter().fold(0.0f64, |a, b| a.max(b.abs()));
+        let significant = c
+            .x_full
+            .iter()
+            .zip(&sol.x)
+            .any(|(a, b)| (a - b).abs() > 1e-6 * b.abs().max(1e-3 * scale));
+        if c.result.distance2 > bound && significant {
             let worst = c
                 .result
                 .deviation
