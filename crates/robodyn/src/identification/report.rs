@@ -432,7 +432,7 @@ pub fn plot_fit(path: &Path, id: &Identification) -> Result<()> {
                 .map(|v| format!(" (relative error {:.2} %)", 100.0 * v.per_joint[k].relative_error))
                 .unwrap_or_default();
             (
-                format!("joint {j} {}{err}", id.joint_names[k]),
+                format!("joint {j} ({}){err}", id.joint_names[k]),
                 vec![
                     ("measured".to_string(), rows.y.iter().map(|y| y[k]).collect()),
                     ("predicted".to_string(), pred.iter().map(|y| y[k]).collect()),
