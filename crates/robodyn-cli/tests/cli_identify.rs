@@ -8,7 +8,10 @@ use common::{robot, run, tmp};
 use std::process::Command;
 
 fn fails(args: &[&str]) -> String {
-    let out = Command::new(env!("CARGO_BIN_EXE_robodyn")).args(args).output().unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_robodyn"))
+        .args(args)
+        .output()
+        .unwrap();
     assert!(!out.status.success(), "robodyn {args:?} should fail");
     String::from_utf8_lossy(&out.stderr).to_string()
 }
@@ -19,9 +22,26 @@ fn excite_simulate_identify_round_trip() {
     let reference = tmp("identify", "excite.csv");
     let plot = tmp("identify", "excite.svg");
     let text = run(&[
-        "excite", &rx90, "--period", "4", "--harmonics", "4", "--qd-max", "1.5", "--qdd-max", "6",
-        "--iterations", "60", "--rate", "200", "--periods", "2", "--output",
-        reference.to_str().unwrap(), "--plot", plot.to_str().unwrap(),
+        "excite",
+        &rx90,
+        "--period",
+        "4",
+        "--harmonics",
+        "4",
+        "--qd-max",
+        "1.5",
+        "--qdd-max",
+        "6",
+        "--iterations",
+        "60",
+        "--rate",
+        "200",
+        "--periods",
+        "2",
+        "--output",
+        reference.to_str().unwrap(),
+        "--plot",
+        plot.to_str().unwrap(),
     ]);
     assert!(text.contains("condition number"), "{text}");
     let svg = std::fs::read_to_string(&plot).unwrap();
@@ -29,49 +49,114 @@ fn excite_simulate_identify_round_trip() {
     // simulate the robot tracking the reference (PD), logging q, qd, qdd, tau
     let traj = tmp("identify", "traj.csv");
     run(&[
-        "simulate", &rx90, "--duration", "8", "--dt", "0.001", "--output-step", "0.004",
-        "--track", reference.to_str().unwrap(), "--kp", "400", "--kd", "40",
-        "--coulomb-smoothing", "0", "--output", traj.to_str().unwrap(),
+        "simulate",
+        &rx90,
+        "--duration",
+        "8",
+        "--dt",
+        "0.001",
+        "--output-step",
+        "0.004",
+        "--track",
+        reference.to_str().unwrap(),
+        "--kp",
+        "400",
+        "--kd",
+        "40",
+        "--coulomb-smoothing",
+        "0",
+        "--output",
+        traj.to_str().unwrap(),
     ]);
     let json = run(&[
-        "identify", &rx90, "--data", traj.to_str().unwrap(), "--estimator", "ols", "--validation",
-        "0.7:1", "--format", "json",
+        "identify",
+        &rx90,
+        "--data",
+        traj.to_str().unwrap(),
+        "--estimator",
+        "ols",
+        "--validation",
+        "0.7:1",
+        "--format",
+        "json",
     ]);
     let v: serde_json::Value = serde_json::from_str(&json).unwrap();
-    for key in ["parameters", "condition_number", "relative_error", "per_joint"] {
+    for key in [
+        "parameters",
+        "condition_number",
+        "relative_error",
+        "per_joint",
+    ] {
         assert!(v.get(key).is_some(), "JSON key {key}");
     }
     assert_eq!(v["per_joint"].as_array().unwrap().len(), 6);
-    assert!(v["per_joint"][0].get("rms").is_some() && v["per_joint"][0].get("relative_error").is_some());
+    assert!(
+        v["per_joint"][0].get("rms").is_some() && v["per_joint"][0].get("relative_error").is_some()
+    );
     assert!(v["relative_error"].as_f64().unwrap() < 1e-9);
     // the same base parameters from the robot file, by base-params
     let bp: serde_json::Value = serde_json::from_str(&run(&[
-        "base-params", &rx90, "--method", "numeric", "--format", "json",
+        "base-params",
+        &rx90,
+        "--method",
+        "numeric",
+        "--format",
+        "json",
     ]))
     .unwrap();
     let base = bp["base"].as_array().unwrap();
     let params = v["parameters"].as_array().unwrap();
     assert_eq!(base.len(), params.len());
-    let scale = base.iter().map(|b| b["value"].as_f64().unwrap().abs()).fold(0.0, f64::max);
+    let scale = base
+        .iter()
+        .map(|b| b["value"].as_f64().unwrap().abs())
+        .fold(0.0, f64::max);
     for (b, p) in base.iter().zip(params) {
         assert_eq!(b["name"], p["name"]);
         let (x, t) = (p["value"].as_f64().unwrap(), b["value"].as_f64().unwrap());
-        assert!((x - t).abs() <= 1e-8 * t.abs().max(1e-3 * scale), "{}: {x} vs {t}", b["name"]);
+        assert!(
+            (x - t).abs() <= 1e-8 * t.abs().max(1e-3 * scale),
+            "{}: {x} vs {t}",
+            b["name"]
+        );
         assert!(p.get("relative_std").is_some());
     }
     // CSV table and the consistent robot file, which simulates
-    let csv = run(&["identify", &rx90, "--data", traj.to_str().unwrap(), "--estimator", "ols", "--format", "csv"]);
+    let csv = run(&[
+        "identify",
+        &rx90,
+        "--data",
+        traj.to_str().unwrap(),
+        "--estimator",
+        "ols",
+        "--format",
+        "csv",
+    ]);
     assert!(csv.starts_with("name,value,std,relative_std,equation"));
     let written = tmp("identify", "identified.toml");
     let fit = tmp("identify", "fit.svg");
     run(&[
-        "identify", &rx90, "--data", traj.to_str().unwrap(), "--estimator", "ols",
-        "--write-robot", written.to_str().unwrap(), "--plot", fit.to_str().unwrap(),
+        "identify",
+        &rx90,
+        "--data",
+        traj.to_str().unwrap(),
+        "--estimator",
+        "ols",
+        "--write-robot",
+        written.to_str().unwrap(),
+        "--plot",
+        fit.to_str().unwrap(),
     ]);
     assert!(std::fs::read_to_string(&fit).unwrap().contains("predicted"));
     let out = tmp("identify", "resim.csv");
     run(&[
-        "simulate", written.to_str().unwrap(), "--duration", "0.2", "--dt", "0.001", "--output",
+        "simulate",
+        written.to_str().unwrap(),
+        "--duration",
+        "0.2",
+        "--dt",
+        "0.001",
+        "--output",
         out.to_str().unwrap(),
     ]);
 }
@@ -87,9 +172,19 @@ fn identify_refuses_bad_input_with_a_reason() {
     }
     std::fs::write(&log, &s).unwrap();
     let e = fails(&["identify", &rx90, "--data", log.to_str().unwrap()]);
-    assert!(e.contains("no effect") || e.contains("rank-deficient"), "{e}");
+    assert!(
+        e.contains("no effect") || e.contains("rank-deficient"),
+        "{e}"
+    );
     // cut-off above Nyquist
-    let e = fails(&["identify", &rx90, "--data", log.to_str().unwrap(), "--cutoff", "600"]);
+    let e = fails(&[
+        "identify",
+        &rx90,
+        "--data",
+        log.to_str().unwrap(),
+        "--cutoff",
+        "600",
+    ]);
     assert!(e.contains("Nyquist"), "{e}");
     // missing column
     std::fs::write(&log, "t,q1,tau1\n0,0,0\n0.001,0,0\n").unwrap();
@@ -98,7 +193,11 @@ fn identify_refuses_bad_input_with_a_reason() {
     // time not uniform
     let mut s = String::from("t,q1,q2,q3,q4,q5,q6,tau1,tau2,tau3,tau4,tau5,tau6\n");
     for k in 0..10 {
-        let t = if k < 5 { k as f64 * 0.001 } else { k as f64 * 0.002 };
+        let t = if k < 5 {
+            k as f64 * 0.001
+        } else {
+            k as f64 * 0.002
+        };
         s.push_str(&format!("{t},0,0,0,0,0,0,0,0,0,0,0,0\n"));
     }
     std::fs::write(&log, &s).unwrap();
@@ -109,7 +208,16 @@ fn identify_refuses_bad_input_with_a_reason() {
     let e = fails(&["identify", &rx90, "--data", log.to_str().unwrap()]);
     assert!(e.contains("--gains"), "{e}");
     // excite needs limits
-    let e = fails(&["excite", &rx90, "--period", "4", "--harmonics", "3", "--output", log.to_str().unwrap()]);
+    let e = fails(&[
+        "excite",
+        &rx90,
+        "--period",
+        "4",
+        "--harmonics",
+        "3",
+        "--output",
+        log.to_str().unwrap(),
+    ]);
     assert!(e.contains("velocity limit"), "{e}");
 }
 
@@ -128,5 +236,8 @@ fn transmission_with_drive_parameters_is_refused_by_the_dynamics_commands() {
     let out = tmp("identify_tr", "tx40_copy.toml");
     run(&["convert", &robot("tx40.toml"), out.to_str().unwrap()]);
     let copy = std::fs::read_to_string(&out).unwrap();
-    assert!(copy.contains("[transmission]") && copy.contains("[0.0, 0.0, 0.0, 0.0, 32.0, 32.0]"), "{copy}");
+    assert!(
+        copy.contains("[transmission]") && copy.contains("[0.0, 0.0, 0.0, 0.0, 32.0, 32.0]"),
+        "{copy}"
+    );
 }

@@ -15,10 +15,15 @@ use std::collections::BTreeMap;
 const SAMPLES: usize = 100_000;
 
 fn bench(c: &mut Criterion) {
-    let path = std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots/rx90.toml"));
+    let path = std::path::Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../robots/rx90.toml"
+    ));
     let mut acc = ModelAccess::new(load_description(path, &BTreeMap::new()).unwrap()).unwrap();
     let n = acc.actuated_joints().len();
-    let free: Vec<f64> = (0..n * 8).map(|k| 0.8 * ((k * 37 % 17) as f64 / 8.0 - 1.0)).collect();
+    let free: Vec<f64> = (0..n * 8)
+        .map(|k| 0.8 * ((k * 37 % 17) as f64 / 8.0 - 1.0))
+        .collect();
     let tr = FourierTrajectory::from_free(10.0, &vec![0.0; n], 5, &free);
     // 1 kHz for 100 s; torques by the inverse dynamic model
     let samples: Vec<RawSample> = (0..SAMPLES)
@@ -26,16 +31,29 @@ fn bench(c: &mut Criterion) {
             let t = k as f64 * 1e-3;
             let [q, qd, qdd] = tr.eval(t);
             let y = acc.inverse_dynamics(&q, &qd, &qdd).unwrap();
-            RawSample { t, q, y, qd: Some(qd), qdd: Some(qdd) }
+            RawSample {
+                t,
+                q,
+                y,
+                qd: Some(qd),
+                qdd: Some(qdd),
+            }
         })
         .collect();
-    let with_derivatives = MemoryLog { name: "100k samples".into(), samples };
+    let with_derivatives = MemoryLog {
+        name: "100k samples".into(),
+        samples,
+    };
     let positions_only = MemoryLog {
         name: "100k samples, positions".into(),
         samples: with_derivatives
             .samples
             .iter()
-            .map(|s| RawSample { qd: None, qdd: None, ..s.clone() })
+            .map(|s| RawSample {
+                qd: None,
+                qdd: None,
+                ..s.clone()
+            })
             .collect(),
     };
     let opt = Options {
@@ -52,7 +70,14 @@ fn bench(c: &mut Criterion) {
         b.iter(|| {
             for s in &with_derivatives.samples {
                 params
-                    .rows(&mut acc, &s.q, s.qd.as_ref().unwrap(), s.qdd.as_ref().unwrap(), &mut rows, &mut te)
+                    .rows(
+                        &mut acc,
+                        &s.q,
+                        s.qd.as_ref().unwrap(),
+                        s.qdd.as_ref().unwrap(),
+                        &mut rows,
+                        &mut te,
+                    )
                     .unwrap();
             }
             rows[0]

@@ -74,9 +74,18 @@ fn written_robot_is_consistent_and_reproduces_the_base_parameters() {
     let mut acc = ModelAccess::new(rx90()).unwrap();
     let log = log(&acc);
     let id = identify(&mut acc, &log, &opts(false)).unwrap();
-    assert!(id.warnings.iter().all(|w| !w.contains("not physically consistent")), "{:?}", id.warnings);
+    assert!(
+        id.warnings
+            .iter()
+            .all(|w| !w.contains("not physically consistent")),
+        "{:?}",
+        id.warnings
+    );
     let c = id.consistent.as_ref().expect("consistent parameters");
-    eprintln!("{} ; distance^2 {:.3e}, max deviation {:.3e} std", c.solver, c.distance2, c.max_deviation);
+    eprintln!(
+        "{} ; distance^2 {:.3e}, max deviation {:.3e} std",
+        c.solver, c.distance2, c.max_deviation
+    );
     // write, reload and compare
     let path = std::env::temp_dir().join(format!("robodyn-identified-{}.toml", std::process::id()));
     let desc = acc.description_with(&id.standard_parameters()).unwrap();
@@ -88,14 +97,24 @@ fn written_robot_is_consistent_and_reproduces_the_base_parameters() {
     let scale = id.x.iter().fold(0.0f64, |a, b| a.max(b.abs()));
     for (i, p) in id.parameters.iter().enumerate() {
         let e = (x[i] - id.x[i]).abs() / id.x[i].abs().max(1e-3 * scale);
-        assert!(e < 1e-6, "{}: written robot {} vs identified {} ({e:e})", p.name, x[i], id.x[i]);
+        assert!(
+            e < 1e-6,
+            "{}: written robot {} vs identified {} ({e:e})",
+            p.name,
+            x[i],
+            id.x[i]
+        );
     }
     // consistent: every pseudo-inertia PSD (to the solver's tolerance), drives >= 0
     let lo = min_pseudo_inertia_eigenvalue(&k);
     assert!(lo > -1e-9, "pseudo-inertia eigenvalue {lo}");
     for j in 0..6 {
         let ev = pseudo_inertia(&k[13 * j..13 * j + 10]).symmetric_eigenvalues();
-        assert!(ev.min() > -1e-9 * ev.max().abs().max(1.0), "link {}: {ev:?}", j + 1);
+        assert!(
+            ev.min() > -1e-9 * ev.max().abs().max(1.0),
+            "link {}: {ev:?}",
+            j + 1
+        );
         for p in 10..13 {
             assert!(k[13 * j + p] >= 0.0);
         }
@@ -104,7 +123,13 @@ fn written_robot_is_consistent_and_reproduces_the_base_parameters() {
     // the written robot simulates
     let n = reloaded.actuated_joints().len();
     let rows = reloaded
-        .simulate_tracking(&|t| vec![0.3 * t.sin(); n], 0.5, 0.01, &vec![100.0; n], &vec![20.0; n])
+        .simulate_tracking(
+            &|t| vec![0.3 * t.sin(); n],
+            0.5,
+            0.01,
+            &vec![100.0; n],
+            &vec![20.0; n],
+        )
         .unwrap();
     assert_eq!(rows.len(), 51);
 }
@@ -120,7 +145,13 @@ fn constrained_identification_of_consistent_data_finds_the_truth() {
     let scale = truth.iter().fold(0.0f64, |a, b| a.max(b.abs()));
     for (i, p) in id.parameters.iter().enumerate() {
         let e = (id.x[i] - truth[i]).abs() / truth[i].abs().max(1e-3 * scale);
-        assert!(e < 1e-6, "{}: {} vs true {} ({e:e})", p.name, id.x[i], truth[i]);
+        assert!(
+            e < 1e-6,
+            "{}: {} vs true {} ({e:e})",
+            p.name,
+            id.x[i],
+            truth[i]
+        );
     }
     assert!(id.estimator.contains("consistency"));
 }
@@ -139,11 +170,20 @@ fn deliberately_inconsistent_estimates_are_projected_and_reported() {
     let log = log(&acc);
     let id = identify(&mut acc, &log, &opts(false)).unwrap();
     let zz6 = id.parameters.iter().position(|p| p.name == "ZZ6").unwrap();
-    assert!((id.x[zz6] + 0.01).abs() < 1e-9, "the unconstrained estimate is exact: {}", id.x[zz6]);
-    let c = id.consistent.as_ref().unwrap();
-    eprintln!("{}: distance^2 {:.3e}, ZZ6 consistent {:.3e}", c.solver, c.distance2, c.x[zz6]);
     assert!(
-        id.warnings.iter().any(|w| w.contains("not physically consistent")),
+        (id.x[zz6] + 0.01).abs() < 1e-9,
+        "the unconstrained estimate is exact: {}",
+        id.x[zz6]
+    );
+    let c = id.consistent.as_ref().unwrap();
+    eprintln!(
+        "{}: distance^2 {:.3e}, ZZ6 consistent {:.3e}",
+        c.solver, c.distance2, c.x[zz6]
+    );
+    assert!(
+        id.warnings
+            .iter()
+            .any(|w| w.contains("not physically consistent")),
         "{:?}",
         id.warnings
     );
@@ -153,7 +193,8 @@ fn deliberately_inconsistent_estimates_are_projected_and_reported() {
     let constrained = identify(&mut acc, &log, &opts(true)).unwrap();
     assert!(constrained.x[zz6] >= -1e-9);
     assert!(
-        constrained.relative_error > 1e3 * id.relative_error.max(1e-15) && constrained.relative_error > 1e-6,
+        constrained.relative_error > 1e3 * id.relative_error.max(1e-15)
+            && constrained.relative_error > 1e-6,
         "constrained {:e} vs unconstrained {:e}",
         constrained.relative_error,
         id.relative_error

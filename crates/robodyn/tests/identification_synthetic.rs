@@ -23,7 +23,13 @@ fn access(name: &str) -> ModelAccess {
 }
 
 /// A random Fourier trajectory (seeded) around `start`, velocity amplitude ~ `amp` w.
-fn trajectory(start: &[f64], harmonics: usize, period: f64, amp: f64, seed: u64) -> FourierTrajectory {
+fn trajectory(
+    start: &[f64],
+    harmonics: usize,
+    period: f64,
+    amp: f64,
+    seed: u64,
+) -> FourierTrajectory {
     let mut rng = rng(seed);
     let m = FourierTrajectory::free_per_joint(harmonics);
     let w = 2.0 * std::f64::consts::PI / period;
@@ -170,7 +176,8 @@ fn two_sigma_coverage_of_the_reported_standard_deviations() {
     let n = acc.actuated_joints().len();
     let rms: Vec<f64> = (0..n)
         .map(|j| {
-            (clean.samples.iter().map(|s| s.y[j] * s.y[j]).sum::<f64>() / clean.samples.len() as f64)
+            (clean.samples.iter().map(|s| s.y[j] * s.y[j]).sum::<f64>()
+                / clean.samples.len() as f64)
                 .sqrt()
         })
         .collect();
@@ -187,9 +194,9 @@ fn two_sigma_coverage_of_the_reported_standard_deviations() {
         let mut r = rng(1000 + run as u64);
         let mut log = clean.clone();
         for s in &mut log.samples {
-            for j in 0..n {
+            for (j, (y, rms)) in s.y.iter_mut().zip(&rms).enumerate() {
                 // 1 % .. 6 % of the joint's RMS torque, different per joint
-                s.y[j] += 0.01 * (1.0 + j as f64) * rms[j] * gauss(&mut r);
+                *y += 0.01 * (1.0 + j as f64) * rms * gauss(&mut r);
             }
         }
         let id = identify(&mut acc, &log, &opt).unwrap();
@@ -281,14 +288,18 @@ fn iv_removes_the_bias_of_noisy_positions() {
     .model
     .names();
     let (wls, iv) = (&sums[0], &sums[1]);
-    let ratio = |e: &[f64], s: &[f64]| -> Vec<f64> { e.iter().zip(s).map(|(e, s)| e / s).collect() };
+    let ratio =
+        |e: &[f64], s: &[f64]| -> Vec<f64> { e.iter().zip(s).map(|(e, s)| e / s).collect() };
     let (rw, ri) = (ratio(&wls.1, &wls.2), ratio(&iv.1, &iv.2));
     let rms = |v: &[f64]| (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt();
     let biased: Vec<usize> = (0..rw.len()).filter(|&k| rw[k].abs() > 3.0).collect();
     let abs_w: f64 = biased.iter().map(|&k| wls.1[k].abs()).sum();
     let abs_i: f64 = biased.iter().map(|&k| iv.1[k].abs()).sum();
     for (k, name) in names.iter().enumerate() {
-        eprintln!("{name:8} WLS bias {:>8.2} std   IV bias {:>8.2} std", rw[k], ri[k]);
+        eprintln!(
+            "{name:8} WLS bias {:>8.2} std   IV bias {:>8.2} std",
+            rw[k], ri[k]
+        );
     }
     eprintln!(
         "mean error / std over {runs} runs, RMS over the {} parameters: WLS {:.2}, IV {:.2}; \
@@ -301,7 +312,11 @@ fn iv_removes_the_bias_of_noisy_positions() {
     );
     // measured: RMS 2.4 (WLS) vs 0.16 (IV); 8 parameters biased by > 3 std, whose absolute
     // errors IV reduces 37-fold
-    assert!(rms(&rw) > 2.0 && biased.len() >= 5, "no bias to remove: {}", rms(&rw));
+    assert!(
+        rms(&rw) > 2.0 && biased.len() >= 5,
+        "no bias to remove: {}",
+        rms(&rw)
+    );
     assert!(rms(&ri) < 0.8, "IV still biased: RMS {:.2} std", rms(&ri));
     assert!(abs_i < 0.2 * abs_w, "IV errors {abs_i:e} vs WLS {abs_w:e}");
 }
@@ -330,7 +345,9 @@ fn sr400_identified_as_a_closed_chain() {
     let inertial = id
         .parameters
         .iter()
-        .filter(|p| !p.name.starts_with("IA") && !p.name.starts_with("FS") && !p.name.starts_with("FV"))
+        .filter(|p| {
+            !p.name.starts_with("IA") && !p.name.starts_with("FS") && !p.name.starts_with("FV")
+        })
         .count();
     eprintln!(
         "SR400: {} parameters ({inertial} inertial), max relative error {e:.2e} ({p}), condition {:.1}",

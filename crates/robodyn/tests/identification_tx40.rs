@@ -22,7 +22,9 @@ fn tx40_dir() -> Option<PathBuf> {
 }
 
 fn data() -> Option<PathBuf> {
-    let found = tx40_dir().map(|d| d.join("tx40_joint.csv")).filter(|p| p.is_file());
+    let found = tx40_dir()
+        .map(|d| d.join("tx40_joint.csv"))
+        .filter(|p| p.is_file());
     if found.is_none() {
         let msg = "shared/data/tx40/tx40_joint.csv not found above CARGO_MANIFEST_DIR";
         assert!(
@@ -72,7 +74,12 @@ fn tx40_real_log() {
     assert!(id.validation.as_ref().unwrap().relative_error < 0.15);
     for f in &id.per_joint {
         eprintln!("  joint {}: {:.2} %", f.joint, 100.0 * f.relative_error);
-        assert!(f.relative_error < 0.2, "joint {}: {}", f.joint, f.relative_error);
+        assert!(
+            f.relative_error < 0.2,
+            "joint {}: {}",
+            f.joint,
+            f.relative_error
+        );
     }
     let value = |name: &str| {
         let k = id.parameters.iter().position(|p| p.name == name).unwrap();

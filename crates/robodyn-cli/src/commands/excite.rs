@@ -89,7 +89,9 @@ fn per_joint(name: &str, s: Option<&str>, n: usize) -> CliResult<Option<Vec<f64>
     match v.len() {
         1 => Ok(Some(vec![v[0]; n])),
         k if k == n => Ok(Some(v)),
-        k => Err(format!("--{name} has {k} values: give one, or one per actuated joint ({n})").into()),
+        k => Err(
+            format!("--{name} has {k} values: give one, or one per actuated joint ({n})").into(),
+        ),
     }
 }
 
@@ -186,10 +188,13 @@ pub fn run(a: Args) -> CliResult {
     eprintln!("wrote {}", a.output.display());
     if let Some(p) = &a.plot {
         let names = ["q", "qd", "qdd"];
-        let panels: Vec<(String, Vec<(String, Vec<f64>)>)> = (0..3)
+        let panels: Vec<robodyn::identification::report::Panel> = (0..3)
             .map(|k| {
                 (
-                    format!("{} of the actuated joints", ["positions", "velocities", "accelerations"][k]),
+                    format!(
+                        "{} of the actuated joints",
+                        ["positions", "velocities", "accelerations"][k]
+                    ),
                     joints
                         .iter()
                         .enumerate()

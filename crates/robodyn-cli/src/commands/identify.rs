@@ -172,7 +172,11 @@ pub fn run(a: Args) -> CliResult {
         border: a.border,
         validation: parse_validation(&a.validation)?,
         use_log_derivatives: !a.differentiate,
-        gains: a.gains.as_deref().map(|g| parse_list("gains", g)).transpose()?,
+        gains: a
+            .gains
+            .as_deref()
+            .map(|g| parse_list("gains", g))
+            .transpose()?,
         min_speed: a.min_speed,
         iv_iterations: a.iv_iterations,
         iv_bandwidth: a.iv_bandwidth,

@@ -145,10 +145,22 @@ pub fn pseudo_inertia(k: &[f64]) -> Matrix4<f64> {
         [k[0], k[1], k[2], k[3], k[4], k[5], k[6], k[7], k[8], k[9]];
     let t = 0.5 * (xx + yy + zz);
     Matrix4::new(
-        t - xx, -xy, -xz, mx, //
-        -xy, t - yy, -yz, my, //
-        -xz, -yz, t - zz, mz, //
-        mx, my, mz, m,
+        t - xx,
+        -xy,
+        -xz,
+        mx, //
+        -xy,
+        t - yy,
+        -yz,
+        my, //
+        -xz,
+        -yz,
+        t - zz,
+        mz, //
+        mx,
+        my,
+        mz,
+        m,
     )
 }
 
@@ -367,7 +379,13 @@ pub fn consistent_parameters(
         }
         q[a] = -2.0 * (0..=p).map(|i| re[(i, a)] * tw[(i, p)]).sum::<f64>() / s2;
     }
-    add_prior(&vars, &access.standard_parameters(), PRIOR_WEIGHT, &mut pm, &mut q);
+    add_prior(
+        &vars,
+        &access.standard_parameters(),
+        PRIOR_WEIGHT,
+        &mut pm,
+        &mut q,
+    );
     let (v, text) = solve(&vars, &pm, &q)?;
     let mut sol = finish(access, model, &vars, &v, estimate, text)?;
     // increase of the weighted residual, in units of sigma^2: the squared Mahalanobis distance

@@ -214,7 +214,12 @@ struct ScaledSvd {
 fn scaled_svd(r: &Mat<f64>) -> Result<ScaledSvd> {
     let p = r.ncols();
     let norms: Vec<f64> = (0..p)
-        .map(|c| (0..r.nrows()).map(|i| r[(i, c)] * r[(i, c)]).sum::<f64>().sqrt())
+        .map(|c| {
+            (0..r.nrows())
+                .map(|i| r[(i, c)] * r[(i, c)])
+                .sum::<f64>()
+                .sqrt()
+        })
         .collect();
     let mut a = Mat::<f64>::zeros(r.nrows(), p);
     for c in 0..p {
@@ -248,16 +253,26 @@ pub fn least_squares(t: &Mat<f64>, rows: usize, names: &[String]) -> Result<LsSo
     let r = Mat::from_fn(p, p, |i, j| t[(i, j)]);
     let z: Vec<f64> = (0..p).map(|i| t[(i, p)]).collect();
     let svd = scaled_svd(&r)?;
-    if let Some(&k) = svd.norms.iter().enumerate().find(|(_, &n)| n == 0.0).map(|(k, _)| k).as_ref() {
+    if let Some(&k) = svd
+        .norms
+        .iter()
+        .enumerate()
+        .find(|(_, &n)| n == 0.0)
+        .map(|(k, _)| k)
+        .as_ref()
+    {
         return Err(Error::Numerical(format!(
             "parameter {} has no effect on the measured torques (its column of W is zero): the \
              motion does not excite it",
-            names.get(k).cloned().unwrap_or_else(|| format!("#{}", k + 1))
+            names
+                .get(k)
+                .cloned()
+                .unwrap_or_else(|| format!("#{}", k + 1))
         )));
     }
     let smax = svd.s[0];
     let smin = *svd.s.last().unwrap();
-    if !(smin > RANK_TOLERANCE * smax) {
+    if smin.is_nan() || smin <= RANK_TOLERANCE * smax {
         // the parameters with large components in the null direction
         let v = &svd.v;
         let mut parts: Vec<(f64, usize)> = (0..p).map(|i| (v[(i, p - 1)].abs(), i)).collect();
@@ -410,7 +425,7 @@ pub fn iv_solve(parts: &[(&IvAccumulator, f64)]) -> Result<(Vec<f64>, Mat<f64>)>
         .thin_svd()
         .map_err(|e| Error::Numerical(format!("SVD of Z^T W failed: {e:?}")))?;
     let s: Vec<f64> = (0..p).map(|k| svd.S()[k]).collect();
-    if !(s[p - 1] > 1e-14 * s[0]) {
+    if s[p - 1].is_nan() || s[p - 1] <= 1e-14 * s[0] {
         return Err(Error::Numerical(format!(
             "the instrumental variables are not correlated with every column of the observation \
              matrix (Z^T W singular, sigma_min/sigma_max = {:.1e})",
@@ -489,7 +504,9 @@ mod tests {
             f.push(&[a, b, 2.0 * a - b], a + b);
         }
         let names = vec!["A".to_string(), "B".into(), "C".into()];
-        let e = least_squares(f.factor(), 50, &names).unwrap_err().to_string();
+        let e = least_squares(f.factor(), 50, &names)
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("rank-deficient") && e.contains('C'), "{e}");
     }
 }

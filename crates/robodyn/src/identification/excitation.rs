@@ -44,7 +44,12 @@ impl FourierTrajectory {
 
     /// From the free coefficients (per joint a_j1..a_j(L-1), b_j1..b_j(L-1)): the last
     /// harmonic makes the trajectory start and end at rest.
-    pub fn from_free(period: f64, start: &[f64], harmonics: usize, free: &[f64]) -> FourierTrajectory {
+    pub fn from_free(
+        period: f64,
+        start: &[f64],
+        harmonics: usize,
+        free: &[f64],
+    ) -> FourierTrajectory {
         let n = start.len();
         let m = Self::free_per_joint(harmonics);
         assert_eq!(free.len(), n * m, "free coefficients");
@@ -197,7 +202,10 @@ impl Problem<'_> {
             }
         }
         let mut s = f64::INFINITY;
-        let mut binding = Binding { joint: 0, what: "none" };
+        let mut binding = Binding {
+            joint: 0,
+            what: "none",
+        };
         let mut bind = |v: f64, j: usize, what: &'static str, s: &mut f64| {
             if v < *s {
                 *s = v;
@@ -285,8 +293,11 @@ impl Problem<'_> {
             }
         }
         for c in 0..p {
-            let norm = (0..w.nrows()).map(|i| w[(i, c)] * w[(i, c)]).sum::<f64>().sqrt();
-            if !(norm > 0.0) {
+            let norm = (0..w.nrows())
+                .map(|i| w[(i, c)] * w[(i, c)])
+                .sum::<f64>()
+                .sqrt();
+            if norm.is_nan() || norm <= 0.0 {
                 return None;
             }
             for i in 0..w.nrows() {
@@ -317,7 +328,11 @@ impl CostFunction for Problem<'_> {
 /// Design an exciting trajectory: random starting points, then Nelder–Mead on the free
 /// coefficients; every candidate is scaled to its binding limit before its condition number is
 /// computed, so the result satisfies the limits.
-pub fn design(access: &mut ModelAccess, params: &mut ParameterModel, opt: &DesignOptions) -> Result<Design> {
+pub fn design(
+    access: &mut ModelAccess,
+    params: &mut ParameterModel,
+    opt: &DesignOptions,
+) -> Result<Design> {
     use rand::Rng;
     let n = access.actuated_joints().len();
     if opt.harmonics < 2 {
@@ -327,7 +342,10 @@ pub fn design(access: &mut ModelAccess, params: &mut ParameterModel, opt: &Desig
         )));
     }
     if !(opt.period.is_finite() && opt.period > 0.0) {
-        return Err(Error::Input(format!("period {} s must be positive", opt.period)));
+        return Err(Error::Input(format!(
+            "period {} s must be positive",
+            opt.period
+        )));
     }
     if opt.start.len() != n || opt.limits.len() != n {
         return Err(Error::Input(format!(
@@ -343,7 +361,9 @@ pub fn design(access: &mut ModelAccess, params: &mut ParameterModel, opt: &Desig
                 access.actuated_joints()[j]
             )));
         }
-        if l.q_min.is_some_and(|lo| lo >= opt.start[j]) || l.q_max.is_some_and(|hi| hi <= opt.start[j]) {
+        if l.q_min.is_some_and(|lo| lo >= opt.start[j])
+            || l.q_max.is_some_and(|hi| hi <= opt.start[j])
+        {
             return Err(Error::Input(format!(
                 "joint {}: the start position {} is not inside the position limits",
                 access.actuated_joints()[j],
@@ -396,11 +416,7 @@ pub fn design(access: &mut ModelAccess, params: &mut ParameterModel, opt: &Desig
         .configure(|s| s.max_iters(opt.iterations))
         .run()
         .map_err(|e| Error::Numerical(format!("the excitation optimization failed: {e}")))?;
-    let xbest = res
-        .state
-        .get_best_param()
-        .cloned()
-        .unwrap_or(x0);
+    let xbest = res.state.get_best_param().cloned().unwrap_or(x0);
     let problem = res.problem.problem.expect("problem returned");
     let (tr, binding) = problem.feasible(&xbest).ok_or_else(|| {
         Error::Numerical("the optimized trajectory cannot be scaled to the limits".into())
@@ -415,7 +431,12 @@ pub fn design(access: &mut ModelAccess, params: &mut ParameterModel, opt: &Desig
         let [q, qd, qdd] = tr.eval(opt.period * k as f64 / (4 * opt.samples) as f64);
         let tau = inner.access.inverse_dynamics(&q, &qd, &qdd)?;
         for j in 0..n {
-            let v = [(q[j] - opt.start[j]).abs(), qd[j].abs(), qdd[j].abs(), tau[j].abs()];
+            let v = [
+                (q[j] - opt.start[j]).abs(),
+                qd[j].abs(),
+                qdd[j].abs(),
+                tau[j].abs(),
+            ];
             for (a, b) in peaks[j].iter_mut().zip(v) {
                 *a = a.max(b);
             }
@@ -437,7 +458,9 @@ mod tests {
 
     #[test]
     fn starts_and_ends_at_rest_and_derivatives_agree() {
-        let free: Vec<f64> = (0..2 * 2 * 3).map(|k| ((k * 7 % 5) as f64 - 2.0) * 0.3).collect();
+        let free: Vec<f64> = (0..2 * 2 * 3)
+            .map(|k| ((k * 7 % 5) as f64 - 2.0) * 0.3)
+            .collect();
         let tr = FourierTrajectory::from_free(4.0, &[0.2, -0.5], 4, &free);
         assert_eq!(tr.free(), free);
         for t in [0.0, 4.0] {

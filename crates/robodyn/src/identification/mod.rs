@@ -26,7 +26,9 @@ pub mod signal;
 
 use crate::error::{Error, Result};
 use data::{summarize, Effort, LogSource, LogSummary};
-use estimators::{combine, iv_solve, joint_sigma, least_squares, output_sq, residual_sq, restrict, LsSolution};
+use estimators::{
+    combine, iv_solve, joint_sigma, least_squares, output_sq, residual_sq, restrict, LsSolution,
+};
 use faer::Mat;
 use model_access::ModelAccess;
 use observation::{run_pass, Instruments, PassResult, Processing, ValidationRows};
@@ -289,11 +291,9 @@ pub fn processing(summary: &LogSummary, opt: &Options) -> Result<(Processing, Pr
     } else {
         None
     };
-    let border = opt.border.unwrap_or_else(|| {
-        lowpass
-            .as_ref()
-            .map_or(0, |f| f.settling_samples(1e-3))
-    });
+    let border = opt
+        .border
+        .unwrap_or_else(|| lowpass.as_ref().map_or(0, |f| f.settling_samples(1e-3)));
     let decimation_skip = decimation_filter
         .as_ref()
         .map_or(0, |f| f.settling_samples(1e-3));
@@ -306,7 +306,11 @@ pub fn processing(summary: &LogSummary, opt: &Options) -> Result<(Processing, Pr
                     "validation segment {a}:{b}: fractions 0 <= from < to <= 1 of the log expected"
                 )));
             }
-            let end = if b >= 1.0 { f64::INFINITY } else { summary.t0 + b * duration };
+            let end = if b >= 1.0 {
+                f64::INFINITY
+            } else {
+                summary.t0 + b * duration
+            };
             Some((summary.t0 + a * duration, end))
         }
     };
@@ -372,7 +376,11 @@ fn joint_fits(
                 joint: access.actuated_joints()[k],
                 name: names[k].clone(),
                 rows,
-                rms: if rows > 0 { (r / rows as f64).sqrt() } else { 0.0 },
+                rms: if rows > 0 {
+                    (r / rows as f64).sqrt()
+                } else {
+                    0.0
+                },
                 relative_error: if y > 0.0 { (r / y).sqrt() } else { 0.0 },
                 sigma: sigma.map(|s| s[k]),
             }
@@ -382,7 +390,11 @@ fn joint_fits(
 }
 
 /// Identify the parameters of `access`'s robot from `log`.
-pub fn identify(access: &mut ModelAccess, log: &dyn LogSource, opt: &Options) -> Result<Identification> {
+pub fn identify(
+    access: &mut ModelAccess,
+    log: &dyn LogSource,
+    opt: &Options,
+) -> Result<Identification> {
     let mut model = ParameterModel::build(access, &opt.parameters)?;
     let n = model.joints_count();
     let p = model.count();
@@ -404,7 +416,11 @@ pub fn identify(access: &mut ModelAccess, log: &dyn LogSource, opt: &Options) ->
         )));
     }
     let ts: Vec<Mat<f64>> = pass.fit.iter_mut().map(|f| f.factor().clone()).collect();
-    let ols = least_squares(&combine(&ts.iter().map(|t| (t, 1.0)).collect::<Vec<_>>()), rows, &names)?;
+    let ols = least_squares(
+        &combine(&ts.iter().map(|t| (t, 1.0)).collect::<Vec<_>>()),
+        rows,
+        &names,
+    )?;
     let (mut sol, sigma): (LsSolution, Option<Vec<f64>>) = match opt.estimator {
         Estimator::Ols => (ols.clone(), None),
         Estimator::Wls | Estimator::Iv => {
@@ -416,14 +432,19 @@ pub fn identify(access: &mut ModelAccess, log: &dyn LogSource, opt: &Options) ->
                     joint_sigma(f.factor(), r)
                 })
                 .collect::<Result<Vec<f64>>>()?;
-            if let Some(k) = sig.iter().position(|s| !(*s > 0.0)) {
+            if let Some(k) = sig.iter().position(|s| s.is_nan() || *s <= 0.0) {
                 return Err(Error::Numerical(format!(
                     "joint {}: its equations are fitted exactly (sigma = 0), so Gautier's weight \
                      1/sigma is infinite; use --estimator ols (noise-free data)",
                     access.actuated_joints()[k]
                 )));
             }
-            let tw = combine(&ts.iter().zip(&sig).map(|(t, s)| (t, 1.0 / s)).collect::<Vec<_>>());
+            let tw = combine(
+                &ts.iter()
+                    .zip(&sig)
+                    .map(|(t, s)| (t, 1.0 / s))
+                    .collect::<Vec<_>>(),
+            );
             (least_squares(&tw, rows, &names)?, Some(sig))
         }
     };
@@ -451,15 +472,30 @@ pub fn identify(access: &mut ModelAccess, log: &dyn LogSource, opt: &Options) ->
             let k = model.joint_side_drives(&model.base_robot_parameters(&x));
             let mut tracking = access.tracking_model(&k, 0.05)?;
             let a = tracking.inertia_diagonal(&access.reference_actuated())?;
-            let kp: Vec<f64> = a.iter().map(|a| a.abs().max(1e-6) * omega * omega).collect();
-            let kd: Vec<f64> = a.iter().map(|a| a.abs().max(1e-6) * 2.0 * 0.8 * omega).collect();
+            let kp: Vec<f64> = a
+                .iter()
+                .map(|a| a.abs().max(1e-6) * omega * omega)
+                .collect();
+            let kd: Vec<f64> = a
+                .iter()
+                .map(|a| a.abs().max(1e-6) * 2.0 * 0.8 * omega)
+                .collect();
             let mut ins = Instruments::new(tracking, kp, kd, model.offsets(&x), substeps);
             let ivpass: PassResult = run_pass(log, &mut model, access, &proc, Some(&mut ins))?;
             deviation = ivpass.instrument_deviation;
             let acc = ivpass.iv.expect("instrument accumulators");
-            let (x_new, m) = iv_solve(&acc.iter().zip(&sig).map(|(a, s)| (a, 1.0 / s)).collect::<Vec<_>>())?;
+            let (x_new, m) = iv_solve(
+                &acc.iter()
+                    .zip(&sig)
+                    .map(|(a, s)| (a, 1.0 / s))
+                    .collect::<Vec<_>>(),
+            )?;
             // residual variance of the weighted rows at the IV estimate
-            let res_w: f64 = ts.iter().zip(&sig).map(|(t, s)| residual_sq(t, &x_new) / (s * s)).sum();
+            let res_w: f64 = ts
+                .iter()
+                .zip(&sig)
+                .map(|(t, s)| residual_sq(t, &x_new) / (s * s))
+                .sum();
             let s2 = res_w / (rows - p) as f64;
             let std: Vec<f64> = (0..p).map(|i| (s2 * m[(i, i)]).max(0.0).sqrt()).collect();
             last_change = x_new
@@ -494,7 +530,12 @@ pub fn identify(access: &mut ModelAccess, log: &dyn LogSource, opt: &Options) ->
         });
     }
     let tw: Mat<f64> = match &sigma {
-        Some(sig) => combine(&ts.iter().zip(sig).map(|(t, s)| (t, 1.0 / s)).collect::<Vec<_>>()),
+        Some(sig) => combine(
+            &ts.iter()
+                .zip(sig)
+                .map(|(t, s)| (t, 1.0 / s))
+                .collect::<Vec<_>>(),
+        ),
         None => combine(&ts.iter().map(|t| (t, 1.0)).collect::<Vec<_>>()),
     };
     // physically consistent parameters: the constrained least squares, which is also the

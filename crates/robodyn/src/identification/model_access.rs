@@ -53,7 +53,10 @@ pub enum Rotors {
 }
 
 /// A robot file read for identification: the description and its symbol overrides applied.
-pub fn load_description(path: &Path, overrides: &BTreeMap<String, f64>) -> Result<RobotDescription> {
+pub fn load_description(
+    path: &Path,
+    overrides: &BTreeMap<String, f64>,
+) -> Result<RobotDescription> {
     let mut desc = crate::io::load_description(path)?;
     desc.symbols
         .extend(overrides.iter().map(|(k, v)| (k.clone(), *v)));
@@ -318,7 +321,12 @@ impl ModelAccess {
 
     /// The equivalent tree's state for (q_a, qd_a, qdd_a) into `self.q`, `self.qd`, `self.qdd`;
     /// for a closed chain q_p by continuation from the previous sample and G returned.
-    fn tree_state(&mut self, qa: &[f64], qda: &[f64], qdda: &[f64]) -> Result<Option<DMatrix<f64>>> {
+    fn tree_state(
+        &mut self,
+        qa: &[f64],
+        qda: &[f64],
+        qdda: &[f64],
+    ) -> Result<Option<DMatrix<f64>>> {
         match &mut self.closed {
             None => {
                 for (k, &j) in self.actuated.iter().enumerate() {
@@ -364,7 +372,14 @@ impl ModelAccess {
     ) -> Result<()> {
         let g = self.tree_state(qa, qda, qdda)?;
         let model = self.robot.numeric();
-        regressor(model, &mut self.ws, &self.q, &self.qd, &self.qdd, &mut self.phi);
+        regressor(
+            model,
+            &mut self.ws,
+            &self.q,
+            &self.qd,
+            &self.qdd,
+            &mut self.phi,
+        );
         wrench_torques(model, &mut self.ws, &self.q, &mut self.tau_e);
         let m = cols.len();
         match g {
@@ -440,7 +455,8 @@ impl ModelAccess {
             let a = inertia_matrix(&robot, &s.q)?;
             let a = match &s.g {
                 Some(g) => g.transpose() * a * g,
-                None => a.select_rows(movable.iter().map(|j| j - 1).collect::<Vec<_>>().iter())
+                None => a
+                    .select_rows(movable.iter().map(|j| j - 1).collect::<Vec<_>>().iter())
                     .select_columns(movable.iter().map(|j| j - 1).collect::<Vec<_>>().iter()),
             };
             lo = lo.min(a.symmetric_eigenvalues().min());
@@ -475,7 +491,7 @@ impl ModelAccess {
             let nl = model.nl;
             Ok(TrackingModel::Tree {
                 smoothing,
-                ws: DirectWorkspace::new(&model),
+                ws: Box::new(DirectWorkspace::new(&model)),
                 model: Box::new(model),
                 joints: self.actuated.clone(),
                 q: vec![0.0; nl],
@@ -485,7 +501,8 @@ impl ModelAccess {
             })
         } else {
             let robot = self.robot.with_standard_parameters(&k)?;
-            let dynamics = ClosedChainDynamics::new(&robot)?.with_coulomb_smoothing(Some(smoothing));
+            let dynamics =
+                ClosedChainDynamics::new(&robot)?.with_coulomb_smoothing(Some(smoothing));
             Ok(TrackingModel::Closed(Box::new(dynamics)))
         }
     }
@@ -554,7 +571,7 @@ pub enum TrackingModel {
     Tree {
         smoothing: f64,
         model: Box<DynModel<f64>>,
-        ws: DirectWorkspace,
+        ws: Box<DirectWorkspace>,
         joints: Vec<usize>,
         q: Vec<f64>,
         qd: Vec<f64>,
@@ -607,7 +624,8 @@ impl TrackingModel {
                     q[j - 1] = qa[k];
                     qd[j - 1] = qda[k];
                     let (fs, s) = (model.link(j).fs, qda[k]);
-                    tau[j - 1] = taua[k] + fs * (s.signum() * f64::from(s != 0.0) - (s / *smoothing).tanh());
+                    tau[j - 1] =
+                        taua[k] + fs * (s.signum() * f64::from(s != 0.0) - (s / *smoothing).tanh());
                 }
                 ddm(model, ws, Method::Composite, q, qd, tau, qdd)?;
                 for (k, &j) in joints.iter().enumerate() {

@@ -67,6 +67,9 @@ pub struct PassResult {
     pub instrument_deviation: f64,
 }
 
+/// A measured sample the simulation tracks: t, q, qd and the torque.
+type Reference = (f64, Vec<f64>, Vec<f64>, Vec<f64>);
+
 /// The simulation behind the instruments of IDIM-IV: the current model driven by the measured
 /// torque (offsets removed) plus a PD correction toward the measured (filtered) motion, so that
 /// it follows the motion without the measurement noise; the instrument rows are W at the
@@ -79,12 +82,18 @@ pub struct Instruments {
     /// RK4 steps per sample.
     pub substeps: usize,
     state: Option<(Vec<f64>, Vec<f64>)>,
-    previous: Option<(f64, Vec<f64>, Vec<f64>, Vec<f64>)>,
+    previous: Option<Reference>,
     deviation: f64,
 }
 
 impl Instruments {
-    pub fn new(model: TrackingModel, kp: Vec<f64>, kd: Vec<f64>, offsets: Vec<f64>, substeps: usize) -> Self {
+    pub fn new(
+        model: TrackingModel,
+        kp: Vec<f64>,
+        kd: Vec<f64>,
+        offsets: Vec<f64>,
+        substeps: usize,
+    ) -> Self {
         Instruments {
             model,
             kp,
@@ -97,10 +106,18 @@ impl Instruments {
         }
     }
 
-    fn accel(&mut self, q: &[f64], qd: &[f64], reference: &(f64, Vec<f64>, Vec<f64>, Vec<f64>), out: &mut [f64]) -> Result<()> {
+    fn accel(
+        &mut self,
+        q: &[f64],
+        qd: &[f64],
+        reference: &Reference,
+        out: &mut [f64],
+    ) -> Result<()> {
         let (_, qr, qdr, y) = reference;
         let tau: Vec<f64> = (0..q.len())
-            .map(|k| y[k] - self.offsets[k] + self.kp[k] * (qr[k] - q[k]) + self.kd[k] * (qdr[k] - qd[k]))
+            .map(|k| {
+                y[k] - self.offsets[k] + self.kp[k] * (qr[k] - q[k]) + self.kd[k] * (qdr[k] - qd[k])
+            })
             .collect();
         self.model.accel(q, qd, &tau, out)
     }
@@ -114,7 +131,12 @@ impl Instruments {
                 // RK4 with the previous sample's reference and torque held (zero-order hold)
                 let h = (t - prev.0) / self.substeps as f64;
                 let (mut qs, mut qds) = s;
-                let mut k = [vec![0.0; 2 * n], vec![0.0; 2 * n], vec![0.0; 2 * n], vec![0.0; 2 * n]];
+                let mut k = [
+                    vec![0.0; 2 * n],
+                    vec![0.0; 2 * n],
+                    vec![0.0; 2 * n],
+                    vec![0.0; 2 * n],
+                ];
                 let mut a = vec![0.0; n];
                 for _ in 0..self.substeps {
                     let mut yq = qs.clone();
@@ -133,7 +155,8 @@ impl Instruments {
                     }
                     for i in 0..n {
                         qs[i] += h / 6.0 * (k[0][i] + 2.0 * k[1][i] + 2.0 * k[2][i] + k[3][i]);
-                        qds[i] += h / 6.0 * (k[0][n + i] + 2.0 * k[1][n + i] + 2.0 * k[2][n + i] + k[3][n + i]);
+                        qds[i] += h / 6.0
+                            * (k[0][n + i] + 2.0 * k[1][n + i] + 2.0 * k[2][n + i] + k[3][n + i]);
                     }
                 }
                 if qs.iter().chain(&qds).any(|v| !v.is_finite()) {
@@ -228,7 +251,10 @@ impl Pass<'_> {
 
     /// A filtered position sample, in order: central differences need its neighbours.
     fn filtered(&mut self, q: Vec<f64>) -> Result<()> {
-        let (t, y) = self.pending.pop_front().expect("one pending sample per filtered one");
+        let (t, y) = self
+            .pending
+            .pop_front()
+            .expect("one pending sample per filtered one");
         self.window.push_back((t, q, y));
         if self.window.len() == 3 {
             let (a, b, c) = (&self.window[0], &self.window[1], &self.window[2]);
@@ -267,8 +293,14 @@ impl Pass<'_> {
     fn kept(&mut self, s: Processed) -> Result<()> {
         self.out.samples_used += 1;
         let (n, p) = (self.n, self.p);
-        self.params
-            .rows(self.access, &s.q, &s.qd, &s.qdd, &mut self.w, &mut self.tau_e)?;
+        self.params.rows(
+            self.access,
+            &s.q,
+            &s.qd,
+            &s.qdd,
+            &mut self.w,
+            &mut self.tau_e,
+        )?;
         if self.w.iter().any(|v| !v.is_finite()) {
             return Err(Error::Numerical(format!(
                 "the observation matrix is not finite at t = {} s",
@@ -293,7 +325,9 @@ impl Pass<'_> {
         self.dec_count += 1;
         if let Some(d) = &mut self.decimator {
             d.step(&mut self.channels);
-            if self.dec_count <= self.dec_skip || (self.dec_count - self.dec_skip) % self.proc.decimation != 0 {
+            if self.dec_count <= self.dec_skip
+                || !(self.dec_count - self.dec_skip).is_multiple_of(self.proc.decimation)
+            {
                 return Ok(());
             }
         }
@@ -309,7 +343,10 @@ impl Pass<'_> {
             }
             if self.proc.keep_validation_rows {
                 self.out.validation_rows.t.push(s.t);
-                self.out.validation_rows.y.push(ch[n * p..n * p + n].to_vec());
+                self.out
+                    .validation_rows
+                    .y
+                    .push(ch[n * p..n * p + n].to_vec());
                 self.out.validation_rows.w.push(ch[..n * p].to_vec());
             }
         } else {

@@ -242,7 +242,14 @@ impl ParameterModel {
 
     /// Motor-joint drive columns of motor k at (qd_a, qdd_a): the joint torques of unit Ia_k,
     /// Fs_k or Fv_k, R_k^T (R_k qdd), R_k^T sign(R_k qd), R_k^T (R_k qd).
-    fn motor_column(r: &[Vec<f64>], k: usize, which: usize, qd: &[f64], qdd: &[f64], out: &mut [f64]) {
+    fn motor_column(
+        r: &[Vec<f64>],
+        k: usize,
+        which: usize,
+        qd: &[f64],
+        qdd: &[f64],
+        out: &mut [f64],
+    ) {
         let row = &r[k];
         let dot = |v: &[f64]| row.iter().zip(v).map(|(a, b)| a * b).sum::<f64>();
         let s = match which {
@@ -273,7 +280,10 @@ impl ParameterModel {
         access: &mut ModelAccess,
         wanted: &[(usize, usize)],
         seed: u64,
-    ) -> Result<(Vec<(usize, usize)>, Vec<((usize, usize), Vec<(usize, f64)>)>)> {
+    ) -> Result<(
+        Vec<(usize, usize)>,
+        Vec<((usize, usize), Vec<(usize, f64)>)>,
+    )> {
         let r = self.transmission.as_ref().expect("transmission");
         let nb = self.base.base.len();
         let total = nb + wanted.len();
@@ -320,7 +330,10 @@ impl ParameterModel {
                 .sum::<f64>()
                 .sqrt();
             if std::env::var("ROBODYN_DEBUG").is_ok() {
-                eprintln!("motor column {m:?}: relative distance {:e}", residual / norm);
+                eprintln!(
+                    "motor column {m:?}: relative distance {:e}",
+                    residual / norm
+                );
             }
             if residual > GROUP_TOLERANCE * norm {
                 kept_cols.push(nb + c);
@@ -328,7 +341,8 @@ impl ParameterModel {
             } else {
                 // kept motor columns come after the base parameters, in `kept` order
                 // coefficients whose contribution is at rounding level are dropped
-                let col_norm = |k: usize| (0..rows).map(|i| a[(i, k)] * a[(i, k)]).sum::<f64>().sqrt();
+                let col_norm =
+                    |k: usize| (0..rows).map(|i| a[(i, k)] * a[(i, k)]).sum::<f64>().sqrt();
                 grouped.push((
                     m,
                     (0..kept_cols.len())
@@ -353,7 +367,14 @@ impl ParameterModel {
         tau_e: &mut [f64],
     ) -> Result<()> {
         let (n, p, nb) = (self.n, self.params.len(), self.base.base.len());
-        access.rows(qa, qda, qdda, &self.base.base, &mut self.base_rows, &mut self.tau_e)?;
+        access.rows(
+            qa,
+            qda,
+            qdda,
+            &self.base.base,
+            &mut self.base_rows,
+            &mut self.tau_e,
+        )?;
         tau_e.copy_from_slice(&self.tau_e);
         let mut col = vec![0.0; n];
         for i in 0..n {
@@ -418,7 +439,7 @@ fn check_transmission(r: &[Vec<f64>], n: usize) -> Result<()> {
     let sv = m
         .singular_values()
         .map_err(|e| Error::Numerical(format!("SVD of the transmission failed: {e:?}")))?;
-    if !(sv[n - 1] > 1e-12 * sv[0]) {
+    if sv[n - 1].is_nan() || sv[n - 1] <= 1e-12 * sv[0] {
         return Err(Error::Input(
             "the transmission matrix R is singular: motor positions must determine the joint \
              positions"

@@ -41,7 +41,9 @@ pub fn to_text(id: &Identification) -> String {
         pr.samples, pr.sample_rate, pr.duration
     ));
     if pr.derivatives_from_log {
-        s.push_str("Velocities and accelerations: the log's qd, qdd columns (not differentiated)\n");
+        s.push_str(
+            "Velocities and accelerations: the log's qd, qdd columns (not differentiated)\n",
+        );
     }
     if let Some((o, fc)) = pr.lowpass {
         s.push_str(&format!(
@@ -69,7 +71,10 @@ pub fn to_text(id: &Identification) -> String {
             "Fit: {} decimated samples outside [{a:.4}, {b:.4}) s; validation: {} samples in it\n",
             pr.fit_samples, pr.validation_samples
         )),
-        None => s.push_str(&format!("Fit: {} decimated samples (no validation segment)\n", pr.fit_samples)),
+        None => s.push_str(&format!(
+            "Fit: {} decimated samples (no validation segment)\n",
+            pr.fit_samples
+        )),
     }
     s.push_str(&format!(
         "Condition number of W (unit columns): {:.4e} (as given: {:.4e})\n",
@@ -99,7 +104,13 @@ pub fn to_text(id: &Identification) -> String {
         .collect();
     let head = ["parameter", "value", "std", "rel.std %", "equation"];
     let w: Vec<usize> = (0..4)
-        .map(|c| rows.iter().map(|r| r[c].len()).chain([head[c].len()]).max().unwrap_or(1))
+        .map(|c| {
+            rows.iter()
+                .map(|r| r[c].len())
+                .chain([head[c].len()])
+                .max()
+                .unwrap_or(1)
+        })
         .collect();
     let line = |r: [&str; 5]| {
         format!(
@@ -128,7 +139,11 @@ pub fn to_text(id: &Identification) -> String {
         "RMS",
         "rel.err %",
         "sigma (WLS)",
-        if id.validation.is_some() { "  valid. rel.err %" } else { "" }
+        if id.validation.is_some() {
+            "  valid. rel.err %"
+        } else {
+            ""
+        }
     ));
     for (k, f) in id.per_joint.iter().enumerate() {
         let v = id
@@ -143,7 +158,9 @@ pub fn to_text(id: &Identification) -> String {
             f.rows,
             f.rms,
             100.0 * f.relative_error,
-            f.sigma.map(|x| format!("{x:.5e}")).unwrap_or_else(|| "-".into()),
+            f.sigma
+                .map(|x| format!("{x:.5e}"))
+                .unwrap_or_else(|| "-".into()),
         ));
     }
     if let Some(iv) = &id.iv {
@@ -151,7 +168,11 @@ pub fn to_text(id: &Identification) -> String {
             "\nIDIM-IV: {} iteration(s), {}; last change {:.3e} std; simulated motion within \
              {:.3e} of the measured one\n",
             iv.iterations,
-            if iv.converged { "converged" } else { "NOT converged" },
+            if iv.converged {
+                "converged"
+            } else {
+                "NOT converged"
+            },
             iv.last_change,
             iv.deviation
         ));
@@ -324,12 +345,15 @@ pub fn to_csv(id: &Identification) -> String {
     s
 }
 
+/// A panel: its title and its curves (label, values).
+pub type Panel = (String, Vec<(String, Vec<f64>)>);
+
 /// One panel per joint: curves (label, values) against t.
 pub fn plot_panels(
     path: &Path,
     title: &str,
     t: &[f64],
-    panels: &[(String, Vec<(String, Vec<f64>)>)],
+    panels: &[Panel],
     y_label: &str,
     bold_first: bool,
 ) -> Result<()> {
@@ -345,9 +369,7 @@ pub fn plot_panels(
     let height = 60 + 220 * panels.len() as u32;
     let root = SVGBackend::new(path, (1100, height)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| ds(&e))?;
-    let root = root
-        .titled(title, ("sans-serif", 22))
-        .map_err(|e| ds(&e))?;
+    let root = root.titled(title, ("sans-serif", 22)).map_err(|e| ds(&e))?;
     let areas = root.split_evenly((panels.len(), 1));
     let colors = [
         RGBColor(20, 20, 20),
@@ -365,7 +387,9 @@ pub fn plot_panels(
             .iter()
             .flat_map(|(_, v)| v.iter().copied())
             .filter(|v| v.is_finite())
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+                (a.min(v), b.max(v))
+            });
         let (lo, hi) = if !lo.is_finite() {
             (-1.0, 1.0)
         } else if hi - lo < 1e-12 * (1.0 + lo.abs()) {
@@ -423,18 +447,26 @@ pub fn plot_fit(path: &Path, id: &Identification) -> Result<()> {
     }
     let pred = id.predicted_validation();
     let v = id.validation.as_ref();
-    let panels: Vec<(String, Vec<(String, Vec<f64>)>)> = id
+    let panels: Vec<Panel> = id
         .joints
         .iter()
         .enumerate()
         .map(|(k, j)| {
             let err = v
-                .map(|v| format!(" (relative error {:.2} %)", 100.0 * v.per_joint[k].relative_error))
+                .map(|v| {
+                    format!(
+                        " (relative error {:.2} %)",
+                        100.0 * v.per_joint[k].relative_error
+                    )
+                })
                 .unwrap_or_default();
             (
                 format!("joint {j} ({}){err}", id.joint_names[k]),
                 vec![
-                    ("measured".to_string(), rows.y.iter().map(|y| y[k]).collect()),
+                    (
+                        "measured".to_string(),
+                        rows.y.iter().map(|y| y[k]).collect(),
+                    ),
                     ("predicted".to_string(), pred.iter().map(|y| y[k]).collect()),
                 ],
             )

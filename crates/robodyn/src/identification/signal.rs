@@ -383,7 +383,10 @@ impl ZeroPhaseStream {
 /// (x[k+1] - x[k-1]) / (2 dt) and (x[k+1] - 2 x[k] + x[k-1]) / dt^2.
 #[inline]
 pub fn central_differences(prev: f64, cur: f64, next: f64, dt: f64) -> (f64, f64) {
-    ((next - prev) / (2.0 * dt), (next - 2.0 * cur + prev) / (dt * dt))
+    (
+        (next - prev) / (2.0 * dt),
+        (next - 2.0 * cur + prev) / (dt * dt),
+    )
 }
 
 #[cfg(test)]
@@ -437,7 +440,10 @@ mod tests {
             })
             .collect();
         let whole: Vec<Vec<f64>> = (0..2)
-            .map(|c| f.filtfilt(&x.iter().map(|v| v[c]).collect::<Vec<_>>()).unwrap())
+            .map(|c| {
+                f.filtfilt(&x.iter().map(|v| v[c]).collect::<Vec<_>>())
+                    .unwrap()
+            })
             .collect();
         let mut s = ZeroPhaseStream::new(f, 2);
         let mut got: Vec<Vec<f64>> = Vec::new();
@@ -467,7 +473,8 @@ mod tests {
     /// its zero-phase output are the same.
     #[test]
     fn matches_scipy_butter_and_sosfiltfilt() {
-        let cases: [(usize, f64, f64, &[(usize, f64)]); 3] = [
+        type Case<'a> = (usize, f64, f64, &'a [(usize, f64)]);
+        let cases: [Case; 3] = [
             (
                 4,
                 30.0,

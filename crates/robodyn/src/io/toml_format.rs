@@ -6,8 +6,7 @@
 use crate::error::{Error, Item, Location, Result};
 use crate::model::{
     validate_structure, JointLimits, JointType, LinkDesc, RobotDescription, Transmission,
-    GEOMETRIC_PARAMETERS,
-    STANDARD_PARAMETERS, WRENCH_COMPONENTS,
+    GEOMETRIC_PARAMETERS, STANDARD_PARAMETERS, WRENCH_COMPONENTS,
 };
 use crate::Robot;
 use robodyn_symbolic::Expr;
@@ -462,7 +461,12 @@ pub fn parse_description(text: &str, file: Option<&str>) -> Result<(RobotDescrip
 }
 
 /// A constant (number or expression over the file's symbols).
-fn constant(text: &str, file: Option<&str>, symbols: &BTreeMap<String, f64>, v: &SV) -> Result<f64> {
+fn constant(
+    text: &str,
+    file: Option<&str>,
+    symbols: &BTreeMap<String, f64>,
+    v: &SV,
+) -> Result<f64> {
     to_expr(text, file, v)?
         .eval(&|s| symbols.get(s).copied())
         .map_err(|e| Error::parse(file, line_of(text, v.span()), e.to_string()))
@@ -534,11 +538,17 @@ fn parse_transmission(
     let tt = t.get_ref();
     let joints = tt.joints.clone().unwrap_or_else(|| desc.actuated_joints());
     let n = joints.len();
-    if let Some(&j) = joints.iter().find(|&&j| j == 0 || j > desc.nl || !desc.frame(j).actuated) {
+    if let Some(&j) = joints
+        .iter()
+        .find(|&&j| j == 0 || j > desc.nl || !desc.frame(j).actuated)
+    {
         return Err(Error::parse(
             file,
             line,
-            format!("transmission: joint {j} is not an actuated joint of the tree (1..{})", desc.nl),
+            format!(
+                "transmission: joint {j} is not an actuated joint of the tree (1..{})",
+                desc.nl
+            ),
         ));
     }
     if tt.matrix.len() != n {
@@ -557,7 +567,11 @@ fn parse_transmission(
             return Err(Error::parse(
                 file,
                 line,
-                format!("transmission: row {} has {} entries, {n} expected", k + 1, row.len()),
+                format!(
+                    "transmission: row {} has {} entries, {n} expected",
+                    k + 1,
+                    row.len()
+                ),
             ));
         }
         matrix.push(

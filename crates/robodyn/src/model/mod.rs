@@ -7,8 +7,8 @@ mod structure;
 
 pub use constants::{DynModel, FrameConstants, LinkConstants};
 pub use description::{
-    param, FrameDesc, JointLimits, JointType, LinkDesc, RobotDescription, Transmission, GEOMETRIC_PARAMETERS,
-    STANDARD_PARAMETERS, WRENCH_COMPONENTS,
+    param, FrameDesc, JointLimits, JointType, LinkDesc, RobotDescription, Transmission,
+    GEOMETRIC_PARAMETERS, STANDARD_PARAMETERS, WRENCH_COMPONENTS,
 };
 pub use structure::{path_from_base, ClosedLoop, Structure, StructureType};
 
