@@ -1,5 +1,5 @@
-//! Numerical method for the base parameters on 30-joint random trees and on the SR400 closed
-//! chain (loop-closure sampler), and the symbolic rules.
+//! Numerical method for the base parameters on 30- and 100-link random trees and on the SR400
+//! closed chain (loop-closure sampler), and the symbolic rules.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use robodyn::algorithms::base_parameters::{
@@ -23,6 +23,16 @@ fn bench(c: &mut Criterion) {
     g.sample_size(10);
     g.bench_function("numeric_30_joint_tree", |b| {
         b.iter(|| numeric_base_parameters(&robot, &mut TreeSampler, &opt).unwrap())
+    });
+    // growth: a 100-link tree (the example base_parameters_scale goes to 500 links)
+    let big = random_tree(&mut rng(100), 100, &TreeOptions::default());
+    let big_opt = NumericOptions {
+        selection: ParameterSelection::new(&big, RotorMode::Actuated, true),
+        samples: None,
+        seed: 1,
+    };
+    g.bench_function("numeric_100_link_tree", |b| {
+        b.iter(|| numeric_base_parameters(&big, &mut TreeSampler, &big_opt).unwrap())
     });
     g.bench_function("symbolic_30_joint_tree", |b| {
         b.iter(|| symbolic_base_parameters(robot.description(), &sel).unwrap())

@@ -19,6 +19,7 @@ pub mod geometry;
 pub mod identification;
 pub mod io;
 pub mod model;
+pub mod report;
 pub mod scalar;
 pub mod simulation;
 pub mod testing;

@@ -215,7 +215,7 @@ fn random_trees_numeric_base_model_reproduces_torques() {
 // Symbolic method
 
 use robodyn::algorithms::base_parameters::{
-    collect_by_coefficient, symbolic_base_parameters, SymbolicBase,
+    collect_by_coefficient, symbolic_base_parameters, ParameterNames, SymbolicBase,
 };
 
 /// Base regressor (symbolic base set) times the symbolic grouped values against the full model
@@ -272,7 +272,7 @@ fn sr400_symbolic_matches_table_10_2_and_the_chapter_listing() {
         eprintln!(
             "{} = {}",
             parameter_name(sb.base[r]),
-            collect_by_coefficient(e, 8)
+            collect_by_coefficient(e, &ParameterNames::standard(8))
         );
     }
     let table = expected(
@@ -334,7 +334,7 @@ fn sr400_symbolic_matches_table_10_2_and_the_chapter_listing() {
         assert!(
             diff.is_zero(),
             "{name}R: got {} , chapter {eq}; difference {diff}",
-            collect_by_coefficient(&sb.equations[r], 8)
+            collect_by_coefficient(&sb.equations[r], &ParameterNames::standard(8))
         );
     }
     // every other base parameter is its own symbol
@@ -353,7 +353,10 @@ fn sr400_symbolic_matches_table_10_2_and_the_chapter_listing() {
     assert_eq!(inertial, 39);
     assert_eq!(sb.parallelograms, vec![9]);
     let zz2 = base_names.iter().position(|n| n == "ZZ2").unwrap();
-    eprintln!("{}", collect_by_coefficient(&sb.equations[zz2], 8));
+    eprintln!(
+        "{}",
+        collect_by_coefficient(&sb.equations[zz2], &ParameterNames::standard(8))
+    );
     // values: symbolic grouped values reproduce the closed-chain torques
     let err = check_symbolic_reproduces(&robot, &sb, &mut Sr400Sampler, 5);
     assert!(err < 1e-9, "SR400 symbolic base model error {err:e}");
@@ -467,7 +470,7 @@ fn random_trees_symbolic_agrees_with_numeric() {
 /// (closed chain: G^T Gamma_tr with the test sampler; RX-90: Gamma_tr directly).
 #[test]
 fn base_robot_file_reproduces_the_full_model() {
-    use robodyn::algorithms::base_parameters::{base_robot, Report};
+    use robodyn::algorithms::base_parameters::{base_robot, ParameterNames, Summary};
     use robodyn::algorithms::inverse_dynamics::inverse_dynamics;
     let dir = std::env::temp_dir().join(format!("robodyn-basep-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
@@ -483,7 +486,11 @@ fn base_robot_file_reproduces_the_full_model() {
         }
         let full = robot.with_standard_parameters(&k).unwrap();
         let sb = symbolic_base_parameters(robot.description(), &sel).unwrap();
-        let report = Report::from_symbolic(full.description(), &sb);
+        let report = Summary::from_symbolic(
+            full.description(),
+            &sb,
+            &ParameterNames::of(full.description()),
+        );
         let values: Vec<f64> = report.base.iter().map(|b| b.value.unwrap()).collect();
         let desc = base_robot(robot.description(), &sb.base, &values).unwrap();
         let path = dir.join(format!("{name}-base.toml"));
@@ -518,12 +525,17 @@ fn base_robot_file_reproduces_the_full_model() {
 
 #[test]
 fn report_formats_carry_count_and_lists() {
-    use robodyn::algorithms::base_parameters::Report;
+    use robodyn::algorithms::base_parameters::{ParameterNames, Summary};
+    use robodyn::report::base_parameters as write;
     let robot = sr400();
     let sel = ParameterSelection::new(&robot, RotorMode::Actuated, false);
     let sb = symbolic_base_parameters(robot.description(), &sel).unwrap();
-    let rep = Report::from_symbolic(robot.description(), &sb);
-    let j = rep.to_json();
+    let rep = Summary::from_symbolic(
+        robot.description(),
+        &sb,
+        &ParameterNames::of(robot.description()),
+    );
+    let j = write::json(&rep);
     assert_eq!(j["count"], 42);
     assert_eq!(j["base"].as_array().unwrap().len(), 42);
     assert_eq!(j["base"][0]["name"], "ZZR1");
@@ -536,7 +548,7 @@ fn report_formats_carry_count_and_lists() {
     assert_eq!(row(7), "7 0 0 0 0 0 0 MXR7 MY7 0 0 0");
     assert_eq!(row(8), "8 0 0 0 0 0 0 0 MY8 0 0 -");
     assert!(row(4).ends_with("IA4"));
-    let latex = rep.to_latex();
+    let latex = write::latex(&rep);
     assert!(latex.contains("ZZR_{1} &="), "{latex}");
 }
 
@@ -576,6 +588,7 @@ fn sr400_other_selections_symbolic_equals_numeric() {
     let every = ParameterSelection {
         rotor: vec![true; 8],
         friction: vec![true; 8],
+        absent: Default::default(),
     };
     let cases = [
         ParameterSelection::new(&robot, RotorMode::All, true),

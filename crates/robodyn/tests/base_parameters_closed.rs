@@ -9,7 +9,7 @@ use rand::Rng;
 use robodyn::algorithms::base_parameters::inertial_bound;
 use robodyn::algorithms::base_parameters::{
     compare_methods, numeric_base_parameters, symbolic_base_parameters, ClosedChainSampler,
-    NumericBase, NumericOptions, Report, Sampler, SymbolicBase, TreeSampler,
+    NumericBase, NumericOptions, ParameterNames, Sampler, Summary, SymbolicBase, TreeSampler,
 };
 use robodyn::algorithms::closed_chain::ClosedChain;
 use robodyn::algorithms::inverse_dynamics::inverse_dynamics;
@@ -285,7 +285,7 @@ fn sr400_general_sampler_gives_table_10_2() {
         );
         let sb = symbolic_base_parameters(robot.description(), &sel).unwrap();
         assert_eq!(names(&sb.base), names(&nb.base), "{file}");
-        assert!(compare_methods(&sb, &nb).same());
+        assert!(compare_methods(&sb, &nb, &ParameterNames::standard(robot.nl())).same());
         // values parameter by parameter: symbolic equations vs K1 + beta K2
         let k = random_parameters(&robot, &sel, 3);
         let kopt: Vec<Option<f64>> = k.iter().map(|&v| Some(v)).collect();
@@ -333,15 +333,19 @@ fn every_bundled_robot_counts_bounds_and_reproduces_the_full_model() {
             );
             let drive = sel.columns().len() - 10 * robot.nl();
             assert!(nb.count() <= bm + drive, "{label}");
-            let cmp = compare_methods(&sb, &nb);
+            let cmp = compare_methods(&sb, &nb, &ParameterNames::standard(robot.nl()));
             if robot.is_tree() || sb.unhandled_loops.is_empty() {
                 assert!(cmp.same(), "{label}: {}", cmp.note());
             } else {
                 assert!(sb.count() >= nb.count(), "{label}: {}", cmp.note());
                 if !cmp.same() {
-                    let mut rep = Report::from_symbolic(robot.description(), &sb);
+                    let mut rep = Summary::from_symbolic(
+                        robot.description(),
+                        &sb,
+                        &ParameterNames::of(robot.description()),
+                    );
                     rep.add_comparison(&cmp);
-                    let text = rep.to_text();
+                    let text = robodyn::report::base_parameters::text(&rep);
                     // the block under the title names the arbiter and the differing parameters
                     let head: String = text.lines().take(4).collect::<Vec<_>>().join("\n");
                     assert!(
@@ -352,11 +356,15 @@ fn every_bundled_robot_counts_bounds_and_reproduces_the_full_model() {
                     for p in cmp.symbolic_only.iter().chain(&cmp.numeric_only) {
                         assert!(head.contains(p.as_str()), "{label}: {p} not named: {head}");
                     }
-                    let j = rep.to_json();
+                    let j = robodyn::report::base_parameters::json(&rep);
                     assert_eq!(j["comparison"]["arbiter"], "numeric");
                     assert_eq!(j["comparison"]["numeric_count"], nb.count());
                     assert_eq!(j["comparison"]["symbolic_count"], sb.count());
-                    assert!(rep.to_latex().contains("% THE METHODS DIFFER"), "{label}");
+                    assert!(
+                        robodyn::report::base_parameters::latex(&rep)
+                            .contains("% THE METHODS DIFFER"),
+                        "{label}"
+                    );
                 }
             }
             eprintln!(

@@ -4,10 +4,11 @@
 
 use crate::common::{CliResult, RobotArgs};
 use robodyn::algorithms::base_parameters::{
-    base_robot, compare_methods, numeric_base_parameters, symbolic_base_parameters,
-    ClosedChainSampler, NumericOptions, Report, TreeSampler,
+    base_robot, compare_methods, geometry_robot, numeric_base_parameters_auto, standard_values,
+    symbolic_base_parameters, NumericOptions, ParameterNames, Summary,
 };
-use robodyn::algorithms::regressor::{ParameterSelection, RotorMode};
+use robodyn::algorithms::regressor::{ParameterSelection, RotorMode, ZeroParameters};
+use robodyn::report::base_parameters as write;
 use std::path::PathBuf;
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
@@ -34,6 +35,14 @@ pub enum Rotor {
     None,
 }
 
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Zeros {
+    /// A parameter written as a literal 0 does not exist (SYMORO's meaning).
+    Absent,
+    /// A literal 0 is a value: the parameter exists.
+    Value,
+}
+
 #[derive(clap::Args, Debug)]
 pub struct Args {
     #[command(flatten)]
@@ -53,6 +62,10 @@ pub struct Args {
     /// Seed of the random samples of the numerical method.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// What a parameter written as a literal 0 means (default: absent for a SYMORO .par, as in
+    /// SYMORO; value for .toml and .urdf).
+    #[arg(long, value_enum)]
+    pub zeros: Option<Zeros>,
     /// Write a base robot (.toml) whose parameters are the grouped values.
     #[arg(long, value_name = "FILE.toml")]
     pub write_robot: Option<PathBuf>,
@@ -66,43 +79,83 @@ pub fn run(a: Args) -> CliResult {
         Rotor::All => RotorMode::All,
         Rotor::None => RotorMode::None,
     };
-    let sel = ParameterSelection::from_description(&desc, rotor, !a.no_friction);
+    let zeros = match a.zeros {
+        Some(Zeros::Absent) => ZeroParameters::Absent,
+        Some(Zeros::Value) => ZeroParameters::Value,
+        None => ZeroParameters::for_path(&a.robot.robot),
+    };
+    let sel = ParameterSelection::from_description(&desc, rotor, !a.no_friction)
+        .with_zero_parameters(&desc, zeros);
+    let names = ParameterNames::of(&desc);
     let symbolic = match a.method {
         Method::Symbolic | Method::Both => Some(symbolic_base_parameters(&desc, &sel)?),
         Method::Numeric => None,
     };
     let numeric = match a.method {
         Method::Numeric | Method::Both => {
-            let robot = robodyn::Robot::new(desc.clone())
-                .map_err(|e| format!("the numerical method needs every symbol's value: {e}"))?;
+            // the geometry, with generic values for symbols without value
+            let (robot, generic) = geometry_robot(&desc)?;
             let opt = NumericOptions {
                 selection: sel.clone(),
                 samples: None,
                 seed: a.seed,
             };
-            let nb = if robot.is_tree() {
-                numeric_base_parameters(&robot, &mut TreeSampler, &opt)?
-            } else {
-                // consistent samples by loop closure from the assembly configuration
-                let mut sampler = ClosedChainSampler::new(&robot)?;
-                numeric_base_parameters(&robot, &mut sampler, &opt)?
-            };
-            Some((robot, nb))
+            let (nb, start) = numeric_base_parameters_auto(&robot, &opt)?;
+            let mut notes = Vec::new();
+            if let Some(start) = start {
+                notes.push(format!("closed chain: {}", start.describe()));
+            }
+            if !generic.is_empty() {
+                let list: Vec<String> = generic
+                    .iter()
+                    .map(|(s, v)| format!("{s} = {}", (v * 1e4).round() / 1e4))
+                    .collect();
+                notes.push(format!(
+                    "symbols without value took generic values for the numerical method ({}): \
+                     the count and the grouping hold for generic values of them, not for \
+                     special ones (give values with --set)",
+                    list.join(", ")
+                ));
+            }
+            Some((nb, notes))
         }
         Method::Symbolic => None,
     };
+    let values = standard_values(&desc);
     let mut report = match (&symbolic, &numeric) {
-        (Some(sb), _) => Report::from_symbolic(&desc, sb),
-        (None, Some((robot, nb))) => Report::from_numeric(&desc, nb, &robot.standard_parameters()),
-        _ => unreachable!(),
+        (Some(sb), _) => Summary::from_symbolic(&desc, sb, &names),
+        (None, Some((nb, _))) => Summary::from_numeric(&desc, nb, &names, &values),
+        _ => unreachable!("a method is chosen"),
     };
-    if let (Some(sb), Some((_, nb))) = (&symbolic, &numeric) {
-        report.add_comparison(&compare_methods(sb, nb));
+    if let Some((nb, notes)) = &numeric {
+        report.notes.extend(notes.iter().cloned());
+        if let Some(sb) = &symbolic {
+            report.add_comparison(&compare_methods(sb, nb, &names));
+        }
+    }
+    if !report.has_values() {
+        let missing: Vec<String> = desc
+            .links
+            .iter()
+            .flat_map(|l| l.params.iter())
+            .zip(&values)
+            .filter(|(_, v)| v.is_none())
+            .flat_map(|(e, _)| e.symbols())
+            .filter(|s| !desc.symbols.contains_key(s))
+            .take(6)
+            .collect();
+        if !missing.is_empty() {
+            report.notes.push(format!(
+                "values left out where a parameter has no numeric value ({}{})",
+                missing.join(", "),
+                if missing.len() == 6 { ", ..." } else { "" }
+            ));
+        }
     }
     match a.format {
-        Format::Text => print!("{}", report.to_text()),
-        Format::Latex => print!("{}", report.to_latex()),
-        Format::Json => println!("{}", serde_json::to_string_pretty(&report.to_json())?),
+        Format::Text => print!("{}", write::text(&report)),
+        Format::Latex => print!("{}", write::latex(&report)),
+        Format::Json => println!("{}", serde_json::to_string_pretty(&write::json(&report))?),
     }
     if let Some(path) = &a.write_robot {
         let values: Vec<f64> = report

@@ -8,14 +8,14 @@
 //! every loop (the numerical method is then the arbiter).
 
 use crate::common::{CliResult, RobotArgs, Table, TableOutput};
-use robodyn::algorithms::base_parameters::report::grouped_name;
 use robodyn::algorithms::base_parameters::{
     numeric_base_parameters, symbolic_base_parameters, ClosedChainSampler, NumericOptions,
+    ParameterNames,
 };
 use robodyn::algorithms::closed_chain::ClosedChain;
 use robodyn::algorithms::inverse_dynamics::check_state;
 use robodyn::algorithms::regressor::{
-    parameter_name, regressor, wrench_torques, ParameterSelection, RotorMode, PARAMS_PER_LINK,
+    regressor, wrench_torques, ParameterSelection, RotorMode, ZeroParameters, PARAMS_PER_LINK,
 };
 use robodyn::Workspace;
 use std::path::PathBuf;
@@ -45,7 +45,12 @@ pub fn run(a: Args) -> CliResult {
     let robot = a.robot.load()?;
     let nl = robot.nl();
     let t = Table::read(&a.input)?;
-    let sel = ParameterSelection::new(&robot, RotorMode::Actuated, !a.no_friction);
+    let sel = ParameterSelection::new(&robot, RotorMode::Actuated, !a.no_friction)
+        .with_zero_parameters(
+            robot.description(),
+            ZeroParameters::for_path(&a.robot.robot),
+        );
+    let names = ParameterNames::of(robot.description());
     let closed = if robot.is_tree() {
         None
     } else {
@@ -76,11 +81,10 @@ pub fn run(a: Args) -> CliResult {
             (0..nb.count())
                 .map(|r| {
                     let i = nb.base[r];
-                    let regrouped = (0..nb.grouped.len()).any(|c| nb.beta[(r, c)].abs() > 1e-9);
-                    let n = if regrouped {
-                        grouped_name(i)
+                    let n = if nb.is_regrouped(r) {
+                        names.grouped(i).to_string()
                     } else {
-                        parameter_name(i)
+                        names.name(i).to_string()
                     };
                     (i, n)
                 })
@@ -90,9 +94,9 @@ pub fn run(a: Args) -> CliResult {
                 .map(|r| {
                     let i = sb.base[r];
                     let n = if sb.is_regrouped(r) {
-                        grouped_name(i)
+                        names.grouped(i).to_string()
                     } else {
-                        parameter_name(i)
+                        names.name(i).to_string()
                     };
                     (i, n)
                 })
@@ -100,7 +104,7 @@ pub fn run(a: Args) -> CliResult {
         }
     } else {
         let c = sel.columns();
-        let n = c.iter().map(|&i| parameter_name(i)).collect();
+        let n = c.iter().map(|&i| names.name(i).to_string()).collect();
         (c, n)
     };
     let idx: Vec<[usize; 3]> = joints

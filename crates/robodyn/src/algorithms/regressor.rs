@@ -44,12 +44,37 @@ pub enum RotorMode {
     None,
 }
 
-/// Which of the drive parameters IA, FS, FV are kept, joint by joint (index j-1). The ten
-/// inertial parameters of every link are always in K.
+/// What a parameter written as a literal `0` in the robot file means.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ZeroParameters {
+    /// SYMORO's meaning (SYMORO+, OpenSYMORO): the parameter does not exist; it is not a column
+    /// of the regressor and not a base parameter. A symbol whose value is 0 stays a parameter.
+    Absent,
+    /// A number like any other: the parameter exists and its value is 0 (URDF inertias, the
+    /// numeric values of robodyn's TOML files).
+    Value,
+}
+
+impl ZeroParameters {
+    /// The meaning of the file format (by extension): `.par` -> [`ZeroParameters::Absent`],
+    /// `.toml` and `.urdf` -> [`ZeroParameters::Value`] (see docs/robot-format.md).
+    pub fn for_path(path: &std::path::Path) -> ZeroParameters {
+        match path.extension().and_then(|e| e.to_str()) {
+            Some(e) if e.eq_ignore_ascii_case("par") => ZeroParameters::Absent,
+            _ => ZeroParameters::Value,
+        }
+    }
+}
+
+/// Which of the drive parameters IA, FS, FV are kept, joint by joint (index j-1), and which
+/// standard parameters do not exist (`absent`, K indices: written as a literal 0 in a SYMORO
+/// file). The ten inertial parameters of every link are in K unless absent.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct ParameterSelection {
     pub rotor: Vec<bool>,
     pub friction: Vec<bool>,
+    /// K indices (13 per link) of the parameters that do not exist.
+    pub absent: std::collections::BTreeSet<usize>,
 }
 
 impl ParameterSelection {
@@ -74,6 +99,34 @@ impl ParameterSelection {
             friction: (1..=nl)
                 .map(|j| friction && f(j).actuated && f(j).joint.is_movable())
                 .collect(),
+            absent: Default::default(),
+        }
+    }
+
+    /// Apply `zeros` to the parameters of `desc` written as a literal 0: with
+    /// [`ZeroParameters::Absent`] they leave K (a symbol, even one whose value is 0, stays).
+    pub fn with_zero_parameters(mut self, desc: &RobotDescription, zeros: ZeroParameters) -> Self {
+        self.absent.clear();
+        if zeros == ZeroParameters::Absent {
+            for (j, l) in desc.links.iter().enumerate() {
+                for (p, e) in l.params.iter().enumerate() {
+                    if e.is_zero() {
+                        self.absent.insert(PARAMS_PER_LINK * j + p);
+                    }
+                }
+            }
+        }
+        self
+    }
+
+    /// Whether standard parameter `index` (K index) is in the selection for its drive part
+    /// (rotor, friction), whether or not it exists.
+    pub fn slot(&self, index: usize) -> bool {
+        let j = index / PARAMS_PER_LINK;
+        match index % PARAMS_PER_LINK {
+            10 => self.rotor[j],
+            11 | 12 => self.friction[j],
+            _ => true,
         }
     }
 
@@ -82,25 +135,15 @@ impl ParameterSelection {
         ParameterSelection {
             rotor: vec![true; nl],
             friction: vec![true; nl],
+            absent: Default::default(),
         }
     }
 
-    /// Indices in K (13 per link) of the selected parameters, in K's order.
+    /// Indices in K (13 per link) of the selected parameters that exist, in K's order.
     pub fn columns(&self) -> Vec<usize> {
-        let mut c = Vec::new();
-        for j in 0..self.rotor.len() {
-            for p in 0..PARAMS_PER_LINK {
-                let keep = match p {
-                    10 => self.rotor[j],
-                    11 | 12 => self.friction[j],
-                    _ => true,
-                };
-                if keep {
-                    c.push(PARAMS_PER_LINK * j + p);
-                }
-            }
-        }
-        c
+        (0..PARAMS_PER_LINK * self.rotor.len())
+            .filter(|&i| self.slot(i) && !self.absent.contains(&i))
+            .collect()
     }
 }
 

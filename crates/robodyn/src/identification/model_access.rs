@@ -5,14 +5,15 @@
 //! changes this file only.
 
 use crate::algorithms::base_parameters::{
-    numeric_base_parameters, ClosedChainSampler, NumericOptions, Report, Sampler, TreeSampler,
+    numeric_base_parameters, standard_values, ClosedChainSampler, NumericOptions,
+    ParameterNames, Sampler, Summary, TreeSampler,
 };
 use crate::algorithms::closed_chain::{ClosedChain, ClosedChainWorkspace};
 use crate::algorithms::direct_dynamics::{ddm, DirectWorkspace, Method};
 use crate::algorithms::inertia_matrix::inertia_matrix;
 use crate::algorithms::inverse_dynamics::rnea;
 use crate::algorithms::regressor::{
-    parameter_name, regressor, wrench_torques, ParameterSelection, RotorMode, PARAMS_PER_LINK,
+    regressor, wrench_torques, ParameterSelection, RotorMode, PARAMS_PER_LINK,
 };
 use crate::error::{Error, Result};
 use crate::model::{DynModel, JointLimits, JointType, RobotDescription, Transmission};
@@ -39,10 +40,6 @@ pub fn format_coefficient(x: f64) -> String {
     crate::algorithms::base_parameters::numeric::format_coefficient(x)
 }
 
-/// Name of standard parameter `index` of K (`XX1`, ..., `FV<NL>`).
-pub fn standard_name(index: usize) -> String {
-    parameter_name(index)
-}
 
 /// Which drive parameters the base set includes (as `base-params --rotor/--no-friction`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -211,6 +208,14 @@ impl ModelAccess {
             .unwrap_or_default()
     }
 
+    /// Name of standard parameter `index` of K as the base-parameter report names it (the
+    /// file's own names when it gives them, else `XX1`, ..., `FV<NL>`).
+    pub fn standard_name(&self, index: usize) -> String {
+        ParameterNames::of(self.robot.description())
+            .name(index)
+            .to_string()
+    }
+
     /// The robot's standard parameters K (13 per link).
     pub fn standard_parameters(&self) -> Vec<f64> {
         self.robot.standard_parameters()
@@ -244,10 +249,12 @@ impl ModelAccess {
             let mut sampler = ClosedChainSampler::new(&self.robot)?;
             numeric_base_parameters(&self.robot, &mut sampler, &opt)?
         };
-        let report = Report::from_numeric(
-            self.robot.description(),
+        let desc = self.robot.description();
+        let report = Summary::from_numeric(
+            desc,
             &nb,
-            &self.robot.standard_parameters(),
+            &ParameterNames::of(desc),
+            &standard_values(desc),
         );
         Ok(BaseSet {
             names: report.base.iter().map(|b| b.name.clone()).collect(),

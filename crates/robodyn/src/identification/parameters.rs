@@ -12,7 +12,7 @@
 //! vertical axis into ZZR1 with the factor R_11^2).
 
 use super::model_access::{
-    format_coefficient, standard_name, BaseSet, ModelAccess, Rotors, FS, FV, IA, PER_LINK,
+    format_coefficient, BaseSet, ModelAccess, Rotors, FS, FV, IA, PER_LINK,
 };
 use crate::error::{Error, Result};
 use faer::linalg::solvers::SolveLstsq;
@@ -151,8 +151,8 @@ impl ParameterModel {
                 let j = joints[k];
                 let index = PER_LINK * (j - 1) + which;
                 params.push(Parameter {
-                    name: standard_name(index),
-                    equation: standard_name(index),
+                    name: access.standard_name(index),
+                    equation: access.standard_name(index),
                     kind: Kind::Motor { motor: k, which },
                 });
                 map.push(vec![(index, 1.0)]);
@@ -165,9 +165,9 @@ impl ParameterModel {
                     let mag = format_coefficient(c.abs());
                     let sign = if c < 0.0 { " - " } else { " + " };
                     let term = if mag == "1" {
-                        standard_name(index)
+                        access.standard_name(index)
                     } else {
-                        format!("{mag}*{}", standard_name(index))
+                        format!("{mag}*{}", access.standard_name(index))
                     };
                     params[r].equation.push_str(&format!("{sign}{term}"));
                     if !params[r].name.contains('R') {

@@ -1,25 +1,87 @@
 //! Base inertial parameters (§10.2.4, §10.3.4–10.3.6).
 //!
 //! - [`numeric`]: the numerical method (stacked regressor, rank, ordered QR, beta);
-//! - [`symbolic`]: the rules of §10.3.6 with the grouping equations as expressions.
+//! - [`symbolic`]: the rules of §10.3.6 with the grouping equations as expressions;
+//! - [`closed`]: consistent random states of a closed chain for the numerical method;
+//! - [`names`]: the robot's own names of the standard parameters;
+//! - [`summary`]: the structured result (table, lists, equations, values, comparison); its
+//!   writers (text, LaTeX, JSON) are in [`crate::report::base_parameters`].
 
+pub mod closed;
+pub mod names;
 pub mod numeric;
+pub mod summary;
+pub mod symbolic;
 
+pub use closed::{ClosedChainSampler, StartReport};
+pub use names::ParameterNames;
 pub use numeric::{
     numeric_base_parameters, ConsistentSample, NumericBase, NumericOptions, Sampler, TreeSampler,
 };
-pub mod symbolic;
-
+pub use summary::{base_robot, compare_methods, standard_values, MethodComparison, Summary};
 pub use symbolic::{collect_by_coefficient, symbolic_base_parameters, SymbolicBase};
-pub mod report;
 
-pub mod closed;
+use crate::error::{Error, Result};
+use crate::model::{JointType, Robot, RobotDescription};
+use robodyn_symbolic::Expr;
 
-pub use closed::ClosedChainSampler;
+/// The robot the numerical method samples: `desc`'s geometry, where every symbol without a
+/// value takes the generic value of the symbolic method ([`symbolic::generic_value`]), and
+/// every inertial parameter and external wrench set to zero (the regressor does not depend on
+/// them). Returns the robot and the symbols given a generic value (name, value): the count and
+/// the grouping then hold for generic geometry, the values of the base parameters are unknown.
+pub fn geometry_robot(desc: &RobotDescription) -> Result<(Robot, Vec<(String, f64)>)> {
+    let mut d = desc.clone();
+    for l in d.links.iter_mut() {
+        for e in l.params.iter_mut().chain(l.wrench.iter_mut()) {
+            *e = Expr::zero();
+        }
+    }
+    let mut generic = Vec::new();
+    let mut exprs: Vec<&Expr> = Vec::new();
+    for f in &d.frames {
+        exprs.extend(f.geometric());
+    }
+    for v in [&d.gravity, &d.w0, &d.wp0, &d.v0, &d.vp0] {
+        exprs.extend(v.iter());
+    }
+    let missing: std::collections::BTreeSet<String> = exprs
+        .iter()
+        .flat_map(|e| e.symbols())
+        .filter(|s| !d.symbols.contains_key(s))
+        .collect();
+    for s in missing {
+        let v = symbolic::generic_value(&s);
+        d.symbols.insert(s.clone(), v);
+        generic.push((s, v));
+    }
+    let robot = Robot::new(d).map_err(|e| {
+        Error::Input(format!(
+            "{}: the geometry cannot be evaluated for the numerical method: {e}",
+            desc.name
+        ))
+    })?;
+    Ok((robot, generic))
+}
 
-pub use report::{base_robot, compare_methods, MethodComparison, Report};
-
-use crate::model::{JointType, Robot};
+/// The numerical method with the sampler the structure needs: random states for a tree, the
+/// loop-closure sampler ([`ClosedChainSampler`]) for a closed chain, whose start (and branch)
+/// is returned too.
+pub fn numeric_base_parameters_auto(
+    robot: &Robot,
+    opt: &NumericOptions,
+) -> Result<(NumericBase, Option<StartReport>)> {
+    if robot.is_tree() {
+        Ok((numeric_base_parameters(robot, &mut TreeSampler, opt)?, None))
+    } else {
+        let mut sampler = ClosedChainSampler::new(robot)?;
+        let start = sampler.start().clone();
+        Ok((
+            numeric_base_parameters(robot, &mut sampler, opt)?,
+            Some(start),
+        ))
+    }
+}
 
 /// Upper bound b_m of the number of base inertial parameters of the links (rotors and friction
 /// not included): eq 10.24 for a tree, eq 10.57 for a closed chain with `n_parallelograms`

@@ -4,28 +4,41 @@
 //! 1. Sample `s` random consistent states (q_tr, qd_tr, qdd_tr) with their G = dq_tr/dq_a
 //!    ([`Sampler`]; identity for a tree) and stack the closed-chain regressors G^T Phi into the
 //!    observation matrix W (s N rows, one column per selected standard parameter).
+//!    W is one dense faer matrix whose size is checked before it is allocated
+//!    ([`MAX_OBSERVATION_BYTES`]); it is dropped once its R factor is computed.
 //! 2. Parameters with no effect: columns with ||W_c|| <= [`NO_EFFECT_TOLERANCE`] max_c ||W_c||.
-//! 3. The remaining columns are scaled to unit norm (so the tolerance does not depend on units).
-//!    The rank r (the number of base parameters) comes from the singular values of the scaled W:
-//!    sigma_k > tol with tol = [`RANK_TOLERANCE`] * sigma_max.
-//! 4. Which parameters are kept: an *unpivoted* Householder QR of the scaled W in the column
+//! 3. The remaining columns are scaled to unit norm (so the tolerance does not depend on units);
+//!    tol = [`RANK_TOLERANCE`] * sigma_max (sigma_max from the SVD of R for up to
+//!    [`SVD_COLUMNS`] columns, by power iteration on R beyond).
+//! 4. Which parameters are kept: an *unpivoted* Householder QR (faer) of the scaled W in the column
 //!    order of K (link 1 first, XX XY XZ YY YZ ZZ MX MY MZ M IA FS FV in each link). |R_kk| is the
 //!    distance of column k from the span of the columns before it, so a column is kept when
 //!    |R_kk| > tol and grouped otherwise: a dependent group keeps its earliest members. This order
 //!    matches the symbolic rules: Theorem 10.1 groups YY_j into XX_j (XX first) and MZ_j, M_j into
 //!    the parameters of a(j) < j (lower links first); Table 10.1 keeps MX_j/MY_j over MZ_j;
 //!    parallelogram loops group the link of larger number into the smaller one; a rotor inertia
-//!    IA_j comes after the ZZ it groups into. The count kept must equal the SVD rank, otherwise
-//!    the samples are ill-conditioned and an error is returned.
-//! 5. W = [W1 W2] (kept, grouped): beta solves W1 beta = W2 in the least-squares sense (exact
-//!    up to rounding), so Phi K = Phi_1 (K1 + beta K2), i.e. K_base = K1 + beta K2.
+//!    IA_j comes after the ZZ it groups into.
+//! 5. W = [W1 W2] (kept, grouped): a QR of R with its columns in the order [kept, grouped] gives
+//!    [[R11, R12], [0, R22]]; beta = R11^-1 R12 solves W1 beta = W2 in the least-squares sense,
+//!    so Phi K = Phi_1 (K1 + beta K2), i.e. K_base = K1 + beta K2. The rank is certified: the
+//!    smallest singular value of R11 (inverse iteration) must exceed tol and ||R22||_F (what the
+//!    kept columns leave of the grouped ones) must not; otherwise the samples are
+//!    ill-conditioned and an error is returned, never a count.
+//!
+//! Absent parameters (a literal 0 in a SYMORO file, [`ParameterSelection::absent`]) are not in
+//! K, but as in SYMORO a base parameter may take their place (MXR2 = d3 M3 when MX2 is written
+//! 0): their columns are candidates when they lie in the span of the existing ones (distance
+//! <= tol), so both methods name the same base parameters.
 
 use super::super::regressor::{
-    closed_chain_regressor, parameter_name, regressor, ParameterSelection, PARAMS_PER_LINK,
+    closed_chain_regressor, regressor, ParameterSelection, PARAMS_PER_LINK,
 };
+use super::names::ParameterNames;
 use crate::error::{Error, Result};
 use crate::model::Robot;
 use crate::workspace::Workspace;
+use faer::reborrow::{Reborrow, ReborrowMut};
+use faer::{Mat, MatRef, Par};
 use nalgebra::DMatrix;
 use rand::{Rng, RngCore};
 
@@ -38,6 +51,15 @@ pub const NO_EFFECT_TOLERANCE: f64 = 1e-10;
 /// tight on random trees), while independent columns of randomly sampled states are many orders
 /// above 1e-9.
 pub const RANK_TOLERANCE: f64 = 1e-9;
+
+/// Largest observation matrix W the numerical method allocates (1 GiB: about 10,000 columns,
+/// some 780 links with every drive parameter); beyond, it returns an error before allocating.
+/// The peak memory is about 2.5 times W (W, then its R factor and one reordered copy).
+pub const MAX_OBSERVATION_BYTES: usize = 1 << 30;
+
+/// Up to this many columns the singular values of W are computed (SVD of R) and reported;
+/// beyond, sigma_max comes from power iteration on R and `singular_values` is empty.
+pub const SVD_COLUMNS: usize = 800;
 
 /// A consistent state of the equivalent tree with the Jacobian G = dq_tr/dq_a.
 #[derive(Clone, Debug)]
@@ -84,7 +106,8 @@ impl Sampler for TreeSampler {
 #[derive(Clone, Debug)]
 pub struct NumericOptions {
     pub selection: ParameterSelection,
-    /// Number of sampled states (default: enough for 3 rows per column, at least 20).
+    /// Number of sampled states (default: 3 rows per column up to 3000 rows, then 1.25 rows
+    /// per column; at least 20 samples).
     pub samples: Option<usize>,
     pub seed: u64,
 }
@@ -92,20 +115,28 @@ pub struct NumericOptions {
 /// Result of the numerical method. Parameter indices are indices in K (13 per link).
 #[derive(Clone, Debug)]
 pub struct NumericBase {
-    /// The selected standard parameters (columns of W), in K order.
+    /// The selected standard parameters that exist (columns of W), in K order.
     pub columns: Vec<usize>,
-    /// Base parameters (kept, independent columns W1), in K order.
+    /// Base parameters (kept, independent columns W1), in K order. An absent parameter (see
+    /// `absent`) can be one: its value is then its grouped parameters alone.
     pub base: Vec<usize>,
     /// Grouped parameters (dependent columns W2), in K order.
     pub grouped: Vec<usize>,
     /// Parameters with no effect (zero columns).
     pub no_effect: Vec<usize>,
+    /// Parameters of the selection that do not exist (literal 0 in a SYMORO file).
+    pub absent: Vec<usize>,
     /// K_base = K1 + beta K2 (base.len() x grouped.len()).
     pub beta: DMatrix<f64>,
     /// Numerical rank tolerance used on the scaled W.
     pub tolerance: f64,
-    /// Singular values of the scaled W (non-zero columns), largest first.
+    /// Singular values of the scaled W (non-zero columns), largest first; empty above
+    /// [`SVD_COLUMNS`] columns.
     pub singular_values: Vec<f64>,
+    /// Smallest singular value of the kept columns W1 (scaled) and largest residual of the
+    /// grouped ones (||R22||_F): the rank certificate, sigma_min > tolerance >= residual.
+    pub sigma_min_kept: f64,
+    pub residual_grouped: f64,
     /// Rows of W.
     pub rows: usize,
 }
@@ -116,50 +147,74 @@ impl NumericBase {
         self.base.len()
     }
 
-    /// Base parameter values K1 + beta K2 for a full standard vector K (13 per link).
+    /// Base parameter values K1 + beta K2 for a full standard vector K (13 per link; absent
+    /// parameters count as 0).
     pub fn base_values(&self, k: &[f64]) -> Vec<f64> {
+        let value = |i: usize| {
+            if self.absent.contains(&i) {
+                0.0
+            } else {
+                k[i]
+            }
+        };
         self.base
             .iter()
             .enumerate()
             .map(|(r, &b)| {
-                k[b] + self
-                    .grouped
-                    .iter()
-                    .enumerate()
-                    .map(|(c, &g)| self.beta[(r, c)] * k[g])
-                    .sum::<f64>()
+                value(b)
+                    + self
+                        .grouped
+                        .iter()
+                        .enumerate()
+                        .map(|(c, &g)| self.beta[(r, c)] * k[g])
+                        .sum::<f64>()
             })
             .collect()
     }
 
-    /// Names of the base parameters.
-    pub fn base_names(&self) -> Vec<String> {
-        self.base.iter().map(|&i| parameter_name(i)).collect()
+    /// Whether base parameter number `r` is a combination (grouped parameters, or it takes the
+    /// place of an absent parameter).
+    pub fn is_regrouped(&self, r: usize) -> bool {
+        self.absent.contains(&self.base[r])
+            || (0..self.grouped.len()).any(|c| self.beta[(r, c)].abs() > 1e-9)
     }
 
-    /// Grouping equation of base parameter number `r` as text, e.g. `XX2 - YY2 + 0.36*M3`.
-    /// Coefficients are rounded to 12 significant digits for display only.
-    pub fn equation(&self, r: usize) -> String {
-        let mut s = parameter_name(self.base[r]);
+    /// Grouping equation of base parameter number `r` as text, e.g. `XX2 - YY2 + 9/25*M3`, in
+    /// `names`. Coefficients are shown as short rationals when they are (display only).
+    pub fn equation(&self, r: usize, names: &ParameterNames) -> String {
+        let b = self.base[r];
+        let mut s = if self.absent.contains(&b) {
+            String::new()
+        } else {
+            names.name(b).to_string()
+        };
         for (c, &g) in self.grouped.iter().enumerate() {
-            let b = self.beta[(r, c)];
-            if b.abs() < 1e-9 {
+            let v = self.beta[(r, c)];
+            if v.abs() < 1e-9 {
                 continue;
             }
-            let mag = format_coefficient(b.abs());
-            let sign = if b < 0.0 { " - " } else { " + " };
-            if mag == "1" {
-                s.push_str(&format!("{sign}{}", parameter_name(g)));
+            let mag = format_coefficient(v.abs());
+            let term = if mag == "1" {
+                names.name(g).to_string()
             } else {
-                s.push_str(&format!("{sign}{mag}*{}", parameter_name(g)));
-            }
+                format!("{mag}*{}", names.name(g))
+            };
+            s = match (s.is_empty(), v < 0.0) {
+                (true, false) => term,
+                (true, true) => format!("-{term}"),
+                (false, neg) => format!("{s} {} {term}", if neg { "-" } else { "+" }),
+            };
         }
-        s
+        if s.is_empty() {
+            "0".into()
+        } else {
+            s
+        }
     }
 }
 
 /// A coefficient for display: a short rational (p/q with q <= 64) when it is one to 1e-9,
-/// otherwise 12 significant digits.
+/// otherwise the shortest decimal that round-trips the value rounded to 12 significant digits.
 pub fn format_coefficient(x: f64) -> String {
     for q in 1..=64i64 {
         let p = (x * q as f64).round();
@@ -171,9 +226,213 @@ pub fn format_coefficient(x: f64) -> String {
             };
         }
     }
-    let s = format!("{x:.12e}");
-    let v: f64 = s.parse().unwrap_or(x);
+    let v: f64 = format!("{x:.11e}").parse().unwrap_or(x);
     format!("{v}")
+}
+
+/// Parallelism of the dense factorizations (every core rayon has).
+fn par() -> Par {
+    Par::rayon(0)
+}
+
+/// Householder QR of `a` in place, unpivoted and *without skipping any column*: R is in the
+/// upper triangle (below it: the Householder vectors), and |R_kk| is the distance of column k
+/// from the span of the columns before it, for every k. (faer's `qr_in_place` is rank
+/// revealing: it skips a column whose residual is at rounding level and leaves R in echelon
+/// form, which does not give that distance column by column.) Blocked: panels of 32 columns,
+/// each factored column by column, then applied to the trailing columns in compact WY form
+/// (I - V T V^T) with faer's matrix products.
+///
+/// Column c is zero below row `last_row(c)` (nondecreasing in c): each panel works only on the
+/// rows down to the last nonzero row of its columns. A tree's W with its rows ordered by joint
+/// is such a staircase (link j's columns are zero in the rows of the joints after j), and so is
+/// R with its columns reordered, kept ones first ([`refactor`]): both cost far less than a
+/// dense QR.
+fn qr_in_place_staircase(mut a: faer::MatMut<'_, f64>, last_row: &dyn Fn(usize) -> usize) {
+    use faer::linalg::matmul::matmul;
+    use faer::Accum;
+    let (m_all, n) = (a.nrows(), a.ncols());
+    const B: usize = 32;
+    let mut k = 0;
+    let kmax = m_all.min(n);
+    while k < kmax {
+        let b = B.min(kmax - k);
+        let mut tau = [0.0f64; B];
+        // rows below the panel's last nonzero row stay zero (in the panel and in V)
+        let m = (k..k + b)
+            .map(|c| last_row(c).max(c) + 1)
+            .max()
+            .unwrap_or(m_all)
+            .min(m_all);
+        // panel: columns k..k+b, rows k..m (column slices: W is column-major)
+        for c in k..k + b {
+            let (mut left, mut right) = a.rb_mut().split_at_col_mut(c + 1);
+            let v = left
+                .rb_mut()
+                .col_mut(c)
+                .try_as_col_major_mut()
+                .expect("column-major")
+                .as_slice_mut();
+            let v = &mut v[..m];
+            let x0 = v[c];
+            let sigma: f64 = v[c + 1..].iter().map(|x| x * x).sum();
+            if sigma == 0.0 {
+                tau[c - k] = 0.0;
+                continue;
+            }
+            let norm = (x0 * x0 + sigma).sqrt();
+            let beta = if x0 >= 0.0 { -norm } else { norm };
+            let scale = 1.0 / (x0 - beta);
+            v[c + 1..].iter_mut().for_each(|x| *x *= scale);
+            v[c] = beta;
+            let t = (beta - x0) / beta;
+            tau[c - k] = t;
+            // apply H = I - t v v^T (v_c = 1) to the rest of the panel
+            let v = &v[c + 1..];
+            for cc in 0..(k + b - c - 1) {
+                let y = &mut right
+                    .rb_mut()
+                    .col_mut(cc)
+                    .try_as_col_major_mut()
+                    .expect("column-major")
+                    .as_slice_mut()[..m];
+                let dot = y[c] + v.iter().zip(&y[c + 1..]).map(|(p, q)| p * q).sum::<f64>();
+                let f = t * dot;
+                y[c] -= f;
+                y[c + 1..].iter_mut().zip(v).for_each(|(q, p)| *q -= f * p);
+            }
+        }
+        if k + b < n {
+            // V (m-k x b, unit lower trapezoidal) and T (b x b upper) of the compact WY form
+            let v = Mat::from_fn(m - k, b, |i, j| match i.cmp(&j) {
+                std::cmp::Ordering::Less => 0.0,
+                std::cmp::Ordering::Equal => 1.0,
+                std::cmp::Ordering::Greater => a[(k + i, k + j)],
+            });
+            let mut tm = Mat::<f64>::zeros(b, b);
+            for j in 0..b {
+                tm[(j, j)] = tau[j];
+                if j > 0 && tau[j] != 0.0 {
+                    // T[0..j, j] = -tau_j T[0..j, 0..j] (V[:, 0..j]^T v_j)
+                    let w = v.as_ref().subcols(0, j).transpose() * v.as_ref().col(j);
+                    let tw = tm.as_ref().submatrix(0, 0, j, j) * &w;
+                    for i in 0..j {
+                        tm[(i, j)] = -tau[j] * tw[i];
+                    }
+                }
+            }
+            // A_trail <- (I - V T V^T)^T A_trail = A_trail - V T^T (V^T A_trail)
+            let mut trail = a.rb_mut().submatrix_mut(k, k + b, m - k, n - k - b);
+            let mut y = Mat::<f64>::zeros(b, n - k - b);
+            matmul(
+                y.as_mut(),
+                Accum::Replace,
+                v.transpose(),
+                trail.rb(),
+                1.0,
+                par(),
+            );
+            let ty = tm.transpose() * &y;
+            matmul(trail.rb_mut(), Accum::Add, &v, &ty, -1.0, par());
+        }
+        k += b;
+    }
+}
+
+/// The n x n upper triangle of a factored `m x n` matrix (rows beyond m are zero).
+fn upper(a: MatRef<'_, f64>) -> Mat<f64> {
+    let n = a.ncols();
+    Mat::from_fn(n, n, |i, j| {
+        if i <= j && i < a.nrows() {
+            a[(i, j)]
+        } else {
+            0.0
+        }
+    })
+}
+
+/// QR of the columns `cols` of R, in that order; returns the new R (cols.len() x cols.len()).
+fn refactor(r: &Mat<f64>, cols: &[usize]) -> Mat<f64> {
+    let mut a = Mat::from_fn(r.nrows(), cols.len(), |i, j| r[(i, cols[j])]);
+    // column j of R is zero below row cols[j]; the reflectors of the columns before it mix rows
+    // down to the largest of their own, so column j stays zero below the running maximum
+    let mut last = Vec::with_capacity(cols.len());
+    let mut running = 0;
+    for &c in cols {
+        running = running.max(c);
+        last.push(running.min(r.nrows().saturating_sub(1)));
+    }
+    qr_in_place_staircase(a.as_mut(), &|j| last[j]);
+    upper(a.as_ref())
+}
+
+/// Largest singular value of an upper triangular R by power iteration on R^T R.
+fn sigma_max(r: MatRef<'_, f64>) -> f64 {
+    let n = r.ncols();
+    if n == 0 {
+        return 0.0;
+    }
+    let mut x = faer::Col::<f64>::from_fn(n, |i| 1.0 + (i % 7) as f64 * 0.1);
+    let mut s = 0.0;
+    // a 0.1 % estimate is plenty for a tolerance (each step reads R twice)
+    for _ in 0..30 {
+        let y = r * &x;
+        let z = r.transpose() * &y;
+        let nz = z.norm_l2();
+        if nz == 0.0 {
+            return 0.0;
+        }
+        let next = nz.sqrt() / x.norm_l2().sqrt();
+        x = z / nz;
+        if (next - s).abs() <= 1e-3 * next {
+            return next;
+        }
+        s = next;
+    }
+    s
+}
+
+/// Smallest singular value of an upper triangular R (full rank expected) by inverse iteration
+/// (two triangular solves per step); 0 when R has a zero on its diagonal.
+fn sigma_min_upper(r: MatRef<'_, f64>) -> f64 {
+    use faer::linalg::triangular_solve as ts;
+    let n = r.ncols();
+    if n == 0 {
+        return f64::INFINITY;
+    }
+    if (0..n).any(|i| r[(i, i)] == 0.0 || !r[(i, i)].is_finite()) {
+        return 0.0;
+    }
+    let mut x = Mat::<f64>::from_fn(n, 1, |i, _| 1.0 + (i % 5) as f64 * 0.3);
+    let mut est = 0.0;
+    for _ in 0..30 {
+        let nx = x.norm_l2();
+        x /= nx;
+        // y = (R^T R)^-1 x: R^T u = x, then R y = u
+        ts::solve_lower_triangular_in_place(r.transpose(), x.as_mut(), par());
+        ts::solve_upper_triangular_in_place(r, x.as_mut(), par());
+        let g = x.norm_l2(); // ~ 1 / sigma_min^2
+        let next = 1.0 / g.sqrt();
+        if !next.is_finite() {
+            return 0.0;
+        }
+        if (next - est).abs() <= 1e-3 * next {
+            return next;
+        }
+        est = next;
+    }
+    est
+}
+
+/// Rows of W per sample (N) and the number of samples for `ncols` columns.
+fn sample_count(opt: &NumericOptions, ncols: usize, n_rows_per: usize) -> usize {
+    opt.samples.unwrap_or_else(|| {
+        let target = (3 * ncols).min(3000.max(ncols + ncols / 4));
+        // at least 20 samples, unless that exceeds the target (large trees: N = NL rows each)
+        target
+            .div_ceil(n_rows_per)
+            .max(20.min(target.div_ceil(n_rows_per) + 2))
+    })
 }
 
 /// Run the numerical method on `robot` with `sampler`.
@@ -183,26 +442,63 @@ pub fn numeric_base_parameters(
     opt: &NumericOptions,
 ) -> Result<NumericBase> {
     let nl = robot.nl();
-    if opt.selection.rotor.len() != nl || opt.selection.friction.len() != nl {
+    let sel = &opt.selection;
+    if sel.rotor.len() != nl || sel.friction.len() != nl {
         return Err(Error::Input(format!(
             "the parameter selection has {} entries, the robot has NL = {nl} links",
-            opt.selection.rotor.len()
+            sel.rotor.len()
         )));
     }
-    let columns = opt.selection.columns();
-    let ncols = columns.len();
+    let columns = sel.columns();
+    // W's columns: the existing parameters (K order), then the absent ones of the selection
+    let all: Vec<usize> = (0..PARAMS_PER_LINK * nl)
+        .filter(|&i| sel.slot(i) && !sel.absent.contains(&i))
+        .chain((0..PARAMS_PER_LINK * nl).filter(|&i| sel.slot(i) && sel.absent.contains(&i)))
+        .collect();
+    let absent: Vec<usize> = all
+        .iter()
+        .copied()
+        .filter(|i| sel.absent.contains(i))
+        .collect();
+    let ncols = all.len();
+    // size check before any allocation: N <= NL rows per sample, so rows <= max(target + NL,
+    // 20 NL); phi (NL x 13 NL) is allocated too
+    let bound_rows = opt
+        .samples
+        .map(|s| s.saturating_mul(nl))
+        .unwrap_or_else(|| {
+            (3 * ncols)
+                .min(3000.max(ncols + ncols / 4))
+                .saturating_add(nl)
+                .max(20 * nl)
+        });
+    let bytes = bound_rows
+        .saturating_mul(ncols.max(1))
+        .saturating_add(nl.saturating_mul(PARAMS_PER_LINK * nl))
+        .saturating_mul(8);
+    if bytes > MAX_OBSERVATION_BYTES {
+        return Err(Error::Input(format!(
+            "{}: the numerical method would need an observation matrix W of about {bound_rows} x \
+             {ncols} ({:.1} GiB, about {:.1} GiB in all); the limit is {:.1} GiB \
+             (MAX_OBSERVATION_BYTES, about 10,000 parameters). Use the symbolic method for this \
+             robot, or fewer drive parameters (--rotor none, --no-friction)",
+            robot.name(),
+            bytes as f64 / (1u64 << 30) as f64,
+            2.5 * bytes as f64 / (1u64 << 30) as f64,
+            MAX_OBSERVATION_BYTES as f64 / (1u64 << 30) as f64
+        )));
+    }
     let mut rng = crate::testing::rng(opt.seed);
     let model = robot.numeric();
     let mut ws = Workspace::new(model);
     let mut phi = DMatrix::zeros(nl, PARAMS_PER_LINK * nl);
-    // first sample fixes N (rows per sample)
+    // the first sample fixes N (rows per sample)
     let first = sampler.sample(robot, &mut rng)?;
     let n_rows_per = first.g.as_ref().map_or(nl, |g| g.ncols()).max(1);
-    let samples = opt
-        .samples
-        .unwrap_or_else(|| (3 * ncols).div_ceil(n_rows_per).max(20));
+    let samples = sample_count(opt, columns.len(), n_rows_per);
     let rows = samples * n_rows_per;
-    let mut w = DMatrix::zeros(rows, ncols);
+    let tree_rows = first.g.is_none();
+    let mut w = Mat::<f64>::zeros(rows, ncols);
     let mut s = first;
     for k in 0..samples {
         if k > 0 {
@@ -228,90 +524,171 @@ pub fn numeric_base_parameters(
                 "the regressor of a sampled state is not finite".into(),
             ));
         }
-        for (c, &col) in columns.iter().enumerate() {
+        for (c, &col) in all.iter().enumerate() {
             for r in 0..n_rows_per {
-                w[(k * n_rows_per + r, c)] = block[(r, col)];
+                // a tree's rows by joint, then sample: the column of link j is zero in the rows
+                // of joints after j (only its ancestors a(j) < j and j itself carry it)
+                let row = if tree_rows {
+                    r * samples + k
+                } else {
+                    k * n_rows_per + r
+                };
+                w[(row, c)] = block[(r, col)];
             }
         }
     }
-    // 2. no-effect columns
-    let norms: Vec<f64> = (0..ncols).map(|c| w.column(c).norm()).collect();
-    let max_norm = norms.iter().cloned().fold(0.0, f64::max);
-    let mut no_effect = Vec::new();
-    let mut live = Vec::new();
-    for c in 0..ncols {
-        if norms[c] <= NO_EFFECT_TOLERANCE * max_norm || max_norm == 0.0 {
-            no_effect.push(columns[c]);
+    // 2. no-effect columns (existing parameters); absent columns of no effect are dropped
+    let norms: Vec<f64> = (0..ncols).map(|c| w.col(c).norm_l2()).collect();
+    let is_absent = |c: usize| sel.absent.contains(&all[c]);
+    let max_norm = (0..ncols)
+        .filter(|&c| !is_absent(c))
+        .map(|c| norms[c])
+        .fold(0.0, f64::max);
+    let zero = |c: usize| max_norm == 0.0 || norms[c] <= NO_EFFECT_TOLERANCE * max_norm;
+    let no_effect: Vec<usize> = (0..ncols)
+        .filter(|&c| !is_absent(c) && zero(c))
+        .map(|c| all[c])
+        .collect();
+    // 3. unit columns: existing ones first (K order), then the absent candidates
+    let live: Vec<usize> = (0..ncols).filter(|&c| !zero(c)).collect();
+    let n_present = live.iter().filter(|&&c| !is_absent(c)).count();
+    // scaled and packed to the left in place (live is increasing): no second copy of W
+    for (j, &c) in live.iter().enumerate() {
+        let f = 1.0 / norms[c];
+        if c == j {
+            w.col_mut(j).iter_mut().for_each(|x| *x *= f);
         } else {
-            live.push(c);
+            let (mut left, right) = w.as_mut().split_at_col_mut(c);
+            let src = right.col(0);
+            left.rb_mut()
+                .col_mut(j)
+                .iter_mut()
+                .zip(src.iter())
+                .for_each(|(d, x)| *d = x * f);
         }
     }
-    // 3. scaled matrix and rank
-    let mut ws_mat = DMatrix::zeros(rows, live.len());
-    for (k, &c) in live.iter().enumerate() {
-        ws_mat.set_column(k, &(w.column(c) / norms[c]));
+    let mut a = w.as_mut().subcols_mut(0, live.len());
+    // a tree's W is a staircase (rows by joint): column c is zero below the rows of its link
+    let mut last = Vec::with_capacity(live.len());
+    let mut running = 0;
+    for &c in &live {
+        let lr = if tree_rows {
+            (all[c] / PARAMS_PER_LINK + 1) * samples - 1
+        } else {
+            rows - 1
+        };
+        running = running.max(lr.min(rows - 1));
+        last.push(running);
     }
-    let qr = ws_mat.clone().qr();
-    let r = qr.r();
-    let mut singular_values: Vec<f64> = if live.is_empty() {
-        Vec::new()
+    qr_in_place_staircase(a.rb_mut(), &|j| last[j]);
+    let r_all = upper(a.rb());
+    drop(w);
+    // R of the existing columns alone (the leading block): sigma_max and tolerance
+    let r_present = r_all.as_ref().submatrix(0, 0, n_present, n_present);
+    let singular_values: Vec<f64> = if n_present <= SVD_COLUMNS {
+        let mut sv = r_present
+            .to_owned()
+            .singular_values()
+            .map_err(|_| Error::Numerical("the SVD of W did not converge".into()))?;
+        sv.sort_by(|x, y| y.total_cmp(x));
+        sv
     } else {
-        r.clone().singular_values().iter().cloned().collect()
+        Vec::new()
     };
-    singular_values.sort_by(|a, b| b.partial_cmp(a).unwrap());
-    let smax = singular_values.first().cloned().unwrap_or(0.0);
+    let smax = singular_values
+        .first()
+        .copied()
+        .unwrap_or_else(|| sigma_max(r_present));
     let tol = RANK_TOLERANCE * smax;
-    let rank = singular_values.iter().filter(|&&x| x > tol).count();
-    // 4. ordered selection (unpivoted QR in K order)
-    let mut kept = Vec::new();
+    // absent columns in the span of the existing ones: distance below tol
+    let candidates: Vec<usize> = {
+        let mut c: Vec<usize> = (0..live.len())
+            .filter(|&k| {
+                k < n_present || {
+                    let d = (n_present..live.len().min(rows))
+                        .map(|i| r_all[(i, k)] * r_all[(i, k)])
+                        .sum::<f64>()
+                        .sqrt();
+                    d <= tol
+                }
+            })
+            .collect();
+        c.sort_by_key(|&k| all[live[k]]);
+        c
+    };
+    // 4. ordered selection: unpivoted QR in K order (the first QR already is, without absent
+    // candidates)
+    let r_k = if candidates.len() == n_present {
+        None
+    } else {
+        Some(refactor(&r_all, &candidates))
+    };
+    let diag = |i: usize| match &r_k {
+        Some(r) => r[(i, i)],
+        None => r_all[(i, i)],
+    };
+    let mut kept = Vec::new(); // indices into `live`
     let mut dep = Vec::new();
-    for (k, &c) in live.iter().enumerate() {
-        if r[(k, k)].abs() > tol {
-            kept.push(c);
-        } else {
-            dep.push(c);
+    for (i, &k) in candidates.iter().enumerate() {
+        if diag(i).abs() > tol {
+            kept.push(k);
+        } else if k < n_present {
+            dep.push(k);
         }
     }
-    if kept.len() != rank {
+    drop(r_k);
+
+    // 5. beta and the rank certificate: QR of R's columns [kept, grouped]
+    let order: Vec<usize> = kept.iter().chain(&dep).copied().collect();
+    let r2 = refactor(&r_all, &order);
+    drop(r_all);
+    let nk = kept.len();
+    let r11 = r2.as_ref().submatrix(0, 0, nk, nk);
+    let sigma_min_kept = sigma_min_upper(r11);
+    let residual_grouped = {
+        let mut sq = 0.0;
+        for j in nk..order.len() {
+            for i in nk..=j.min(r2.nrows() - 1) {
+                sq += r2[(i, j)] * r2[(i, j)];
+            }
+        }
+        sq.sqrt()
+    };
+    if nk > 0 && (sigma_min_kept <= tol || residual_grouped > tol) {
         return Err(Error::Numerical(format!(
-            "the ordered QR keeps {} columns but the numerical rank is {rank} (tolerance {tol:e}); \
-             the samples are ill-conditioned, try more samples or another seed",
-            kept.len()
+            "{}: the numerical rank is not clear from these samples (smallest singular value \
+             of the kept columns {sigma_min_kept:e}, residual of the grouped ones \
+             {residual_grouped:e}, tolerance {tol:e}); the samples are ill-conditioned: try \
+             more samples or another seed",
+            robot.name()
         )));
     }
-    // 5. beta
-    let scaled = |set: &[usize]| {
-        let mut m = DMatrix::zeros(rows, set.len());
-        for (k, &c) in set.iter().enumerate() {
-            m.set_column(k, &(w.column(c) / norms[c]));
-        }
-        m
-    };
-    let w1 = scaled(&kept);
-    let w2 = scaled(&dep);
-    let beta_n = if dep.is_empty() || kept.is_empty() {
-        DMatrix::zeros(kept.len(), dep.len())
-    } else {
-        let qr1 = w1.qr();
-        let qtb = qr1.q().transpose() * w2;
-        qr1.r().solve_upper_triangular(&qtb).ok_or_else(|| {
-            Error::Numerical("the kept columns are singular (cannot compute beta)".into())
-        })?
-    };
-    let mut beta = beta_n;
-    for (a, &kc) in kept.iter().enumerate() {
-        for (b, &dc) in dep.iter().enumerate() {
-            beta[(a, b)] *= norms[dc] / norms[kc];
+    let mut beta_s = Mat::from_fn(nk, dep.len(), |i, j| r2[(i, nk + j)]);
+    if nk > 0 && !dep.is_empty() {
+        faer::linalg::triangular_solve::solve_upper_triangular_in_place(
+            r11,
+            beta_s.as_mut(),
+            par(),
+        );
+    }
+    let col = |k: usize| all[live[k]];
+    let mut beta = DMatrix::zeros(nk, dep.len());
+    for (x, &kc) in kept.iter().enumerate() {
+        for (y, &dc) in dep.iter().enumerate() {
+            beta[(x, y)] = beta_s[(x, y)] * norms[live[dc]] / norms[live[kc]];
         }
     }
     Ok(NumericBase {
-        base: kept.iter().map(|&c| columns[c]).collect(),
-        grouped: dep.iter().map(|&c| columns[c]).collect(),
+        base: kept.iter().map(|&k| col(k)).collect(),
+        grouped: dep.iter().map(|&k| col(k)).collect(),
         no_effect,
+        absent,
         columns,
         beta,
         tolerance: tol,
         singular_values,
+        sigma_min_kept,
+        residual_grouped,
         rows,
     })
 }

@@ -45,6 +45,7 @@ use robodyn_symbolic::{Expr, Node};
 use std::collections::{BTreeMap, BTreeSet};
 
 use super::super::regressor::{ParameterSelection, PARAMS_PER_LINK};
+use super::names::ParameterNames;
 
 const XX: usize = 0;
 const XY: usize = 1;
@@ -78,6 +79,47 @@ pub struct SymbolicBase {
     pub unhandled_loops: Vec<usize>,
     /// Parallelogram loops detected (cut joint numbers).
     pub parallelograms: Vec<usize>,
+    /// Terms dropped as rounding noise of the file's floats ([`FLOAT_TERM_TOLERANCE`]).
+    pub dropped_float_terms: usize,
+}
+
+/// A term of a grouping equation whose coefficient is a float (inexact: the file gave floats,
+/// as a URDF does) below this fraction of the largest coefficient of its equation is rounding
+/// noise of the geometry (e.g. 2.4e-23*YY5 from cos(pi/2) computed in floats) and is dropped.
+/// Exact coefficients are never dropped.
+pub const FLOAT_TERM_TOLERANCE: f64 = 1e-12;
+
+/// `e` (expanded) without its float-noise terms, and how many were dropped.
+fn drop_float_noise(e: Expr) -> (Expr, usize) {
+    let terms: Vec<Expr> = match e.node() {
+        Node::Add(v) => v.clone(),
+        _ => return (e, 0),
+    };
+    let coef = |t: &Expr| -> (f64, bool) {
+        match t.node() {
+            Node::Mul(f) => match f[0].node() {
+                Node::Float(x) => (*x, true),
+                _ => (f[0].as_f64().unwrap_or(1.0), false),
+            },
+            Node::Float(x) => (*x, true),
+            _ => (t.as_f64().unwrap_or(1.0), false),
+        }
+    };
+    let largest = terms.iter().map(|t| coef(t).0.abs()).fold(0.0, f64::max);
+    let keep: Vec<Expr> = terms
+        .iter()
+        .filter(|t| {
+            let (c, float) = coef(t);
+            !(float && c.abs() < FLOAT_TERM_TOLERANCE * largest)
+        })
+        .cloned()
+        .collect();
+    let dropped = terms.len() - keep.len();
+    if dropped == 0 {
+        (e, 0)
+    } else {
+        (Expr::sum(keep), dropped)
+    }
 }
 
 impl SymbolicBase {
@@ -127,7 +169,9 @@ struct Geo {
     poses: Vec<Vec<(Matrix3<f64>, Vector3<f64>)>>,
 }
 
-fn generic_value(name: &str) -> f64 {
+/// The generic value given to a symbol without value: deterministic from its name, in
+/// [0.3, 1.67], never 0 and never a multiple of pi/2 (so it is never taken to be special).
+pub fn generic_value(name: &str) -> f64 {
     // deterministic "generic" value from the name: never 0, never a multiple of pi/2
     let h = name.bytes().fold(1469598103934665603u64, |h, b| {
         (h ^ b as u64).wrapping_mul(1099511628211)
@@ -316,85 +360,298 @@ fn rz(delta: &Expr) -> Matrix3<Expr> {
     Matrix3::new(c.clone(), -s.clone(), z(), s, c, z(), z(), z(), Expr::one())
 }
 
-/// A detected parallelogram loop (§10.3.5): pairs (low, high, lowA_high) of parallel links and
-/// the two links holding the cut joint and its twin.
-struct Parallelogram {
-    cut: usize,
-    /// The two tree joints inside the loop (of links b and e): qd_b = -qd_e.
-    inner: (usize, usize),
-    pairs: Vec<(usize, usize, Matrix3<Expr>)>,
+/// A detected parallelogram loop (§10.3.5): pairs (low, high, lowA_high) of parallel links
+/// (eq 10.54: equal angular velocities), the joints of the loop whose velocities are equal or
+/// opposite, and the cut joint.
+#[derive(Clone, Debug)]
+pub struct Parallelogram {
+    /// Cut joint k of the loop.
+    pub cut: usize,
+    /// Couples of tree joints of the loop whose velocities are +-qd of each other (their drive
+    /// parameters group into the lowest one's).
+    pub coupled: Vec<(usize, usize)>,
+    /// (low, high, lowA_high): link `high` keeps the orientation lowA_high with respect to link
+    /// `low` (0 = the base).
+    pub pairs: Vec<(usize, usize, Matrix3<Expr>)>,
 }
 
+/// Parallelogram loops of `desc` (symbols without value take generic values), by cut joint.
+pub fn parallelograms(desc: &RobotDescription) -> Result<Vec<Parallelogram>> {
+    let st = validate_structure(desc)?;
+    let geo = Geo::new(desc, &st.ant)?;
+    Ok(st
+        .loops
+        .iter()
+        .filter_map(|l| detect_parallelogram(desc, &geo, l))
+        .collect())
+}
+
+/// Planar side vector of a link: O_x -> O_next in the frame of the link (x, y components).
+fn planar(p: &Vector3<f64>) -> nalgebra::Vector2<f64> {
+    nalgebra::Vector2::new(p.x, p.y)
+}
+
+/// Position of the origin of frame `x` in the frame of its antecedent.
+fn offset(geo: &Geo, x: usize) -> Vector3<f64> {
+    geo.frames[x - 1].transform(&0.0).1
+}
+
+/// Detect a parallelogram loop from the geometry (§10.3.5, Figure 10.2). Every joint of the
+/// loop (tree joints and the cut joint) is revolute, with its axis parallel to the others in
+/// the same direction. The loop is read as a polygon in the plane of the axes: each link of the
+/// loop carries one side, from its joint O_x to the next joint of its branch (or to the cut
+/// joint and its twin, which coincide), and the root link r carries the side between the first
+/// joints of the two branches (read in the frame of the first joint of the cut's branch at
+/// q = 0, a frame fixed on r whose z is the axis). Sides of zero length (two joints on one
+/// point: SR400's O_2 = O_7, the older TwoLoops' O_3 = O_8) are dropped. The loop is a
+/// parallelogram when four sides remain, opposite ones of equal length: the links carrying
+/// opposite sides then keep their relative orientation (eq 10.54, w_x = w_y). With psi_x the
+/// angle of link x about the axis and phi'_x the angle of its side in its frame (plus pi when
+/// the polygon runs the side backwards, on the twin's branch), opposite sides satisfy
+/// psi_x + phi'_x = psi_y + phi'_y + pi, so xA_y = Rz(phi'_x - phi'_y - pi) (derived).
 fn detect_parallelogram(
     desc: &RobotDescription,
-    st: &Structure,
     geo: &Geo,
     l: &crate::model::ClosedLoop,
 ) -> Option<Parallelogram> {
-    if l.branch_i.len() != 2 || l.branch_j.len() != 2 {
+    let (k, tw) = (l.cut, l.twin);
+    let revolute = |x: usize| desc.frame(x).joint == JointType::Revolute;
+    let joints: Vec<usize> = l.tree_joints().chain([k]).collect();
+    if !joints.iter().all(|&x| revolute(x)) {
         return None;
     }
-    let (a, b, c, e) = (l.branch_i[0], l.branch_i[1], l.branch_j[0], l.branch_j[1]);
-    let (k, tw) = (l.cut, l.twin);
-    for x in [a, b, c, e, k] {
-        if desc.frame(x).joint != JointType::Revolute {
-            return None;
-        }
-    }
-    // all axes parallel, same direction
-    for cfg in 0..geo.configs.len() {
-        let z0 = geo.z(cfg, a);
-        for x in [b, c, e, k, tw] {
-            if (geo.z(cfg, x) - z0).norm() > GEOMETRY_TOLERANCE {
-                return None;
-            }
-        }
-        // O_a = O_c
-        if (geo.poses[cfg][a].1 - geo.poses[cfg][c].1).norm() > GEOMETRY_TOLERANCE {
-            return None;
-        }
-    }
-    let _ = st;
-    // side vectors in the frames of their links (planar part)
-    let side = |x: usize| {
-        let (_, p) = geo.frames[x - 1].transform(&0.0);
-        nalgebra::Vector2::new(p.x, p.y)
+    let (&first_i, &first_j) = (l.branch_i.first()?, l.branch_j.first()?);
+    let same_axis = |x: usize| {
+        (0..geo.configs.len())
+            .all(|c| (geo.z(c, x) - geo.z(c, first_i)).norm() < GEOMETRY_TOLERANCE)
     };
-    // link a carries joint b, link b the cut joint k, link c carries e, link e the twin
-    let (sa, sb, sc, se) = (side(b), side(k), side(e), side(tw));
-    // theta offsets of the joint frames do not change the side vector (P does not depend on theta)
-    if (sa.norm() - se.norm()).abs() > GEOMETRY_TOLERANCE
-        || (sb.norm() - sc.norm()).abs() > GEOMETRY_TOLERANCE
-        || sa.norm() < GEOMETRY_TOLERANCE
-        || sb.norm() < GEOMETRY_TOLERANCE
+    if !joints.iter().chain([&tw]).all(|&x| same_axis(x)) {
+        return None;
+    }
+    // sides: (link, planar vector in the link's frame, run backwards)
+    let mut sides: Vec<(usize, Vector3<f64>, bool)> = Vec::new();
+    // root side O_first_j -> O_first_i, in the frame of joint first_i at q = 0
+    let a0 = geo.frames[first_i - 1].transform(&0.0).0;
+    sides.push((
+        l.root,
+        a0.transpose() * (offset(geo, first_i) - offset(geo, first_j)),
+        false,
+    ));
+    let next = |branch: &[usize], n: usize, end: usize| branch.get(n + 1).copied().unwrap_or(end);
+    for (n, &x) in l.branch_i.iter().enumerate() {
+        sides.push((x, offset(geo, next(&l.branch_i, n, k)), false));
+    }
+    for (n, &x) in l.branch_j.iter().enumerate().rev() {
+        sides.push((x, offset(geo, next(&l.branch_j, n, tw)), true));
+    }
+    sides.retain(|(_, v, _)| planar(v).norm() > GEOMETRY_TOLERANCE);
+    if sides.len() != 4 {
+        return None;
+    }
+    let len = |n: usize| planar(&sides[n].1).norm();
+    if (len(0) - len(2)).abs() > GEOMETRY_TOLERANCE || (len(1) - len(3)).abs() > GEOMETRY_TOLERANCE
     {
         return None;
     }
-    let phi = |v: nalgebra::Vector2<f64>| v.y.atan2(v.x);
-    // sides in the frames of their links, angles measured from x of the link frame: links with
-    // parallel sides have world angles psi_x + phi_x = psi_y + phi_y, so xA_y = Rz(phi_x - phi_y)
-    let mut pairs = Vec::new();
-    for (x, px, y, py) in [(a, phi(sa), e, phi(se)), (b, phi(sb), c, phi(sc))] {
-        let (lo, plo, hi, phi_hi) = if x < y {
-            (x, px, y, py)
+    let angle = |n: usize| {
+        let v = planar(&sides[n].1);
+        v.y.atan2(v.x)
+            + if sides[n].2 {
+                std::f64::consts::PI
+            } else {
+                0.0
+            }
+    };
+    let pair = |m: usize, n: usize| {
+        let (x, y) = (sides[m].0, sides[n].0);
+        let (lo, hi, d) = if x < y {
+            (x, y, angle(m) - angle(n) - std::f64::consts::PI)
         } else {
-            (y, py, x, px)
+            (y, x, angle(n) - angle(m) - std::f64::consts::PI)
         };
-        pairs.push((lo, hi, rz(&exact_angle(plo - phi_hi))));
-    }
+        // the root side is read in the frame of joint first_i at q = 0: rA_hi = rA_first_i(0) Rz
+        let rot = rz(&exact_angle(d));
+        let a = if x == l.root || y == l.root {
+            frame_expr(desc, first_i).0 * rot
+        } else {
+            rot
+        };
+        (lo, hi, a)
+    };
+    let pairs = vec![pair(0, 2), pair(1, 3)];
     Some(Parallelogram {
         cut: k,
-        inner: (b.min(e), b.max(e)),
+        coupled: coupled_joints(l, &pairs),
         pairs,
     })
 }
 
-/// Run the symbolic method on a description (symbols may lack values).
+/// Tree joints of a loop whose velocities are +-qd of each other: the pairs give w_y - w_x =
+/// sum of qd_j on the path root -> y minus those on root -> x (every joint of the loop turns
+/// about the same axis; the joints before the root cancel). A joint couple (u, v) is coupled
+/// when qd_u + s qd_v (s = +-1) is a combination of these relations.
+fn coupled_joints(
+    l: &crate::model::ClosedLoop,
+    pairs: &[(usize, usize, Matrix3<Expr>)],
+) -> Vec<(usize, usize)> {
+    let joints: Vec<usize> = l.tree_joints().collect();
+    let n = joints.len();
+    let path = |x: usize| -> Vec<usize> {
+        for b in [&l.branch_i, &l.branch_j] {
+            if let Some(p) = b.iter().position(|&y| y == x) {
+                return b[..=p].to_vec();
+            }
+        }
+        Vec::new() // the root
+    };
+    let rel: Vec<nalgebra::DVector<f64>> = pairs
+        .iter()
+        .map(|(x, y, _)| {
+            let mut v = nalgebra::DVector::zeros(n);
+            for j in path(*y) {
+                v[joints.iter().position(|&q| q == j).unwrap()] += 1.0;
+            }
+            for j in path(*x) {
+                v[joints.iter().position(|&q| q == j).unwrap()] -= 1.0;
+            }
+            v
+        })
+        .collect();
+    let m = nalgebra::DMatrix::from_columns(&rel);
+    let in_span = |t: &nalgebra::DVector<f64>| {
+        let svd = m.clone().svd(true, true);
+        svd.solve(t, 1e-9)
+            .map(|c| (&m * c - t).norm() < 1e-9)
+            .unwrap_or(false)
+    };
+    let mut out = Vec::new();
+    for u in 0..n {
+        for v in u + 1..n {
+            if [1.0, -1.0].into_iter().any(|s| {
+                let mut t = nalgebra::DVector::zeros(n);
+                t[u] = 1.0;
+                t[v] = s;
+                in_span(&t)
+            }) {
+                out.push((joints[u].min(joints[v]), joints[u].max(joints[v])));
+            }
+        }
+    }
+    out
+}
+
+/// Classes of links with equal angular velocities over every parallelogram (eq 10.54 is
+/// transitive: the older TwoLoops has w_4 = w_8 in one loop and w_8 = w_1 in the other): for
+/// each link, the lowest link of its class and loA_link (composed along the pairs), None for
+/// the lowest itself. Eqs 10.55–10.56 then move J_link into J_lowest.
+fn parallel_classes(ps: &[Parallelogram], nl: usize) -> Vec<Option<(usize, Matrix3<Expr>)>> {
+    let mut adj: Vec<Vec<(usize, Matrix3<Expr>)>> = vec![Vec::new(); nl + 1];
+    for p in ps {
+        for (lo, hi, a) in &p.pairs {
+            adj[*lo].push((*hi, a.clone()));
+            adj[*hi].push((*lo, a.transpose()));
+        }
+    }
+    let mut out: Vec<Option<(usize, Matrix3<Expr>)>> = vec![None; nl + 1];
+    let mut seen = vec![false; nl + 1];
+    for lo in 0..=nl {
+        if seen[lo] || adj[lo].is_empty() {
+            continue;
+        }
+        seen[lo] = true;
+        let mut queue = std::collections::VecDeque::from([(lo, Matrix3::<Expr>::identity())]);
+        while let Some((x, ax)) = queue.pop_front() {
+            for (y, a) in adj[x].clone() {
+                if !seen[y] {
+                    seen[y] = true;
+                    let ay = (&ax * a).map(|e| e.expand());
+                    out[y] = Some((lo, ay.clone()));
+                    queue.push_back((y, ay));
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Classes of coupled joints over every parallelogram (union of the couples).
+fn coupled_classes(ps: &[Parallelogram]) -> Vec<Vec<usize>> {
+    let mut classes: Vec<BTreeSet<usize>> = Vec::new();
+    for p in ps {
+        for &(u, v) in &p.coupled {
+            let hits: Vec<usize> = (0..classes.len())
+                .filter(|&c| classes[c].contains(&u) || classes[c].contains(&v))
+                .collect();
+            let mut merged: BTreeSet<usize> = [u, v].into_iter().collect();
+            for &c in hits.iter().rev() {
+                merged.extend(classes.remove(c));
+            }
+            classes.push(merged);
+        }
+    }
+    classes
+        .into_iter()
+        .map(|c| c.into_iter().collect())
+        .collect()
+}
+
+/// What the rules need to know about the robot: its topology, numeric geometry and, per link,
+/// the joint r1 of its branch and whether it lies between r1 and r2.
+struct Context<'a> {
+    desc: &'a RobotDescription,
+    st: Structure,
+    geo: Geo,
+    /// r1 of the branch through j (first revolute joint from the base), per link.
+    r1: Vec<Option<usize>>,
+    /// r1 <= j < r2: no revolute joint not parallel to r1 on the path up to j.
+    between: Vec<bool>,
+}
+
+impl<'a> Context<'a> {
+    fn new(desc: &'a RobotDescription) -> Result<Context<'a>> {
+        let st = validate_structure(desc)?;
+        let geo = Geo::new(desc, &st.ant)?;
+        let nl = desc.nl;
+        let mut r1 = vec![None; nl + 1];
+        let mut between = vec![false; nl + 1];
+        for j in 1..=nl {
+            let path = path_from_base(&st.ant, j);
+            r1[j] = path
+                .iter()
+                .copied()
+                .find(|&k| desc.frame(k).joint == JointType::Revolute);
+            between[j] = r1[j].is_some_and(|r| {
+                !path.iter().any(|&k| {
+                    k > r && desc.frame(k).joint == JointType::Revolute && !geo.parallel(k, r)
+                })
+            });
+        }
+        Ok(Context {
+            desc,
+            st,
+            geo,
+            r1,
+            between,
+        })
+    }
+
+    fn joint(&self, j: usize) -> JointType {
+        self.desc.frame(j).joint
+    }
+
+    fn path(&self, j: usize) -> Vec<usize> {
+        path_from_base(&self.st.ant, j)
+    }
+}
+
+/// Run the symbolic method on a description (symbols may lack values). Parameters outside
+/// `sel` (drive parameters not selected) are not parameters; absent ones (`sel.absent`, a
+/// literal 0 in a SYMORO file) start at 0 but can still receive grouped parameters (as in
+/// SYMORO: MXR2 = d3*M3 when MX2 is written 0).
 pub fn symbolic_base_parameters(
     desc: &RobotDescription,
     sel: &ParameterSelection,
 ) -> Result<SymbolicBase> {
-    let st = validate_structure(desc)?;
     let nl = desc.nl;
     if sel.rotor.len() != nl || sel.friction.len() != nl {
         return Err(Error::Input(format!(
@@ -402,293 +659,113 @@ pub fn symbolic_base_parameters(
             sel.rotor.len()
         )));
     }
-    let geo = Geo::new(desc, &st.ant)?;
-    let columns = sel.columns();
-    let colset: BTreeSet<usize> = columns.iter().copied().collect();
-    let mut s = State {
-        kr: (1..=nl)
-            .map(|j| {
-                std::array::from_fn(|p| {
-                    if colset.contains(&(PARAMS_PER_LINK * (j - 1) + p)) {
-                        sym(j, p)
-                    } else {
-                        Expr::zero()
-                    }
-                })
-            })
-            .collect(),
-        alive: (1..=nl)
-            .map(|j| std::array::from_fn(|p| colset.contains(&(PARAMS_PER_LINK * (j - 1) + p))))
-            .collect(),
-    };
-    let joint = |j: usize| desc.frame(j).joint;
-    let path = |j: usize| path_from_base(&st.ant, j);
-    // r1 of the branch through j, and whether an r2 occurs on the path up to j
-    let r1_of = |j: usize| {
-        path(j)
-            .into_iter()
-            .find(|&k| joint(k) == JointType::Revolute)
-    };
-    let has_r2 = |j: usize| -> bool {
-        match r1_of(j) {
-            None => false,
-            Some(r1) => path(j)
-                .into_iter()
-                .any(|k| k > r1 && joint(k) == JointType::Revolute && !geo.parallel(k, r1)),
-        }
-    };
-    let between = |j: usize| r1_of(j).is_some() && !has_r2(j);
-
-    // rotor inertias (§9.4.2.5)
-    for j in 1..=nl {
-        if !s.alive[j - 1][IA] {
-            continue;
-        }
-        let before: Vec<usize> = path(j).into_iter().filter(|&k| k != j).collect();
-        let group = match joint(j) {
-            JointType::Revolute => before
-                .iter()
-                .filter(|&&k| joint(k) == JointType::Revolute)
-                .all(|&k| geo.perpendicular(k, j)),
-            JointType::Prismatic => {
-                before.iter().all(|&k| match joint(k) {
-                    JointType::Revolute => geo.parallel(k, j),
-                    JointType::Prismatic => geo.perpendicular(k, j),
-                    JointType::Fixed => true,
-                }) && geo.perpendicular_to_gravity(j)
-            }
-            JointType::Fixed => false,
-        };
-        if group {
-            let e = s.get(j, IA);
-            s.kill(j, IA);
-            if joint(j) == JointType::Revolute {
-                s.add(j, ZZ, e);
-            } else {
-                // the mass column of j is qdd_j in row j plus that of a point mass fixed on a(j)
-                // at q_j = 0: MR_j = M_j + IA_j and a point mass -IA_j on a(j)
-                s.add(j, M, e.clone());
-                let (a, p) = frame_expr(desc, j);
-                let z = Matrix3::from_element(Expr::zero());
-                let zv = Vector3::from_element(Expr::zero());
-                s.add_all(st.ant[j], transfer(&a, &p, &z, &zv, &-e));
-            }
-        }
-    }
-
-    // parallelogram loops
+    check_geometry_names(desc)?;
+    let ctx = Context::new(desc)?;
+    let mut s = State::new(nl, sel);
+    rotor_inertias(&ctx, &mut s);
     let mut parallelograms = Vec::new();
     let mut unhandled_loops = Vec::new();
-    for l in &st.loops {
-        match detect_parallelogram(desc, &st, &geo, l) {
+    for l in &ctx.st.loops {
+        match detect_parallelogram(desc, &ctx.geo, l) {
             Some(p) => parallelograms.push((p, l.clone())),
             None => unhandled_loops.push(l.cut),
         }
     }
-
-    // inner joints of a parallelogram: w_b = w_c and w_e = w_a give qd_e = -qd_b, so the drive
-    // parameters (energy 1/2 IA qd^2, friction through G^T) of the higher joint group into the
-    // lower one's (derived from 10.54)
-    for (p, _) in &parallelograms {
-        let (lo, hi) = p.inner;
-        for q in [IA, IA + 1, IA + 2] {
-            if s.alive[hi - 1][q] && s.alive[lo - 1][q] {
-                let e = s.get(hi, q);
-                s.kill(hi, q);
-                s.add(lo, q, e);
-            }
-        }
+    let ps: Vec<Parallelogram> = parallelograms.iter().map(|(p, _)| p.clone()).collect();
+    for class in coupled_classes(&ps) {
+        parallelogram_drive_parameters(&class, &mut s);
     }
-
+    let classes = parallel_classes(&ps, nl);
     for j in (1..=nl).rev() {
-        let i = st.ant[j];
-        let mut tensor_moved = false;
-        for (p, l) in &parallelograms {
-            // rule 1, eq 10.51c: h_i lambda_k^10 = h_j lambda_{k+B}^10
-            let (li, lj) = (l.link_i, l.link_j);
-            if j == li.max(lj) {
-                let lam10 = |frame: usize| -> [Expr; 10] {
-                    let (_, pp) = frame_expr(desc, frame);
-                    let (x, y, z) = (pp.x.clone(), pp.y.clone(), pp.z.clone());
-                    [
-                        y.clone() * y.clone() + z.clone() * z.clone(),
-                        -(x.clone() * y.clone()),
-                        -(x.clone() * z.clone()),
-                        x.clone() * x.clone() + z.clone() * z.clone(),
-                        -(y.clone() * z.clone()),
-                        x.clone() * x.clone() + y.clone() * y.clone(),
-                        x,
-                        y,
-                        z,
-                        Expr::one(),
-                    ]
-                };
-                let ci = lam10(l.cut);
-                let cj = lam10(l.twin);
-                // relation sum_p ci_p h_{li,p} - sum_p cj_p h_{lj,p} = 0
-                let (own, own_c, other, other_c) = if j == li {
-                    (li, ci, lj, cj)
-                } else {
-                    (lj, cj, li, ci)
-                };
-                if let Some(pstar) = [MX, MY]
-                    .into_iter()
-                    .find(|&q| !own_c[q].is_zero() && s.alive[own - 1][q])
-                {
-                    let kstar = s.get(own, pstar);
-                    let cstar = own_c[pstar].clone();
-                    s.kill(own, pstar);
-                    for q in 0..10 {
-                        if q != pstar && !own_c[q].is_zero() {
-                            let e = -(own_c[q].clone() / cstar.clone()) * kstar.clone();
-                            s.add(own, q, e);
-                        }
-                        if !other_c[q].is_zero() {
-                            let e = (other_c[q].clone() / cstar.clone()) * kstar.clone();
-                            s.add(other, q, e);
-                        }
-                    }
-                }
-            }
-            // eqs 10.55-10.56: J_high into J_low
-            for (lo, hi, a) in &p.pairs {
-                if *hi == j {
-                    let jm = s.j_matrix(j);
-                    let t = a * jm * a.transpose();
-                    for q in 0..6 {
-                        s.kill(j, q);
-                    }
-                    s.add_tensor(*lo, &t);
-                    tensor_moved = true;
-                }
-            }
+        for (_, l) in &parallelograms {
+            cut_joint_relation(desc, l, j, &mut s);
         }
-        let (a, p) = frame_expr(desc, j);
-        let zero3 = || Vector3::from_element(Expr::zero());
-        match joint(j) {
-            JointType::Revolute => {
-                // Theorem 10.1
-                let yy = if tensor_moved {
-                    Expr::zero()
-                } else {
-                    s.get(j, YY)
-                };
-                let (mz, m) = (s.get(j, MZ), s.get(j, M));
-                if !tensor_moved {
-                    s.add(j, XX, -yy.clone());
-                    s.kill(j, YY);
-                }
-                s.kill(j, MZ);
-                s.kill(j, M);
-                let jj = Matrix3::from_diagonal(&Vector3::new(yy.clone(), yy, Expr::zero()));
-                let ms = Vector3::new(Expr::zero(), Expr::zero(), mz);
-                s.add_all(i, transfer(&a, &p, &jj, &ms, &m));
-            }
+        let tensor_moved = parallel_links(&classes, j, &mut s);
+        match ctx.joint(j) {
+            JointType::Revolute => theorem_10_1(&ctx, j, tensor_moved, &mut s),
             JointType::Prismatic => {
-                // Theorem 10.2 (10.20b)
                 if !tensor_moved {
-                    let jm = s.j_matrix(j);
-                    for q in 0..6 {
-                        s.kill(j, q);
-                    }
-                    s.add_tensor(i, &(&a * jm * a.transpose()));
+                    theorem_10_2(&ctx, j, &mut s);
                 }
-                if r1_of(j).is_none() {
-                    // rule 7
-                    for q in [MX, MY, MZ] {
-                        s.kill(j, q);
-                    }
-                } else if between(j) {
-                    let r1 = r1_of(j).unwrap();
-                    if geo.parallel(j, r1) {
-                        // rule 3 (10.23): MZ_j eliminated, MX_j MY_j grouped into a(j)
-                        let ms = Vector3::new(s.get(j, MX), s.get(j, MY), Expr::zero());
-                        for q in [MX, MY, MZ] {
-                            s.kill(j, q);
-                        }
-                        let t = transfer(
-                            &a,
-                            &p,
-                            &Matrix3::from_element(Expr::zero()),
-                            &ms,
-                            &Expr::zero(),
-                        );
-                        s.add_all(i, t);
-                    } else {
-                        // rule 4, Table 10.1: relation jA_r1 z . h_MS = const
-                        let mut rot = Matrix3::<Expr>::identity();
-                        for k in path(j).into_iter().filter(|&k| k > r1) {
-                            let (ak, _) = frame_expr(desc, k);
-                            rot *= ak;
-                        }
-                        // z_r1 in R_j = (r1 A_j)^T e3
-                        let u: Vec<Expr> = (0..3).map(|c| rot[(2, c)].clone()).collect();
-                        let un: Vec<f64> = {
-                            let (ra, _) = &geo.poses[0][j];
-                            let (rr, _) = &geo.poses[0][r1];
-                            let v = ra.transpose() * rr.column(2);
-                            vec![v.x, v.y, v.z]
-                        };
-                        if let Some(e) = [2usize, 1, 0]
-                            .into_iter()
-                            .find(|&c| un[c].abs() > GEOMETRY_TOLERANCE)
-                        {
-                            let ke = s.get(j, MX + e);
-                            s.kill(j, MX + e);
-                            for c in 0..3 {
-                                if c != e && un[c].abs() > GEOMETRY_TOLERANCE {
-                                    s.add(j, MX + c, -(u[c].clone() / u[e].clone()) * ke.clone());
-                                }
-                            }
-                        }
-                    }
-                }
+                prismatic_first_moments(&ctx, j, &mut s);
             }
-            JointType::Fixed => {
-                let jm = s.j_matrix(j);
-                let ms = Vector3::new(s.get(j, MX), s.get(j, MY), s.get(j, MZ));
-                let m = s.get(j, M);
-                for q in 0..10 {
-                    s.kill(j, q);
-                }
-                let _ = zero3;
-                s.add_all(i, transfer(&a, &p, &jm, &ms, &m));
-            }
+            JointType::Fixed => fixed_frame(&ctx, j, &mut s),
         }
-        if joint(j) == JointType::Revolute && between(j) {
-            // rule 5
-            for q in [XX, XY, XZ, YZ] {
-                s.kill(j, q);
-            }
-            // rule 6
-            let r1 = r1_of(j).unwrap();
-            // "a_j along a_r1": the same line, not only parallel
-            let coaxial = (0..geo.configs.len()).all(|c| {
-                let z = geo.z(c, r1);
-                let dp = geo.poses[c][j].1 - geo.poses[c][r1].1;
-                geo.parallel(j, r1) && dp.cross(&z).norm() < GEOMETRY_TOLERANCE
-            });
-            let all_vertical = coaxial
-                && path(j)
-                    .into_iter()
-                    .filter(|&k| joint(k) != JointType::Fixed)
-                    .all(|k| {
-                        geo.parallel(k, r1) && (geo.g.norm() == 0.0 || geo.parallel_to_gravity(k))
-                    });
-            if all_vertical {
-                s.kill(j, MX);
-                s.kill(j, MY);
-            }
+        if ctx.joint(j) == JointType::Revolute && ctx.between[j] {
+            rules_5_6(&ctx, j, &mut s);
+        }
+    }
+    Ok(s.finish(sel, unhandled_loops, &parallelograms))
+}
+
+/// The standard parameter symbols (`XX2`, `M3`...) are the unknowns of the equations: a
+/// geometric symbol of the same name would make the equations ambiguous.
+fn check_geometry_names(desc: &RobotDescription) -> Result<()> {
+    let mut exprs: Vec<&Expr> = Vec::new();
+    for f in &desc.frames {
+        exprs.extend(f.geometric());
+    }
+    exprs.extend(desc.gravity.iter().chain(&desc.vp0));
+    for e in exprs {
+        if let Some(n) = e
+            .symbols()
+            .into_iter()
+            .find(|n| standard_index(n, desc.nl).is_some())
+        {
+            return Err(Error::Input(format!(
+                "the geometric symbol `{n}` has the name of a standard parameter; rename it \
+                 (the grouping equations use the standard parameters as unknowns)"
+            )));
+        }
+    }
+    Ok(())
+}
+
+impl State {
+    fn new(nl: usize, sel: &ParameterSelection) -> State {
+        let index = |j: usize, p: usize| PARAMS_PER_LINK * (j - 1) + p;
+        State {
+            kr: (1..=nl)
+                .map(|j| {
+                    std::array::from_fn(|p| {
+                        let i = index(j, p);
+                        if sel.slot(i) && !sel.absent.contains(&i) {
+                            sym(j, p)
+                        } else {
+                            Expr::zero()
+                        }
+                    })
+                })
+                .collect(),
+            alive: (1..=nl)
+                .map(|j| std::array::from_fn(|p| sel.slot(index(j, p))))
+                .collect(),
         }
     }
 
-    let mut base = Vec::new();
-    let mut equations = Vec::new();
-    let mut used = BTreeSet::new();
-    for j in 1..=nl {
-        for p in 0..PARAMS_PER_LINK {
-            if s.alive[j - 1][p] {
-                let e = s.get(j, p).expand();
+    /// Base parameters: the live parameters whose expression is not zero.
+    fn finish(
+        self,
+        sel: &ParameterSelection,
+        unhandled_loops: Vec<usize>,
+        parallelograms: &[(Parallelogram, crate::model::ClosedLoop)],
+    ) -> SymbolicBase {
+        let nl = self.kr.len();
+        let columns = sel.columns();
+        let mut base = Vec::new();
+        let mut equations = Vec::new();
+        let mut used = BTreeSet::new();
+        let mut dropped_float_terms = 0;
+        for j in 1..=nl {
+            for p in 0..PARAMS_PER_LINK {
+                if !self.alive[j - 1][p] {
+                    continue;
+                }
+                let (e, dropped) = drop_float_noise(self.get(j, p).expand());
+                dropped_float_terms += dropped;
+                if e.is_zero() {
+                    continue;
+                }
                 for name in e.symbols() {
                     if let Some(k) = standard_index(&name, nl) {
                         used.insert(k);
@@ -698,32 +775,294 @@ pub fn symbolic_base_parameters(
                 equations.push(e);
             }
         }
+        let baseset: BTreeSet<usize> = base.iter().copied().collect();
+        let grouped = columns
+            .iter()
+            .copied()
+            .filter(|c| !baseset.contains(c) && used.contains(c))
+            .collect();
+        let no_effect = columns
+            .iter()
+            .copied()
+            .filter(|c| !baseset.contains(c) && !used.contains(c))
+            .collect();
+        SymbolicBase {
+            columns,
+            base,
+            equations,
+            grouped,
+            no_effect,
+            unhandled_loops,
+            parallelograms: parallelograms.iter().map(|(p, _)| p.cut).collect(),
+            dropped_float_terms,
+        }
     }
-    let baseset: BTreeSet<usize> = base.iter().copied().collect();
-    let grouped = columns
-        .iter()
-        .copied()
-        .filter(|c| !baseset.contains(c) && used.contains(c))
-        .collect();
-    let no_effect = columns
-        .iter()
-        .copied()
-        .filter(|c| !baseset.contains(c) && !used.contains(c))
-        .collect();
-    Ok(SymbolicBase {
-        columns,
-        base,
-        equations,
-        grouped,
-        no_effect,
-        unhandled_loops,
-        parallelograms: parallelograms.iter().map(|(p, _)| p.cut).collect(),
-    })
+}
+
+/// Rotor inertias (§9.4.2.5, derived): IA_j into ZZ_j when w_j . z_j = qd_j identically (every
+/// revolute axis before j perpendicular to z_j); IA_j of a prismatic joint into M_j when every
+/// revolute axis before j is parallel to z_j, every prismatic one perpendicular and z_j is
+/// perpendicular to gravity: the column of M_j is then qdd_j in row j plus that of a point mass
+/// fixed on a(j) at q_j = 0, so MR_j = M_j + IA_j and a point mass -IA_j goes to a(j).
+fn rotor_inertias(ctx: &Context, s: &mut State) {
+    let geo = &ctx.geo;
+    for j in 1..=ctx.desc.nl {
+        if !s.alive[j - 1][IA] {
+            continue;
+        }
+        let before: Vec<usize> = ctx.path(j).into_iter().filter(|&k| k != j).collect();
+        let group = match ctx.joint(j) {
+            JointType::Revolute => before
+                .iter()
+                .filter(|&&k| ctx.joint(k) == JointType::Revolute)
+                .all(|&k| geo.perpendicular(k, j)),
+            JointType::Prismatic => {
+                before.iter().all(|&k| match ctx.joint(k) {
+                    JointType::Revolute => geo.parallel(k, j),
+                    JointType::Prismatic => geo.perpendicular(k, j),
+                    JointType::Fixed => true,
+                }) && geo.perpendicular_to_gravity(j)
+            }
+            JointType::Fixed => false,
+        };
+        if !group {
+            continue;
+        }
+        let e = s.get(j, IA);
+        s.kill(j, IA);
+        if ctx.joint(j) == JointType::Revolute {
+            s.add(j, ZZ, e);
+        } else {
+            s.add(j, M, e.clone());
+            let (a, p) = frame_expr(ctx.desc, j);
+            let z = Matrix3::from_element(Expr::zero());
+            let zv = Vector3::from_element(Expr::zero());
+            s.add_all(ctx.st.ant[j], transfer(&a, &p, &z, &zv, &-e));
+        }
+    }
+}
+
+/// Joints of a parallelogram whose velocities are equal or opposite (from 10.54: w_b = w_c and
+/// w_e = w_a give qd_e = -qd_b; with a side on the root link, qd_c = qd_a = -qd_b): their drive
+/// parameters (energy 1/2 IA qd^2; FV qd and FS sign(qd) through G^T, both even in the sign of
+/// the velocity) group into the lowest joint's.
+fn parallelogram_drive_parameters(class: &[usize], s: &mut State) {
+    for q in [IA, IA + 1, IA + 2] {
+        let live: Vec<usize> = class
+            .iter()
+            .copied()
+            .filter(|&j| s.alive[j - 1][q])
+            .collect();
+        if let Some((&lo, rest)) = live.split_first() {
+            for &hi in rest {
+                let e = s.get(hi, q);
+                s.kill(hi, q);
+                s.add(lo, q, e);
+            }
+        }
+    }
+}
+
+/// lambda^10 of frame `frame` (eqs 10.15–10.17: the coefficients of the ten inertial
+/// parameters of a(frame) in the energy function of link `frame` at q = 0).
+fn lambda10(desc: &RobotDescription, frame: usize) -> [Expr; 10] {
+    let (_, pp) = frame_expr(desc, frame);
+    let (x, y, z) = (pp.x.clone(), pp.y.clone(), pp.z.clone());
+    [
+        y.clone() * y.clone() + z.clone() * z.clone(),
+        -(x.clone() * y.clone()),
+        -(x.clone() * z.clone()),
+        x.clone() * x.clone() + z.clone() * z.clone(),
+        -(y.clone() * z.clone()),
+        x.clone() * x.clone() + y.clone() * y.clone(),
+        x,
+        y,
+        z,
+        Expr::one(),
+    ]
+}
+
+/// Rule 1, eq 10.51c at the higher of the two links holding the cut joint and its twin:
+/// h_i lambda_k^10 = h_j lambda_{k+B}^10 eliminates MX (or MY) of that link.
+fn cut_joint_relation(
+    desc: &RobotDescription,
+    l: &crate::model::ClosedLoop,
+    j: usize,
+    s: &mut State,
+) {
+    let (li, lj) = (l.link_i, l.link_j);
+    if j != li.max(lj) {
+        return;
+    }
+    let (ci, cj) = (lambda10(desc, l.cut), lambda10(desc, l.twin));
+    // relation sum_p ci_p h_{li,p} - sum_p cj_p h_{lj,p} = 0
+    let (own, own_c, other, other_c) = if j == li {
+        (li, ci, lj, cj)
+    } else {
+        (lj, cj, li, ci)
+    };
+    let Some(pstar) = [MX, MY]
+        .into_iter()
+        .find(|&q| !own_c[q].is_zero() && s.alive[own - 1][q])
+    else {
+        return;
+    };
+    let kstar = s.get(own, pstar);
+    let cstar = own_c[pstar].clone();
+    s.kill(own, pstar);
+    for q in 0..10 {
+        if q != pstar && !own_c[q].is_zero() {
+            s.add(own, q, -(own_c[q].clone() / cstar.clone()) * kstar.clone());
+        }
+        if !other_c[q].is_zero() {
+            s.add(
+                other,
+                q,
+                (other_c[q].clone() / cstar.clone()) * kstar.clone(),
+            );
+        }
+    }
+}
+
+/// Eqs 10.55–10.56: the inertia tensor of a link whose angular velocity equals that of a
+/// lower link (its class in [`parallel_classes`]) into the lower one's, JR_lo = J_lo +
+/// loA_j J_j jA_lo (into the base: no effect). Returns whether link j's tensor moved.
+fn parallel_links(classes: &[Option<(usize, Matrix3<Expr>)>], j: usize, s: &mut State) -> bool {
+    let Some((lo, a)) = &classes[j] else {
+        return false;
+    };
+    let t = a * s.j_matrix(j) * a.transpose();
+    for q in 0..6 {
+        s.kill(j, q);
+    }
+    s.add_tensor(*lo, &t);
+    true
+}
+
+/// Theorem 10.1 (revolute j, eqs 10.14–10.19, any gamma and b): YY_j into XX_j, and YY_j, MZ_j,
+/// M_j into link a(j) by the rigid transfer of (diag(YY, YY, 0), (0, 0, MZ), M). When the
+/// tensor of j moved to a parallel link (10.55), only MZ_j and M_j move.
+fn theorem_10_1(ctx: &Context, j: usize, tensor_moved: bool, s: &mut State) {
+    let (a, p) = frame_expr(ctx.desc, j);
+    let yy = if tensor_moved {
+        Expr::zero()
+    } else {
+        s.get(j, YY)
+    };
+    let (mz, m) = (s.get(j, MZ), s.get(j, M));
+    if !tensor_moved {
+        s.add(j, XX, -yy.clone());
+        s.kill(j, YY);
+    }
+    s.kill(j, MZ);
+    s.kill(j, M);
+    let jj = Matrix3::from_diagonal(&Vector3::new(yy.clone(), yy, Expr::zero()));
+    let ms = Vector3::new(Expr::zero(), Expr::zero(), mz);
+    s.add_all(ctx.st.ant[j], transfer(&a, &p, &jj, &ms, &m));
+}
+
+/// Theorem 10.2 (prismatic j, eq 10.20b): iJR_i = iJ_i + iA_j jJ_j jA_i.
+fn theorem_10_2(ctx: &Context, j: usize, s: &mut State) {
+    let (a, _) = frame_expr(ctx.desc, j);
+    let jm = s.j_matrix(j);
+    for q in 0..6 {
+        s.kill(j, q);
+    }
+    s.add_tensor(ctx.st.ant[j], &(&a * jm * a.transpose()));
+}
+
+/// Rules 3, 4 and 7 on the first moments of a prismatic link j: before r1 (rule 7) they have
+/// no effect; between r1 and r2, parallel to r1 (rule 3, eq 10.23 derived from first
+/// principles: with z_j parallel to every rotation axis of a(j) the q_j-dependent terms
+/// vanish), MZ_j has no effect and MX_j, MY_j go to a(j) as a rigid first moment at q_j = 0;
+/// not parallel (rule 4, Table 10.1), the relation jA_r1 z . MS_j = const removes one of them.
+fn prismatic_first_moments(ctx: &Context, j: usize, s: &mut State) {
+    let Some(r1) = ctx.r1[j] else {
+        for q in [MX, MY, MZ] {
+            s.kill(j, q);
+        }
+        return;
+    };
+    if !ctx.between[j] {
+        return;
+    }
+    let (a, p) = frame_expr(ctx.desc, j);
+    if ctx.geo.parallel(j, r1) {
+        let ms = Vector3::new(s.get(j, MX), s.get(j, MY), Expr::zero());
+        for q in [MX, MY, MZ] {
+            s.kill(j, q);
+        }
+        let zero = Matrix3::from_element(Expr::zero());
+        s.add_all(ctx.st.ant[j], transfer(&a, &p, &zero, &ms, &Expr::zero()));
+        return;
+    }
+    let mut rot = Matrix3::<Expr>::identity();
+    for k in ctx.path(j).into_iter().filter(|&k| k > r1) {
+        rot *= frame_expr(ctx.desc, k).0;
+    }
+    // z_r1 in R_j = (r1 A_j)^T e3
+    let u: Vec<Expr> = (0..3).map(|c| rot[(2, c)].clone()).collect();
+    let un = {
+        let (ra, _) = &ctx.geo.poses[0][j];
+        let (rr, _) = &ctx.geo.poses[0][r1];
+        ra.transpose() * rr.column(2)
+    };
+    if let Some(e) = [2usize, 1, 0]
+        .into_iter()
+        .find(|&c| un[c].abs() > GEOMETRY_TOLERANCE)
+    {
+        let ke = s.get(j, MX + e);
+        s.kill(j, MX + e);
+        for c in 0..3 {
+            if c != e && un[c].abs() > GEOMETRY_TOLERANCE {
+                s.add(j, MX + c, -(u[c].clone() / u[e].clone()) * ke.clone());
+            }
+        }
+    }
+}
+
+/// A fixed frame (sigma = 2) moves all ten parameters of its link into a(j) (rigid body).
+fn fixed_frame(ctx: &Context, j: usize, s: &mut State) {
+    let (a, p) = frame_expr(ctx.desc, j);
+    let jm = s.j_matrix(j);
+    let ms = Vector3::new(s.get(j, MX), s.get(j, MY), s.get(j, MZ));
+    let m = s.get(j, M);
+    for q in 0..10 {
+        s.kill(j, q);
+    }
+    s.add_all(ctx.st.ant[j], transfer(&a, &p, &jm, &ms, &m));
+}
+
+/// Rules 5 and 6 (revolute j with r1 <= j < r2): XX XY XZ YZ have no effect (rule 5); MX MY
+/// too when a_j is on the line of a_r1 (not only parallel: an offset parallel axis keeps them,
+/// found by the random-tree cross-check) and every axis before is parallel to gravity (rule 6).
+fn rules_5_6(ctx: &Context, j: usize, s: &mut State) {
+    for q in [XX, XY, XZ, YZ] {
+        s.kill(j, q);
+    }
+    let geo = &ctx.geo;
+    let r1 = ctx.r1[j].expect("between r1 and r2");
+    let coaxial = (0..geo.configs.len()).all(|c| {
+        let z = geo.z(c, r1);
+        let dp = geo.poses[c][j].1 - geo.poses[c][r1].1;
+        geo.parallel(j, r1) && dp.cross(&z).norm() < GEOMETRY_TOLERANCE
+    });
+    let all_vertical = coaxial
+        && ctx
+            .path(j)
+            .into_iter()
+            .filter(|&k| ctx.joint(k) != JointType::Fixed)
+            .all(|k| geo.parallel(k, r1) && (geo.g.norm() == 0.0 || geo.parallel_to_gravity(k)));
+    if all_vertical {
+        s.kill(j, MX);
+        s.kill(j, MY);
+    }
 }
 
 /// Collect an expanded grouping equation by standard parameter and then by coefficient, for
 /// display: `d3^2*(M3 + M4 + M5 + M6)`. `nl` tells which symbols are standard parameters.
-pub fn collect_by_coefficient(e: &Expr, nl: usize) -> String {
+pub fn collect_by_coefficient(e: &Expr, names: &ParameterNames) -> String {
+    let nl = names.nl();
     let e = e.expand();
     let terms: Vec<Expr> = match e.node() {
         Node::Add(v) => v.clone(),
@@ -766,13 +1105,7 @@ pub fn collect_by_coefficient(e: &Expr, nl: usize) -> String {
             groups.push((c, vec![k]));
         }
     }
-    let name = |k: usize| {
-        format!(
-            "{}{}",
-            STANDARD_PARAMETERS[k % PARAMS_PER_LINK],
-            k / PARAMS_PER_LINK + 1
-        )
-    };
+    let name = |k: usize| names.name(k).to_string();
     let mut out = String::new();
     for (c, ks) in &groups {
         let (neg, mag) = match c.as_f64() {
@@ -810,6 +1143,7 @@ pub fn collect_by_coefficient(e: &Expr, nl: usize) -> String {
         }
     }
     for t in rest {
+        let t = names.rename(&t);
         if out.is_empty() {
             out = t.to_string();
         } else {

@@ -1,0 +1,4 @@
+//! Writers of the results for people and other programs (text, LaTeX, JSON), apart from the
+//! algorithms that compute them.
+
+pub mod base_parameters;
