@@ -3,8 +3,8 @@
 //! inconsistent estimates are projected onto the consistent set and reported.
 
 use robodyn::identification::consistency::{min_pseudo_inertia_eigenvalue, pseudo_inertia};
-use robodyn::identification::data::{MemoryLog, RawSample};
-use robodyn::identification::excitation::FourierTrajectory;
+use robodyn::identification::data::MemoryLog;
+use robodyn::identification::excitation::{simulated_log, FourierTrajectory};
 use robodyn::identification::model_access::{load_description, save_description, ModelAccess};
 use robodyn::identification::{identify, Estimator, Options};
 use std::collections::BTreeMap;
@@ -29,31 +29,7 @@ fn log(acc: &ModelAccess) -> MemoryLog {
         .map(|k| 0.9 * ((k * 37 % 17) as f64 / 8.0 - 1.0))
         .collect();
     let tr = FourierTrajectory::from_free(4.0, &vec![0.0; n], 5, &free);
-    let k = acc.standard_parameters();
-    let a = acc
-        .tracking_model(&k, 1e-3)
-        .unwrap()
-        .inertia_diagonal(&vec![0.0; n])
-        .unwrap();
-    let w = 2.0 * std::f64::consts::PI * 5.0;
-    let kp: Vec<f64> = a.iter().map(|a| a * w * w).collect();
-    let kd: Vec<f64> = a.iter().map(|a| 1.4 * a * w).collect();
-    let rows = acc
-        .simulate_tracking(&|t| tr.eval(t)[0].clone(), 8.0, 0.004, &kp, &kd)
-        .unwrap();
-    MemoryLog {
-        name: "simulated".into(),
-        samples: rows
-            .into_iter()
-            .map(|(t, [q, qd, qdd, tau])| RawSample {
-                t,
-                q,
-                y: tau,
-                qd: Some(qd),
-                qdd: Some(qdd),
-            })
-            .collect(),
-    }
+    simulated_log(acc, &tr, 8.0, 0.004, 5.0).unwrap()
 }
 
 fn opts(consistent: bool) -> Options {

@@ -5,7 +5,7 @@
 
 use rand::Rng;
 use robodyn::identification::data::{MemoryLog, RawSample};
-use robodyn::identification::excitation::FourierTrajectory;
+use robodyn::identification::excitation::{simulated_log, FourierTrajectory};
 use robodyn::identification::model_access::{load_description, ModelAccess};
 use robodyn::identification::{identify, Estimator, Identification, Options};
 use robodyn::testing::{random_tree_description, rng, TreeOptions};
@@ -42,35 +42,10 @@ fn trajectory(
     FourierTrajectory::from_free(period, start, harmonics, &free)
 }
 
-/// Simulated log: PD tracking (loop at `loop_hz`) of the trajectory from rest; every row
-/// (t, q, qd, qdd, tau) satisfies the direct dynamic model exactly.
+/// Simulated log: PD tracking (5 Hz loop) of the trajectory from rest; every row (t, q, qd,
+/// qdd, tau) satisfies the direct dynamic model exactly.
 fn simulate(acc: &ModelAccess, tr: &FourierTrajectory, duration: f64, dt: f64) -> MemoryLog {
-    let k = acc.standard_parameters();
-    let q0 = tr.eval(0.0)[0].clone();
-    let a = acc
-        .tracking_model(&k, 1e-3)
-        .unwrap()
-        .inertia_diagonal(&q0)
-        .unwrap();
-    let w = 2.0 * std::f64::consts::PI * 5.0;
-    let kp: Vec<f64> = a.iter().map(|a| a * w * w).collect();
-    let kd: Vec<f64> = a.iter().map(|a| 2.0 * 0.7 * a * w).collect();
-    let rows = acc
-        .simulate_tracking(&|t| tr.eval(t)[0].clone(), duration, dt, &kp, &kd)
-        .unwrap();
-    MemoryLog {
-        name: format!("simulated {}", acc.name()),
-        samples: rows
-            .into_iter()
-            .map(|(t, [q, qd, qdd, tau])| RawSample {
-                t,
-                q,
-                y: tau,
-                qd: Some(qd),
-                qdd: Some(qdd),
-            })
-            .collect(),
-    }
+    simulated_log(acc, tr, duration, dt, 5.0).unwrap()
 }
 
 /// Largest |x - truth| / max(|truth|, floor max|truth|) over the parameters.

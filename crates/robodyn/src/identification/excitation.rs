@@ -11,6 +11,7 @@
 //! acceleration and torque limits (penalties, the trajectory scaled down until it satisfies
 //! them).
 
+use super::data::{MemoryLog, RawSample};
 use super::model_access::ModelAccess;
 use super::parameters::ParameterModel;
 use crate::error::{Error, Result};
@@ -116,6 +117,40 @@ impl FourierTrajectory {
         }
         t
     }
+}
+
+/// The log the robot (its file's parameters) would give tracking `trajectory` from rest with a
+/// PD controller whose loop has bandwidth `loop_hz` (gains from the inertia matrix's diagonal
+/// at the start): t, q, qd, qdd and the joint torques every `dt` over `duration`, each row
+/// satisfying the direct dynamic model exactly (synthetic logs for tests and benchmarks).
+pub fn simulated_log(
+    access: &ModelAccess,
+    trajectory: &FourierTrajectory,
+    duration: f64,
+    dt: f64,
+    loop_hz: f64,
+) -> Result<MemoryLog> {
+    let k = access.standard_parameters();
+    let q0 = trajectory.eval(0.0)[0].clone();
+    let a = access.tracking_model(&k, 1e-3)?.inertia_diagonal(&q0)?;
+    let w = 2.0 * PI * loop_hz;
+    let kp: Vec<f64> = a.iter().map(|a| a * w * w).collect();
+    let kd: Vec<f64> = a.iter().map(|a| 1.4 * a * w).collect();
+    let rows =
+        access.simulate_tracking(&|t| trajectory.eval(t)[0].clone(), duration, dt, &kp, &kd)?;
+    Ok(MemoryLog {
+        name: format!("simulated {}", access.name()),
+        samples: rows
+            .into_iter()
+            .map(|(t, [q, qd, qdd, tau])| RawSample {
+                t,
+                q,
+                y: tau,
+                qd: Some(qd),
+                qdd: Some(qdd),
+            })
+            .collect(),
+    })
 }
 
 /// Limits of one joint for the design (velocity and acceleration required).

@@ -5,8 +5,8 @@
 //! changes this file only.
 
 use crate::algorithms::base_parameters::{
-    numeric_base_parameters, standard_values, ClosedChainSampler, NumericOptions,
-    ParameterNames, Sampler, Summary, TreeSampler,
+    numeric_base_parameters, standard_values, ClosedChainSampler, NumericOptions, ParameterNames,
+    Sampler, Summary, TreeSampler,
 };
 use crate::algorithms::closed_chain::{ClosedChain, ClosedChainWorkspace};
 use crate::algorithms::direct_dynamics::{ddm, DirectWorkspace, Method};
@@ -39,7 +39,6 @@ pub const FV: usize = 12;
 pub fn format_coefficient(x: f64) -> String {
     crate::algorithms::base_parameters::numeric::format_coefficient(x)
 }
-
 
 /// Which drive parameters the base set includes (as `base-params --rotor/--no-friction`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -250,12 +249,8 @@ impl ModelAccess {
             numeric_base_parameters(&self.robot, &mut sampler, &opt)?
         };
         let desc = self.robot.description();
-        let report = Summary::from_numeric(
-            desc,
-            &nb,
-            &ParameterNames::of(desc),
-            &standard_values(desc),
-        );
+        let report =
+            Summary::from_numeric(desc, &nb, &ParameterNames::of(desc), &standard_values(desc));
         Ok(BaseSet {
             names: report.base.iter().map(|b| b.name.clone()).collect(),
             equations: report.base.iter().map(|b| b.equation.clone()).collect(),

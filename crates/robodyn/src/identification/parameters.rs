@@ -11,9 +11,7 @@
 //! column in the span of the columns before it is grouped into them, e.g. the rotor of a first
 //! vertical axis into ZZR1 with the factor R_11^2).
 
-use super::model_access::{
-    format_coefficient, BaseSet, ModelAccess, Rotors, FS, FV, IA, PER_LINK,
-};
+use super::model_access::{format_coefficient, BaseSet, ModelAccess, Rotors, FS, FV, IA, PER_LINK};
 use crate::error::{Error, Result};
 use faer::linalg::solvers::SolveLstsq;
 use faer::Mat;

@@ -223,15 +223,22 @@ impl SosState {
 
     /// Filter one sample.
     #[inline]
-    pub fn step(&mut self, mut x: f64) -> f64 {
-        for (s, z) in self.sos.iter().zip(self.z.iter_mut()) {
-            let y = s[0] * x + z[0];
-            z[0] = s[1] * x - s[4] * y + z[1];
-            z[1] = s[2] * x - s[5] * y;
-            x = y;
-        }
-        x
+    pub fn step(&mut self, x: f64) -> f64 {
+        sos_step(&self.sos, &mut self.z, x)
     }
+}
+
+/// One sample through cascaded sections in direct form II transposed (`sosfilt`'s recursion):
+/// y = b0 x + z0, z0 <- b1 x - a1 y + z1, z1 <- b2 x - a2 y, section after section.
+#[inline]
+fn sos_step(sos: &[[f64; 6]], z: &mut [[f64; 2]], mut x: f64) -> f64 {
+    for (s, z) in sos.iter().zip(z.iter_mut()) {
+        let y = s[0] * x + z[0];
+        z[0] = s[1] * x - s[4] * y + z[1];
+        z[1] = s[2] * x - s[5] * y;
+        x = y;
+    }
+    x
 }
 
 /// Causal filtering of many parallel channels at once (the columns of the observation matrix
@@ -261,15 +268,8 @@ impl ParallelFilter {
     /// Filter one sample of every channel in place.
     pub fn step(&mut self, x: &mut [f64]) {
         let ns = self.sos.len();
-        for (c, v) in x.iter_mut().enumerate() {
-            let mut u = *v;
-            for (s, z) in self.sos.iter().zip(self.z[c * ns..(c + 1) * ns].iter_mut()) {
-                let y = s[0] * u + z[0];
-                z[0] = s[1] * u - s[4] * y + z[1];
-                z[1] = s[2] * u - s[5] * y;
-                u = y;
-            }
-            *v = u;
+        for (v, z) in x.iter_mut().zip(self.z.chunks_mut(ns)) {
+            *v = sos_step(&self.sos, z, *v);
         }
     }
 }
