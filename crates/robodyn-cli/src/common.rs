@@ -37,9 +37,32 @@ impl RobotArgs {
         Ok(m)
     }
 
-    /// Load and validate the robot (all symbols need values).
+    /// Load and validate the robot (all symbols need values). A motor-joint transmission with
+    /// nonzero motor drive parameters is refused: only `identify` and `excite` apply it.
     pub fn load(&self) -> CliResult<Robot> {
-        Ok(robodyn::io::load_with(&self.robot, &self.overrides()?)?)
+        let robot = robodyn::io::load_with(&self.robot, &self.overrides()?)?;
+        if let Some(t) = &robot.description().transmission {
+            let k = robot.standard_parameters();
+            let identity = t.matrix.iter().enumerate().all(|(r, row)| {
+                row.iter()
+                    .enumerate()
+                    .all(|(c, &x)| x == if r == c { 1.0 } else { 0.0 })
+            });
+            let driven = t
+                .joints
+                .iter()
+                .any(|&j| (10..13).any(|p| k[13 * (j - 1) + p] != 0.0));
+            if !identity && driven {
+                return Err(format!(
+                    "{}: the robot has a motor-joint [transmission] and motor drive parameters \
+                     (IA, FS, FV); this command does not apply transmissions (only `robodyn \
+                     identify` and `robodyn excite` do), so it would read them as joint-side values",
+                    self.robot.display()
+                )
+                .into());
+            }
+        }
+        Ok(robot)
     }
 }
 

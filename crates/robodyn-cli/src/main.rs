@@ -39,6 +39,10 @@ enum Command {
     Simulate(commands::simulate::Args),
     /// Customized symbolic models (idm, inertia, h, ddm, closed) as text, LaTeX or code.
     Generate(commands::generate::Args),
+    /// Identify base parameters, friction and drive parameters from a measured log.
+    Identify(commands::identify::Args),
+    /// Design an exciting trajectory (finite Fourier series minimizing the condition number).
+    Excite(commands::excite::Args),
 }
 
 fn main() {
@@ -54,6 +58,8 @@ fn main() {
         Command::Ddm(a) => commands::ddm::run(a),
         Command::Simulate(a) => commands::simulate::run(a),
         Command::Generate(a) => commands::generate::run(a),
+        Command::Identify(a) => commands::identify::run(a),
+        Command::Excite(a) => commands::excite::run(a),
     };
     if let Err(e) = result {
         eprintln!("robodyn: error: {e}");

@@ -80,6 +80,8 @@ pub mod codegen;
 pub mod data;
 pub mod error;
 pub mod geometry;
+#[allow(missing_docs)] // the options and reports are documented in docs/models/identification.md
+pub mod identification;
 #[cfg(feature = "io")]
 #[allow(missing_docs)] // documented by the readers' rewrite (issue 14.8)
 pub mod io;

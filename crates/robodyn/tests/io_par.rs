@@ -245,7 +245,11 @@ fn values_missing_are_reported_by_symbol_and_line() {
 #[test]
 fn documented_example_is_the_bundled_sr400() {
     let doc = std::fs::read_to_string(robots().join("../docs/robot-format.md")).unwrap();
-    let start = doc.find("```toml\n").expect("a toml block") + "```toml\n".len();
+    // the complete example: the toml block that starts with the SR400's comment
+    let start = doc
+        .find("```toml\n# Acma SR400")
+        .expect("the SR400 toml block")
+        + "```toml\n".len();
     let end = start + doc[start..].find("```").unwrap();
     let r = toml_format::parse_robot(&doc[start..end], Some("robot-format.md")).unwrap();
     let e = torque_difference(&r, &load("sr400.toml"), 9);

@@ -11,8 +11,8 @@ use crate::error::{Error, Location, Result};
 use crate::io::source::LineIndex;
 pub use crate::io::SourceMap;
 use crate::model::{
-    validate_structure, JointType, LinkDesc, RobotDescription, GEOMETRIC_PARAMETERS,
-    STANDARD_PARAMETERS, WRENCH_COMPONENTS,
+    validate_structure, JointLimits, JointType, LinkDesc, RobotDescription, Transmission,
+    GEOMETRIC_PARAMETERS, STANDARD_PARAMETERS, WRENCH_COMPONENTS,
 };
 use crate::Robot;
 use robodyn_symbolic::Expr;
@@ -51,6 +51,25 @@ struct FileTop {
     frame: Vec<Spanned<FrameTable>>,
     #[serde(default)]
     link: Vec<Spanned<LinkTable>>,
+    transmission: Option<Spanned<TransmissionTable>>,
+}
+
+/// `[transmission]`: m = R q over the actuated joints (see `docs/robot-format.md`).
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct TransmissionTable {
+    joints: Option<Vec<usize>>,
+    matrix: Vec<Vec<SV>>,
+}
+
+/// `limits = { q = [min, max], qd = .., qdd = .., tau = .. }` of a `[[frame]]`.
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct LimitsTable {
+    q: Option<Vec<SV>>,
+    qd: Option<SV>,
+    qdd: Option<SV>,
+    tau: Option<SV>,
 }
 
 #[derive(Deserialize, Debug)]
@@ -69,6 +88,7 @@ struct FrameTable {
     d: Option<SV>,
     theta: Option<SV>,
     r: Option<SV>,
+    limits: Option<Spanned<LimitsTable>>,
 }
 
 #[derive(Deserialize, Debug)]
@@ -386,6 +406,10 @@ impl<'a> Reader<'a> {
                         self.expr(&format!("frame {j}, {pname}"), v)?;
                 }
             }
+            if let Some(l) = &f.limits {
+                let lim = self.limits(j, &desc.symbols, l)?;
+                desc.limits.insert(j, lim);
+            }
         }
         Ok(())
     }
@@ -495,8 +519,130 @@ pub fn parse_description(text: &str, file: Option<&str>) -> Result<(RobotDescrip
     r.links(&top, &mut desc)?;
     r.base(&top, &mut desc)?;
     r.assembly(&top, &mut desc)?;
+    if let Some(t) = &top.transmission {
+        desc.transmission = Some(r.transmission(&desc, t)?);
+    }
     validate_structure(&desc).map_err(|e| r.map.locate(e))?;
     Ok((desc, r.map))
+}
+
+impl Reader<'_> {
+    /// A constant (number or expression over the file's symbols).
+    fn constant(&self, key: &str, symbols: &BTreeMap<String, f64>, v: &SV) -> Result<f64> {
+        self.expr(key, v)?
+            .eval(&|s| symbols.get(s).copied())
+            .map_err(|e| self.err(v.span(), format!("{key}: {e}")))
+    }
+
+    /// `limits = {..}` of frame j.
+    fn limits(
+        &self,
+        j: usize,
+        symbols: &BTreeMap<String, f64>,
+        l: &Spanned<LimitsTable>,
+    ) -> Result<JointLimits> {
+        let span = l.span();
+        let t = l.get_ref();
+        let key = format!("frame {j}, limits");
+        let c = |v: &SV| self.constant(&key, symbols, v);
+        let positive = |name: &str, v: &Option<SV>| -> Result<Option<f64>> {
+            match v {
+                Some(v) => {
+                    let x = c(v)?;
+                    if x > 0.0 {
+                        Ok(Some(x))
+                    } else {
+                        Err(self.err(
+                            v.span(),
+                            format!("frame {j}, limits: {name} = {x} must be positive"),
+                        ))
+                    }
+                }
+                None => Ok(None),
+            }
+        };
+        let (q_min, q_max) = match &t.q {
+            Some(q) if q.len() == 2 => {
+                let (a, b) = (c(&q[0])?, c(&q[1])?);
+                if a >= b {
+                    return Err(self.err(
+                        span,
+                        format!("frame {j}, limits: q = [{a}, {b}] is not an interval [min, max]"),
+                    ));
+                }
+                (Some(a), Some(b))
+            }
+            Some(q) => {
+                return Err(self.err(
+                    span,
+                    format!(
+                        "frame {j}, limits: q has {} entries, [min, max] expected",
+                        q.len()
+                    ),
+                ))
+            }
+            None => (None, None),
+        };
+        Ok(JointLimits {
+            q_min,
+            q_max,
+            qd: positive("qd", &t.qd)?,
+            qdd: positive("qdd", &t.qdd)?,
+            tau: positive("tau", &t.tau)?,
+        })
+    }
+
+    /// `[transmission]`: m = R q over the actuated joints.
+    fn transmission(
+        &self,
+        desc: &RobotDescription,
+        t: &Spanned<TransmissionTable>,
+    ) -> Result<Transmission> {
+        let span = t.span();
+        let tt = t.get_ref();
+        let joints = tt.joints.clone().unwrap_or_else(|| desc.actuated_joints());
+        let n = joints.len();
+        if let Some(&j) = joints
+            .iter()
+            .find(|&&j| j == 0 || j > desc.nl || !desc.frame(j).actuated)
+        {
+            return Err(self.err(
+                span.clone(),
+                format!(
+                    "transmission: joint {j} is not an actuated joint of the tree (1..{})",
+                    desc.nl
+                ),
+            ));
+        }
+        if tt.matrix.len() != n {
+            return Err(self.err(
+            span.clone(),
+            format!(
+                "transmission: matrix has {} rows, {n} expected (one per motor, as many as joints {joints:?})",
+                tt.matrix.len()
+            ),
+        ));
+        }
+        let mut matrix = Vec::with_capacity(n);
+        for (k, row) in tt.matrix.iter().enumerate() {
+            if row.len() != n {
+                return Err(self.err(
+                    span.clone(),
+                    format!(
+                        "transmission: row {} has {} entries, {n} expected",
+                        k + 1,
+                        row.len()
+                    ),
+                ));
+            }
+            matrix.push(
+                row.iter()
+                    .map(|v| self.constant("transmission, matrix", &desc.symbols, v))
+                    .collect::<Result<Vec<f64>>>()?,
+            );
+        }
+        Ok(Transmission { joints, matrix })
+    }
 }
 
 /// Read a TOML robot and validate it into a [`Robot`] (every symbol needs a value).
@@ -581,6 +727,18 @@ pub fn write_description(desc: &RobotDescription) -> String {
                 s.push_str(&format!("{} = {}\n", GEOMETRIC_PARAMETERS[k], fmt_value(e)));
             }
         }
+        if let Some(l) = desc.limits.get(&(idx + 1)) {
+            let mut parts = Vec::new();
+            if let (Some(a), Some(b)) = (l.q_min, l.q_max) {
+                parts.push(format!("q = [{a:?}, {b:?}]"));
+            }
+            for (name, v) in [("qd", l.qd), ("qdd", l.qdd), ("tau", l.tau)] {
+                if let Some(v) = v {
+                    parts.push(format!("{name} = {v:?}"));
+                }
+            }
+            s.push_str(&format!("limits = {{ {} }}\n", parts.join(", ")));
+        }
     }
     for (idx, l) in desc.links.iter().enumerate() {
         s.push_str(&format!(
@@ -598,6 +756,21 @@ pub fn write_description(desc: &RobotDescription) -> String {
                 s.push_str(&format!("{} = {}\n", WRENCH_COMPONENTS[k], fmt_value(e)));
             }
         }
+    }
+    if let Some(t) = &desc.transmission {
+        let rows: Vec<String> = t
+            .matrix
+            .iter()
+            .map(|r| {
+                let v: Vec<String> = r.iter().map(|x| format!("{x:?}")).collect();
+                format!("  [{}],", v.join(", "))
+            })
+            .collect();
+        s.push_str(&format!(
+            "\n[transmission]\njoints = {:?}\nmatrix = [\n{}\n]\n",
+            t.joints,
+            rows.join("\n")
+        ));
     }
     s
 }

@@ -227,6 +227,38 @@ pub struct RobotDescription {
     pub assembly: Option<Vec<f64>>,
     /// Notes carried with the description (source of numbers, comments).
     pub notes: Vec<String>,
+    /// Linear transmission between motors and actuated joints (coupled wrists); `None`: each
+    /// actuated joint has its own motor and IA, FS, FV are joint-side values.
+    pub transmission: Option<Transmission>,
+    /// Joint limits by frame number (used by excitation design); absent: no limit known.
+    pub limits: BTreeMap<usize, JointLimits>,
+}
+
+/// Motor positions m = R q over the actuated joints `joints` (R square, motors x joints). With a
+/// transmission, IA, FS, FV of link `joints[k]` are the parameters of motor k (row k of R), in
+/// motor units, and the joint torques they produce are
+/// tau = R^T (IA m_dd + FV m_d + FS sign(m_d)), m = R q.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Transmission {
+    /// Actuated joints (frame numbers), the columns of R, in order.
+    pub joints: Vec<usize>,
+    /// R, one row per motor.
+    pub matrix: Vec<Vec<f64>>,
+}
+
+/// Limits of one joint (rad or m, per second, per second squared; N m or N).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct JointLimits {
+    /// Lower position limit.
+    pub q_min: Option<f64>,
+    /// Upper position limit.
+    pub q_max: Option<f64>,
+    /// Largest speed |qd|.
+    pub qd: Option<f64>,
+    /// Largest acceleration |qdd|.
+    pub qdd: Option<f64>,
+    /// Largest torque or force |tau|.
+    pub tau: Option<f64>,
 }
 
 impl RobotDescription {
@@ -263,6 +295,8 @@ impl RobotDescription {
             symbols: BTreeMap::new(),
             assembly: None,
             notes: Vec::new(),
+            transmission: None,
+            limits: BTreeMap::new(),
         }
     }
 

@@ -11,8 +11,8 @@ mod structure;
 pub use constants::{DynModel, FrameConstants, LinkConstants};
 pub use coordinates::Coordinates;
 pub use description::{
-    param, FrameDesc, JointType, LinkDesc, RobotDescription, GEOMETRIC_PARAMETERS,
-    STANDARD_PARAMETERS, WRENCH_COMPONENTS,
+    param, FrameDesc, JointLimits, JointType, LinkDesc, RobotDescription, Transmission,
+    GEOMETRIC_PARAMETERS, STANDARD_PARAMETERS, WRENCH_COMPONENTS,
 };
 pub use environment::{BaseMotion, Environment, Wrench};
 pub use structure::{path_from_base, ClosedLoop, Structure, StructureType};
@@ -334,6 +334,12 @@ impl Robot {
     /// Passive movable tree joints (mu = 0): q_p.
     pub fn passive_joints(&self) -> Vec<usize> {
         self.desc.passive_joints()
+    }
+
+    /// The value of an expression over the robot's symbols (e.g. a geometric parameter).
+    pub fn value(&self, e: &Expr) -> Result<f64> {
+        e.eval(&|s| self.desc.symbols.get(s).copied())
+            .map_err(|err| Error::Input(err.to_string()))
     }
 
     /// Numeric standard parameters, 13 per link (XX..FV), link 1 first.

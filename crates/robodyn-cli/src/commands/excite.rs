@@ -1,0 +1,268 @@
+//! `robodyn excite ROBOT --period T --harmonics N --output traj.csv`: an exciting trajectory for
+//! identification, a finite Fourier series per actuated joint whose coefficients minimize the
+//! condition number of the base-parameter observation matrix under position, velocity,
+//! acceleration and torque limits, starting and ending at rest.
+
+use crate::common::{parse_list, CliResult, RobotArgs};
+use robodyn::identification::excitation::{design, DesignOptions, Limits};
+use robodyn::identification::model_access::{load_description, ModelAccess};
+use robodyn::identification::parameters::{ParameterModel, ParameterOptions};
+use robodyn::identification::report::plot_panels;
+use robodyn::identification::Rotors;
+use serde_json::json;
+use std::io::Write;
+use std::path::PathBuf;
+
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Format {
+    Text,
+    Json,
+}
+
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    #[command(flatten)]
+    pub robot: RobotArgs,
+    /// Period T of the Fourier series (s).
+    #[arg(long)]
+    pub period: f64,
+    /// Harmonics per joint (at least 2).
+    #[arg(long)]
+    pub harmonics: usize,
+    /// Start and end position of the actuated joints (default: the assembly's, else zeros).
+    #[arg(long, allow_hyphen_values = true)]
+    pub start: Option<String>,
+    /// Lower position limits (one value for all joints or one per joint; default: the robot
+    /// file's `limits`, else none).
+    #[arg(long, allow_hyphen_values = true)]
+    pub q_min: Option<String>,
+    /// Upper position limits.
+    #[arg(long, allow_hyphen_values = true)]
+    pub q_max: Option<String>,
+    /// Velocity limits (required here or in the robot file).
+    #[arg(long)]
+    pub qd_max: Option<String>,
+    /// Acceleration limits (required here or in the robot file).
+    #[arg(long)]
+    pub qdd_max: Option<String>,
+    /// Torque limits (the robot file's parameters; default: the file's `limits`, else none).
+    #[arg(long)]
+    pub tau_max: Option<String>,
+    /// Samples per period at which the observation matrix is evaluated.
+    #[arg(long, default_value_t = 100)]
+    pub samples: usize,
+    /// Nelder-Mead iterations.
+    #[arg(long, default_value_t = 1500)]
+    pub iterations: u64,
+    /// Random starting trajectories tried before the optimization.
+    #[arg(long, default_value_t = 20)]
+    pub restarts: usize,
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Which rotor inertias are parameters (as identify).
+    #[arg(long, value_enum, default_value = "actuated")]
+    pub rotor: crate::commands::identify::RotorArg,
+    #[arg(long)]
+    pub no_friction: bool,
+    #[arg(long)]
+    pub offsets: bool,
+    /// Rate of the CSV rows (Hz).
+    #[arg(long, default_value_t = 200.0)]
+    pub rate: f64,
+    /// Periods written to the CSV.
+    #[arg(long, default_value_t = 1)]
+    pub periods: usize,
+    /// CSV: t, q<j>, qd<j>, qdd<j> of the actuated joints (a reference for the robot's
+    /// controller, e.g. `robodyn simulate --track`).
+    #[arg(long)]
+    pub output: PathBuf,
+    /// SVG plot of the positions, velocities and accelerations.
+    #[arg(long)]
+    pub plot: Option<PathBuf>,
+    #[arg(long, value_enum, default_value = "text")]
+    pub format: Format,
+}
+
+fn per_joint(name: &str, s: Option<&str>, n: usize) -> CliResult<Option<Vec<f64>>> {
+    let Some(s) = s else { return Ok(None) };
+    let v = parse_list(name, s)?;
+    match v.len() {
+        1 => Ok(Some(vec![v[0]; n])),
+        k if k == n => Ok(Some(v)),
+        k => Err(
+            format!("--{name} has {k} values: give one, or one per actuated joint ({n})").into(),
+        ),
+    }
+}
+
+pub fn run(a: Args) -> CliResult {
+    let desc = load_description(&a.robot.robot, &a.robot.overrides()?)?;
+    let mut access = ModelAccess::new(desc)?;
+    let joints = access.actuated_joints().to_vec();
+    let n = joints.len();
+    let start = match per_joint("start", a.start.as_deref(), n)? {
+        Some(v) => v,
+        None => access.reference_actuated()?,
+    };
+    let cli = |name: &str, s: &Option<String>| per_joint(name, s.as_deref(), n);
+    let (qmin, qmax, qd, qdd, tau) = (
+        cli("q-min", &a.q_min)?,
+        cli("q-max", &a.q_max)?,
+        cli("qd-max", &a.qd_max)?,
+        cli("qdd-max", &a.qdd_max)?,
+        cli("tau-max", &a.tau_max)?,
+    );
+    let mut limits = Vec::with_capacity(n);
+    for (k, &j) in joints.iter().enumerate() {
+        let f = access.limits(j);
+        let pick = |c: &Option<Vec<f64>>, file: Option<f64>| c.as_ref().map(|v| v[k]).or(file);
+        let need = |v: Option<f64>, what: &str, opt: &str| -> CliResult<f64> {
+            v.ok_or_else(|| {
+                format!(
+                    "joint {j}: no {what} limit: give --{opt} or `limits` in the robot file's frame {j}"
+                )
+                .into()
+            })
+        };
+        limits.push(Limits {
+            q_min: pick(&qmin, f.q_min),
+            q_max: pick(&qmax, f.q_max),
+            qd: need(pick(&qd, f.qd), "velocity", "qd-max")?,
+            qdd: need(pick(&qdd, f.qdd), "acceleration", "qdd-max")?,
+            tau: pick(&tau, f.tau),
+        });
+    }
+    let mut params = ParameterModel::build(
+        &mut access,
+        &ParameterOptions {
+            rotors: match a.rotor {
+                crate::commands::identify::RotorArg::Actuated => Rotors::Actuated,
+                crate::commands::identify::RotorArg::All => Rotors::All,
+                crate::commands::identify::RotorArg::None => Rotors::None,
+            },
+            friction: !a.no_friction,
+            offsets: a.offsets,
+            seed: a.seed,
+        },
+    )?;
+    let opt = DesignOptions {
+        period: a.period,
+        harmonics: a.harmonics,
+        start,
+        limits,
+        samples: a.samples,
+        iterations: a.iterations,
+        restarts: a.restarts,
+        seed: a.seed,
+    };
+    let d = design(&mut access, &mut params, &opt)?;
+    if !(a.rate.is_finite() && a.rate > 0.0) || a.periods == 0 {
+        return Err("--rate must be positive and --periods at least 1".into());
+    }
+    // CSV
+    let rows = (a.period * a.periods as f64 * a.rate).round() as usize;
+    let mut out = std::io::BufWriter::new(
+        std::fs::File::create(&a.output).map_err(|e| format!("{}: {e}", a.output.display()))?,
+    );
+    let mut header = vec!["t".to_string()];
+    for p in ["q", "qd", "qdd"] {
+        header.extend(joints.iter().map(|j| format!("{p}{j}")));
+    }
+    writeln!(out, "{}", header.join(","))?;
+    let mut series: Vec<Vec<Vec<f64>>> = vec![vec![Vec::new(); n]; 3];
+    let mut times = Vec::new();
+    for k in 0..=rows {
+        let t = k as f64 / a.rate;
+        let s = d.trajectory.eval(t % a.period);
+        let mut line = vec![format!("{t:.9e}")];
+        for (v, ser) in s.iter().zip(series.iter_mut()) {
+            for j in 0..n {
+                line.push(format!("{:.12e}", v[j]));
+                ser[j].push(v[j]);
+            }
+        }
+        times.push(t);
+        writeln!(out, "{}", line.join(","))?;
+    }
+    out.flush()?;
+    eprintln!("wrote {}", a.output.display());
+    if let Some(p) = &a.plot {
+        let names = ["q", "qd", "qdd"];
+        let panels: Vec<robodyn::identification::report::Panel> = (0..3)
+            .map(|k| {
+                (
+                    format!(
+                        "{} of the actuated joints",
+                        ["positions", "velocities", "accelerations"][k]
+                    ),
+                    joints
+                        .iter()
+                        .enumerate()
+                        .map(|(i, j)| (format!("{}{j}", names[k]), series[k][i].clone()))
+                        .collect(),
+                )
+            })
+            .collect();
+        plot_panels(
+            p,
+            &format!(
+                "{}: excitation, {} harmonics, period {} s, condition number {:.1}",
+                access.name(),
+                a.harmonics,
+                a.period,
+                d.condition
+            ),
+            &times,
+            &panels,
+            "rad, rad/s, rad/s^2",
+            false,
+        )?;
+        eprintln!("wrote {}", p.display());
+    }
+    match a.format {
+        Format::Text => {
+            println!(
+                "{}: excitation trajectory, {} harmonics, period {} s, {} parameters",
+                access.name(),
+                a.harmonics,
+                a.period,
+                params.count()
+            );
+            println!(
+                "condition number of W (unit columns, {} samples): {:.4} (best random start {:.4}; \
+                 {} evaluations)",
+                a.samples, d.condition, d.initial_condition, d.evaluations
+            );
+            println!(
+                "scaled to the {} limit of joint {}",
+                d.binding.what, joints[d.binding.joint]
+            );
+            println!("  joint  max|q-start|       max|qd|      max|qdd|      max|tau|");
+            for (k, j) in joints.iter().enumerate() {
+                let p = d.peaks[k];
+                println!(
+                    "  {j:<5} {:>13.5} {:>13.5} {:>13.5} {:>13.5}",
+                    p[0], p[1], p[2], p[3]
+                );
+            }
+        }
+        Format::Json => println!(
+            "{}",
+            serde_json::to_string_pretty(&json!({
+                "robot": access.name(),
+                "period": a.period,
+                "harmonics": a.harmonics,
+                "condition_number": d.condition,
+                "initial_condition_number": d.initial_condition,
+                "evaluations": d.evaluations,
+                "binding": {"joint": joints[d.binding.joint], "limit": d.binding.what},
+                "start": d.trajectory.start,
+                "a": d.trajectory.a,
+                "b": d.trajectory.b,
+                "peaks": joints.iter().zip(&d.peaks).map(|(j, p)| json!({
+                    "joint": j, "q": p[0], "qd": p[1], "qdd": p[2], "tau": p[3]})).collect::<Vec<_>>(),
+            }))?
+        ),
+    }
+    Ok(())
+}

@@ -1,0 +1,225 @@
+//! `robodyn identify ROBOT --data log.csv`: base parameters (and friction, rotor inertias,
+//! offsets) identified from measured positions and torques, with their relative standard
+//! deviations, the condition number and the per-joint errors; optionally a fit plot on a
+//! validation segment and a physically consistent robot file.
+
+use crate::common::{parse_list, CliResult, RobotArgs};
+use robodyn::identification::data::{CsvLog, JointLabels};
+use robodyn::identification::model_access::{load_description, save_description, ModelAccess};
+use robodyn::identification::parameters::ParameterOptions;
+use robodyn::identification::{identify, report, EssentialOptions, Estimator, Options, Rotors};
+use std::path::PathBuf;
+
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum EstimatorArg {
+    /// Ordinary least squares.
+    Ols,
+    /// Weighted least squares, each joint's rows weighted by 1/sigma_j (Gautier).
+    Wls,
+    /// Instrumental variables (IDIM-IV), weighted like WLS.
+    Iv,
+}
+
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Format {
+    Text,
+    Json,
+    Csv,
+}
+
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RotorArg {
+    Actuated,
+    All,
+    None,
+}
+
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    #[command(flatten)]
+    pub robot: RobotArgs,
+    /// Log (CSV): t, q<j>, tau<j> (or i<j> with --gains), optionally qd<j>, qdd<j>; j the frame
+    /// number of each actuated joint, or `_<name>` with the joint's name.
+    #[arg(long)]
+    pub data: PathBuf,
+    #[arg(long, value_enum, default_value = "wls")]
+    pub estimator: EstimatorArg,
+    /// Identify under the physical-consistency constraints (pseudo-inertia PSD, friction and
+    /// rotor inertia >= 0), solved as an SDP.
+    #[arg(long)]
+    pub consistent: bool,
+    /// Which rotor inertias are parameters (as base-params).
+    #[arg(long, value_enum, default_value = "actuated")]
+    pub rotor: RotorArg,
+    /// Leave out the Coulomb and viscous friction.
+    #[arg(long)]
+    pub no_friction: bool,
+    /// Add a constant torque offset per joint.
+    #[arg(long)]
+    pub offsets: bool,
+    /// Also report the essential parameters.
+    #[arg(long)]
+    pub essential: bool,
+    /// Essential parameters: drop parameters while the largest relative std is above this (%).
+    #[arg(long, default_value_t = 10.0)]
+    pub essential_max_std: f64,
+    /// Essential parameters: ... and the relative error grows by less than this fraction.
+    #[arg(long, default_value_t = 0.02)]
+    pub essential_tolerance: f64,
+    /// Joint-space bandwidth of the robot's dynamics (Hz): the filter and decimation defaults
+    /// follow from it.
+    #[arg(long, default_value_t = 10.0)]
+    pub bandwidth: f64,
+    /// Cut-off of the zero-phase position low-pass (Hz; default 10 x bandwidth, at most 0.4 x
+    /// the sample rate).
+    #[arg(long)]
+    pub cutoff: Option<f64>,
+    /// Order of the position low-pass.
+    #[arg(long, default_value_t = 4)]
+    pub filter_order: usize,
+    /// Decimation factor (default floor(0.8 fs / (4 bandwidth))).
+    #[arg(long)]
+    pub decimation: Option<usize>,
+    /// Samples dropped at each end (default: the settling time of the position filter).
+    #[arg(long)]
+    pub border: Option<usize>,
+    /// Validation segment as fractions of the log, FROM:TO (default 0.8:1), or `none`.
+    #[arg(long, default_value = "0.8:1")]
+    pub validation: String,
+    /// Differentiate the filtered positions even when the log has qd, qdd.
+    #[arg(long)]
+    pub differentiate: bool,
+    /// Drive gains (torque per ampere), one per motor, when the log has currents i<j>.
+    #[arg(long, allow_hyphen_values = true)]
+    pub gains: Option<String>,
+    /// Leave out a joint's rows where |qd_j| is below this (rad/s or m/s).
+    #[arg(long, default_value_t = 0.0)]
+    pub min_speed: f64,
+    /// IDIM-IV: iterations.
+    #[arg(long, default_value_t = 8)]
+    pub iv_iterations: usize,
+    /// IDIM-IV: bandwidth of the tracking loop of the simulation (Hz; default bandwidth / 4).
+    #[arg(long)]
+    pub iv_bandwidth: Option<f64>,
+    /// Seed of the numerical base-parameter method's random states.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    #[arg(long, value_enum, default_value = "text")]
+    pub format: Format,
+    /// Write the report to a file instead of standard output.
+    #[arg(long)]
+    pub output: Option<PathBuf>,
+    /// SVG of measured and predicted torques on the validation segment.
+    #[arg(long)]
+    pub plot: Option<PathBuf>,
+    /// Write a physically consistent robot file (.toml) with the identified parameters.
+    #[arg(long, value_name = "FILE.toml")]
+    pub write_robot: Option<PathBuf>,
+    /// Exit with an error (code 1) when the report has warnings.
+    #[arg(long)]
+    pub strict: bool,
+}
+
+fn parse_validation(s: &str) -> CliResult<Option<(f64, f64)>> {
+    if s == "none" {
+        return Ok(None);
+    }
+    let (a, b) = s
+        .split_once(':')
+        .ok_or_else(|| format!("--validation {s}: expected FROM:TO (fractions) or none"))?;
+    let f = |v: &str| -> CliResult<f64> {
+        v.trim()
+            .parse::<f64>()
+            .map_err(|_| format!("--validation {s}: `{v}` is not a number").into())
+    };
+    Ok(Some((f(a)?, f(b)?)))
+}
+
+pub fn run(a: Args) -> CliResult {
+    let desc = load_description(&a.robot.robot, &a.robot.overrides()?)?;
+    let mut access = ModelAccess::new(desc)?;
+    let labels = JointLabels {
+        numbers: access.actuated_joints().to_vec(),
+        names: access.joint_names(),
+    };
+    let log = CsvLog::open(&a.data, &labels)?;
+    let opt = Options {
+        parameters: ParameterOptions {
+            rotors: match a.rotor {
+                RotorArg::Actuated => Rotors::Actuated,
+                RotorArg::All => Rotors::All,
+                RotorArg::None => Rotors::None,
+            },
+            friction: !a.no_friction,
+            offsets: a.offsets,
+            seed: a.seed,
+        },
+        estimator: match a.estimator {
+            EstimatorArg::Ols => Estimator::Ols,
+            EstimatorArg::Wls => Estimator::Wls,
+            EstimatorArg::Iv => Estimator::Iv,
+        },
+        consistent: a.consistent,
+        standard: a.write_robot.is_some(),
+        essential: a.essential.then_some(EssentialOptions {
+            max_relative_std: a.essential_max_std,
+            tolerance: a.essential_tolerance,
+        }),
+        bandwidth: a.bandwidth,
+        cutoff: a.cutoff,
+        filter_order: a.filter_order,
+        decimation: a.decimation,
+        border: a.border,
+        validation: parse_validation(&a.validation)?,
+        use_log_derivatives: !a.differentiate,
+        gains: a
+            .gains
+            .as_deref()
+            .map(|g| parse_list("gains", g))
+            .transpose()?,
+        min_speed: a.min_speed,
+        iv_iterations: a.iv_iterations,
+        iv_bandwidth: a.iv_bandwidth,
+        keep_validation_rows: a.plot.is_some(),
+    };
+    let id = identify(&mut access, &log, &opt)?;
+    let text = match a.format {
+        Format::Text => report::to_text(&id),
+        Format::Json => format!("{}\n", serde_json::to_string_pretty(&report::to_json(&id))?),
+        Format::Csv => report::to_csv(&id),
+    };
+    match &a.output {
+        Some(p) => std::fs::write(p, &text).map_err(|e| format!("{}: {e}", p.display()))?,
+        None => print!("{text}"),
+    }
+    if let Some(p) = &a.plot {
+        report::plot_fit(p, &id)?;
+        eprintln!("wrote {}", p.display());
+    }
+    if let Some(p) = &a.write_robot {
+        let mut desc = access.description_with(&id.standard_parameters())?;
+        desc.name = format!("{} (identified)", desc.name);
+        desc.notes.push(format!(
+            "Identified by robodyn identify from {} ({}): physically consistent standard \
+             parameters (pseudo-inertia PSD per link, drive parameters >= 0), the constrained \
+             least-squares fit, at squared Mahalanobis distance {:.3} from the unconstrained \
+             estimate.",
+            a.data.display(),
+            id.estimator,
+            id.consistent.as_ref().map_or(0.0, |c| c.distance2)
+        ));
+        save_description(&desc, p)?;
+        eprintln!("wrote {}", p.display());
+    }
+    for w in &id.warnings {
+        eprintln!("robodyn: warning: {w}");
+    }
+    if a.strict && !id.warnings.is_empty() {
+        return Err(format!(
+            "--strict: the identification has {} warning(s)",
+            id.warnings.len()
+        )
+        .into());
+    }
+    Ok(())
+}

@@ -1,0 +1,751 @@
+//! Identification of the base parameters from measured motion and torques (the inverse dynamic
+//! identification model, IDIM: Gautier 1990; Khalil & Dombre ch. 12), for trees and closed
+//! chains (Gamma_cl = G^T Phi K, eq 10.40, in the actuated coordinates).
+//!
+//! - [`data`]: logs (CSV, streamed);
+//! - [`signal`]: Butterworth design, zero-phase filtering, parallel decimation filter;
+//! - [`parameters`]: the identified vector (base parameters, motor drive parameters of a
+//!   transmission, offsets) and its rows;
+//! - [`observation`]: one streaming pass building the triangular factors of [W Y];
+//! - [`estimators`]: OLS, Gautier's WLS, relative standard deviations, condition number,
+//!   IDIM-IV;
+//! - [`consistency`]: physically consistent standard parameters (SDP, pseudo-inertia PSD);
+//! - [`excitation`]: finite Fourier series minimizing the condition number;
+//! - [`report`]: table (text, JSON, CSV) and SVG plots;
+//! - [`model_access`]: the only calls into the rest of the library.
+
+pub mod consistency;
+pub mod data;
+pub mod estimators;
+pub mod excitation;
+pub mod model_access;
+pub mod observation;
+pub mod parameters;
+pub mod report;
+pub mod signal;
+
+use crate::error::{Error, Result};
+use data::{summarize, Effort, LogSource, LogSummary};
+use estimators::{
+    combine, iv_solve, joint_sigma, least_squares, output_sq, residual_sq, restrict, LsSolution,
+};
+use faer::Mat;
+use model_access::ModelAccess;
+use observation::{run_pass, Instruments, PassResult, Processing, ValidationRows};
+use parameters::{Kind, Parameter, ParameterModel, ParameterOptions};
+use signal::Butterworth;
+
+pub use model_access::Rotors;
+
+/// The estimator of the final values.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Estimator {
+    /// Ordinary least squares.
+    Ols,
+    /// Weighted least squares, each joint's rows divided by the standard deviation of its error
+    /// (Gautier 1997).
+    Wls,
+    /// Instrumental variables (IDIM-IV), weighted as WLS.
+    Iv,
+}
+
+/// Essential parameters: drop the least identifiable parameter (largest relative standard
+/// deviation) while that is above `max_relative_std` and the relative error grows by less than
+/// `tolerance` (relative).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EssentialOptions {
+    pub max_relative_std: f64,
+    pub tolerance: f64,
+}
+
+impl Default for EssentialOptions {
+    fn default() -> Self {
+        EssentialOptions {
+            max_relative_std: 10.0,
+            tolerance: 0.02,
+        }
+    }
+}
+
+/// Options of [`identify`].
+#[derive(Clone, Debug)]
+pub struct Options {
+    pub parameters: ParameterOptions,
+    pub estimator: Estimator,
+    /// Identify under the physical-consistency constraints (SDP).
+    pub consistent: bool,
+    /// Compute standard parameters consistent with the estimate (needed by `--write-robot`).
+    pub standard: bool,
+    pub essential: Option<EssentialOptions>,
+    /// Joint-space bandwidth of the robot's dynamics (Hz); defaults follow from it.
+    pub bandwidth: f64,
+    /// Low-pass of the positions: cut-off (Hz, default 10 x bandwidth, at most 0.4 fs), order.
+    pub cutoff: Option<f64>,
+    pub filter_order: usize,
+    /// Decimation factor (default: floor(0.8 fs / (4 bandwidth)), at least 1).
+    pub decimation: Option<usize>,
+    /// Samples dropped at each end (default: the settling of the position filter).
+    pub border: Option<usize>,
+    /// Validation segment as fractions [from, to) of the log's duration; None: all rows fit.
+    pub validation: Option<(f64, f64)>,
+    /// Use qd, qdd of the log when given (else differentiate the filtered positions).
+    pub use_log_derivatives: bool,
+    /// Drive gains (currents to torques), per motor.
+    pub gains: Option<Vec<f64>>,
+    pub min_speed: f64,
+    /// IDIM-IV: iterations and the bandwidth of the tracking loop of the simulation (Hz).
+    pub iv_iterations: usize,
+    pub iv_bandwidth: Option<f64>,
+    pub keep_validation_rows: bool,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            parameters: ParameterOptions::default(),
+            estimator: Estimator::Wls,
+            consistent: false,
+            standard: false,
+            essential: None,
+            bandwidth: 10.0,
+            cutoff: None,
+            filter_order: 4,
+            decimation: None,
+            border: None,
+            validation: Some((0.8, 1.0)),
+            use_log_derivatives: true,
+            gains: None,
+            min_speed: 0.0,
+            iv_iterations: 8,
+            iv_bandwidth: None,
+            keep_validation_rows: false,
+        }
+    }
+}
+
+/// Fit of one joint's equations.
+#[derive(Clone, Debug, PartialEq)]
+pub struct JointFit {
+    pub joint: usize,
+    pub name: String,
+    /// Rows used.
+    pub rows: usize,
+    /// RMS of the residual (N m or N).
+    pub rms: f64,
+    /// ||Y_j - W_j X|| / ||Y_j||.
+    pub relative_error: f64,
+    /// Gautier's standard deviation of the joint's error (the WLS weight is 1 / sigma).
+    pub sigma: Option<f64>,
+}
+
+/// The processing applied, with every value used (printed by the report).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ProcessingReport {
+    pub source: String,
+    pub samples: usize,
+    pub sample_rate: f64,
+    pub duration: f64,
+    pub bandwidth: f64,
+    pub derivatives_from_log: bool,
+    /// (order, cut-off Hz) of the zero-phase position low-pass.
+    pub lowpass: Option<(usize, f64)>,
+    pub decimation: usize,
+    /// (order, cut-off Hz) of the parallel decimation low-pass.
+    pub decimation_filter: Option<(usize, f64)>,
+    pub border: usize,
+    pub decimation_skip: usize,
+    pub min_speed: f64,
+    pub fit_samples: usize,
+    pub validation_samples: usize,
+    pub validation: Option<(f64, f64)>,
+    pub slow_rows: Vec<usize>,
+}
+
+/// Validation on the segment left out of the fit.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Validation {
+    pub from: f64,
+    pub to: f64,
+    pub relative_error: f64,
+    pub per_joint: Vec<JointFit>,
+}
+
+/// The essential parameters found.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Essential {
+    /// Indices (into the parameters) kept.
+    pub kept: Vec<usize>,
+    pub x: Vec<f64>,
+    pub relative_std: Vec<f64>,
+    pub relative_error: f64,
+    pub full_relative_error: f64,
+}
+
+/// IDIM-IV iterations.
+#[derive(Clone, Debug, PartialEq)]
+pub struct IvReport {
+    pub iterations: usize,
+    pub converged: bool,
+    /// Largest change of the last iteration, in standard deviations.
+    pub last_change: f64,
+    /// Largest distance between the simulated and the measured positions.
+    pub deviation: f64,
+    /// The weighted least-squares estimate the iterations started from.
+    pub wls: Vec<f64>,
+}
+
+/// Physically consistent standard parameters.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Consistent {
+    /// Standard parameters K (13 per link) satisfying the constraints.
+    pub standard: Vec<f64>,
+    /// Their base parameters (the identified vector without offsets).
+    pub x: Vec<f64>,
+    /// (x_consistent - x_estimate) / std per parameter, and the largest.
+    pub deviation: Vec<f64>,
+    pub max_deviation: f64,
+    /// Squared Mahalanobis distance of the consistent set from the unconstrained estimate
+    /// (x_c - x)^T Cov^-1 (x_c - x): chi-square with p degrees of freedom when the true
+    /// parameters are consistent.
+    pub distance2: f64,
+    /// Smallest eigenvalue of a link's pseudo-inertia matrix (kg m^2 scale) and of A(q).
+    pub min_pseudo_inertia_eigenvalue: f64,
+    pub min_inertia_eigenvalue: f64,
+    pub solver: String,
+}
+
+/// Result of [`identify`].
+#[derive(Clone, Debug)]
+pub struct Identification {
+    pub robot: String,
+    pub joints: Vec<usize>,
+    pub joint_names: Vec<String>,
+    pub parameters: Vec<Parameter>,
+    pub estimator: String,
+    pub x: Vec<f64>,
+    pub std: Vec<f64>,
+    pub relative_std: Vec<f64>,
+    pub condition_number: f64,
+    pub condition_number_unscaled: f64,
+    pub relative_error: f64,
+    pub per_joint: Vec<JointFit>,
+    pub validation: Option<Validation>,
+    pub processing: ProcessingReport,
+    pub essential: Option<Essential>,
+    pub iv: Option<IvReport>,
+    pub consistent: Option<Consistent>,
+    pub warnings: Vec<String>,
+    pub notes: Vec<String>,
+    pub validation_rows: ValidationRows,
+    /// The parameter model (rows, maps) for predictions and robot files.
+    pub model: ParameterModel,
+}
+
+impl Identification {
+    /// Standard parameters of a robot file reproducing the estimate: the consistent ones when
+    /// computed, else the base robot (every other standard parameter zero).
+    pub fn standard_parameters(&self) -> Vec<f64> {
+        match &self.consistent {
+            Some(c) => c.standard.clone(),
+            None => self.model.base_robot_parameters(&self.x),
+        }
+    }
+
+    /// Predicted torques of the validation rows (N per row).
+    pub fn predicted_validation(&self) -> Vec<Vec<f64>> {
+        let p = self.x.len();
+        let n = self.joints.len();
+        self.validation_rows
+            .w
+            .iter()
+            .map(|w| {
+                (0..n)
+                    .map(|k| (0..p).map(|c| w[k * p + c] * self.x[c]).sum())
+                    .collect()
+            })
+            .collect()
+    }
+}
+
+/// Processing settings from the log's sample rate and the options.
+pub fn processing(summary: &LogSummary, opt: &Options) -> Result<(Processing, ProcessingReport)> {
+    let fs = summary.sample_rate();
+    let bw = opt.bandwidth;
+    if !(bw.is_finite() && bw > 0.0) {
+        return Err(Error::Input(format!("bandwidth {bw} Hz must be positive")));
+    }
+    let derivatives = summary.has_derivatives && opt.use_log_derivatives;
+    let lowpass = if derivatives {
+        None
+    } else {
+        let fc = opt.cutoff.unwrap_or((10.0 * bw).min(0.4 * fs));
+        Some(Butterworth::lowpass(opt.filter_order, fc, fs)?)
+    };
+    let nd = match opt.decimation {
+        Some(0) => return Err(Error::Input("decimation factor 0: give 1 or more".into())),
+        Some(d) => d,
+        None => ((0.8 * fs / (4.0 * bw)).floor() as usize).max(1),
+    };
+    let decimation_filter = if nd > 1 {
+        Some(Butterworth::lowpass(8, 0.8 * fs / (2.0 * nd as f64), fs)?)
+    } else {
+        None
+    };
+    let border = opt
+        .border
+        .unwrap_or_else(|| lowpass.as_ref().map_or(0, |f| f.settling_samples(1e-3)));
+    let decimation_skip = decimation_filter
+        .as_ref()
+        .map_or(0, |f| f.settling_samples(1e-3));
+    let duration = summary.duration();
+    let validation = match opt.validation {
+        None => None,
+        Some((a, b)) => {
+            if !(0.0..=1.0).contains(&a) || !(0.0..=1.0).contains(&b) || a >= b {
+                return Err(Error::Input(format!(
+                    "validation segment {a}:{b}: fractions 0 <= from < to <= 1 of the log expected"
+                )));
+            }
+            let end = if b >= 1.0 {
+                f64::INFINITY
+            } else {
+                summary.t0 + b * duration
+            };
+            Some((summary.t0 + a * duration, end))
+        }
+    };
+    if summary.effort == Effort::Current && opt.gains.is_none() {
+        return Err(Error::Input(format!(
+            "{}: the log has motor currents (i<j>): give the drive gains (--gains) to convert \
+             them to torques",
+            summary.source
+        )));
+    }
+    let proc = Processing {
+        dt: summary.dt,
+        lowpass: lowpass.clone(),
+        decimation: nd,
+        decimation_filter: decimation_filter.clone(),
+        decimation_skip,
+        border,
+        validation,
+        gains: opt.gains.clone(),
+        min_speed: opt.min_speed,
+        keep_validation_rows: opt.keep_validation_rows,
+    };
+    let report = ProcessingReport {
+        source: summary.source.clone(),
+        samples: summary.samples,
+        sample_rate: fs,
+        duration,
+        bandwidth: bw,
+        derivatives_from_log: derivatives,
+        lowpass: lowpass.map(|f| (f.order, f.cutoff)),
+        decimation: nd,
+        decimation_filter: decimation_filter.map(|f| (f.order, f.cutoff)),
+        border,
+        decimation_skip,
+        min_speed: opt.min_speed,
+        fit_samples: 0,
+        validation_samples: 0,
+        validation: validation.map(|(a, b)| (a, b.min(summary.t0 + duration))),
+        slow_rows: Vec::new(),
+    };
+    Ok((proc, report))
+}
+
+fn joint_fits(
+    access: &ModelAccess,
+    factors: &mut [estimators::TriangularFactor],
+    x: &[f64],
+    sigma: Option<&[f64]>,
+) -> (Vec<JointFit>, f64) {
+    let names = access.joint_names();
+    let (mut res, mut out) = (0.0, 0.0);
+    let fits = factors
+        .iter_mut()
+        .enumerate()
+        .map(|(k, f)| {
+            let rows = f.rows();
+            let t = f.factor();
+            let r = residual_sq(t, x);
+            let y = output_sq(t);
+            res += r;
+            out += y;
+            JointFit {
+                joint: access.actuated_joints()[k],
+                name: names[k].clone(),
+                rows,
+                rms: if rows > 0 {
+                    (r / rows as f64).sqrt()
+                } else {
+                    0.0
+                },
+                relative_error: if y > 0.0 { (r / y).sqrt() } else { 0.0 },
+                sigma: sigma.map(|s| s[k]),
+            }
+        })
+        .collect();
+    (fits, if out > 0.0 { (res / out).sqrt() } else { 0.0 })
+}
+
+/// Identify the parameters of `access`'s robot from `log`.
+pub fn identify(
+    access: &mut ModelAccess,
+    log: &dyn LogSource,
+    opt: &Options,
+) -> Result<Identification> {
+    let mut model = ParameterModel::build(access, &opt.parameters)?;
+    let n = model.joints_count();
+    let p = model.count();
+    let names = model.names();
+    let summary = summarize(log, n)?;
+    let (proc, mut preport) = processing(&summary, opt)?;
+    let mut warnings = Vec::new();
+    let mut notes = Vec::new();
+    let mut pass = run_pass(log, &mut model, access, &proc, None)?;
+    preport.fit_samples = pass.fit_samples;
+    preport.validation_samples = pass.validation_samples;
+    preport.slow_rows = pass.slow_rows.clone();
+    let rows: usize = pass.fit.iter().map(|f| f.rows()).sum();
+    if rows <= p {
+        return Err(Error::Input(format!(
+            "{rows} equations for {p} parameters after decimation (by {}) and border removal \
+             ({} samples at each end): the log ({} samples) is too short",
+            proc.decimation, proc.border, summary.samples
+        )));
+    }
+    let ts: Vec<Mat<f64>> = pass.fit.iter_mut().map(|f| f.factor().clone()).collect();
+    let ols = least_squares(
+        &combine(&ts.iter().map(|t| (t, 1.0)).collect::<Vec<_>>()),
+        rows,
+        &names,
+    )?;
+    let (mut sol, sigma): (LsSolution, Option<Vec<f64>>) = match opt.estimator {
+        Estimator::Ols => (ols.clone(), None),
+        Estimator::Wls | Estimator::Iv => {
+            let sig = pass
+                .fit
+                .iter_mut()
+                .map(|f| {
+                    let r = f.rows();
+                    joint_sigma(f.factor(), r)
+                })
+                .collect::<Result<Vec<f64>>>()?;
+            if let Some(k) = sig.iter().position(|s| s.is_nan() || *s <= 0.0) {
+                return Err(Error::Numerical(format!(
+                    "joint {}: its equations are fitted exactly (sigma = 0), so Gautier's weight \
+                     1/sigma is infinite; use --estimator ols (noise-free data)",
+                    access.actuated_joints()[k]
+                )));
+            }
+            let tw = combine(
+                &ts.iter()
+                    .zip(&sig)
+                    .map(|(t, s)| (t, 1.0 / s))
+                    .collect::<Vec<_>>(),
+            );
+            (least_squares(&tw, rows, &names)?, Some(sig))
+        }
+    };
+    let mut estimator = match opt.estimator {
+        Estimator::Ols => "OLS",
+        Estimator::Wls => "WLS",
+        Estimator::Iv => "IDIM-IV",
+    }
+    .to_string();
+    // IDIM-IV
+    let mut iv_report = None;
+    if opt.estimator == Estimator::Iv {
+        let sig = sigma.clone().expect("weights");
+        let wls_x = sol.x.clone();
+        let mut x = sol.x.clone();
+        let mut converged = false;
+        let mut last_change = f64::INFINITY;
+        let mut deviation = 0.0;
+        let mut it = 0;
+        let f_iv = opt.iv_bandwidth.unwrap_or(opt.bandwidth / 4.0);
+        let omega = 2.0 * std::f64::consts::PI * f_iv;
+        let substeps = ((proc.dt / 2e-4).ceil() as usize).max(1);
+        while it < opt.iv_iterations.max(1) {
+            it += 1;
+            let k = model.joint_side_drives(&model.base_robot_parameters(&x));
+            let mut tracking = access.tracking_model(&k, 0.05)?;
+            let a = tracking.inertia_diagonal(&access.reference_actuated()?)?;
+            let kp: Vec<f64> = a
+                .iter()
+                .map(|a| a.abs().max(1e-6) * omega * omega)
+                .collect();
+            let kd: Vec<f64> = a
+                .iter()
+                .map(|a| a.abs().max(1e-6) * 2.0 * 0.8 * omega)
+                .collect();
+            let mut ins = Instruments::new(tracking, kp, kd, model.offsets(&x), substeps);
+            let ivpass: PassResult = run_pass(log, &mut model, access, &proc, Some(&mut ins))?;
+            deviation = ivpass.instrument_deviation;
+            let acc = ivpass.iv.expect("instrument accumulators");
+            let (x_new, m) = iv_solve(
+                &acc.iter()
+                    .zip(&sig)
+                    .map(|(a, s)| (a, 1.0 / s))
+                    .collect::<Vec<_>>(),
+            )?;
+            // residual variance of the weighted rows at the IV estimate
+            let res_w: f64 = ts
+                .iter()
+                .zip(&sig)
+                .map(|(t, s)| residual_sq(t, &x_new) / (s * s))
+                .sum();
+            let s2 = res_w / (rows - p) as f64;
+            let std: Vec<f64> = (0..p).map(|i| (s2 * m[(i, i)]).max(0.0).sqrt()).collect();
+            last_change = x_new
+                .iter()
+                .zip(&x)
+                .zip(&std)
+                .map(|((a, b), s)| (a - b).abs() / s.max(f64::MIN_POSITIVE))
+                .fold(0.0, f64::max);
+            x = x_new;
+            sol.x = x.clone();
+            sol.std = std;
+            sol.sigma2 = s2;
+            if last_change < 0.02 {
+                converged = true;
+                break;
+            }
+        }
+        sol.residual_sq = ts.iter().map(|t| residual_sq(t, &x)).sum();
+        if !converged {
+            warnings.push(format!(
+                "IDIM-IV did not converge in {it} iterations: the last iteration changed a \
+                 parameter by {last_change:.2} standard deviations (more iterations: \
+                 --iv-iterations; a slower tracking loop: --iv-bandwidth)"
+            ));
+        }
+        iv_report = Some(IvReport {
+            iterations: it,
+            converged,
+            last_change,
+            deviation,
+            wls: wls_x,
+        });
+    }
+    let tw: Mat<f64> = match &sigma {
+        Some(sig) => combine(
+            &ts.iter()
+                .zip(sig)
+                .map(|(t, s)| (t, 1.0 / s))
+                .collect::<Vec<_>>(),
+        ),
+        None => combine(&ts.iter().map(|t| (t, 1.0)).collect::<Vec<_>>()),
+    };
+    // physically consistent parameters: the constrained least squares, which is also the
+    // consistent set nearest to the unconstrained estimate in the metric of its covariance
+    let mut consistent = None;
+    if opt.consistent || opt.standard {
+        let c = consistency::consistent_parameters(access, &model, &tw, &sol)?;
+        let bound = p as f64 + 3.0 * (2.0 * p as f64).sqrt();
+        // changes at rounding level (a noise-free fit whose true values lie on the boundary,
+        // e.g. zero friction) are not reported
+        let scale = sol.x.iter().fold(0.0f64, |a, b| a.max(b.abs()));
+        let significant = c
+            .x_full
+            .iter()
+            .zip(&sol.x)
+            .any(|(a, b)| (a - b).abs() > 1e-6 * b.abs().max(1e-3 * scale));
+        if c.result.distance2 > bound && significant {
+            let worst = c
+                .result
+                .deviation
+                .iter()
+                .enumerate()
+                .max_by(|a, b| a.1.abs().partial_cmp(&b.1.abs()).unwrap())
+                .map_or(0, |(i, _)| i);
+            warnings.push(format!(
+                "the unconstrained estimate is not physically consistent: the nearest consistent \
+                 set is at a squared Mahalanobis distance {:.1} (above {bound:.1}, the 99.8 % \
+                 quantile of chi-square with {p} degrees of freedom); largest change {:.1} standard \
+                 deviations ({})",
+                c.result.distance2, c.result.max_deviation, names[worst]
+            ));
+        }
+        if opt.consistent {
+            sol.x = c.x_full.clone();
+            estimator.push_str(" under physical-consistency constraints (SDP)");
+            notes.push(
+                "the standard deviations are those of the unconstrained estimate; parameters whose \
+                 constraint is active are at the boundary of the consistent set"
+                    .into(),
+            );
+        }
+        consistent = Some(c.result);
+    }
+    // essential parameters
+    let essential = match opt.essential {
+        Some(e) => Some(essential_parameters(&tw, &ts, rows, &names, &e)?),
+        None => None,
+    };
+    let relative_std = sol.relative_std();
+    let (per_joint, relative_error) = joint_fits(access, &mut pass.fit, &sol.x, sigma.as_deref());
+    let validation = match proc.validation {
+        Some(_) if pass.validation_samples > 0 => {
+            let (pj, re) = joint_fits(access, &mut pass.validation, &sol.x, None);
+            let (a, b) = preport.validation.expect("validation segment");
+            Some(Validation {
+                from: a,
+                to: b,
+                relative_error: re,
+                per_joint: pj,
+            })
+        }
+        Some((a, _)) => {
+            warnings.push(format!(
+                "the validation segment (from t = {a:.3} s) has no sample after border removal"
+            ));
+            None
+        }
+        None => None,
+    };
+    // warnings
+    if sol.condition > 1e4 {
+        warnings.push(format!(
+            "the observation matrix is ill-conditioned (condition number {:.3e} with unit \
+             columns): the motion excites some parameters poorly; their values are unreliable \
+             (see the relative standard deviations; design an exciting motion: robodyn excite)",
+            sol.condition
+        ));
+    }
+    let poor: Vec<String> = names
+        .iter()
+        .zip(&relative_std)
+        .filter(|(_, r)| **r > 50.0)
+        .map(|(n, r)| format!("{n} ({r:.0} %)"))
+        .collect();
+    if !poor.is_empty() {
+        warnings.push(format!(
+            "{} parameter(s) poorly identified (relative standard deviation above 50 %): {} — \
+             their values are not significant (--essential drops them)",
+            poor.len(),
+            poor.join(", ")
+        ));
+    }
+    if relative_error > 0.5 {
+        warnings.push(format!(
+            "the model explains the torques poorly: relative error {:.1} % over the fit rows",
+            100.0 * relative_error
+        ));
+    }
+    if let Some(v) = &validation {
+        if v.relative_error > 2.0 * relative_error && v.relative_error > 0.05 {
+            warnings.push(format!(
+                "the validation segment is predicted much worse than the fit ({:.1} % vs {:.1} %): \
+                 the model may be over-fitted or the segment excites other effects",
+                100.0 * v.relative_error,
+                100.0 * relative_error
+            ));
+        }
+    }
+    if let Some((_, fd)) = preport.decimation_filter {
+        if fd < 2.0 * opt.bandwidth {
+            notes.push(format!(
+                "the decimation low-pass ({fd:.3} Hz) is below twice the bandwidth: the \
+                 dynamics are filtered too, consistently on both sides (parallel filtering)"
+            ));
+        }
+    }
+    let total_slow: usize = pass.slow_rows.iter().sum();
+    if total_slow > 0 {
+        notes.push(format!(
+            "{total_slow} joint rows of the fit left out by --min-speed {} (per joint {:?})",
+            opt.min_speed, pass.slow_rows
+        ));
+    }
+    if let Some(t) = &model.transmission {
+        let _ = t;
+        notes.push(
+            "with the transmission, IA/FS/FV of a joint's link are its motor's parameters in \
+             motor units (tau = R^T (Ia m_dd + Fv m_d + Fs sign(m_d)), m = R q)"
+                .into(),
+        );
+    }
+    Ok(Identification {
+        robot: access.name().to_string(),
+        joints: access.actuated_joints().to_vec(),
+        joint_names: access.joint_names(),
+        parameters: model.params.clone(),
+        estimator,
+        x: sol.x.clone(),
+        std: sol.std.clone(),
+        relative_std,
+        condition_number: sol.condition,
+        condition_number_unscaled: sol.condition_unscaled,
+        relative_error,
+        per_joint,
+        validation,
+        processing: preport,
+        essential,
+        iv: iv_report,
+        consistent,
+        warnings,
+        notes,
+        validation_rows: std::mem::take(&mut pass.validation_rows),
+        model,
+    })
+}
+
+/// Essential parameters (see [`EssentialOptions`]).
+fn essential_parameters(
+    tw: &Mat<f64>,
+    ts: &[Mat<f64>],
+    rows: usize,
+    names: &[String],
+    opt: &EssentialOptions,
+) -> Result<Essential> {
+    let p = tw.ncols() - 1;
+    let rel_error = |keep: &[usize], x: &[f64]| -> f64 {
+        let mut full = vec![0.0; p];
+        for (k, &i) in keep.iter().enumerate() {
+            full[i] = x[k];
+        }
+        let r: f64 = ts.iter().map(|t| residual_sq(t, &full)).sum();
+        let y: f64 = ts.iter().map(output_sq).sum();
+        (r / y).sqrt()
+    };
+    let mut keep: Vec<usize> = (0..p).collect();
+    let sub = |keep: &[usize]| -> Result<LsSolution> {
+        let names: Vec<String> = keep.iter().map(|&i| names[i].clone()).collect();
+        least_squares(&restrict(tw, keep), rows, &names)
+    };
+    let mut sol = sub(&keep)?;
+    let e0 = rel_error(&keep, &sol.x);
+    loop {
+        let rs = sol.relative_std();
+        let (worst, &worst_std) = rs
+            .iter()
+            .enumerate()
+            .max_by(|a, b| a.1.partial_cmp(b.1).unwrap_or(std::cmp::Ordering::Equal))
+            .expect("at least one parameter");
+        if worst_std <= opt.max_relative_std || keep.len() == 1 {
+            break;
+        }
+        let mut trial = keep.clone();
+        trial.remove(worst);
+        let tsol = sub(&trial)?;
+        if rel_error(&trial, &tsol.x) > (1.0 + opt.tolerance) * e0 {
+            break;
+        }
+        keep = trial;
+        sol = tsol;
+    }
+    Ok(Essential {
+        relative_std: sol.relative_std(),
+        relative_error: rel_error(&keep, &sol.x),
+        full_relative_error: e0,
+        kept: keep,
+        x: sol.x,
+    })
+}
+
+/// Names of the parameters of a given kind (for reports and tests).
+pub fn is_offset(p: &Parameter) -> bool {
+    matches!(p.kind, Kind::Offset(_))
+}

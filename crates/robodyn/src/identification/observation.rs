@@ -1,0 +1,434 @@
+//! One streaming pass over a log: filtered positions, central differences, the rows of the
+//! observation matrix W and the torques Y, the parallel decimation of both, and the rows folded
+//! into one triangular factor per joint (fit and validation segments) — and, for IDIM-IV, the
+//! rows of the instrument matrix from a simulation of the current model tracking the measured
+//! motion. Memory does not depend on the length of the log.
+
+use super::data::{LogSource, RawSample};
+use super::estimators::{IvAccumulator, TriangularFactor};
+use super::model_access::{ModelAccess, TrackingModel};
+use super::parameters::ParameterModel;
+use super::signal::{central_differences, Butterworth, ParallelFilter, ZeroPhaseStream};
+use crate::error::{Error, Result};
+use std::collections::VecDeque;
+
+/// How a log is processed (every number printed by the report).
+#[derive(Clone, Debug)]
+pub struct Processing {
+    /// Sample time of the log (s).
+    pub dt: f64,
+    /// Zero-phase low-pass of the positions (None when the log gives qd and qdd).
+    pub lowpass: Option<Butterworth>,
+    /// Keep every `decimation`-th sample after the parallel low-pass.
+    pub decimation: usize,
+    /// Low-pass of the parallel decimation (None when `decimation` is 1).
+    pub decimation_filter: Option<Butterworth>,
+    /// Outputs of the decimation filter skipped at the start (its transient; input rate).
+    pub decimation_skip: usize,
+    /// Samples dropped at each end (input rate).
+    pub border: usize,
+    /// Time interval [from, to) whose rows are kept for validation instead of the fit.
+    pub validation: Option<(f64, f64)>,
+    /// Drive gains: Y = gains * current (per joint; with a transmission, motor currents and
+    /// Y = R^T (gains * current)).
+    pub gains: Option<Vec<f64>>,
+    /// A joint's row of a decimated sample is left out when |qd_j| is below this (rad/s or m/s).
+    pub min_speed: f64,
+    /// Rows of the validation segment kept for the plot.
+    pub keep_validation_rows: bool,
+}
+
+/// Decimated validation rows (for the plot): t, Y (N per sample), W (N p per sample).
+#[derive(Clone, Debug, Default)]
+pub struct ValidationRows {
+    pub t: Vec<f64>,
+    pub y: Vec<Vec<f64>>,
+    pub w: Vec<Vec<f64>>,
+}
+
+/// What a pass produced.
+#[derive(Clone, Debug)]
+pub struct PassResult {
+    /// One factor per joint of the fit rows and of the validation rows.
+    pub fit: Vec<TriangularFactor>,
+    pub validation: Vec<TriangularFactor>,
+    /// Instrumental-variable accumulators per joint (fit rows) when instruments were given.
+    pub iv: Option<Vec<IvAccumulator>>,
+    pub samples_read: usize,
+    /// Samples between the borders (input rate).
+    pub samples_used: usize,
+    /// Decimated samples in the fit and the validation segments.
+    pub fit_samples: usize,
+    pub validation_samples: usize,
+    /// Rows left out by `min_speed`, per joint.
+    pub slow_rows: Vec<usize>,
+    pub validation_rows: ValidationRows,
+    /// Largest |q_sim - q_measured| of the instrument simulation (rad or m).
+    pub instrument_deviation: f64,
+}
+
+/// A measured sample the simulation tracks: t, q, qd and the torque.
+type Reference = (f64, Vec<f64>, Vec<f64>, Vec<f64>);
+
+/// The simulation behind the instruments of IDIM-IV: the current model driven by the measured
+/// torque (offsets removed) plus a PD correction toward the measured (filtered) motion, so that
+/// it follows the motion without the measurement noise; the instrument rows are W at the
+/// simulated states.
+pub struct Instruments {
+    pub model: TrackingModel,
+    pub kp: Vec<f64>,
+    pub kd: Vec<f64>,
+    pub offsets: Vec<f64>,
+    /// RK4 steps per sample.
+    pub substeps: usize,
+    state: Option<(Vec<f64>, Vec<f64>)>,
+    previous: Option<Reference>,
+    deviation: f64,
+}
+
+impl Instruments {
+    pub fn new(
+        model: TrackingModel,
+        kp: Vec<f64>,
+        kd: Vec<f64>,
+        offsets: Vec<f64>,
+        substeps: usize,
+    ) -> Self {
+        Instruments {
+            model,
+            kp,
+            kd,
+            offsets,
+            substeps: substeps.max(1),
+            state: None,
+            previous: None,
+            deviation: 0.0,
+        }
+    }
+
+    fn accel(
+        &mut self,
+        q: &[f64],
+        qd: &[f64],
+        reference: &Reference,
+        out: &mut [f64],
+    ) -> Result<()> {
+        let (_, qr, qdr, y) = reference;
+        let tau: Vec<f64> = (0..q.len())
+            .map(|k| {
+                y[k] - self.offsets[k] + self.kp[k] * (qr[k] - q[k]) + self.kd[k] * (qdr[k] - qd[k])
+            })
+            .collect();
+        self.model.accel(q, qd, &tau, out)
+    }
+
+    /// Advance to the sample (t, q, qd, y) and return the simulated state there.
+    fn step(&mut self, t: f64, q: &[f64], qd: &[f64], y: &[f64]) -> Result<[Vec<f64>; 3]> {
+        let n = q.len();
+        let current = (t, q.to_vec(), qd.to_vec(), y.to_vec());
+        let (mut qs, mut qds) = match (self.state.take(), self.previous.take()) {
+            (Some(s), Some(prev)) => {
+                // RK4 with the previous sample's reference and torque held (zero-order hold)
+                let h = (t - prev.0) / self.substeps as f64;
+                let (mut qs, mut qds) = s;
+                let mut k = [
+                    vec![0.0; 2 * n],
+                    vec![0.0; 2 * n],
+                    vec![0.0; 2 * n],
+                    vec![0.0; 2 * n],
+                ];
+                let mut a = vec![0.0; n];
+                for _ in 0..self.substeps {
+                    let mut yq = qs.clone();
+                    let mut yv = qds.clone();
+                    for st in 0..4 {
+                        if st > 0 {
+                            let c = if st == 3 { 1.0 } else { 0.5 };
+                            for i in 0..n {
+                                yq[i] = qs[i] + c * h * k[st - 1][i];
+                                yv[i] = qds[i] + c * h * k[st - 1][n + i];
+                            }
+                        }
+                        self.accel(&yq, &yv, &prev, &mut a)?;
+                        k[st][..n].copy_from_slice(&yv);
+                        k[st][n..].copy_from_slice(&a);
+                    }
+                    for i in 0..n {
+                        qs[i] += h / 6.0 * (k[0][i] + 2.0 * k[1][i] + 2.0 * k[2][i] + k[3][i]);
+                        qds[i] += h / 6.0
+                            * (k[0][n + i] + 2.0 * k[1][n + i] + 2.0 * k[2][n + i] + k[3][n + i]);
+                    }
+                }
+                if qs.iter().chain(&qds).any(|v| !v.is_finite()) {
+                    return Err(Error::Numerical(format!(
+                        "the instrument simulation of the current model diverged at t = {t} s"
+                    )));
+                }
+                (qs, qds)
+            }
+            _ => (q.to_vec(), qd.to_vec()),
+        };
+        let mut qdd = vec![0.0; n];
+        self.accel(&qs, &qds, &current, &mut qdd)?;
+        for i in 0..n {
+            self.deviation = self.deviation.max((qs[i] - q[i]).abs());
+        }
+        self.previous = Some(current);
+        self.state = Some((qs.clone(), qds.clone()));
+        Ok([std::mem::take(&mut qs), std::mem::take(&mut qds), qdd])
+    }
+}
+
+/// A sample after filtering and differentiation.
+struct Processed {
+    t: f64,
+    q: Vec<f64>,
+    qd: Vec<f64>,
+    qdd: Vec<f64>,
+    y: Vec<f64>,
+}
+
+struct Pass<'a> {
+    params: &'a mut ParameterModel,
+    access: &'a mut ModelAccess,
+    proc: &'a Processing,
+    instruments: Option<&'a mut Instruments>,
+    n: usize,
+    p: usize,
+    stream: Option<ZeroPhaseStream>,
+    pending: VecDeque<(f64, Vec<f64>)>,
+    window: VecDeque<(f64, Vec<f64>, Vec<f64>)>,
+    tail: VecDeque<Processed>,
+    processed: usize,
+    decimator: Option<ParallelFilter>,
+    dec_count: usize,
+    dec_skip: usize,
+    channels: Vec<f64>,
+    w: Vec<f64>,
+    z: Vec<f64>,
+    tau_e: Vec<f64>,
+    out: PassResult,
+}
+
+impl Pass<'_> {
+    fn raw(&mut self, s: RawSample) -> Result<()> {
+        self.out.samples_read += 1;
+        let y = match &self.proc.gains {
+            Some(g) => {
+                let scaled: Vec<f64> = s.y.iter().zip(g).map(|(i, g)| i * g).collect();
+                match &self.params.transmission {
+                    // tau = R^T tau_m
+                    Some(r) => (0..self.n)
+                        .map(|c| (0..self.n).map(|m| r[m][c] * scaled[m]).sum())
+                        .collect(),
+                    None => scaled,
+                }
+            }
+            None => s.y,
+        };
+        match (s.qd, s.qdd) {
+            (Some(qd), Some(qdd)) => self.processed_sample(Processed {
+                t: s.t,
+                q: s.q,
+                qd,
+                qdd,
+                y,
+            }),
+            _ => {
+                let stream = self.stream.as_mut().ok_or_else(|| {
+                    Error::Input("the log has no qd/qdd and no position filter was set".into())
+                })?;
+                self.pending.push_back((s.t, y));
+                let mut outs = Vec::new();
+                stream.push(&s.q, &mut |v| outs.push(v.to_vec()));
+                for q in outs {
+                    self.filtered(q)?;
+                }
+                Ok(())
+            }
+        }
+    }
+
+    /// A filtered position sample, in order: central differences need its neighbours.
+    fn filtered(&mut self, q: Vec<f64>) -> Result<()> {
+        let (t, y) = self
+            .pending
+            .pop_front()
+            .expect("one pending sample per filtered one");
+        self.window.push_back((t, q, y));
+        if self.window.len() == 3 {
+            let (a, b, c) = (&self.window[0], &self.window[1], &self.window[2]);
+            let dt = self.proc.dt;
+            let (mut qd, mut qdd) = (vec![0.0; self.n], vec![0.0; self.n]);
+            for k in 0..self.n {
+                (qd[k], qdd[k]) = central_differences(a.1[k], b.1[k], c.1[k], dt);
+            }
+            let s = Processed {
+                t: b.0,
+                q: b.1.clone(),
+                qd,
+                qdd,
+                y: b.2.clone(),
+            };
+            self.window.pop_front();
+            self.processed_sample(s)?;
+        }
+        Ok(())
+    }
+
+    /// Border removal: the first `border` samples are dropped, the last `border` held back.
+    fn processed_sample(&mut self, s: Processed) -> Result<()> {
+        self.processed += 1;
+        if self.processed <= self.proc.border {
+            return Ok(());
+        }
+        self.tail.push_back(s);
+        if self.tail.len() > self.proc.border {
+            let s = self.tail.pop_front().expect("non-empty");
+            self.kept(s)?;
+        }
+        Ok(())
+    }
+
+    fn kept(&mut self, s: Processed) -> Result<()> {
+        self.out.samples_used += 1;
+        let (n, p) = (self.n, self.p);
+        self.params.rows(
+            self.access,
+            &s.q,
+            &s.qd,
+            &s.qdd,
+            &mut self.w,
+            &mut self.tau_e,
+        )?;
+        if self.w.iter().any(|v| !v.is_finite()) {
+            return Err(Error::Numerical(format!(
+                "the observation matrix is not finite at t = {} s",
+                s.t
+            )));
+        }
+        let iv = self.instruments.is_some();
+        if let Some(ins) = self.instruments.as_deref_mut() {
+            let [qs, qds, qdds] = ins.step(s.t, &s.q, &s.qd, &s.y)?;
+            let mut te = vec![0.0; n];
+            self.params
+                .rows(self.access, &qs, &qds, &qdds, &mut self.z, &mut te)?;
+        }
+        // channels: W (n p), Y (n), Z (n p)
+        self.channels[..n * p].copy_from_slice(&self.w);
+        for k in 0..n {
+            self.channels[n * p + k] = s.y[k] - self.tau_e[k];
+        }
+        if iv {
+            self.channels[n * p + n..].copy_from_slice(&self.z);
+        }
+        self.dec_count += 1;
+        if let Some(d) = &mut self.decimator {
+            d.step(&mut self.channels);
+            if self.dec_count <= self.dec_skip
+                || !(self.dec_count - self.dec_skip).is_multiple_of(self.proc.decimation)
+            {
+                return Ok(());
+            }
+        }
+        let validation = self
+            .proc
+            .validation
+            .is_some_and(|(a, b)| s.t >= a && s.t < b);
+        let ch = &self.channels;
+        if validation {
+            self.out.validation_samples += 1;
+            for k in 0..n {
+                self.out.validation[k].push(&ch[k * p..(k + 1) * p], ch[n * p + k]);
+            }
+            if self.proc.keep_validation_rows {
+                self.out.validation_rows.t.push(s.t);
+                self.out
+                    .validation_rows
+                    .y
+                    .push(ch[n * p..n * p + n].to_vec());
+                self.out.validation_rows.w.push(ch[..n * p].to_vec());
+            }
+        } else {
+            self.out.fit_samples += 1;
+            for k in 0..n {
+                if s.qd[k].abs() < self.proc.min_speed {
+                    self.out.slow_rows[k] += 1;
+                    continue;
+                }
+                let w = &ch[k * p..(k + 1) * p];
+                let y = ch[n * p + k];
+                self.out.fit[k].push(w, y);
+                if let Some(acc) = &mut self.out.iv {
+                    let z = &ch[n * p + n + k * p..n * p + n + (k + 1) * p];
+                    acc[k].push(z, w, y);
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Run one pass over `log`.
+pub fn run_pass(
+    log: &dyn LogSource,
+    params: &mut ParameterModel,
+    access: &mut ModelAccess,
+    proc: &Processing,
+    instruments: Option<&mut Instruments>,
+) -> Result<PassResult> {
+    access.restart();
+    let n = params.joints_count();
+    let p = params.count();
+    let iv = instruments.is_some();
+    let channels = n * p + n + if iv { n * p } else { 0 };
+    let decimator = proc
+        .decimation_filter
+        .as_ref()
+        .filter(|_| proc.decimation > 1)
+        .map(|f| ParallelFilter::new(f, channels));
+    let mut pass = Pass {
+        stream: proc.lowpass.clone().map(|f| ZeroPhaseStream::new(f, n)),
+        params,
+        access,
+        proc,
+        instruments,
+        n,
+        p,
+        pending: VecDeque::new(),
+        window: VecDeque::new(),
+        tail: VecDeque::new(),
+        processed: 0,
+        decimator,
+        dec_count: 0,
+        dec_skip: proc.decimation_skip,
+        channels: vec![0.0; channels],
+        w: vec![0.0; n * p],
+        z: vec![0.0; n * p],
+        tau_e: vec![0.0; n],
+        out: PassResult {
+            fit: (0..n).map(|_| TriangularFactor::new(p)).collect(),
+            validation: (0..n).map(|_| TriangularFactor::new(p)).collect(),
+            iv: iv.then(|| (0..n).map(|_| IvAccumulator::new(p)).collect()),
+            samples_read: 0,
+            samples_used: 0,
+            fit_samples: 0,
+            validation_samples: 0,
+            slow_rows: vec![0; n],
+            validation_rows: ValidationRows::default(),
+            instrument_deviation: 0.0,
+        },
+    };
+    log.read(&mut |s| pass.raw(s))?;
+    if let Some(mut stream) = pass.stream.take() {
+        let mut outs = Vec::new();
+        stream.finish(&mut |v| outs.push(v.to_vec()))?;
+        for q in outs {
+            pass.filtered(q)?;
+        }
+    }
+    if let Some(ins) = pass.instruments.as_deref() {
+        pass.out.instrument_deviation = ins.deviation;
+    }
+    Ok(pass.out)
+}
