@@ -187,8 +187,9 @@ fn solve(vars: &Variables, p_dense: &Mat<f64>, q: &[f64]) -> Result<(Vec<f64>, S
     {
         let _ = (vars, p_dense, q);
         Err(Error::Input(
-            "robodyn was built without the `sdp` feature (Clarabel with LAPACK): physically \
-             consistent parameters are not available"
+            "physically consistent parameters need the `sdp` feature (Clarabel's semidefinite \
+             programs with the system's LAPACK): install LAPACK (Debian/Ubuntu: apt-get install \
+             libopenblas-dev pkg-config gfortran) and build with `--features robodyn/sdp`"
                 .into(),
         ))
     }
