@@ -4,7 +4,7 @@
 //! exact rational constants, `pi`, `sin`/`cos`, canonicalising constructors that fold trivial
 //! algebra on construction, expansion, substitution, numeric evaluation, parsing and printing.
 
-#![warn(missing_docs)]
+#![deny(missing_docs)]
 
 pub mod emit;
 mod expr;

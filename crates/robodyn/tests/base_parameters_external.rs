@@ -259,3 +259,224 @@ fn every_external_file_symbolic_and_numeric_counts_agree_or_are_explained() {
     );
     eprintln!("{}", table.join("\n"));
 }
+
+/// The loaded description of an external file, or `None` (with the skip rule of the suite)
+/// when `shared/` is missing.
+fn external_description(file: &str) -> Option<(PathBuf, robodyn::RobotDescription)> {
+    let Some(dir) = external_dir() else {
+        assert_eq!(
+            std::env::var("ROBODYN_ALLOW_MISSING_SHARED").as_deref(),
+            Ok("1"),
+            "shared/cases/external not found"
+        );
+        return None;
+    };
+    let path = dir.join(file);
+    let desc = robodyn::io::load_description(&path).unwrap_or_else(|e| panic!("{file}: {e}"));
+    Some((path, desc))
+}
+
+/// Issue 12.7: OpenSYMORO's TwoLoops puts twin frame 12 on twin frame 11 (fixed on link 8). The
+/// loops close on link 8: random closure solutions make R_9 = R_11 and R_10 = R_12 as frames
+/// composed by `geometry::frame_transforms` (its own walk down the antecedents, not the
+/// loop-closure kinematics), W matches central differences of the solved q_p, and the same
+/// mechanism written with frame 12 directly on link 8 (frame 11's parameters, frame 12 being the
+/// identity on 11) gives the same closure and the same base parameters.
+#[test]
+fn twoloops_twin_frame_on_a_twin_frame_closes_on_its_link() {
+    use rand::Rng;
+    use robodyn::algorithms::base_parameters::ClosedChainSampler;
+    use robodyn::{loop_closure, ClosedChain};
+    for file in [
+        "opensymoro-symoro/TwoLoops.par",
+        "symoro-robots/two-loops.par",
+    ] {
+        let Some((_, desc)) = external_description(file) else {
+            return;
+        };
+        assert_eq!((desc.nl, desc.nj, desc.frame(12).ant), (8, 10, 11), "{file}");
+        let (robot, _) = geometry_robot(&desc).unwrap();
+        let st = robot.structure();
+        assert_eq!(
+            st.loops
+                .iter()
+                .map(|l| (l.cut, l.twin, l.link_i, l.link_j))
+                .collect::<Vec<_>>(),
+            [(9, 11, 7, 8), (10, 12, 6, 8)],
+            "{file}: loop 2 closes on link 8, which frame 11 (under frame 12) is fixed on"
+        );
+        // the flattened description: frame 12 = frame 11 (12 is the identity on 11)
+        let mut flat = desc.clone();
+        let f11 = desc.frame(11).clone();
+        assert!(desc.frame(12).geometric().iter().all(|e| e.is_zero()));
+        flat.frames[11] = robodyn::model::FrameDesc {
+            name: desc.frame(12).name.clone(),
+            ..f11
+        };
+        let (flat_robot, _) = geometry_robot(&flat).unwrap();
+
+        let start = ClosedChainSampler::new(&robot).unwrap().start().clone();
+        let chain = ClosedChain::new(&robot).unwrap().with_tolerance(1e-14);
+        let flat_chain = ClosedChain::new(&flat_robot).unwrap().with_tolerance(1e-14);
+        let pick = |frames: &[usize]| -> Vec<f64> { frames.iter().map(|&j| start.q[j - 1]).collect() };
+        let (qa0, qp0) = (
+            pick(chain.coordinates().frames()),
+            pick(chain.passive_coordinates().frames()),
+        );
+        let b0 = chain.branch_from(&qa0, &qp0).unwrap();
+        let fb0 = flat_chain.branch_from(&qa0, &qp0).unwrap();
+        let mut rng = robodyn::testing::rng(12);
+        let mut worst_w: f64 = 0.0;
+        for _ in 0..8 {
+            let qa: Vec<f64> = qa0.iter().map(|x| x + rng.random_range(-0.3..0.3)).collect();
+            let s = loop_closure(&chain, &mut b0.clone(), &qa).unwrap();
+            let mut q: Vec<f64> = s.q_tree.iter().copied().collect();
+            q.extend(s.q_c.iter());
+            let t = robodyn::geometry::frame_transforms(&robot, &q);
+            for (k, tw) in [(9, 11), (10, 12)] {
+                assert!((t[k - 1].rot - t[tw - 1].rot).amax() < 1e-10, "{file}: R_{k} vs R_{tw}");
+                assert!((t[k - 1].pos - t[tw - 1].pos).amax() < 1e-10, "{file}: O_{k} vs O_{tw}");
+            }
+            // not vacuous: the same q_a with q_p moved leaves loop 2 open
+            let mut open = q.clone();
+            open[5] += 0.1; // joint 6, passive, on loop 2 only
+            let t_open = robodyn::geometry::frame_transforms(&robot, &open);
+            assert!((t_open[9].pos - t_open[11].pos).norm() > 1e-3, "{file}");
+            // the flattened description: the same solution
+            let fs = loop_closure(&flat_chain, &mut fb0.clone(), &qa).unwrap();
+            assert!((fs.q_p.clone() - s.q_p.clone()).amax() < 1e-9, "{file}: flat q_p");
+            // W = d q_p / d q_a (10.30) against central differences of the solved q_p
+            let h = 1e-5;
+            for col in 0..qa.len() {
+                let (mut qp, mut qm) = (qa.clone(), qa.clone());
+                qp[col] += h;
+                qm[col] -= h;
+                let sp = loop_closure(&chain, &mut b0.clone(), &qp).unwrap();
+                let sm = loop_closure(&chain, &mut b0.clone(), &qm).unwrap();
+                for row in 0..s.q_p.len() {
+                    let fd = (sp.q_p[row] - sm.q_p[row]) / (2.0 * h);
+                    let e = (fd - s.w[(row, col)]).abs() / s.w[(row, col)].abs().max(1.0);
+                    worst_w = worst_w.max(e);
+                    assert!(e < 1e-6, "{file}: W[{row},{col}] = {} vs {fd}", s.w[(row, col)]);
+                }
+            }
+        }
+        println!("{file}: W vs central differences, max relative error {worst_w:.2e}");
+        // base parameters: the same for both writings, by both methods
+        let sel = ParameterSelection::from_description(&desc, RotorMode::Actuated, true)
+            .with_zero_parameters(&desc, ZeroParameters::Absent);
+        let opt = NumericOptions {
+            selection: sel.clone(),
+            samples: None,
+            seed: 3,
+        };
+        let sym = symbolic_base_parameters(&desc, &sel).unwrap();
+        let sym_flat = symbolic_base_parameters(&flat, &sel).unwrap();
+        assert_eq!(sym.base, sym_flat.base, "{file}: symbolic, both writings");
+        let (num, _) = numeric_base_parameters_auto(&robot, &opt).unwrap();
+        let (num_flat, _) = numeric_base_parameters_auto(&flat_robot, &opt).unwrap();
+        let names = ParameterNames::of(&desc);
+        assert!(
+            compare_methods(&num, &num_flat, &names).same(),
+            "{file}: numeric, both writings"
+        );
+    }
+}
+
+/// Issue 12.4: `generate` drops the parameters a SYMORO `.par` writes as a literal 0 (XY6, IA6,
+/// every FS of `derived/RX90_zeros.par`). The generated IDM has no such symbol, agrees with the
+/// numeric Newton–Euler IDM (10.3–10.12) of the file, where those parameters are 0, at random
+/// states and values, and costs fewer operations than the model that keeps them.
+#[test]
+fn generated_idm_drops_literal_zero_parameters_of_a_par() {
+    use rand::Rng;
+    use robodyn::codegen::{generate, joint_symbol, GenOptions};
+    let Some((path, desc)) = external_description("derived/RX90_zeros.par") else {
+        return;
+    };
+    let gen = |zeros| {
+        let opt = GenOptions {
+            zeros,
+            ..Default::default()
+        };
+        generate(&desc, &opt).unwrap()
+    };
+    let dropped = gen(ZeroParameters::for_path(&path));
+    let kept = gen(ZeroParameters::Value);
+    let symbols = |p: &robodyn_symbolic::Program| -> std::collections::BTreeSet<String> {
+        p.assignments
+            .iter()
+            .chain(&p.outputs)
+            .flat_map(|a| a.expr.symbols())
+            .collect()
+    };
+    let absent: Vec<String> = ["XY6", "IA6"]
+        .into_iter()
+        .map(String::from)
+        .chain((1..=6).map(|j| format!("FS{j}")))
+        .collect();
+    let (sd, sk) = (symbols(&dropped), symbols(&kept));
+    for s in &absent {
+        assert!(!sd.contains(s), "{s} is in the generated IDM");
+        assert!(sk.contains(s), "{s} should be in the model that keeps literal zeros");
+    }
+    let (cd, ck) = (dropped.count(), kept.count());
+    println!("RX90_zeros IDM: {cd:?} (literal zeros dropped) vs {ck:?} (kept)");
+    assert!(
+        cd.mul + cd.add < ck.mul + ck.add,
+        "{cd:?} vs {ck:?}: dropping parameters must cut operations"
+    );
+    // numeric check against the IDM of the file (the literal zeros are zeros there)
+    let mut rng = robodyn::testing::rng(124);
+    for _ in 0..5 {
+        let mut d = desc.clone();
+        let mut names: std::collections::BTreeSet<String> = std::collections::BTreeSet::new();
+        for f in &d.frames {
+            names.extend(f.geometric().iter().flat_map(|e| e.symbols()));
+        }
+        for l in &d.links {
+            names.extend(l.params.iter().chain(&l.wrench).flat_map(|e| e.symbols()));
+        }
+        names.extend(d.gravity.iter().flat_map(|e| e.symbols()));
+        for s in names {
+            d.symbols.insert(s, rng.random_range(0.1..1.0));
+        }
+        let robot = robodyn::Robot::new(d.clone()).unwrap();
+        let n = robot.dof();
+        let state: Vec<Vec<f64>> = (0..3)
+            .map(|_| (0..n).map(|_| rng.random_range(-2.0..2.0)).collect())
+            .collect();
+        let tau = robodyn::inverse_dynamics(&robot, &state[0], &state[1], &state[2]).unwrap();
+        let env = |s: &str| -> Option<f64> {
+            for (k, v) in ["q", "QP", "QDP"].iter().zip(&state) {
+                for j in 1..=n {
+                    if s == joint_symbol(k, j) {
+                        return Some(v[j - 1]);
+                    }
+                }
+            }
+            d.symbols.get(s).copied()
+        };
+        let got = dropped.evaluate(&env).unwrap();
+        assert_eq!(got.len(), n);
+        for j in 0..n {
+            assert!(
+                (got[j] - tau[j]).abs() < 1e-9 * tau[j].abs().max(1.0),
+                "Gamma{}: generated {} vs Newton-Euler {}",
+                j + 1,
+                got[j],
+                tau[j]
+            );
+        }
+        // the model that keeps the parameters, with them given non-zero values, differs
+        let env_kept = |s: &str| -> Option<f64> {
+            if absent.iter().any(|a| a == s) {
+                Some(0.5)
+            } else {
+                env(s)
+            }
+        };
+        let other = kept.evaluate(&env_kept).unwrap();
+        assert!((0..n).any(|j| (other[j] - tau[j]).abs() > 1e-6));
+    }
+}

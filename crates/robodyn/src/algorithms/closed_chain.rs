@@ -21,7 +21,7 @@
 //! the equivalent tree (`chain.robot().coordinates()`).
 //!
 //! Allocation: the `_into` functions allocate nothing once the tracker is on the branch (the
-//! small p x p solves use [`crate::linalg`]'s in-place LU); starting a branch
+//! small p x p solves use the crate's in-place LU); starting a branch
 //! ([`ClosedChain::assembly_branch`], [`ClosedChain::branch_from`]) allocates.
 
 use crate::algorithms::inertia_matrix::composite_inertia_matrix;

@@ -19,6 +19,7 @@ use closed::{closed_form, closed_torques, closed_w, ClosedForm};
 pub use parallel_links::parallel_links;
 
 use crate::algorithms::inertia_matrix::composite_inertia_matrix;
+use crate::algorithms::regressor::ZeroParameters;
 use crate::algorithms::inverse_dynamics::{
     backward_recursion_sharing, forward_recursion_sharing, rnea, SharedOrientation,
 };
@@ -51,6 +52,8 @@ pub enum ModelKind {
 }
 
 impl ModelKind {
+    /// Short name (`idm`, `inertia`, `h`, `ddm`, `closed`, `w`): the default function name's
+    /// suffix.
     pub fn name(self) -> &'static str {
         match self {
             ModelKind::Idm => "idm",
@@ -67,8 +70,11 @@ impl ModelKind {
 /// `replaces` (e.g. `XX2`); `expr` is its value over the standard parameters and the geometry.
 #[derive(Clone, Debug, PartialEq)]
 pub struct GroupedParameter {
+    /// The standard parameter it replaces (`XX2`).
     pub replaces: String,
+    /// Its name in the generated model (`XXR2`).
     pub name: String,
+    /// Its value over the standard parameters and the geometry.
     pub expr: Expr,
 }
 
@@ -76,13 +82,16 @@ pub struct GroupedParameter {
 /// zero (no effect, or grouped into others). Standard parameters in neither list stay.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct BaseParameters {
+    /// The grouped parameters, each replacing one standard parameter.
     pub grouped: Vec<GroupedParameter>,
+    /// Names of the standard parameters set to zero.
     pub zero: BTreeSet<String>,
 }
 
 /// Options of the generator.
 #[derive(Clone, Debug)]
 pub struct GenOptions {
+    /// The model to generate.
     pub model: ModelKind,
     /// Substitute the robot's numeric values for every symbol (geometry and parameters).
     pub numeric: bool,
@@ -102,6 +111,11 @@ pub struct GenOptions {
     pub name: Option<String>,
     /// Run the program optimisations (common subexpressions, dead code).
     pub optimize: bool,
+    /// What a parameter written as a literal `0` means: with [`ZeroParameters::Absent`]
+    /// (SYMORO's `.par`, [`ZeroParameters::for_path`]) it does not exist and is dropped from the
+    /// model, as the regressor and base parameters drop it; the default
+    /// [`ZeroParameters::Value`] keeps it as a symbol (whose value is 0).
+    pub zeros: ZeroParameters,
 }
 
 impl Default for GenOptions {
@@ -116,6 +130,7 @@ impl Default for GenOptions {
             g: None,
             name: None,
             optimize: true,
+            zeros: ZeroParameters::Value,
         }
     }
 }
@@ -192,6 +207,7 @@ fn symbolic_model(desc: &RobotDescription, opt: &GenOptions) -> Result<DynModel<
             None => opt.symmetric && matches!(pname, "XY" | "XZ" | "YZ" | "MX" | "MY"),
         };
         let zero = symmetric_zero
+            || (opt.zeros == ZeroParameters::Absent && e.is_zero())
             || (!opt.friction && matches!(pname, "FS" | "FV"))
             || (!opt.rotor && pname == "IA")
             || opt.base.as_ref().is_some_and(|b| b.zero.contains(&full));
@@ -581,6 +597,18 @@ impl BaseParameters {
         rotor: bool,
         friction: bool,
     ) -> Result<BaseParameters> {
+        Self::symbolic_with_zeros(desc, rotor, friction, ZeroParameters::Value)
+    }
+
+    /// [`BaseParameters::symbolic`], with parameters written as a literal 0 read as `zeros`
+    /// says ([`ZeroParameters::Absent`] for SYMORO's `.par`: they do not exist, so they are
+    /// neither base parameters nor in any grouping).
+    pub fn symbolic_with_zeros(
+        desc: &RobotDescription,
+        rotor: bool,
+        friction: bool,
+        zeros: ZeroParameters,
+    ) -> Result<BaseParameters> {
         use crate::algorithms::base_parameters::symbolic::symbolic_base_parameters;
         use crate::algorithms::regressor::{parameter_name, ParameterSelection, RotorMode};
         let mode = if rotor {
@@ -588,7 +616,8 @@ impl BaseParameters {
         } else {
             RotorMode::None
         };
-        let sel = ParameterSelection::from_description(desc, mode, friction);
+        let sel = ParameterSelection::from_description(desc, mode, friction)
+            .with_zero_parameters(desc, zeros);
         let sb = symbolic_base_parameters(desc, &sel)?;
         if !sb.unhandled_loops.is_empty() {
             return Err(Error::Input(format!(

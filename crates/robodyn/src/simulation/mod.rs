@@ -1,9 +1,9 @@
 //! Simulation: integrate a direct dynamic model from an initial state under a torque input and
-//! stream the trajectory (t, q<j>, qd<j>, qdd<j>, tau<j>, energy, extra columns).
+//! stream the trajectory (`t, q<j>, qd<j>, qdd<j>, tau<j>`, energy, extra columns).
 //!
 //! The integrators only see a [`Dynamics`]: [`TreeDynamics`] for tree robots and
 //! [`ClosedChainDynamics`] for closed chains (actuated coordinates, passive joints re-solved at
-//! every evaluation, extra columns `closure_residual` and the passive q<j>).
+//! every evaluation, extra columns `closure_residual` and the passive `q<j>`).
 
 pub mod closed;
 pub(crate) mod energy;
@@ -195,7 +195,7 @@ impl Ode for StateOde<'_, '_> {
     }
 }
 
-/// Column names of the trajectory: t, q<l>, qd<l>, qdd<l>, tau<l>, energy, extras.
+/// Column names of the trajectory: `t, q<l>, qd<l>, qdd<l>, tau<l>`, energy, extras.
 pub fn trajectory_headers(dynamics: &dyn Dynamics) -> Vec<String> {
     let labels = dynamics.labels();
     let mut h = vec!["t".to_string()];
