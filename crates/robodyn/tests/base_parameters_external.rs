@@ -76,10 +76,6 @@ fn expectation(file: &str) -> Expect {
             "floating",
             "a floating base is refused (documented; a later issue adds it)",
         ),
-        "opensymoro-symoro/TwoLoops.par" | "symoro-robots/two-loops.par" => NotLoading(
-            "antecedent",
-            "a twin frame on another fixed frame (frame 12 on frame 11)",
-        ),
         "freecad-symoro/AKR3000.par" | "freecad-symoro/sr400.par" => NotLoading(
             "entries",
             "the file is inconsistent (NF = 6 with 10 or 14 frames): a correct rejection",
@@ -90,6 +86,12 @@ fn expectation(file: &str) -> Expect {
             "independent closure equations",
             "mu marks more actuated joints than the mechanism has degrees of freedom: the \
              closed-chain model (and so the numerical method) refuses it; the rules still run",
+        ),
+        "opensymoro-symoro/TwoLoops.par" | "symoro-robots/two-loops.par" => NumericRefused(
+            "no regular closed configuration",
+            "no symbol values and no assembly: q = 0 flattens both parallelograms (Wp singular) \
+             and no regular start is found near it; with an assembly it runs (see \
+             twoloops_twin_frame_on_a_twin_frame_closes_on_its_link)",
         ),
         "opensymoro-symoro/AKR3000.par" | "symoro-robots/akr3000.par" => NumericRefused(
             "no regular closed configuration",
@@ -276,6 +278,35 @@ fn external_description(file: &str) -> Option<(PathBuf, robodyn::RobotDescriptio
     Some((path, desc))
 }
 
+/// A regular closed configuration of `robot` (q over frames 1..NL): the closure solver from
+/// seeded random guesses, the first that closes with Wp well conditioned (rcond > 1e-2).
+fn regular_assembly(robot: &robodyn::Robot) -> Vec<f64> {
+    use rand::Rng;
+    let chain = robodyn::ClosedChain::new(robot).unwrap();
+    let mut rng = robodyn::testing::rng(7);
+    for _ in 0..200 {
+        let qa: Vec<f64> = (0..chain.dof())
+            .map(|_| rng.random_range(-1.5..1.5))
+            .collect();
+        let qp: Vec<f64> = (0..chain.passive_coordinates().len())
+            .map(|_| rng.random_range(-1.5..1.5))
+            .collect();
+        if let Ok(b) = chain.branch_from(&qa, &qp) {
+            if b.rcond() > 1e-2 {
+                let mut q = vec![0.0; robot.nl()];
+                for (k, &j) in chain.coordinates().frames().iter().enumerate() {
+                    q[j - 1] = b.q_a()[k];
+                }
+                for (k, &j) in chain.passive_coordinates().frames().iter().enumerate() {
+                    q[j - 1] = b.q_p()[k];
+                }
+                return q;
+            }
+        }
+    }
+    panic!("{}: no regular closed configuration found", robot.name());
+}
+
 /// Issue 12.7: OpenSYMORO's TwoLoops puts twin frame 12 on twin frame 11 (fixed on link 8). The
 /// loops close on link 8: random closure solutions make R_9 = R_11 and R_10 = R_12 as frames
 /// composed by `geometry::frame_transforms` (its own walk down the antecedents, not the
@@ -291,10 +322,24 @@ fn twoloops_twin_frame_on_a_twin_frame_closes_on_its_link() {
         "opensymoro-symoro/TwoLoops.par",
         "symoro-robots/two-loops.par",
     ] {
-        let Some((_, desc)) = external_description(file) else {
+        let Some((_, mut desc)) = external_description(file) else {
             return;
         };
-        assert_eq!((desc.nl, desc.nj, desc.frame(12).ant), (8, 10, 11), "{file}");
+        // the file has no values: those of the same robot in OpenSYMORO's history (SOURCES.md)
+        for (k, v) in [
+            ("d3", 0.5),
+            ("d4", 0.4),
+            ("d7", 0.3),
+            ("d12", 0.35),
+            ("g12", 0.4),
+        ] {
+            desc.symbols.insert(k.to_string(), v);
+        }
+        assert_eq!(
+            (desc.nl, desc.nj, desc.frame(12).ant),
+            (8, 10, 11),
+            "{file}"
+        );
         let (robot, _) = geometry_robot(&desc).unwrap();
         let st = robot.structure();
         assert_eq!(
@@ -313,12 +358,20 @@ fn twoloops_twin_frame_on_a_twin_frame_closes_on_its_link() {
             name: desc.frame(12).name.clone(),
             ..f11
         };
+        // the file has no assembly and q = 0 flattens both parallelograms: give one (as
+        // derived/SR400_assembly.par does for the SR400), found by the closure solver
+        let q_asm = regular_assembly(&robot);
+        let mut desc = desc;
+        desc.assembly = Some(q_asm.clone());
+        flat.assembly = Some(q_asm);
+        let (robot, _) = geometry_robot(&desc).unwrap();
         let (flat_robot, _) = geometry_robot(&flat).unwrap();
 
         let start = ClosedChainSampler::new(&robot).unwrap().start().clone();
         let chain = ClosedChain::new(&robot).unwrap().with_tolerance(1e-14);
         let flat_chain = ClosedChain::new(&flat_robot).unwrap().with_tolerance(1e-14);
-        let pick = |frames: &[usize]| -> Vec<f64> { frames.iter().map(|&j| start.q[j - 1]).collect() };
+        let pick =
+            |frames: &[usize]| -> Vec<f64> { frames.iter().map(|&j| start.q[j - 1]).collect() };
         let (qa0, qp0) = (
             pick(chain.coordinates().frames()),
             pick(chain.passive_coordinates().frames()),
@@ -328,14 +381,23 @@ fn twoloops_twin_frame_on_a_twin_frame_closes_on_its_link() {
         let mut rng = robodyn::testing::rng(12);
         let mut worst_w: f64 = 0.0;
         for _ in 0..8 {
-            let qa: Vec<f64> = qa0.iter().map(|x| x + rng.random_range(-0.3..0.3)).collect();
+            let qa: Vec<f64> = qa0
+                .iter()
+                .map(|x| x + rng.random_range(-0.05..0.05))
+                .collect();
             let s = loop_closure(&chain, &mut b0.clone(), &qa).unwrap();
             let mut q: Vec<f64> = s.q_tree.iter().copied().collect();
             q.extend(s.q_c.iter());
             let t = robodyn::geometry::frame_transforms(&robot, &q);
             for (k, tw) in [(9, 11), (10, 12)] {
-                assert!((t[k - 1].rot - t[tw - 1].rot).amax() < 1e-10, "{file}: R_{k} vs R_{tw}");
-                assert!((t[k - 1].pos - t[tw - 1].pos).amax() < 1e-10, "{file}: O_{k} vs O_{tw}");
+                assert!(
+                    (t[k - 1].rot - t[tw - 1].rot).amax() < 1e-10,
+                    "{file}: R_{k} vs R_{tw}"
+                );
+                assert!(
+                    (t[k - 1].pos - t[tw - 1].pos).amax() < 1e-10,
+                    "{file}: O_{k} vs O_{tw}"
+                );
             }
             // not vacuous: the same q_a with q_p moved leaves loop 2 open
             let mut open = q.clone();
@@ -344,7 +406,10 @@ fn twoloops_twin_frame_on_a_twin_frame_closes_on_its_link() {
             assert!((t_open[9].pos - t_open[11].pos).norm() > 1e-3, "{file}");
             // the flattened description: the same solution
             let fs = loop_closure(&flat_chain, &mut fb0.clone(), &qa).unwrap();
-            assert!((fs.q_p.clone() - s.q_p.clone()).amax() < 1e-9, "{file}: flat q_p");
+            assert!(
+                (fs.q_p.clone() - s.q_p.clone()).amax() < 1e-9,
+                "{file}: flat q_p"
+            );
             // W = d q_p / d q_a (10.30) against central differences of the solved q_p
             let h = 1e-5;
             for col in 0..qa.len() {
@@ -357,7 +422,11 @@ fn twoloops_twin_frame_on_a_twin_frame_closes_on_its_link() {
                     let fd = (sp.q_p[row] - sm.q_p[row]) / (2.0 * h);
                     let e = (fd - s.w[(row, col)]).abs() / s.w[(row, col)].abs().max(1.0);
                     worst_w = worst_w.max(e);
-                    assert!(e < 1e-6, "{file}: W[{row},{col}] = {} vs {fd}", s.w[(row, col)]);
+                    assert!(
+                        e < 1e-6,
+                        "{file}: W[{row},{col}] = {} vs {fd}",
+                        s.w[(row, col)]
+                    );
                 }
             }
         }
@@ -375,10 +444,24 @@ fn twoloops_twin_frame_on_a_twin_frame_closes_on_its_link() {
         assert_eq!(sym.base, sym_flat.base, "{file}: symbolic, both writings");
         let (num, _) = numeric_base_parameters_auto(&robot, &opt).unwrap();
         let (num_flat, _) = numeric_base_parameters_auto(&flat_robot, &opt).unwrap();
-        let names = ParameterNames::of(&desc);
-        assert!(
-            compare_methods(&num, &num_flat, &names).same(),
+        assert_eq!(num.base, num_flat.base, "{file}: numeric, both writings");
+        assert_eq!(
+            num.grouped, num_flat.grouped,
             "{file}: numeric, both writings"
+        );
+        assert!(
+            (&num.beta - &num_flat.beta).amax() < 1e-8,
+            "{file}: numeric grouping coefficients, both writings"
+        );
+        // symbolic vs numeric on this file: issue 12.8 (the rules do not see every relation of
+        // these loops, as for the older TwoLoops files); printed, compared in the main test's
+        // table through the history files
+        let names = ParameterNames::of(&desc);
+        println!(
+            "{file}: symbolic {} numeric {}: {}",
+            sym.count(),
+            num.count(),
+            compare_methods(&sym, &num, &names).note()
         );
     }
 }
@@ -418,7 +501,10 @@ fn generated_idm_drops_literal_zero_parameters_of_a_par() {
     let (sd, sk) = (symbols(&dropped), symbols(&kept));
     for s in &absent {
         assert!(!sd.contains(s), "{s} is in the generated IDM");
-        assert!(sk.contains(s), "{s} should be in the model that keeps literal zeros");
+        assert!(
+            sk.contains(s),
+            "{s} should be in the model that keeps literal zeros"
+        );
     }
     let (cd, ck) = (dropped.count(), kept.count());
     println!("RX90_zeros IDM: {cd:?} (literal zeros dropped) vs {ck:?} (kept)");

@@ -2,8 +2,8 @@
 //! or code (Rust, C, Python, Julia, MATLAB/Octave), with operation counts in the header.
 
 use crate::common::CliResult;
-use robodyn::codegen::{generate, BaseParameters, GenOptions, ModelKind};
 use robodyn::algorithms::regressor::ZeroParameters;
+use robodyn::codegen::{generate, BaseParameters, GenOptions, ModelKind};
 use robodyn_symbolic::{emit, Lang};
 use std::path::PathBuf;
 

@@ -469,7 +469,11 @@ fn detect_parallelogram(
         sides.push((x, offset(geo, next(&l.branch_i, n, k)), false));
     }
     for (n, &x) in l.branch_j.iter().enumerate().rev() {
-        sides.push((x, offset_on_link(geo, desc.nl, next(&l.branch_j, n, tw)), true));
+        sides.push((
+            x,
+            offset_on_link(geo, desc.nl, next(&l.branch_j, n, tw)),
+            true,
+        ));
     }
     sides.retain(|(_, v, _)| planar(v).norm() > GEOMETRY_TOLERANCE);
     if sides.len() != 4 {
