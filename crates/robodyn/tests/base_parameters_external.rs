@@ -173,6 +173,7 @@ fn every_external_file_symbolic_and_numeric_counts_agree_or_are_explained() {
         dir.display()
     );
     let mut table = Vec::new();
+    let mut doc = DocTable::default();
     let mut checked_references = 0;
     for file in &files {
         let path = dir.join(file);
@@ -185,6 +186,7 @@ fn every_external_file_symbolic_and_numeric_counts_agree_or_are_explained() {
                     "{file}: refused for another reason than `{why}`: {e}"
                 );
                 table.push(format!("{file}: does not load ({why})"));
+                doc.refused(file, &e.to_string(), why);
                 continue;
             }
             (Ok(_), Expect::NotLoading(_, why)) => {
@@ -194,6 +196,8 @@ fn every_external_file_symbolic_and_numeric_counts_agree_or_are_explained() {
             (Ok(d), _) => d,
         };
         desc.symbols.extend(values(file));
+        let idm = idm_matches_lagrangian(&desc);
+        let mut counts = Vec::new();
         for friction in [true, false] {
             let sel = ParameterSelection::from_description(&desc, RotorMode::Actuated, friction)
                 .with_zero_parameters(&desc, ZeroParameters::for_path(&path));
@@ -218,6 +222,7 @@ fn every_external_file_symbolic_and_numeric_counts_agree_or_are_explained() {
                         "{label}: symbolic {}, numeric refused ({why})",
                         sb.count()
                     ));
+                    counts.push((sb.count(), None, *why));
                     continue;
                 }
                 (Ok(_), Expect::NumericRefused(_, why)) => {
@@ -252,7 +257,19 @@ fn every_external_file_symbolic_and_numeric_counts_agree_or_are_explained() {
                 nb.count(),
                 if cmp.same() { "" } else { " (explained)" }
             ));
+            let why = match &expect {
+                Expect::RulesKeep(_, why) => *why,
+                _ => "",
+            };
+            counts.push((sb.count(), Some(nb.count()), why));
         }
+        let reference = REFERENCES
+            .iter()
+            .filter(|(f, _, _)| f == file)
+            .map(|(_, fr, n)| format!("{n} ({})", if *fr { "friction" } else { "no friction" }))
+            .collect::<Vec<_>>()
+            .join(", ");
+        doc.loaded(file, &desc, &counts, &reference, idm);
     }
     assert_eq!(
         checked_references,
@@ -260,6 +277,152 @@ fn every_external_file_symbolic_and_numeric_counts_agree_or_are_explained() {
         "a reference file is missing"
     );
     eprintln!("{}", table.join("\n"));
+    doc.check_or_write(&files);
+}
+
+/// The tree inverse dynamics (Newton–Euler, 10.3–10.12) against the Lagrangian route
+/// (`lagrangian_torques`: energies differentiated by hyper-dual numbers) at random states, with
+/// random values (seeded) for every symbol the file leaves without one; a closed robot is
+/// checked on its equivalent tree. Returns the largest relative difference.
+fn idm_matches_lagrangian(desc: &robodyn::RobotDescription) -> f64 {
+    use rand::Rng;
+    let mut d = desc.clone();
+    let mut names = std::collections::BTreeSet::new();
+    for f in &d.frames {
+        names.extend(f.geometric().iter().flat_map(|e| e.symbols()));
+    }
+    for l in &d.links {
+        names.extend(l.params.iter().chain(&l.wrench).flat_map(|e| e.symbols()));
+    }
+    names.extend(d.gravity.iter().flat_map(|e| e.symbols()));
+    let mut rng = robodyn::testing::rng(1212);
+    for s in names {
+        if !d.symbols.contains_key(&s) {
+            d.symbols.insert(s, rng.random_range(0.1..1.0));
+        }
+    }
+    let name = d.name.clone();
+    let robot = robodyn::Robot::new(d).unwrap_or_else(|e| panic!("{name}: {e}"));
+    let n = robot.dof();
+    let mut worst: f64 = 0.0;
+    for _ in 0..3 {
+        let x: Vec<Vec<f64>> = (0..3)
+            .map(|_| (0..n).map(|_| rng.random_range(-1.5..1.5)).collect())
+            .collect();
+        let ne = robodyn::inverse_dynamics(&robot, &x[0], &x[1], &x[2]).unwrap();
+        let lag =
+            robodyn::algorithms::energy::lagrangian_torques(&robot, &x[0], &x[1], &x[2]).unwrap();
+        let scale = ne.amax().max(1.0);
+        worst = worst.max((&ne - &lag).amax() / scale);
+    }
+    assert!(worst < 1e-10, "{name}: Newton-Euler vs Lagrangian {worst:e}");
+    worst
+}
+
+/// `docs/external-files.md`: the table of every external file, generated here and checked
+/// against the committed page (ROBODYN_UPDATE_DOCS=1 rewrites it).
+#[derive(Default)]
+struct DocTable {
+    rows: Vec<String>,
+    loaded: usize,
+    refused: usize,
+    agree: usize,
+    explained: usize,
+    numeric_refused: usize,
+}
+
+impl DocTable {
+    fn refused(&mut self, file: &str, error: &str, why: &str) {
+        self.refused += 1;
+        // the error's first line, without the directory the files were read from
+        let error = error.lines().next().unwrap_or("");
+        let error = error.rsplit("external/").next().unwrap_or(error);
+        self.rows.push(format!(
+            "| `{file}` | - | **refused**: {why}. Error: `{}` | - | - | - | - |",
+            error.replace('|', "\\|")
+        ));
+    }
+
+    fn loaded(
+        &mut self,
+        file: &str,
+        desc: &robodyn::RobotDescription,
+        counts: &[(usize, Option<usize>, &str)],
+        reference: &str,
+        idm: f64,
+    ) {
+        self.loaded += 1;
+        let structure = if desc.nj == desc.nl {
+            format!("tree, NL = {}", desc.nl)
+        } else {
+            format!("closed, NL = {}, NJ = {}", desc.nl, desc.nj)
+        };
+        let cell = |(s, n, _): &(usize, Option<usize>, &str)| match n {
+            Some(n) if n == s => format!("{s} / {n}"),
+            Some(n) => format!("{s} / {n} (explained)"),
+            None => format!("{s} / refused"),
+        };
+        let whys: Vec<&str> = counts.iter().map(|c| c.2).filter(|w| !w.is_empty()).collect();
+        match counts[0].1 {
+            None => self.numeric_refused += 1,
+            Some(n) if n == counts[0].0 && counts[1].1 == Some(counts[1].0) => self.agree += 1,
+            Some(_) => self.explained += 1,
+        }
+        let note = whys.first().map(|w| w.replace('|', "\\|")).unwrap_or_default();
+        self.rows.push(format!(
+            "| `{file}` | {structure} | loads{} | {} | {} | {} | {:.0e} |",
+            if note.is_empty() { String::new() } else { format!(": {note}") },
+            cell(&counts[0]),
+            cell(&counts[1]),
+            if reference.is_empty() { "-" } else { reference },
+            // a bound, not the value: the page must not change with the last bits
+            if idm < 1e-13 { 1e-13 } else if idm < 1e-12 { 1e-12 } else { 1e-10 },
+        ));
+    }
+
+    fn check_or_write(&self, files: &[String]) {
+        let page = format!(
+            "# SYMORO files from other people: what robodyn does with each\n\n\
+             Generated by `crates/robodyn/tests/base_parameters_external.rs` (the test fails when \
+             this page differs from what robodyn does; `ROBODYN_UPDATE_DOCS=1 cargo test -p \
+             robodyn --test base_parameters_external` rewrites it). The files are the {} `.par` \
+             files of the project's external cases (`shared/cases/external/`, read in place; \
+             where they come from: its `SOURCES.md`).\n\n\
+             Summary: {} load, {} are refused for a stated reason; of those that load, the \
+             symbolic rules and the numerical method give the same base parameters on {}, differ \
+             on {} for the reason given, and the numerical method refuses {} (a closed robot \
+             without an assembly or values where it cannot find a regular start, or mu marking \
+             more actuated joints than the mechanism has degrees of freedom).\n\n\
+             Columns: base parameters symbolic / numeric with friction and without (rotor \
+             inertias of the actuated joints in both; a parameter written as a literal 0 does \
+             not exist, as in SYMORO); the reference count where one is published or given by \
+             OpenSYMORO; the largest relative difference of the tree inverse dynamics \
+             (Newton–Euler, 10.3–10.12) from the Lagrangian route at random states and random \
+             values of the file's symbols (a closed robot: its equivalent tree), as an upper \
+             bound.\n\n\
+             | file | structure | robodyn | friction: symbolic / numeric | no friction | \
+             reference | Newton–Euler vs Lagrangian |\n|---|---|---|---|---|---|---|\n{}\n",
+            files.len(),
+            self.loaded,
+            self.refused,
+            self.agree,
+            self.explained,
+            self.numeric_refused,
+            self.rows.join("\n")
+        );
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/external-files.md");
+        if std::env::var("ROBODYN_UPDATE_DOCS").as_deref() == Ok("1") {
+            std::fs::write(&path, &page).unwrap();
+            return;
+        }
+        let committed = std::fs::read_to_string(&path).unwrap_or_default();
+        assert!(
+            committed == page,
+            "{} is not what robodyn does on the external files; rewrite it with \
+             ROBODYN_UPDATE_DOCS=1 (and read the diff)\n{page}",
+            path.display()
+        );
+    }
 }
 
 /// The loaded description of an external file, or `None` (with the skip rule of the suite)
