@@ -20,7 +20,10 @@ fn info_says_what_loop_closure_starts_from() {
     // the file's assembly
     let out = run(&["info", &robot("sr400.toml")]);
     let line = start_line(&out);
-    assert!(line.starts_with("assembly (start of loop closure): q = ["), "{line}");
+    assert!(
+        line.starts_with("assembly (start of loop closure): q = ["),
+        "{line}"
+    );
 
     // none, and q = 0 closes regularly: the passive values printed are the file's q_p = [0, 0]
     let out = run(&["info", &robot("fourbar.toml")]);
@@ -43,8 +46,7 @@ fn info_says_what_loop_closure_starts_from() {
 
     // JSON carries the same note
     let v: serde_json::Value =
-        serde_json::from_str(&run(&["info", &robot("fourbar.toml"), "--format", "json"]))
-            .unwrap();
+        serde_json::from_str(&run(&["info", &robot("fourbar.toml"), "--format", "json"])).unwrap();
     assert!(v["assembly"].is_null());
     assert!(v["start"]
         .as_str()
@@ -72,5 +74,8 @@ fn info_says_when_q0_is_singular_and_how_to_give_an_assembly() {
         line.starts_with("assembly: none, and q = 0 is singular"),
         "{line}"
     );
-    assert!(line.contains("robodyn assembly"), "says how to give one: {line}");
+    assert!(
+        line.contains("robodyn assembly"),
+        "says how to give one: {line}"
+    );
 }

@@ -297,9 +297,9 @@ fn idm_matches_lagrangian(desc: &robodyn::RobotDescription) -> f64 {
     names.extend(d.gravity.iter().flat_map(|e| e.symbols()));
     let mut rng = robodyn::testing::rng(1212);
     for s in names {
-        if !d.symbols.contains_key(&s) {
-            d.symbols.insert(s, rng.random_range(0.1..1.0));
-        }
+        d.symbols
+            .entry(s)
+            .or_insert_with(|| rng.random_range(0.1..1.0));
     }
     let name = d.name.clone();
     let robot = robodyn::Robot::new(d).unwrap_or_else(|e| panic!("{name}: {e}"));
@@ -315,7 +315,10 @@ fn idm_matches_lagrangian(desc: &robodyn::RobotDescription) -> f64 {
         let scale = ne.amax().max(1.0);
         worst = worst.max((&ne - &lag).amax() / scale);
     }
-    assert!(worst < 1e-10, "{name}: Newton-Euler vs Lagrangian {worst:e}");
+    assert!(
+        worst < 1e-10,
+        "{name}: Newton-Euler vs Lagrangian {worst:e}"
+    );
     worst
 }
 
@@ -362,21 +365,38 @@ impl DocTable {
             Some(n) => format!("{s} / {n} (explained)"),
             None => format!("{s} / refused"),
         };
-        let whys: Vec<&str> = counts.iter().map(|c| c.2).filter(|w| !w.is_empty()).collect();
+        let whys: Vec<&str> = counts
+            .iter()
+            .map(|c| c.2)
+            .filter(|w| !w.is_empty())
+            .collect();
         match counts[0].1 {
             None => self.numeric_refused += 1,
             Some(n) if n == counts[0].0 && counts[1].1 == Some(counts[1].0) => self.agree += 1,
             Some(_) => self.explained += 1,
         }
-        let note = whys.first().map(|w| w.replace('|', "\\|")).unwrap_or_default();
+        let note = whys
+            .first()
+            .map(|w| w.replace('|', "\\|"))
+            .unwrap_or_default();
         self.rows.push(format!(
             "| `{file}` | {structure} | loads{} | {} | {} | {} | {:.0e} |",
-            if note.is_empty() { String::new() } else { format!(": {note}") },
+            if note.is_empty() {
+                String::new()
+            } else {
+                format!(": {note}")
+            },
             cell(&counts[0]),
             cell(&counts[1]),
             if reference.is_empty() { "-" } else { reference },
             // a bound, not the value: the page must not change with the last bits
-            if idm < 1e-13 { 1e-13 } else if idm < 1e-12 { 1e-12 } else { 1e-10 },
+            if idm < 1e-13 {
+                1e-13
+            } else if idm < 1e-12 {
+                1e-12
+            } else {
+                1e-10
+            },
         ));
     }
 
