@@ -280,13 +280,8 @@ fn every_external_file_symbolic_and_numeric_counts_agree_or_are_explained() {
     doc.check_or_write(&files);
 }
 
-/// The tree inverse dynamics (Newton–Euler, 10.3–10.12) against the Lagrangian route
-/// (`lagrangian_torques`: energies differentiated by hyper-dual numbers) at random states, with
-/// random values (seeded) for every symbol the file leaves without one; a closed robot is
-/// checked on its equivalent tree. Returns the largest relative difference.
-fn idm_matches_lagrangian(desc: &robodyn::RobotDescription) -> f64 {
-    use rand::Rng;
-    let mut d = desc.clone();
+/// Every symbol of a description's geometry, parameters, wrenches and gravity.
+fn symbols_of(d: &robodyn::RobotDescription) -> std::collections::BTreeSet<String> {
     let mut names = std::collections::BTreeSet::new();
     for f in &d.frames {
         names.extend(f.geometric().iter().flat_map(|e| e.symbols()));
@@ -295,8 +290,18 @@ fn idm_matches_lagrangian(desc: &robodyn::RobotDescription) -> f64 {
         names.extend(l.params.iter().chain(&l.wrench).flat_map(|e| e.symbols()));
     }
     names.extend(d.gravity.iter().flat_map(|e| e.symbols()));
+    names
+}
+
+/// The tree inverse dynamics (Newton–Euler, 10.3–10.12) against the Lagrangian route
+/// (`lagrangian_torques`: energies differentiated by hyper-dual numbers) at random states, with
+/// random values (seeded) for every symbol the file leaves without one; a closed robot is
+/// checked on its equivalent tree. Returns the largest relative difference.
+fn idm_matches_lagrangian(desc: &robodyn::RobotDescription) -> f64 {
+    use rand::Rng;
+    let mut d = desc.clone();
     let mut rng = robodyn::testing::rng(1212);
-    for s in names {
+    for s in symbols_of(&d) {
         d.symbols
             .entry(s)
             .or_insert_with(|| rng.random_range(0.1..1.0));
@@ -699,15 +704,7 @@ fn generated_idm_drops_literal_zero_parameters_of_a_par() {
     let mut rng = robodyn::testing::rng(124);
     for _ in 0..5 {
         let mut d = desc.clone();
-        let mut names: std::collections::BTreeSet<String> = std::collections::BTreeSet::new();
-        for f in &d.frames {
-            names.extend(f.geometric().iter().flat_map(|e| e.symbols()));
-        }
-        for l in &d.links {
-            names.extend(l.params.iter().chain(&l.wrench).flat_map(|e| e.symbols()));
-        }
-        names.extend(d.gravity.iter().flat_map(|e| e.symbols()));
-        for s in names {
+        for s in symbols_of(&d) {
             d.symbols.insert(s, rng.random_range(0.1..1.0));
         }
         let robot = robodyn::Robot::new(d.clone()).unwrap();
