@@ -5,7 +5,7 @@
 //! algebra on construction, expansion, substitution, numeric evaluation, parsing and printing.
 //! [`Program`] is a straight-line list of named assignments (what `robodyn::codegen` records
 //! from the dynamic models), with common subexpressions removed, operation counts and
-//! [`emit`]ters for text, LaTeX, Rust, C, Python, Julia and MATLAB.
+//! emitters ([`emit()`]) for text, LaTeX, Rust, C, Python, Julia and MATLAB.
 //!
 //! # Example
 //!
