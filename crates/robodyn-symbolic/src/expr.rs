@@ -741,9 +741,9 @@ impl Expr {
     }
 
     /// Expand products of sums (distributes multiplication over addition, positive integer powers
-    /// of sums included). A product or power whose expansion would exceed [`EXPAND_TERMS`]
-    /// terms is kept as it is (its factors expanded): the result is always equal to `self`, and
-    /// a file's `(a + b + ... + h)^54` cannot take minutes and gigabytes.
+    /// of sums included). A product or power whose expansion would exceed `EXPAND_TERMS`
+    /// (100 000) terms is kept as it is (its factors expanded): the result is always equal to
+    /// `self`, and a file's `(a + b + ... + h)^54` cannot take minutes and gigabytes.
     pub fn expand(&self) -> Expr {
         grow(|| self.expand_node())
     }

@@ -71,19 +71,16 @@
 // Joint and link numbers are 1-based indices into several parallel arrays (a(j), frames, links):
 // index loops read like the equations.
 #![allow(clippy::needless_range_loop)]
-#![warn(missing_docs)]
+#![deny(missing_docs)]
 
 pub mod algorithms;
 #[cfg(feature = "codegen")]
-#[allow(missing_docs)] // documented by the code-generation work (issue 14.8)
 pub mod codegen;
 pub mod data;
 pub mod error;
 pub mod geometry;
-#[allow(missing_docs)] // the options and reports are documented in docs/models/identification.md
 pub mod identification;
 #[cfg(feature = "io")]
-#[allow(missing_docs)] // documented by the readers' rewrite (issue 14.8)
 pub mod io;
 pub(crate) mod linalg;
 pub mod model;

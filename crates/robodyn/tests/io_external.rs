@@ -20,7 +20,7 @@ fn external() -> PathBuf {
 }
 
 /// The files refused, with a part of the reason the error must give.
-const REFUSED: [(&str, &str); 6] = [
+const REFUSED: [(&str, &str); 4] = [
     // the files themselves are inconsistent (NF = 6 but 14 / 10 frames listed)
     (
         "freecad-symoro/AKR3000.par",
@@ -29,16 +29,6 @@ const REFUSED: [(&str, &str); 6] = [
     (
         "freecad-symoro/sr400.par",
         "Ant has 10 entries, NF = 6 expected",
-    ),
-    // a twin frame whose antecedent is another fixed frame (frame 12 on frame 11): a change of
-    // the structure model, not of the reader
-    (
-        "opensymoro-symoro/TwoLoops.par",
-        "antecedent a(12) = 11 of a cut-joint frame must be a link",
-    ),
-    (
-        "symoro-robots/two-loops.par",
-        "antecedent a(12) = 11 of a cut-joint frame must be a link",
     ),
     // a free-floating base
     (

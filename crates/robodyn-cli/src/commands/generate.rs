@@ -2,6 +2,7 @@
 //! or code (Rust, C, Python, Julia, MATLAB/Octave), with operation counts in the header.
 
 use crate::common::CliResult;
+use robodyn::algorithms::regressor::ZeroParameters;
 use robodyn::codegen::{generate, BaseParameters, GenOptions, ModelKind};
 use robodyn_symbolic::{emit, Lang};
 use std::path::PathBuf;
@@ -84,6 +85,8 @@ pub fn run(a: Args) -> CliResult {
         set: a.set.clone(),
     };
     desc.symbols.extend(rargs.overrides()?);
+    // a literal 0 in a SYMORO .par: the parameter does not exist (as in base-params, regressor)
+    let zeros = ZeroParameters::for_path(&a.robot);
     let base = match a.params {
         Params::Standard => None,
         Params::Base => match &a.base_file {
@@ -93,10 +96,11 @@ pub fn run(a: Args) -> CliResult {
                 Some(BaseParameters::parse(&text, &path.display().to_string())?)
             }
             // the grouping of the symbolic method (Table 10.2 for the SR400)
-            None => Some(BaseParameters::symbolic(
+            None => Some(BaseParameters::symbolic_with_zeros(
                 &desc,
                 !a.no_rotor,
                 !a.no_friction,
+                zeros,
             )?),
         },
     };
@@ -117,6 +121,7 @@ pub fn run(a: Args) -> CliResult {
         g: None,
         name: function_name(&a)?,
         optimize: true,
+        zeros,
     };
     let prog = generate(&desc, &opt)?;
     let lang = match a.lang {

@@ -92,6 +92,45 @@ fn to_json(d: &RobotDescription, s: &robodyn::model::Structure) -> serde_json::V
         "actuated": (1..=d.nl).filter(|&j| d.frame(j).actuated).collect::<Vec<_>>(),
         "passive": (1..=d.nl).filter(|&j| !d.frame(j).actuated && d.frame(j).joint.is_movable()).collect::<Vec<_>>(),
         "notes": d.notes,
+        "assembly": d.assembly,
+        "start": assembly_note(d, s),
+    })
+}
+
+/// Issue 12.2: what a closed robot's loop closure starts from: its `assembly`, or, without one,
+/// q = 0 when the loops close there with Wp regular, else how to give one. `None` for a tree.
+fn assembly_note(d: &RobotDescription, s: &robodyn::model::Structure) -> Option<String> {
+    if s.loops.is_empty() {
+        return None;
+    }
+    if let Some(a) = &d.assembly {
+        let q: Vec<String> = a.iter().map(|x| format!("{x}")).collect();
+        return Some(format!(
+            "assembly (start of loop closure): q = [{}]",
+            q.join(", ")
+        ));
+    }
+    const HOW: &str = "give one: `assembly = [..]` in a .toml, or in a .par the comment \
+        `(* robodyn assembly (joint values where the loops close): 1 = ..; 2 = .. *)` \
+        (docs/robot-format.md), or a start with --guess";
+    let start = robodyn::Robot::new(d.clone())
+        .and_then(|r| robodyn::ClosedChain::new(&r)?.assembly_branch());
+    Some(match start {
+        Ok(b) => {
+            let qp: Vec<String> = b.q_p().iter().map(|x| format!("{x:.6}")).collect();
+            format!(
+                "assembly: none; the start is q_a = 0, where the loops close (q_p = [{}]) with Wp \
+                 regular (reciprocal condition number {:.1e}): results follow that branch; \
+                 if it is not the intended one, {HOW}",
+                qp.join(", "),
+                b.rcond()
+            )
+        }
+        Err(robodyn::Error::SingularStart { rcond, .. }) => format!(
+            "assembly: none, and q = 0 is singular (Wp reciprocal condition number {rcond:.1e}): \
+             closed-chain evaluation refuses to start there; {HOW}"
+        ),
+        Err(e) => format!("assembly: none, and q = 0 cannot serve as the start ({e}); {HOW}"),
     })
 }
 
@@ -165,6 +204,9 @@ fn print_text(d: &RobotDescription, s: &robodyn::model::Structure) {
                 l + 1, lp.cut, lp.link_i, lp.link_j, lp.twin, lp.root, lp.branch_i, lp.branch_j
             );
         }
+    }
+    if let Some(note) = assembly_note(d, s) {
+        println!("{note}");
     }
     let act: Vec<String> = (1..=d.nl)
         .filter(|&j| d.frame(j).actuated)

@@ -21,7 +21,7 @@
 //! the equivalent tree (`chain.robot().coordinates()`).
 //!
 //! Allocation: the `_into` functions allocate nothing once the tracker is on the branch (the
-//! small p x p solves use [`crate::linalg`]'s in-place LU); starting a branch
+//! small p x p solves use the crate's in-place LU); starting a branch
 //! ([`ClosedChain::assembly_branch`], [`ClosedChain::branch_from`]) allocates.
 
 use crate::algorithms::inertia_matrix::composite_inertia_matrix;
@@ -888,6 +888,33 @@ pub fn loop_closure_into(
 
 /// Loop closure on the tracker's branch: q_p, the cut-joint variables, W and the conditioning
 /// at q_a. Allocates.
+///
+/// # Example
+///
+/// A four-bar linkage (`robots/fourbar.toml`: crank 1 actuated, joints 2 and 3 passive, cut
+/// joint 4 with its twin frame 5 on the rocker) driven to crank angles far apart: each is
+/// reached from the previous one on the same assembly branch, and the cut joint's frame 4 meets
+/// its twin 5.
+///
+/// ```
+/// use robodyn::{geometry::frame_transforms, loop_closure, ClosedChain};
+/// # fn main() -> robodyn::Result<()> {
+/// let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots/fourbar.toml");
+/// let robot = robodyn::io::load(path.as_ref())?;
+/// let chain = ClosedChain::new(&robot)?;
+/// let mut branch = chain.assembly_branch()?; // closed at q = 0
+/// for q1 in [2.5, -2.0, 0.7] {
+///     let s = loop_closure(&chain, &mut branch, &[q1])?;
+///     assert!(!s.conditioning.warning);
+///     // an independent check: compose the frames of the tree (joints 1..3, cut joint 4)
+///     let q: Vec<f64> = s.q_tree.iter().chain(s.q_c.iter()).copied().collect();
+///     let t = frame_transforms(&robot, &q);
+///     assert!((t[3].pos - t[4].pos).norm() < 1e-9); // O_4 = O_5
+///     println!("q1 = {q1}: q_p = {}, W = {}", s.q_p, s.w);
+/// }
+/// # Ok(())
+/// # }
+/// ```
 pub fn loop_closure(
     chain: &ClosedChain,
     branch: &mut Branch,
@@ -932,6 +959,33 @@ pub fn closed_state(
 /// Closed-chain inverse dynamic model into `tau_a`: Γ_cl = G^T Γ_tr (10.40, N m or N) of the
 /// actuated joints for q_a, qd_a, qdd_a (actuated joints) under `env`, on the tracker's branch.
 /// Allocation-free on the branch. Returns the conditioning of Wp (check `warning`).
+///
+/// # Example
+///
+/// Torques of the Acma SR400 (a parallelogram loop, Example 10.1) along a trajectory, with the
+/// buffers and the branch tracker made once:
+///
+/// ```
+/// use robodyn::{closed_inverse_dynamics_into, ClosedChain, ClosedData};
+/// # fn main() -> robodyn::Result<()> {
+/// let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots/sr400.toml");
+/// let sr400 = robodyn::io::load(path.as_ref())?;
+/// let chain = ClosedChain::new(&sr400)?; // vectors over the actuated joints 1, 2, 4, 5, 6, 7
+/// let mut data = ClosedData::new(&chain);
+/// let mut branch = chain.assembly_branch()?; // the parallelogram assembly of the file
+/// let mut gamma = vec![0.0; chain.dof()];
+/// for k in 0..100 {
+///     let s = k as f64 * 0.01;
+///     let q_a = [0.1 + s, 0.2 - s, 0.3, 0.4, 0.5 + s, 1.6];
+///     let cond = closed_inverse_dynamics_into(
+///         &chain, &mut data, &mut branch, sr400.environment(),
+///         &q_a, &[0.1; 6], &[0.0; 6], &mut gamma,
+///     )?;
+///     assert!(!cond.warning, "near a singular configuration: {cond:?}");
+/// }
+/// # Ok(())
+/// # }
+/// ```
 #[allow(clippy::too_many_arguments)]
 pub fn closed_inverse_dynamics_into(
     chain: &ClosedChain,

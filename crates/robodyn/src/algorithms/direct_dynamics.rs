@@ -405,6 +405,30 @@ pub fn direct_dynamics_into(
 
 /// Direct dynamic model with the robot's environment: qdd over the movable joints. Allocates;
 /// use [`direct_dynamics_into`] in loops.
+///
+/// # Example
+///
+/// The direct model inverts the inverse one: A(q) qdd + H(q, qd) = Gamma, by either method.
+///
+/// ```
+/// use robodyn::{direct_dynamics, h_vector, inertia_matrix, inverse_dynamics, Method};
+/// # fn main() -> robodyn::Result<()> {
+/// let urdf = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots/rx90.urdf");
+/// let robot = robodyn::io::load(urdf.as_ref())?;
+/// let q = [0.1, -0.4, 1.2, 0.3, -0.7, 0.2];
+/// let qd = [0.5, 0.1, -0.3, 0.8, 0.2, -0.6];
+/// let tau = [1.0, 20.0, 5.0, 0.5, 0.3, 0.1]; // N m
+/// let qdd = direct_dynamics(&robot, &q, &qd, &tau, Method::ArticulatedBody)?;
+/// let qdd_ldl = direct_dynamics(&robot, &q, &qd, &tau, Method::Composite)?;
+/// assert!((&qdd - &qdd_ldl).amax() < 1e-9);
+/// let back = inverse_dynamics(&robot, &q, &qd, qdd.as_slice())?;
+/// let a_qdd_h = inertia_matrix(&robot, &q)? * &qdd + h_vector(&robot, &q, &qd)?;
+/// for k in 0..6 {
+///     assert!((back[k] - tau[k]).abs() < 1e-9 && (a_qdd_h[k] - tau[k]).abs() < 1e-9);
+/// }
+/// # Ok(())
+/// # }
+/// ```
 pub fn direct_dynamics(
     robot: &Robot,
     q: &[f64],

@@ -449,6 +449,58 @@ pub(crate) fn tree_vector_map<R>(
 ///
 /// Errors: [`crate::Error::Dimension`] for a vector of the wrong length or a `data` of another
 /// robot, [`crate::Error::NotFinite`] for a NaN or infinite entry.
+///
+/// # Example
+///
+/// A control loop: one [`Data`] and one output buffer made before the loop, a contact force that
+/// changes at every step set in the [`Environment`] (no new robot, no allocation).
+///
+/// ```
+/// use robodyn::{inverse_dynamics, inverse_dynamics_into, Data};
+/// # fn main() -> robodyn::Result<()> {
+/// let robot = robodyn::io::toml_format::parse_robot(
+///     r#"
+///     name = "planar 2R"
+///     gravity = [0, -9.81, 0]
+///     [[frame]]
+///     j = 1
+///     ant = 0
+///     [[frame]]
+///     j = 2
+///     ant = 1
+///     d = 0.5
+///     [[link]]
+///     j = 1
+///     ZZ = 0.1
+///     MX = 0.25
+///     M = 1.0
+///     [[link]]
+///     j = 2
+///     ZZ = 0.05
+///     MX = 0.2
+///     M = 0.8
+///     "#,
+///     None,
+/// )?;
+/// let mut data = Data::new(&robot);
+/// let mut env = robot.environment().clone(); // gravity [0, -9.81, 0] of the file
+/// let mut tau = vec![0.0; robot.dof()];
+/// for k in 0..1000 {
+///     let t = k as f64 * 1e-3;
+///     let (q, qd, qdd) = ([t.sin(), 0.3], [t.cos(), 0.0], [-t.sin(), 0.0]);
+///     // 2 N along x_2 pushing ON link 2 at O_2 (Pinocchio's `fext` convention)
+///     env.set_wrench_on_link(2, [2.0, 0.0, 0.0].into(), [0.0; 3].into())?;
+///     inverse_dynamics_into(&robot, &mut data, &env, &q, &qd, &qdd, &mut tau)?;
+/// }
+/// // the allocating form uses the file's environment (no contact force)
+/// let at_rest = inverse_dynamics(&robot, &[0.0, 0.0], &[0.0; 2], &[0.0; 2])?;
+/// // holding both links horizontal: joint 1 carries g (MX1 + M2 d2 + MX2) = 9.81 * 0.85
+/// assert!((at_rest[0] - 9.81 * 0.85).abs() < 1e-12);
+/// // a vector of the wrong length is an error, not a panic
+/// assert!(inverse_dynamics(&robot, &[0.0], &[0.0; 2], &[0.0; 2]).is_err());
+/// # Ok(())
+/// # }
+/// ```
 #[allow(clippy::too_many_arguments)]
 pub fn inverse_dynamics_into(
     robot: &Robot,

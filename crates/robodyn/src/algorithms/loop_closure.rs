@@ -25,7 +25,7 @@
 //! branches (forward kinematic recursion with qdd = 0).
 
 //!
-//! This module holds the loop-closure model ([`LoopClosure`], internal to the closed-chain
+//! This module holds the loop-closure model (`LoopClosure`, internal to the closed-chain
 //! model [`crate::ClosedChain`]) and its equations; the public way to solve the loops is the
 //! branch tracker ([`crate::Branch`], [`crate::algorithms::closed_chain::loop_closure`]).
 

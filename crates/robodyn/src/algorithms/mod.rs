@@ -1,6 +1,5 @@
 //! One module per algorithm, named as the chapter names it.
 
-#[allow(missing_docs)] // documented by the base-parameter work (issue 14.7)
 pub mod base_parameters;
 pub mod closed_chain;
 pub mod direct_dynamics;

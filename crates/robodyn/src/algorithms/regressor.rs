@@ -362,6 +362,25 @@ pub fn wrench_torques_into(
 }
 
 /// The regressor (N x 13 NL) at one state with the robot's environment; allocates.
+///
+/// # Example
+///
+/// Gamma = Phi K + Gamma_e with K the standard parameters (§10.2.4):
+///
+/// ```
+/// use robodyn::{inverse_dynamics, regressor, wrench_torques};
+/// # fn main() -> robodyn::Result<()> {
+/// let urdf = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots/rx90.urdf");
+/// let robot = robodyn::io::load(urdf.as_ref())?;
+/// let (q, qd, qdd) = ([0.3, -0.2, 0.9, 0.1, 0.4, -0.5], [0.2; 6], [-0.4; 6]);
+/// let phi = regressor(&robot, &q, &qd, &qdd)?; // 6 x 78
+/// let k = nalgebra::DVector::from_vec(robot.standard_parameters());
+/// let tau = phi * k + wrench_torques(&robot, &q)?;
+/// let newton_euler = inverse_dynamics(&robot, &q, &qd, &qdd)?;
+/// assert!((tau - newton_euler).amax() < 1e-9);
+/// # Ok(())
+/// # }
+/// ```
 pub fn regressor(robot: &Robot, q: &[f64], qd: &[f64], qdd: &[f64]) -> Result<DMatrix<f64>> {
     let mut data = Data::new(robot);
     let mut phi = DMatrix::zeros(robot.dof(), PARAMS_PER_LINK * robot.nl());

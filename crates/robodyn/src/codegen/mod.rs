@@ -22,6 +22,7 @@ use crate::algorithms::inertia_matrix::composite_inertia_matrix;
 use crate::algorithms::inverse_dynamics::{
     backward_recursion_sharing, forward_recursion_sharing, rnea, SharedOrientation,
 };
+use crate::algorithms::regressor::ZeroParameters;
 use crate::data::Data;
 use crate::error::{Error, Item, Result};
 use crate::model::{DynModel, RobotDescription, STANDARD_PARAMETERS};
@@ -51,6 +52,8 @@ pub enum ModelKind {
 }
 
 impl ModelKind {
+    /// Short name (`idm`, `inertia`, `h`, `ddm`, `closed`, `w`): the default function name's
+    /// suffix.
     pub fn name(self) -> &'static str {
         match self {
             ModelKind::Idm => "idm",
@@ -67,8 +70,11 @@ impl ModelKind {
 /// `replaces` (e.g. `XX2`); `expr` is its value over the standard parameters and the geometry.
 #[derive(Clone, Debug, PartialEq)]
 pub struct GroupedParameter {
+    /// The standard parameter it replaces (`XX2`).
     pub replaces: String,
+    /// Its name in the generated model (`XXR2`).
     pub name: String,
+    /// Its value over the standard parameters and the geometry.
     pub expr: Expr,
 }
 
@@ -76,13 +82,16 @@ pub struct GroupedParameter {
 /// zero (no effect, or grouped into others). Standard parameters in neither list stay.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct BaseParameters {
+    /// The grouped parameters, each replacing one standard parameter.
     pub grouped: Vec<GroupedParameter>,
+    /// Names of the standard parameters set to zero.
     pub zero: BTreeSet<String>,
 }
 
 /// Options of the generator.
 #[derive(Clone, Debug)]
 pub struct GenOptions {
+    /// The model to generate.
     pub model: ModelKind,
     /// Substitute the robot's numeric values for every symbol (geometry and parameters).
     pub numeric: bool,
@@ -102,6 +111,11 @@ pub struct GenOptions {
     pub name: Option<String>,
     /// Run the program optimisations (common subexpressions, dead code).
     pub optimize: bool,
+    /// What a parameter written as a literal `0` means: with [`ZeroParameters::Absent`]
+    /// (SYMORO's `.par`, [`ZeroParameters::for_path`]) it does not exist and is dropped from the
+    /// model, as the regressor and base parameters drop it; the default
+    /// [`ZeroParameters::Value`] keeps it as a symbol (whose value is 0).
+    pub zeros: ZeroParameters,
 }
 
 impl Default for GenOptions {
@@ -116,6 +130,7 @@ impl Default for GenOptions {
             g: None,
             name: None,
             optimize: true,
+            zeros: ZeroParameters::Value,
         }
     }
 }
@@ -192,6 +207,7 @@ fn symbolic_model(desc: &RobotDescription, opt: &GenOptions) -> Result<DynModel<
             None => opt.symmetric && matches!(pname, "XY" | "XZ" | "YZ" | "MX" | "MY"),
         };
         let zero = symmetric_zero
+            || (opt.zeros == ZeroParameters::Absent && e.is_zero())
             || (!opt.friction && matches!(pname, "FS" | "FV"))
             || (!opt.rotor && pname == "IA")
             || opt.base.as_ref().is_some_and(|b| b.zero.contains(&full));
@@ -268,6 +284,43 @@ pub(crate) fn pair_name(prefix: &str, i: usize, j: usize) -> String {
 }
 
 /// Generate a customized model of a robot description.
+///
+/// # Example
+///
+/// The customized inverse dynamic model of the RX-90, printed as C and checked against the
+/// numeric Newton–Euler model at one state (inputs `q<j>`, `QP<j>`, `QDP<j>`):
+///
+/// ```
+/// use robodyn::codegen::{generate, joint_symbol, GenOptions, ModelKind};
+/// use robodyn_symbolic::{emit, Lang};
+/// # fn main() -> robodyn::Result<()> {
+/// let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots/rx90.toml");
+/// let desc = robodyn::io::load_description(path.as_ref())?;
+/// let opt = GenOptions { model: ModelKind::Idm, numeric: true, ..GenOptions::default() };
+/// let program = generate(&desc, &opt)?;
+/// let ops = program.count();
+/// println!("{} multiplications, {} additions", ops.mul, ops.add);
+/// let c_source = emit(&program, Lang::C); // also Rust, Python, Julia, MATLAB, text, LaTeX
+/// assert!(c_source.contains("double"));
+///
+/// let (q, qd, qdd) = ([0.1, 0.2, 0.3, 0.4, 0.5, 0.6], [0.3; 6], [-0.2; 6]);
+/// let input = |s: &str| {
+///     (1..=6).find_map(|j| {
+///         [("q", &q), ("QP", &qd), ("QDP", &qdd)]
+///             .iter()
+///             .find(|(kind, _)| s == joint_symbol(kind, j))
+///             .map(|(_, v)| v[j - 1])
+///     })
+/// };
+/// let generated = program.evaluate(&input).expect("every input has a value");
+/// let robot = robodyn::Robot::new(desc)?;
+/// let newton_euler = robodyn::inverse_dynamics(&robot, &q, &qd, &qdd)?;
+/// for j in 0..6 {
+///     assert!((generated[j] - newton_euler[j]).abs() < 1e-9);
+/// }
+/// # Ok(())
+/// # }
+/// ```
 pub fn generate(desc: &RobotDescription, opt: &GenOptions) -> Result<Program> {
     generate_with_progress(desc, opt, &mut |_| {})
 }
@@ -581,6 +634,18 @@ impl BaseParameters {
         rotor: bool,
         friction: bool,
     ) -> Result<BaseParameters> {
+        Self::symbolic_with_zeros(desc, rotor, friction, ZeroParameters::Value)
+    }
+
+    /// [`BaseParameters::symbolic`], with parameters written as a literal 0 read as `zeros`
+    /// says ([`ZeroParameters::Absent`] for SYMORO's `.par`: they do not exist, so they are
+    /// neither base parameters nor in any grouping).
+    pub fn symbolic_with_zeros(
+        desc: &RobotDescription,
+        rotor: bool,
+        friction: bool,
+        zeros: ZeroParameters,
+    ) -> Result<BaseParameters> {
         use crate::algorithms::base_parameters::symbolic::symbolic_base_parameters;
         use crate::algorithms::regressor::{parameter_name, ParameterSelection, RotorMode};
         let mode = if rotor {
@@ -588,7 +653,8 @@ impl BaseParameters {
         } else {
             RotorMode::None
         };
-        let sel = ParameterSelection::from_description(desc, mode, friction);
+        let sel = ParameterSelection::from_description(desc, mode, friction)
+            .with_zero_parameters(desc, zeros);
         let sb = symbolic_base_parameters(desc, &sel)?;
         if !sb.unhandled_loops.is_empty() {
             return Err(Error::Input(format!(

@@ -33,7 +33,9 @@ const PRIOR_WEIGHT: f64 = 1e-6;
 /// A consistent solution and the full identified vector (offsets included).
 #[derive(Clone, Debug)]
 pub struct ConsistentSolution {
+    /// The consistent parameters and their checks.
     pub result: Consistent,
+    /// The identified vector (base parameters, motor parameters, offsets) they give.
     pub x_full: Vec<f64>,
 }
 

@@ -13,11 +13,15 @@ use std::path::{Path, PathBuf};
 /// One sample of a log for the N actuated joints.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct RawSample {
+    /// Time (s).
     pub t: f64,
+    /// Positions of the N actuated joints (rad or m).
     pub q: Vec<f64>,
     /// Joint torques (or motor currents when the log has currents).
     pub y: Vec<f64>,
+    /// Velocities (rad/s or m/s), when the log gives them.
     pub qd: Option<Vec<f64>>,
+    /// Accelerations (rad/s² or m/s²), when the log gives them.
     pub qdd: Option<Vec<f64>>,
 }
 
@@ -33,19 +37,26 @@ pub enum Effort {
 /// Facts about a log found by a first read (columns, size, sample time).
 #[derive(Clone, Debug, PartialEq)]
 pub struct LogSummary {
+    /// The log's name (file path).
     pub source: String,
+    /// Number of samples.
     pub samples: usize,
+    /// Time of the first sample (s).
     pub t0: f64,
+    /// Sample time (s).
     pub dt: f64,
+    /// What the effort columns hold.
     pub effort: Effort,
     /// Whether qd and qdd are given.
     pub has_derivatives: bool,
 }
 
 impl LogSummary {
+    /// Duration (samples - 1) dt (s).
     pub fn duration(&self) -> f64 {
         self.dt * (self.samples.saturating_sub(1)) as f64
     }
+    /// Sample rate 1 / dt (Hz).
     pub fn sample_rate(&self) -> f64 {
         1.0 / self.dt
     }
@@ -66,13 +77,16 @@ pub trait LogSource {
 /// Labels of the joints whose columns are read: frame numbers and names.
 #[derive(Clone, Debug)]
 pub struct JointLabels {
+    /// Frame numbers j of the columns `q<j>`.
     pub numbers: Vec<usize>,
+    /// Joint names of the columns `q_<name>`.
     pub names: Vec<String>,
 }
 
 /// A CSV log on disk.
 #[derive(Clone, Debug)]
 pub struct CsvLog {
+    /// The file.
     pub path: PathBuf,
     labels: JointLabels,
     cols: Columns,
@@ -173,6 +187,7 @@ impl CsvLog {
         })
     }
 
+    /// The joints whose columns are read.
     pub fn labels(&self) -> &JointLabels {
         &self.labels
     }
@@ -256,7 +271,9 @@ impl LogSource for CsvLog {
 /// A log held in memory (tests, logs made by simulation).
 #[derive(Clone, Debug)]
 pub struct MemoryLog {
+    /// Name for messages.
     pub name: String,
+    /// The samples, in time order.
     pub samples: Vec<RawSample>,
 }
 
@@ -285,10 +302,13 @@ pub struct TimeCheck {
     t0: Option<f64>,
     last: Option<f64>,
     dt: Option<f64>,
+    /// Samples checked so far.
     pub samples: usize,
 }
 
 impl TimeCheck {
+    /// Check the next time `t` (s): after the previous one, by the first step to
+    /// [`SAMPLE_TIME_TOLERANCE`]. Errors: [`Error::Input`] naming both times.
     pub fn check(&mut self, t: f64) -> Result<()> {
         if let Some(last) = self.last {
             let step = t - last;

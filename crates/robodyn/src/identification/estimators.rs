@@ -31,6 +31,7 @@ pub struct TriangularFactor {
 }
 
 impl TriangularFactor {
+    /// An empty factor for `p` parameters (no row yet).
     pub fn new(p: usize) -> TriangularFactor {
         TriangularFactor {
             p,
@@ -169,6 +170,7 @@ pub const RANK_TOLERANCE: f64 = 1e-12;
 /// A least-squares solution with its statistics.
 #[derive(Clone, Debug)]
 pub struct LsSolution {
+    /// The estimate (p entries).
     pub x: Vec<f64>,
     /// Standard deviation of each parameter: sqrt of the diagonal of sigma^2 (W^T W)^-1.
     pub std: Vec<f64>,
@@ -176,9 +178,11 @@ pub struct LsSolution {
     pub covariance: Vec<f64>,
     /// sigma^2 = ||rho||^2 / (r - p).
     pub sigma2: f64,
-    /// ||y - W x||^2 and ||y||^2.
+    /// ||y - W x||^2.
     pub residual_sq: f64,
+    /// ||y||^2.
     pub output_sq: f64,
+    /// Rows r of W.
     pub rows: usize,
     /// Condition number of W with columns scaled to unit norm (independent of units).
     pub condition: f64,
@@ -364,13 +368,18 @@ pub fn joint_sigma(t: &Mat<f64>, rows: usize) -> Result<f64> {
 #[derive(Clone, Debug)]
 pub struct IvAccumulator {
     p: usize,
+    /// Z^T W (p x p, row-major).
     pub zw: Vec<f64>,
+    /// Z^T y (p).
     pub zy: Vec<f64>,
+    /// Z^T Z (p x p, row-major).
     pub zz: Vec<f64>,
+    /// Rows accumulated.
     pub rows: usize,
 }
 
 impl IvAccumulator {
+    /// Zero accumulators for `p` parameters.
     pub fn new(p: usize) -> IvAccumulator {
         IvAccumulator {
             p,

@@ -26,11 +26,13 @@ use std::f64::consts::PI;
 /// A finite Fourier series per joint, at rest at t = 0 and t = period.
 #[derive(Clone, Debug, PartialEq)]
 pub struct FourierTrajectory {
+    /// Period T_f = 2 pi / w (s).
     pub period: f64,
     /// Position at t = 0 (and t = period).
     pub start: Vec<f64>,
     /// a_jl, b_jl (N x L).
     pub a: Vec<Vec<f64>>,
+    /// b_jl (N x L).
     pub b: Vec<Vec<f64>>,
 }
 
@@ -158,45 +160,60 @@ pub fn simulated_log(
 /// Limits of one joint for the design (velocity and acceleration required).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Limits {
+    /// Lower position limit (rad or m), if any.
     pub q_min: Option<f64>,
+    /// Upper position limit (rad or m), if any.
     pub q_max: Option<f64>,
+    /// Largest |qd| (rad/s or m/s).
     pub qd: f64,
+    /// Largest |qdd| (rad/s² or m/s²).
     pub qdd: f64,
+    /// Largest |tau| (N m or N), if any.
     pub tau: Option<f64>,
 }
 
 /// Options of [`design`].
 #[derive(Clone, Debug)]
 pub struct DesignOptions {
+    /// Period of the trajectory (s).
     pub period: f64,
+    /// Harmonics L per joint (at least 2: the last one brings the motion to rest).
     pub harmonics: usize,
     /// Start (and end) position of the actuated joints.
     pub start: Vec<f64>,
+    /// Limits per actuated joint.
     pub limits: Vec<Limits>,
     /// Samples per period at which W is evaluated.
     pub samples: usize,
     /// Nelder–Mead iterations and random starting points tried first.
     pub iterations: u64,
+    /// Random starting points tried before Nelder–Mead starts from the best.
     pub restarts: usize,
+    /// Seed of the random starting points.
     pub seed: u64,
 }
 
 /// Which limit makes the scale of the trajectory.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Binding {
+    /// Index of the joint among the actuated joints (0 when `what` is `torque` or `none`).
     pub joint: usize,
+    /// `velocity`, `acceleration`, `position`, `torque` or `none`.
     pub what: &'static str,
 }
 
 /// A designed trajectory.
 #[derive(Clone, Debug)]
 pub struct Design {
+    /// The trajectory found, scaled to its limits.
     pub trajectory: FourierTrajectory,
     /// Condition number (unit columns) of the base-parameter observation matrix over the period.
     pub condition: f64,
     /// The same for the best random starting point.
     pub initial_condition: f64,
+    /// The limit reached by the trajectory.
     pub binding: Binding,
+    /// Cost evaluations made.
     pub evaluations: usize,
     /// Largest |q - start|, |qd|, |qdd|, |tau| per joint over the period.
     pub peaks: Vec<[f64; 4]>,

@@ -54,7 +54,9 @@ pub enum Estimator {
 /// `tolerance` (relative).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct EssentialOptions {
+    /// Relative standard deviation (%) above which a parameter may be dropped (default 10).
     pub max_relative_std: f64,
+    /// Largest relative growth of the relative error accepted per drop (default 0.02).
     pub tolerance: f64,
 }
 
@@ -70,17 +72,21 @@ impl Default for EssentialOptions {
 /// Options of [`identify`].
 #[derive(Clone, Debug)]
 pub struct Options {
+    /// What is identified: rotor inertias, friction, offsets.
     pub parameters: ParameterOptions,
+    /// Estimator of the final values (default WLS).
     pub estimator: Estimator,
     /// Identify under the physical-consistency constraints (SDP).
     pub consistent: bool,
     /// Compute standard parameters consistent with the estimate (needed by `--write-robot`).
     pub standard: bool,
+    /// Reduce to the essential parameters (None: keep every base parameter).
     pub essential: Option<EssentialOptions>,
     /// Joint-space bandwidth of the robot's dynamics (Hz); defaults follow from it.
     pub bandwidth: f64,
     /// Low-pass of the positions: cut-off (Hz, default 10 x bandwidth, at most 0.4 fs), order.
     pub cutoff: Option<f64>,
+    /// Order of the position low-pass (Butterworth, applied forward and backward; default 4).
     pub filter_order: usize,
     /// Decimation factor (default: floor(0.8 fs / (4 bandwidth)), at least 1).
     pub decimation: Option<usize>,
@@ -92,10 +98,13 @@ pub struct Options {
     pub use_log_derivatives: bool,
     /// Drive gains (currents to torques), per motor.
     pub gains: Option<Vec<f64>>,
+    /// A joint's row is left out where |qd_j| is below this (rad/s or m/s; default 0: none).
     pub min_speed: f64,
     /// IDIM-IV: iterations and the bandwidth of the tracking loop of the simulation (Hz).
     pub iv_iterations: usize,
+    /// Bandwidth of the IDIM-IV tracking loop (Hz; default bandwidth / 4).
     pub iv_bandwidth: Option<f64>,
+    /// Keep the decimated rows of the validation segment in the result (for the plot).
     pub keep_validation_rows: bool,
 }
 
@@ -126,7 +135,9 @@ impl Default for Options {
 /// Fit of one joint's equations.
 #[derive(Clone, Debug, PartialEq)]
 pub struct JointFit {
+    /// Frame number of the joint.
     pub joint: usize,
+    /// Joint name.
     pub name: String,
     /// Rows used.
     pub rows: usize,
@@ -141,32 +152,50 @@ pub struct JointFit {
 /// The processing applied, with every value used (printed by the report).
 #[derive(Clone, Debug, PartialEq)]
 pub struct ProcessingReport {
+    /// The log (file name).
     pub source: String,
+    /// Samples in the log.
     pub samples: usize,
+    /// Sample rate fs of the log (Hz).
     pub sample_rate: f64,
+    /// Duration of the log (s).
     pub duration: f64,
+    /// Joint-space bandwidth used (Hz).
     pub bandwidth: f64,
+    /// qd, qdd were read from the log (else differentiated from the filtered positions).
     pub derivatives_from_log: bool,
     /// (order, cut-off Hz) of the zero-phase position low-pass.
     pub lowpass: Option<(usize, f64)>,
+    /// Decimation factor (every n-th filtered sample is a row).
     pub decimation: usize,
     /// (order, cut-off Hz) of the parallel decimation low-pass.
     pub decimation_filter: Option<(usize, f64)>,
+    /// Samples dropped at each end of the log (settling of the position filter).
     pub border: usize,
+    /// Samples dropped at the start by the settling of the decimation filter.
     pub decimation_skip: usize,
+    /// The `min_speed` applied (rad/s or m/s).
     pub min_speed: f64,
+    /// Decimated samples in the fit.
     pub fit_samples: usize,
+    /// Decimated samples in the validation segment.
     pub validation_samples: usize,
+    /// Validation segment [from, to) in s of the log's time, if any.
     pub validation: Option<(f64, f64)>,
+    /// Rows left out by `min_speed`, per joint.
     pub slow_rows: Vec<usize>,
 }
 
 /// Validation on the segment left out of the fit.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Validation {
+    /// Start of the segment (s, log time).
     pub from: f64,
+    /// End of the segment (s, log time).
     pub to: f64,
+    /// ||Y - W X|| / ||Y|| over the segment, with the X of the fit.
     pub relative_error: f64,
+    /// The same per joint.
     pub per_joint: Vec<JointFit>,
 }
 
@@ -175,16 +204,22 @@ pub struct Validation {
 pub struct Essential {
     /// Indices (into the parameters) kept.
     pub kept: Vec<usize>,
+    /// Estimate of the kept parameters (same order).
     pub x: Vec<f64>,
+    /// Their relative standard deviations (%).
     pub relative_std: Vec<f64>,
+    /// ||Y - W X|| / ||Y|| with the kept parameters only.
     pub relative_error: f64,
+    /// The same with every parameter (the reference of the tolerance).
     pub full_relative_error: f64,
 }
 
 /// IDIM-IV iterations.
 #[derive(Clone, Debug, PartialEq)]
 pub struct IvReport {
+    /// Iterations run.
     pub iterations: usize,
+    /// No parameter moved by more than 0.02 standard deviations in the last iteration.
     pub converged: bool,
     /// Largest change of the last iteration, in standard deviations.
     pub last_change: f64,
@@ -203,6 +238,7 @@ pub struct Consistent {
     pub x: Vec<f64>,
     /// (x_consistent - x_estimate) / std per parameter, and the largest.
     pub deviation: Vec<f64>,
+    /// The largest |deviation|.
     pub max_deviation: f64,
     /// Squared Mahalanobis distance of the consistent set from the unconstrained estimate
     /// (x_c - x)^T Cov^-1 (x_c - x): chi-square with p degrees of freedom when the true
@@ -210,32 +246,55 @@ pub struct Consistent {
     pub distance2: f64,
     /// Smallest eigenvalue of a link's pseudo-inertia matrix (kg m^2 scale) and of A(q).
     pub min_pseudo_inertia_eigenvalue: f64,
+    /// Smallest eigenvalue of A(q) over 30 random configurations (kg m^2 scale).
     pub min_inertia_eigenvalue: f64,
+    /// The solver used and its status, as printed in the report.
     pub solver: String,
 }
 
 /// Result of [`identify`].
 #[derive(Clone, Debug)]
 pub struct Identification {
+    /// Robot name.
     pub robot: String,
+    /// Frame numbers of the joints whose torques are modelled (actuated joints).
     pub joints: Vec<usize>,
+    /// Their names.
     pub joint_names: Vec<String>,
+    /// The identified parameters (names, kinds), in the order of `x`.
     pub parameters: Vec<Parameter>,
+    /// The estimator used (`OLS`, `WLS` or `IDIM-IV`, with "under physical-consistency
+    /// constraints (SDP)" when constrained).
     pub estimator: String,
+    /// The estimate X (SI units of each parameter).
     pub x: Vec<f64>,
+    /// Standard deviations of X (same units).
     pub std: Vec<f64>,
+    /// Relative standard deviations 100 std / |x| (%).
     pub relative_std: Vec<f64>,
+    /// Condition number of W with unit-norm columns.
     pub condition_number: f64,
+    /// Condition number of W as built (depends on the units).
     pub condition_number_unscaled: f64,
+    /// ||Y - W X|| / ||Y|| over the fit rows.
     pub relative_error: f64,
+    /// Fit per joint.
     pub per_joint: Vec<JointFit>,
+    /// Prediction of the validation segment, if one was kept out.
     pub validation: Option<Validation>,
+    /// The processing applied, with every value used.
     pub processing: ProcessingReport,
+    /// The essential parameters, when asked for.
     pub essential: Option<Essential>,
+    /// IDIM-IV iterations, for that estimator.
     pub iv: Option<IvReport>,
+    /// Physically consistent standard parameters, when asked for.
     pub consistent: Option<Consistent>,
+    /// Where the result may be unreliable (ill-conditioning, poor fit, ...).
     pub warnings: Vec<String>,
+    /// What the user should know about the processing.
     pub notes: Vec<String>,
+    /// Decimated rows of the validation segment (empty unless `keep_validation_rows`).
     pub validation_rows: ValidationRows,
     /// The parameter model (rows, maps) for predictions and robot files.
     pub model: ParameterModel,
@@ -390,6 +449,36 @@ fn joint_fits(
 }
 
 /// Identify the parameters of `access`'s robot from `log`.
+///
+/// # Example
+///
+/// A noise-free log of the SCARA tracking a Fourier trajectory (simulated with the file's
+/// parameters): ordinary least squares give back the true base parameters.
+///
+/// ```
+/// use robodyn::identification::excitation::{simulated_log, FourierTrajectory};
+/// use robodyn::identification::model_access::{load_description, ModelAccess};
+/// use robodyn::identification::{identify, Estimator, Options};
+/// # fn main() -> robodyn::Result<()> {
+/// let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots/scara.toml");
+/// let mut access = ModelAccess::new(load_description(path.as_ref(), &Default::default())?)?;
+/// let start = access.reference_actuated()?;
+/// let harmonics = 5;
+/// let free: Vec<f64> = (0..start.len() * FourierTrajectory::free_per_joint(harmonics))
+///     .map(|k| 0.4 * ((k as f64) * 1.7).sin())
+///     .collect();
+/// let trajectory = FourierTrajectory::from_free(4.0, &start, harmonics, &free);
+/// let log = simulated_log(&access, &trajectory, 8.0, 0.004, 5.0)?; // t, q, qd, qdd, torques
+/// let opt = Options { estimator: Estimator::Ols, validation: None, ..Options::default() };
+/// let id = identify(&mut access, &log, &opt)?;
+/// let truth = id.model.values(&access.standard_parameters());
+/// for (k, p) in id.parameters.iter().enumerate() {
+///     println!("{:>8} = {:10.5} (true {:10.5})", p.name, id.x[k], truth[k]);
+/// }
+/// assert!(id.relative_error < 1e-8);
+/// # Ok(())
+/// # }
+/// ```
 pub fn identify(
     access: &mut ModelAccess,
     log: &dyn LogSource,

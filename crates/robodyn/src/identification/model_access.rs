@@ -30,9 +30,11 @@ use std::path::Path;
 /// Standard parameters per link (XX XY XZ YY YZ ZZ MX MY MZ M IA FS FV).
 pub const PER_LINK: usize = PARAMS_PER_LINK;
 
-/// Index of IA, FS, FV within a link's 13 standard parameters.
+/// Index of IA (rotor inertia) within a link's 13 standard parameters.
 pub const IA: usize = 10;
+/// Index of FS (Coulomb friction).
 pub const FS: usize = 11;
+/// Index of FV (viscous friction).
 pub const FV: usize = 12;
 
 /// A coefficient for display, as `base-params` prints them (short rationals when they are).
@@ -43,8 +45,11 @@ pub fn format_coefficient(x: f64) -> String {
 /// Which drive parameters the base set includes (as `base-params --rotor/--no-friction`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Rotors {
+    /// IA_j of the actuated joints.
     Actuated,
+    /// IA_j of every movable joint.
     All,
+    /// No rotor inertia.
     None,
 }
 
@@ -78,6 +83,7 @@ pub struct BaseSet {
     pub beta: DMatrix<f64>,
     /// Display names (`XXR2` when regrouped) and grouping equations, as `base-params` prints.
     pub names: Vec<String>,
+    /// Grouping equation of each base parameter (`XXR2 = XX2 + ...`).
     pub equations: Vec<String>,
 }
 
@@ -152,10 +158,12 @@ impl ModelAccess {
         })
     }
 
+    /// Robot name.
     pub fn name(&self) -> &str {
         self.robot.name()
     }
 
+    /// The robot's description.
     pub fn description(&self) -> &RobotDescription {
         self.robot.description()
     }
@@ -165,6 +173,7 @@ impl ModelAccess {
         self.robot.nl()
     }
 
+    /// True for a tree (no closed loop).
     pub fn is_tree(&self) -> bool {
         self.robot.is_tree()
     }
@@ -188,6 +197,7 @@ impl ModelAccess {
         self.robot.frame(j).joint == JointType::Prismatic
     }
 
+    /// The robot's transmission (motor side to joint side), if it has one.
     pub fn transmission(&self) -> Option<&Transmission> {
         self.transmission.as_ref()
     }
@@ -575,16 +585,26 @@ impl ModelAccess {
 
 /// A model simulated in the actuated coordinates: qdd_a = f(q_a, qd_a, tau_a).
 pub enum TrackingModel {
+    /// A tree: its direct dynamics by composite links.
     Tree {
+        /// Coulomb friction sign(qd) replaced by tanh(qd / smoothing) (rad/s or m/s).
         smoothing: f64,
+        /// The numeric model with the current parameters.
         model: Box<DynModel<f64>>,
+        /// Its buffers.
         ws: Box<Data>,
+        /// Frame numbers of the actuated joints (the simulated coordinates).
         joints: Vec<usize>,
+        /// Scratch: tree positions (NL).
         q: Vec<f64>,
+        /// Scratch: tree velocities (NL).
         qd: Vec<f64>,
+        /// Scratch: tree torques (NL).
         tau: Vec<f64>,
+        /// Scratch: tree accelerations (NL).
         qdd: Vec<f64>,
     },
+    /// A closed chain: qdd_a = A_cl^-1 (Gamma_cl - H_cl) on its assembly branch (10.46–10.48).
     Closed(Box<ClosedChainDynamics>),
 }
 

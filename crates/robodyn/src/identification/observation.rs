@@ -41,8 +41,11 @@ pub struct Processing {
 /// Decimated validation rows (for the plot): t, Y (N per sample), W (N p per sample).
 #[derive(Clone, Debug, Default)]
 pub struct ValidationRows {
+    /// Time of each decimated sample (s).
     pub t: Vec<f64>,
+    /// Y per sample: the N measured torques (N m or N).
     pub y: Vec<Vec<f64>>,
+    /// W per sample: N rows of p, row-major.
     pub w: Vec<Vec<f64>>,
 }
 
@@ -51,17 +54,21 @@ pub struct ValidationRows {
 pub struct PassResult {
     /// One factor per joint of the fit rows and of the validation rows.
     pub fit: Vec<TriangularFactor>,
+    /// The same for the validation rows.
     pub validation: Vec<TriangularFactor>,
     /// Instrumental-variable accumulators per joint (fit rows) when instruments were given.
     pub iv: Option<Vec<IvAccumulator>>,
+    /// Samples read from the log (input rate).
     pub samples_read: usize,
     /// Samples between the borders (input rate).
     pub samples_used: usize,
-    /// Decimated samples in the fit and the validation segments.
+    /// Decimated samples in the fit.
     pub fit_samples: usize,
+    /// Decimated samples in the validation segment.
     pub validation_samples: usize,
     /// Rows left out by `min_speed`, per joint.
     pub slow_rows: Vec<usize>,
+    /// Decimated validation rows, when `keep_validation_rows`.
     pub validation_rows: ValidationRows,
     /// Largest |q_sim - q_measured| of the instrument simulation (rad or m).
     pub instrument_deviation: f64,
@@ -75,9 +82,13 @@ type Reference = (f64, Vec<f64>, Vec<f64>, Vec<f64>);
 /// it follows the motion without the measurement noise; the instrument rows are W at the
 /// simulated states.
 pub struct Instruments {
+    /// The robot with the current estimate as its parameters.
     pub model: TrackingModel,
+    /// Proportional gains of the tracking loop per joint (N m / rad or N / m).
     pub kp: Vec<f64>,
+    /// Derivative gains per joint (N m s / rad or N s / m).
     pub kd: Vec<f64>,
+    /// Torque offsets of the estimate, removed from the measured torque (N m or N).
     pub offsets: Vec<f64>,
     /// RK4 steps per sample.
     pub substeps: usize,
@@ -87,6 +98,7 @@ pub struct Instruments {
 }
 
 impl Instruments {
+    /// A simulation that starts at the first measured sample.
     pub fn new(
         model: TrackingModel,
         kp: Vec<f64>,

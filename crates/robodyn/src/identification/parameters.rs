@@ -22,7 +22,12 @@ pub enum Kind {
     /// Base parameter number r of the base set.
     Base(usize),
     /// Drive parameter (`IA`, `FS` or `FV` index) of motor k (transmission).
-    Motor { motor: usize, which: usize },
+    Motor {
+        /// Motor k (0-based, in the transmission's order).
+        motor: usize,
+        /// `IA`, `FS` or `FV` index within a link's 13 standard parameters.
+        which: usize,
+    },
     /// Constant torque offset of actuated joint number k (0-based).
     Offset(usize),
 }
@@ -30,17 +35,23 @@ pub enum Kind {
 /// One identified parameter.
 #[derive(Clone, Debug)]
 pub struct Parameter {
+    /// Display name: the standard parameter's (`ZZ1`), `R` before the link number when grouped
+    /// (`XXR2`), `OFF<j>` for the offset of joint j.
     pub name: String,
     /// Grouping equation (right-hand side), in standard parameters.
     pub equation: String,
+    /// What it is.
     pub kind: Kind,
 }
 
 /// How the parameter vector is chosen.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ParameterOptions {
+    /// Which rotor inertias IA are parameters.
     pub rotors: Rotors,
+    /// Coulomb and viscous friction FS, FV of the actuated joints are parameters.
     pub friction: bool,
+    /// A constant torque offset per actuated joint is a parameter.
     pub offsets: bool,
     /// Seed of the random states of the numerical base-parameter method.
     pub seed: u64,
@@ -60,9 +71,11 @@ impl Default for ParameterOptions {
 /// The identification model X: x = map K (+ offsets), rows of W at each sample.
 #[derive(Clone, Debug)]
 pub struct ParameterModel {
+    /// The identified parameters, in the order of x.
     pub params: Vec<Parameter>,
+    /// The base set of the robot's standard parameters (numerical method).
     pub base: BaseSet,
-    /// x_r = sum_c map[r][c].1 K[map[r][c].0] for the base and motor parameters (empty for
+    /// `x_r = sum_c map[r][c].1 K[map[r][c].0]` for the base and motor parameters (empty for
     /// offsets).
     pub map: Vec<Vec<(usize, f64)>>,
     /// Number of standard parameters (13 NL).
@@ -199,6 +212,7 @@ impl ParameterModel {
         self.n
     }
 
+    /// Display names of the parameters, in the order of x.
     pub fn names(&self) -> Vec<String> {
         self.params.iter().map(|p| p.name.clone()).collect()
     }
@@ -212,7 +226,7 @@ impl ParameterModel {
     }
 
     /// Standard parameters reproducing `x` with every other standard parameter zero (the base
-    /// robot of `base-params --write-robot`): K[base_r] = x_r, K[motor] = x_motor.
+    /// robot of `base-params --write-robot`): `K[base_r] = x_r`, `K[motor] = x_motor`.
     pub fn base_robot_parameters(&self, x: &[f64]) -> Vec<f64> {
         let mut k = vec![0.0; self.standard_count];
         for (p, v) in self.params.iter().zip(x) {

@@ -21,11 +21,13 @@ use std::f64::consts::PI;
 /// (a0 = 1), the layout of `scipy.signal.sosfilt`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Butterworth {
+    /// Filter order (number of poles).
     pub order: usize,
     /// Cut-off frequency (-3 dB) in Hz.
     pub cutoff: f64,
     /// Sample rate in Hz.
     pub sample_rate: f64,
+    /// Second-order sections `[b0 b1 b2 1 a1 a2]`, applied in order.
     pub sos: Vec<[f64; 6]>,
 }
 
@@ -117,7 +119,7 @@ impl Butterworth {
     }
 
     /// Steady-state section states for a unit step input (scipy's `sosfilt_zi`): each section
-    /// solves (I - A^T) z = b[1:] - a[1:] b0 (`lfilter_zi`), scaled by the DC gain of the
+    /// solves `(I - A^T) z = b[1:] - a[1:] b0` (`lfilter_zi`), scaled by the DC gain of the
     /// sections before it.
     pub fn step_state(&self) -> Vec<[f64; 2]> {
         let mut scale = 1.0;
@@ -253,6 +255,7 @@ pub struct ParallelFilter {
 }
 
 impl ParallelFilter {
+    /// Filter `channels` channels with `f`, from a zero state.
     pub fn new(f: &Butterworth, channels: usize) -> ParallelFilter {
         ParallelFilter {
             sos: f.sos.clone(),
@@ -261,6 +264,7 @@ impl ParallelFilter {
         }
     }
 
+    /// Number of channels.
     pub fn channels(&self) -> usize {
         self.channels
     }
@@ -296,6 +300,7 @@ pub struct ZeroPhaseStream {
 }
 
 impl ZeroPhaseStream {
+    /// A stream of samples of `channels` channels filtered forward and backward by `filter`.
     pub fn new(filter: Butterworth, channels: usize) -> ZeroPhaseStream {
         let overlap = filter.settling_samples(1e-15).max(filter.padlen() + 1);
         let block = (4 * overlap).max(1024);
@@ -380,7 +385,7 @@ impl ZeroPhaseStream {
 }
 
 /// Central differences of a uniformly sampled signal at the interior sample k:
-/// (x[k+1] - x[k-1]) / (2 dt) and (x[k+1] - 2 x[k] + x[k-1]) / dt^2.
+/// `(x[k+1] - x[k-1]) / (2 dt)` and `(x[k+1] - 2 x[k] + x[k-1]) / dt^2`.
 #[inline]
 pub fn central_differences(prev: f64, cur: f64, next: f64, dt: f64) -> (f64, f64) {
     (

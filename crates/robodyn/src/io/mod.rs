@@ -60,8 +60,11 @@ impl std::fmt::Display for Warning {
 /// The file formats robodyn reads and writes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Format {
+    /// robodyn's TOML (`docs/robot-format.md`).
     Toml,
+    /// SYMORO's `.par`.
     Par,
+    /// URDF (read only).
     Urdf,
 }
 

@@ -6,6 +6,26 @@ use crate::error::{check_vector, Result};
 /// Which joints a public joint vector holds, in frame order: the movable joints of a tree
 /// ([`crate::Robot::coordinates`]) or the actuated / passive joints of a closed chain
 /// ([`crate::ClosedChain::coordinates`]).
+///
+/// # Example
+///
+/// ```
+/// # fn main() -> robodyn::Result<()> {
+/// let robots = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots");
+/// let rx90 = robodyn::io::load(format!("{robots}/rx90.urdf").as_ref())?;
+/// let c = rx90.coordinates();
+/// let elbow = c.index_of("elbow").expect("a joint of the URDF");
+/// assert_eq!((elbow, c.frame(elbow), c.name(elbow)), (2, 3, "elbow"));
+///
+/// // A closed chain's vectors hold its actuated joints; the passive ones have their own map.
+/// let sr400 = robodyn::io::load(format!("{robots}/sr400.toml").as_ref())?;
+/// let chain = robodyn::ClosedChain::new(&sr400)?;
+/// assert_eq!(chain.coordinates().frames(), &[1, 2, 4, 5, 6, 7]);
+/// assert_eq!(chain.passive_coordinates().frames(), &[3, 8]);
+/// assert_eq!(chain.coordinates().index_of_frame(3), None); // joint 3 is passive
+/// # Ok(())
+/// # }
+/// ```
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Coordinates {
     frames: Vec<usize>,

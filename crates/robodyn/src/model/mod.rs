@@ -78,12 +78,26 @@ pub fn validate_structure(desc: &RobotDescription) -> Result<Structure> {
                     ),
                 ));
             }
-        } else if f.ant > nl {
+        } else if j <= nj && f.ant > nl {
             return Err(Error::invalid(
                 item(),
                 format!(
                     "antecedent a({j}) = {} of a cut-joint frame must be a link (0..{nl})",
                     f.ant
+                ),
+            ));
+        } else if j > nj && f.ant > nl && (f.ant <= nj || f.ant >= j) {
+            // A twin frame may sit on an earlier twin frame (OpenSYMORO's TwoLoops: frame 12 on
+            // frame 11): the chain of fixed frames then ends on a link. A cut joint's frame
+            // moves with its own variable, so nothing may be fixed on it.
+            return Err(Error::invalid(
+                item(),
+                format!(
+                    "antecedent a({j}) = {} of a twin frame must be a link (0..{nl}) or an \
+                     earlier twin frame ({}..{})",
+                    f.ant,
+                    nj + 1,
+                    j - 1
                 ),
             ));
         }
@@ -134,7 +148,7 @@ pub fn validate_structure(desc: &RobotDescription) -> Result<Structure> {
     }
     let b = nj - nl;
     for k in nl + 1..=nj {
-        if ant[k] == ant[k + b] {
+        if ant[k] == structure::carrying_link(&ant, nl, k + b) {
             return Err(Error::invalid(
                 Item::Frame(k, Some("ant".into())),
                 format!(

@@ -11,7 +11,8 @@ pub struct ClosedLoop {
     pub twin: usize,
     /// i = a(k).
     pub link_i: usize,
-    /// j = a(k + B).
+    /// j: the link carrying frame k + B, a(k + B) or, when the twin sits on other twin frames
+    /// (OpenSYMORO's TwoLoops: frame 12 on frame 11), the link that chain of fixed frames ends on.
     pub link_j: usize,
     /// Root of the loop: the nearest common ancestor of i and j (0 = base).
     pub root: usize,
@@ -55,7 +56,7 @@ impl std::fmt::Display for StructureType {
 pub struct Structure {
     /// a(j) for frames 1..NF at index j; `ant[0]` is unused (0).
     pub ant: Vec<usize>,
-    /// children[i]: links k <= NL with a(k) = i, for i = 0..NL.
+    /// `children[i]`: links k <= NL with a(k) = i, for i = 0..NL.
     pub children: Vec<Vec<usize>>,
     /// Main branches: paths (link numbers from the base) to each terminal link.
     pub main_branches: Vec<Vec<usize>>,
@@ -66,7 +67,8 @@ pub struct Structure {
 }
 
 impl Structure {
-    /// Build from the antecedents (already validated: a(j) < j for j <= NL, a(j) <= NL beyond).
+    /// Build from the antecedents (already validated: a(j) < j for j <= NL, a(j) <= NL for the cut
+    /// joints, a(j) a link or an earlier twin frame for the twin frames).
     pub fn new(ant: Vec<usize>, nl: usize, nj: usize) -> Structure {
         let mut children = vec![Vec::new(); nl + 1];
         for j in 1..=nl {
@@ -81,7 +83,7 @@ impl Structure {
         let b = nj - nl;
         let loops = (nl + 1..=nj)
             .map(|k| {
-                let (i, j) = (ant[k], ant[k + b]);
+                let (i, j) = (ant[k], carrying_link(&ant, nl, k + b));
                 let pi = path_from_base(&ant, i);
                 let pj = path_from_base(&ant, j);
                 let common = pi.iter().zip(&pj).take_while(|(a, b)| a == b).count();
@@ -125,6 +127,16 @@ impl Structure {
             j = self.ant[j];
         }
     }
+}
+
+/// The link (0 = base) frame `f` is fixed on: a(f), followed down while it is a frame beyond NL
+/// (a twin frame on another twin frame). `ant` must be validated (a(f) < f beyond NJ).
+pub fn carrying_link(ant: &[usize], nl: usize, f: usize) -> usize {
+    let mut a = ant[f];
+    while a > nl {
+        a = ant[a];
+    }
+    a
 }
 
 /// Links from the base (excluded) to j (included).

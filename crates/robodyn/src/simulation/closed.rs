@@ -3,7 +3,7 @@
 //! open, and the motion stays on the branch it started on), and qdd_a comes from A_cl, H_cl
 //! (10.46–10.48). The energy is the kinetic + potential energy of the whole equivalent tree at
 //! the consistent state (q_tr, qd_tr = G qd_a, 10.29); extra columns: `closure_residual` (max
-//! over the loops) and the passive joints' q<j>.
+//! over the loops) and the passive joints' `q<j>`.
 
 use super::energy::mechanical_energy;
 use super::Dynamics;

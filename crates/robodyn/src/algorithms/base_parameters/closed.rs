@@ -8,7 +8,7 @@
 //! rejected (another drawn) when the closure fails or Wp is ill-conditioned at the sample or
 //! anywhere on the continuation path (a path through a singular configuration may switch
 //! assembly branch; near one, G = [I; W] is inaccurate). Velocities and accelerations come from
-//! [`ClosedChain::state`]: qd_p = W qd_a (10.29), qdd_p = W qdd_a - Wp^-1 Psi (10.42);
+//! [`crate::closed_state`]: qd_p = W qd_a (10.29), qdd_p = W qdd_a - Wp^-1 Psi (10.42);
 //! G = d q_tr / d q_a (10.40).
 //!
 //! The start must be a regular configuration on the intended branch ([`StartReport`]): a start
@@ -53,6 +53,7 @@ pub enum StartOrigin {
 /// The start of the closed-chain sampler: a regular closed configuration and its branch.
 #[derive(Clone, Debug, PartialEq)]
 pub struct StartReport {
+    /// Where the start comes from (assembly, q = 0, or moved from q = 0).
     pub origin: StartOrigin,
     /// Tree joint values 1..NL at the start (closed).
     pub q: Vec<f64>,

@@ -6,6 +6,37 @@
 //! - [`names`]: the robot's own names of the standard parameters;
 //! - [`summary`]: the structured result (table, lists, equations, values, comparison); its
 //!   writers (text, LaTeX, JSON) are in [`crate::report::base_parameters`].
+//!
+//! # Example
+//!
+//! The base parameters of the Acma SR400 (a closed chain) by both methods: the rules of
+//! §10.3.6, with the grouping equations over the file's symbols, and the numerical method on
+//! states sampled on the loop-closure branch. Khalil & Dombre's Table 10.2 has 42 without
+//! friction.
+//!
+//! ```
+//! use robodyn::algorithms::base_parameters::{
+//!     compare_methods, geometry_robot, numeric_base_parameters_auto, symbolic_base_parameters,
+//!     NumericOptions, ParameterNames,
+//! };
+//! use robodyn::algorithms::regressor::{ParameterSelection, RotorMode};
+//! # fn main() -> robodyn::Result<()> {
+//! let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots/sr400.toml");
+//! let desc = robodyn::io::load_description(path.as_ref())?;
+//! let sel = ParameterSelection::from_description(&desc, RotorMode::Actuated, false);
+//! let names = ParameterNames::of(&desc);
+//! let symbolic = symbolic_base_parameters(&desc, &sel)?;
+//! for (r, e) in symbolic.equations.iter().enumerate().filter(|(r, _)| symbolic.is_regrouped(*r)) {
+//!     println!("{} = {e}", names.name(symbolic.base[r])); // e.g. ZZR1 = ZZ1 + YY2 + ...
+//! }
+//! let opt = NumericOptions { selection: sel, samples: None, seed: 1 };
+//! let (robot, _) = geometry_robot(&desc)?; // generic values for symbols without one
+//! let (numeric, _start) = numeric_base_parameters_auto(&robot, &opt)?;
+//! assert!(compare_methods(&symbolic, &numeric, &names).same());
+//! assert_eq!(symbolic.count(), 42);
+//! # Ok(())
+//! # }
+//! ```
 
 pub mod closed;
 pub mod names;

@@ -64,8 +64,11 @@ pub const SVD_COLUMNS: usize = 800;
 /// A consistent state of the equivalent tree with the Jacobian G = dq_tr/dq_a.
 #[derive(Clone, Debug)]
 pub struct ConsistentSample {
+    /// Tree joint positions q_tr, NL entries (rad or m; fixed frames 0).
     pub q: Vec<f64>,
+    /// Tree joint velocities, NL entries (rad/s or m/s).
     pub qd: Vec<f64>,
+    /// Tree joint accelerations, NL entries (rad/s² or m/s²).
     pub qdd: Vec<f64>,
     /// G (NL x N); `None` means identity (tree).
     pub g: Option<DMatrix<f64>>,
@@ -74,6 +77,7 @@ pub struct ConsistentSample {
 /// Produces random consistent states: random for a tree, through the loop-closure equations for a
 /// closed chain.
 pub trait Sampler {
+    /// One random consistent state of `robot` (its equivalent tree) drawn from `rng`.
     fn sample(&mut self, robot: &Robot, rng: &mut dyn RngCore) -> Result<ConsistentSample>;
 }
 
@@ -105,10 +109,12 @@ impl Sampler for TreeSampler {
 /// Options of the numerical method.
 #[derive(Clone, Debug)]
 pub struct NumericOptions {
+    /// The standard parameters (columns of W): rotor inertias, friction, absent parameters.
     pub selection: ParameterSelection,
     /// Number of sampled states (default: 3 rows per column up to 3000 rows, then 1.25 rows
     /// per column; at least 20 samples).
     pub samples: Option<usize>,
+    /// Seed of the random states (the result is a function of it).
     pub seed: u64,
 }
 
@@ -133,9 +139,10 @@ pub struct NumericBase {
     /// Singular values of the scaled W (non-zero columns), largest first; empty above
     /// [`SVD_COLUMNS`] columns.
     pub singular_values: Vec<f64>,
-    /// Smallest singular value of the kept columns W1 (scaled) and largest residual of the
-    /// grouped ones (||R22||_F): the rank certificate, sigma_min > tolerance >= residual.
+    /// Smallest singular value of the kept columns W1 (scaled): with `residual_grouped`, the
+    /// rank certificate sigma_min > tolerance >= residual.
     pub sigma_min_kept: f64,
+    /// Largest residual of the grouped columns after the kept ones (||R22||_F, scaled).
     pub residual_grouped: f64,
     /// Rows of W.
     pub rows: usize,

@@ -31,19 +31,23 @@ pub struct BaseEntry {
 /// Base parameters of a robot by one method.
 #[derive(Clone, Debug)]
 pub struct Summary {
+    /// Robot name.
     pub robot: String,
     /// `symbolic` or `numeric`.
     pub method: &'static str,
+    /// NL, the number of links.
     pub nl: usize,
     /// Standard parameters of the model (selected and existing), K indices.
     pub columns: Vec<usize>,
     /// The robot's names of the standard parameters.
     pub names: ParameterNames,
+    /// The base parameters, in K order of the parameter each one is kept as.
     pub base: Vec<BaseEntry>,
     /// Names of the parameters with no effect.
     pub no_effect: Vec<String>,
     /// Names of the parameters grouped into base parameters.
     pub grouped: Vec<String>,
+    /// What the user must know about the result (start of a closed chain, generic values).
     pub notes: Vec<String>,
     /// Comparison with the other method (`--method both`).
     pub comparison: Option<MethodComparison>,
@@ -314,7 +318,9 @@ pub fn base_robot(
 /// set can be larger; the numerical method is then the arbiter).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct MethodComparison {
+    /// Number of base parameters by the symbolic rules.
     pub symbolic_count: usize,
+    /// Number of base parameters by the numerical method.
     pub numeric_count: usize,
     /// Base by the symbolic rules but grouped or without effect numerically.
     pub symbolic_only: Vec<String>,

@@ -123,6 +123,7 @@ fn drop_float_noise(e: Expr) -> (Expr, usize) {
 }
 
 impl SymbolicBase {
+    /// Number of base parameters.
     pub fn count(&self) -> usize {
         self.base.len()
     }
@@ -345,6 +346,19 @@ fn frame_expr(desc: &RobotDescription, j: usize) -> (Matrix3<Expr>, Vector3<Expr
     fc.transform(&Expr::zero())
 }
 
+/// Position of frame `f` in the link carrying it: a(f)P_f, composed down a chain of twin frames
+/// (OpenSYMORO's TwoLoops: frame 12 fixed on frame 11, fixed on link 8).
+fn position_on_link(desc: &RobotDescription, f: usize) -> Vector3<Expr> {
+    let (_, mut p) = frame_expr(desc, f);
+    let mut a = desc.frame(f).ant;
+    while a > desc.nl {
+        let (ra, pa) = frame_expr(desc, a);
+        p = pa + ra * p;
+        a = desc.frame(a).ant;
+    }
+    p
+}
+
 fn exact_angle(x: f64) -> Expr {
     let k = x / std::f64::consts::FRAC_PI_2;
     if (k - k.round()).abs() < 1e-12 {
@@ -396,6 +410,19 @@ fn offset(geo: &Geo, x: usize) -> Vector3<f64> {
     geo.frames[x - 1].transform(&0.0).1
 }
 
+/// Position of frame `x` in the link carrying it: [`offset`], composed down a chain of twin
+/// frames (OpenSYMORO's TwoLoops: frame 12 fixed on frame 11, fixed on link 8).
+fn offset_on_link(geo: &Geo, nl: usize, x: usize) -> Vector3<f64> {
+    let mut p = offset(geo, x);
+    let mut a = geo.frames[x - 1].ant;
+    while a > nl {
+        let (r, t) = geo.frames[a - 1].transform(&0.0);
+        p = t + r * p;
+        a = geo.frames[a - 1].ant;
+    }
+    p
+}
+
 /// Detect a parallelogram loop from the geometry (§10.3.5, Figure 10.2). Every joint of the
 /// loop (tree joints and the cut joint) is revolute, with its axis parallel to the others in
 /// the same direction. The loop is read as a polygon in the plane of the axes: each link of the
@@ -442,7 +469,11 @@ fn detect_parallelogram(
         sides.push((x, offset(geo, next(&l.branch_i, n, k)), false));
     }
     for (n, &x) in l.branch_j.iter().enumerate().rev() {
-        sides.push((x, offset(geo, next(&l.branch_j, n, tw)), true));
+        sides.push((
+            x,
+            offset_on_link(geo, desc.nl, next(&l.branch_j, n, tw)),
+            true,
+        ));
     }
     sides.retain(|(_, v, _)| planar(v).norm() > GEOMETRY_TOLERANCE);
     if sides.len() != 4 {
@@ -866,7 +897,7 @@ fn parallelogram_drive_parameters(class: &[usize], s: &mut State) {
 /// lambda^10 of frame `frame` (eqs 10.15–10.17: the coefficients of the ten inertial
 /// parameters of a(frame) in the energy function of link `frame` at q = 0).
 fn lambda10(desc: &RobotDescription, frame: usize) -> [Expr; 10] {
-    let (_, pp) = frame_expr(desc, frame);
+    let pp = position_on_link(desc, frame);
     let (x, y, z) = (pp.x.clone(), pp.y.clone(), pp.z.clone());
     [
         y.clone() * y.clone() + z.clone() * z.clone(),
