@@ -1,0 +1,182 @@
+//! robodyn side of the side-by-side benchmark against Pinocchio (`benches/peers/run.py`; not run
+//! by CI). Every call into robodyn is in this file.
+//!
+//! ```text
+//! cargo run --release --example peer_timing -- URDF STATES RESULTS [--samples N] [--target-us T]
+//! ```
+//!
+//! Loads the URDF with robodyn's loader, zeroes the rotor inertias and friction (Pinocchio's
+//! algorithms have neither), reads the states written by `run.py` (joints named as in the URDF,
+//! in Pinocchio's order), writes every algorithm's result on every state to RESULTS in that order
+//! (the agreement check) and prints `time <algorithm> <median ns per call>` lines: a sample times
+//! loops over all states, repeated so that it lasts about T microseconds; the median over the
+//! samples is printed (the same protocol as `pinocchio_peer.cpp`).
+
+use nalgebra::DMatrix;
+use robodyn::algorithms::direct_dynamics::{ddm_aba, ddm_composite, DirectWorkspace};
+use robodyn::algorithms::inertia_matrix::{inertia_matrix_into, InertiaWorkspace};
+use robodyn::algorithms::inverse_dynamics::rnea;
+use robodyn::model::param;
+use robodyn::{Robot, Workspace};
+use std::fmt::Write as _;
+use std::hint::black_box;
+use std::path::Path;
+use std::time::Instant;
+
+type Error = Box<dyn std::error::Error>;
+
+/// One state in robodyn's joint order (NL entries; fixed frames 0).
+struct State {
+    q: Vec<f64>,
+    qd: Vec<f64>,
+    qdd: Vec<f64>,
+    tau: Vec<f64>,
+}
+
+/// The robot with rotor inertia and friction set to zero.
+fn load_robot(path: &Path) -> Result<Robot, Error> {
+    let robot = robodyn::io::load(path)?;
+    let mut k = robot.standard_parameters();
+    for link in k.chunks_mut(13) {
+        link[param::IA] = 0.0;
+        link[param::FS] = 0.0;
+        link[param::FV] = 0.0;
+    }
+    Ok(robot.with_standard_parameters(&k)?)
+}
+
+/// Index in robodyn's state vectors (j - 1) of each joint named in the states file.
+fn joint_indices(robot: &Robot, names: &[&str]) -> Result<Vec<usize>, Error> {
+    names
+        .iter()
+        .map(|n| {
+            (1..=robot.nl())
+                .find(|&j| robot.frame(j).name == *n && robot.frame(j).joint.is_movable())
+                .map(|j| j - 1)
+                .ok_or_else(|| format!("joint {n} is not a movable joint of the robodyn model").into())
+        })
+        .collect()
+}
+
+/// States file: a line `names <joint>...`, then one line per state: q, v, a, tau (nv each).
+fn read_states(robot: &Robot, path: &Path) -> Result<(Vec<usize>, Vec<State>), Error> {
+    let text = std::fs::read_to_string(path)?;
+    let mut lines = text.lines();
+    let header = lines.next().ok_or("empty states file")?;
+    let names: Vec<&str> = header.split_whitespace().skip(1).collect();
+    let idx = joint_indices(robot, &names)?;
+    let nv = idx.len();
+    let mut states = Vec::new();
+    for line in lines.filter(|l| !l.trim().is_empty()) {
+        let x: Vec<f64> = line
+            .split_whitespace()
+            .map(str::parse)
+            .collect::<Result<_, _>>()?;
+        if x.len() != 4 * nv {
+            return Err(format!("state line with {} numbers, {} expected", x.len(), 4 * nv).into());
+        }
+        let scatter = |part: usize| {
+            let mut v = vec![0.0; robot.nl()];
+            for (k, &i) in idx.iter().enumerate() {
+                v[i] = x[part * nv + k];
+            }
+            v
+        };
+        states.push(State {
+            q: scatter(0),
+            qd: scatter(1),
+            qdd: scatter(2),
+            tau: scatter(3),
+        });
+    }
+    Ok((idx, states))
+}
+
+/// Median ns per call of `f` over the states (see the module doc).
+fn time(name: &str, states: &[State], samples: usize, target_us: f64, mut f: impl FnMut(&State)) {
+    let mut pass = || states.iter().for_each(&mut f);
+    pass();
+    let t0 = Instant::now();
+    pass();
+    let one = t0.elapsed().as_secs_f64() * 1e6;
+    let reps = ((target_us / one.max(1e-3)) as usize).max(1);
+    let mut ns: Vec<f64> = (0..samples)
+        .map(|_| {
+            let t = Instant::now();
+            for _ in 0..reps {
+                pass();
+            }
+            t.elapsed().as_secs_f64() * 1e9 / (reps * states.len()) as f64
+        })
+        .collect();
+    ns.sort_by(f64::total_cmp);
+    println!("time {name} {:.1}", ns[ns.len() / 2]);
+}
+
+fn main() -> Result<(), Error> {
+    let args: Vec<String> = std::env::args().collect();
+    if args.len() < 4 {
+        return Err("usage: peer_timing URDF STATES RESULTS [--samples N] [--target-us T]".into());
+    }
+    let (mut samples, mut target_us) = (21usize, 400.0);
+    for kv in args[4..].chunks(2) {
+        match (kv[0].as_str(), kv.get(1)) {
+            ("--samples", Some(v)) => samples = v.parse()?,
+            ("--target-us", Some(v)) => target_us = v.parse()?,
+            _ => return Err(format!("unknown option {}", kv[0]).into()),
+        }
+    }
+    let robot = load_robot(Path::new(&args[1]))?;
+    let (idx, states) = read_states(&robot, Path::new(&args[2]))?;
+    let model = robot.numeric();
+    let nl = robot.nl();
+    let mut ws = Workspace::new(model);
+    let mut iws = InertiaWorkspace::new(model);
+    let mut dws = DirectWorkspace::new(model);
+    let mut a = DMatrix::zeros(nl, nl);
+    let mut out = vec![0.0; nl];
+
+    let mut text = String::new();
+    let put = |text: &mut String, tag: &str, v: &[f64]| {
+        text.push_str(tag);
+        for &i in &idx {
+            write!(text, " {:e}", v[i]).unwrap();
+        }
+        text.push('\n');
+    };
+    for s in &states {
+        rnea(model, &mut ws, &s.q, &s.qd, &s.qdd, &mut out);
+        put(&mut text, "rnea", &out);
+        inertia_matrix_into(model, &mut iws, &s.q, &mut a);
+        text.push_str("crba");
+        for &r in &idx {
+            for &c in &idx {
+                write!(text, " {:e}", a[(r, c)])?;
+            }
+        }
+        text.push('\n');
+        ddm_aba(model, &mut dws, &s.q, &s.qd, &s.tau, &mut out)?;
+        put(&mut text, "aba", &out);
+        ddm_composite(model, &mut dws, &s.q, &s.qd, &s.tau, &mut out)?;
+        put(&mut text, "composite", &out);
+    }
+    std::fs::write(&args[3], text)?;
+
+    time("rnea", &states, samples, target_us, |s| {
+        rnea(model, &mut ws, black_box(&s.q), &s.qd, &s.qdd, &mut out);
+        black_box(&out);
+    });
+    time("crba_full", &states, samples, target_us, |s| {
+        inertia_matrix_into(model, &mut iws, black_box(&s.q), &mut a);
+        black_box(&a);
+    });
+    time("aba", &states, samples, target_us, |s| {
+        ddm_aba(model, &mut dws, black_box(&s.q), &s.qd, &s.tau, &mut out).unwrap();
+        black_box(&out);
+    });
+    time("composite", &states, samples, target_us, |s| {
+        ddm_composite(model, &mut dws, black_box(&s.q), &s.qd, &s.tau, &mut out).unwrap();
+        black_box(&out);
+    });
+    Ok(())
+}
