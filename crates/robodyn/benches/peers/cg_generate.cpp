@@ -6,7 +6,7 @@
 // Pinocchio's own code generators (CodeGenRNEA, CodeGenCRBA, CodeGenABA of
 // pinocchio/codegen/cppadcg-algo.hpp: the algorithm traced on CppAD::AD<CG<double>>, the tape
 // optimized, the C source emitted by CppADCodeGen) with the zero-order forward function only
-// (no Jacobian). The functions are named `cppad_cg_<name>_forward_zero(in, out, atomics)` with
+// (no Jacobian). The functions are named `<name>_forward_zero(in, out, atomics)` with
 // in[0] = x (rnea: [q v a], crba: q, aba: [q v tau]) and out[0] = y (rnea: tau, crba: the upper
 // triangle of M row by row, aba: ddq; Pinocchio's generators run crba and aba in the WORLD
 // convention). codegen.py compiles them with the same flags as robodyn's generated C.

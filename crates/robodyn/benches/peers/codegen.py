@@ -111,7 +111,7 @@ def build_robot(key, cli, gen, cflags, pin, prefix):
                      f"void cg_{name}(const double *x, double *y) {{\n"
                      "  const double *in[1] = {x};\n  double *out[1] = {y};\n"
                      "  struct LangCAtomicFun atomics = {0};\n"
-                     f"  cppad_cg_{name}_forward_zero(in, out, atomics);\n}}\n")
+                     f"  {name}_forward_zero(in, out, atomics);\n}}\n")
         objs.append(wrapper)
     rs = {}
     for model_kind, fname in (("idm", "rd_idm"), ("inertia", "rd_inertia"), ("ddm", "rd_ddm")):
