@@ -53,7 +53,9 @@ fn joint_indices(robot: &Robot, names: &[&str]) -> Result<Vec<usize>, Error> {
             (1..=robot.nl())
                 .find(|&j| robot.frame(j).name == *n && robot.frame(j).joint.is_movable())
                 .map(|j| j - 1)
-                .ok_or_else(|| format!("joint {n} is not a movable joint of the robodyn model").into())
+                .ok_or_else(|| {
+                    format!("joint {n} is not a movable joint of the robodyn model").into()
+                })
         })
         .collect()
 }
