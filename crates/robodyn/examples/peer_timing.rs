@@ -21,7 +21,10 @@ use robodyn::{Robot, Workspace};
 use std::fmt::Write as _;
 use std::hint::black_box;
 use std::path::Path;
-use std::time::Instant;
+
+#[path = "../benches/peers/median.rs"]
+mod median;
+use median::time;
 
 type Error = Box<dyn std::error::Error>;
 
@@ -92,27 +95,6 @@ fn read_states(robot: &Robot, path: &Path) -> Result<(Vec<usize>, Vec<State>), E
         });
     }
     Ok((idx, states))
-}
-
-/// Median ns per call of `f` over the states (see the module doc).
-fn time(name: &str, states: &[State], samples: usize, target_us: f64, mut f: impl FnMut(&State)) {
-    let mut pass = || states.iter().for_each(&mut f);
-    pass();
-    let t0 = Instant::now();
-    pass();
-    let one = t0.elapsed().as_secs_f64() * 1e6;
-    let reps = ((target_us / one.max(1e-3)) as usize).max(1);
-    let mut ns: Vec<f64> = (0..samples)
-        .map(|_| {
-            let t = Instant::now();
-            for _ in 0..reps {
-                pass();
-            }
-            t.elapsed().as_secs_f64() * 1e9 / (reps * states.len()) as f64
-        })
-        .collect();
-    ns.sort_by(f64::total_cmp);
-    println!("time {name} {:.1}", ns[ns.len() / 2]);
 }
 
 fn main() -> Result<(), Error> {

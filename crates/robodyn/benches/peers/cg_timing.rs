@@ -2,6 +2,7 @@
 //! codegen.py; NOT run by CI; compiled with rustc directly, no crate):
 //!
 //!   RD_IDM=... RD_INERTIA=... RD_DDM=... rustc -C opt-level=3 -C target-cpu=native cg_timing.rs
+//!   (with median.rs beside it)
 //!   cg_timing STATES RESULTS [samples] [target_us]
 //!
 //! Same STATES file and protocol as cg_timing.c; RESULTS lines `rs_rnea`, `rs_crba`, `rs_ddm` in
@@ -12,7 +13,8 @@ include!(env!("RD_INERTIA"));
 include!(env!("RD_DDM"));
 
 use std::hint::black_box;
-use std::time::Instant;
+mod median;
+use median::time;
 
 struct States {
     nv: usize,
@@ -62,26 +64,6 @@ fn read_states(path: &str) -> States {
     st
 }
 
-fn time(name: &str, ns: usize, samples: usize, target_us: f64, mut f: impl FnMut(usize)) {
-    let mut pass = || (0..ns).for_each(&mut f);
-    pass();
-    let t0 = Instant::now();
-    pass();
-    let one = t0.elapsed().as_secs_f64() * 1e6;
-    let reps = ((target_us / one.max(1e-3)) as usize).max(1);
-    let mut ts: Vec<f64> = (0..samples)
-        .map(|_| {
-            let t = Instant::now();
-            for _ in 0..reps {
-                pass();
-            }
-            t.elapsed().as_secs_f64() * 1e9 / (reps * ns) as f64
-        })
-        .collect();
-    ts.sort_by(f64::total_cmp);
-    println!("time {name} {:.1}", ts[samples / 2]);
-}
-
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let st = read_states(&args[1]);
@@ -111,15 +93,16 @@ fn main() {
         put(&mut text, "rs_ddm", &mut st.rank.iter().map(|&r| out[r]));
     }
     std::fs::write(&args[2], text).expect("results file");
-    time("rd_idm_rust", ns, samples, target_us, |s| {
+    let states: Vec<usize> = (0..ns).collect();
+    time("rd_idm_rust", &states, samples, target_us, |&s| {
         rd_idm(black_box(&st.q[s]), &st.qd[s], &st.qdd[s], &[], &mut out);
         black_box(&out);
     });
-    time("rd_inertia_rust", ns, samples, target_us, |s| {
+    time("rd_inertia_rust", &states, samples, target_us, |&s| {
         rd_inertia(black_box(&st.q[s]), &[], &mut out);
         black_box(&out);
     });
-    time("rd_ddm_rust", ns, samples, target_us, |s| {
+    time("rd_ddm_rust", &states, samples, target_us, |&s| {
         rd_ddm(black_box(&st.q[s]), &st.qd[s], &st.tau[s], &[], &mut out);
         black_box(&out);
     });

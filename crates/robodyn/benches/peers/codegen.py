@@ -22,7 +22,6 @@ CppADCodeGen, on UR5 and Panda (fixed base). NOT run by CI.
 import argparse
 import json
 import os
-import statistics
 import subprocess
 import sys
 
@@ -179,18 +178,13 @@ def main():
         print(f"  {peers.ROBOTS[key][0]}: " + ", ".join(f"{k} {v:.1e}" for k, v in worst.items()))
     if not ok:
         sys.exit("results disagree: no timing")
-    times = {key: {"c": [], "rs": []} for key in robots}
-    for r in range(args.rounds):
-        for key, robot in robots.items():
-            sides = [("c", robot["c"]), ("rs", robot["rs"])]
-            for side, exe in (sides if r % 2 == 0 else sides[::-1]):
-                times[key][side].append(peers.timed([exe, robot["cgstates"], os.devnull, str(args.samples)]))
-        print(f"round {r + 1}/{args.rounds} done", flush=True)
-
-    def med(side_rounds, name):
-        v = [t[name] for t in side_rounds]
-        m = statistics.median(v)
-        return m, (max(v) - min(v)) / m * 100
+    times = peers.interleaved(
+        args.rounds,
+        list(robots),
+        lambda key: [(side, [robots[key][side], robots[key]["cgstates"], os.devnull, str(args.samples)])
+                     for side in ("c", "rs")],
+    )
+    med = peers.round_stat
 
     print()
     print("| robot | model | robodyn C ns | robodyn Rust ns | CppADCodeGen ns | ratio C | ratio Rust | spread C / Rust / cg |")

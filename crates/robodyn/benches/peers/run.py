@@ -200,6 +200,26 @@ def timed(cmd):
     return {l.split()[1]: float(l.split()[2]) for l in out.splitlines() if l.startswith("time ")}
 
 
+def interleaved(rounds, keys, sides):
+    """Interleaved rounds pinned to one core: sides(key) gives [(side, command)], run in that order
+    in even rounds and reversed in odd ones. Returns times[key][side] = one dict per round."""
+    times = {key: {} for key in keys}
+    for r in range(rounds):
+        for key in keys:
+            order = sides(key)
+            for side, cmd in (order if r % 2 == 0 else order[::-1]):
+                times[key].setdefault(side, []).append(timed(cmd))
+        print(f"round {r + 1}/{rounds} done", flush=True)
+    return times
+
+
+def round_stat(rounds, name):
+    """Median over rounds of a timing, and the spread (max - min) in percent of it."""
+    v = [t[name] for t in rounds]
+    med = statistics.median(v)
+    return med, (max(v) - min(v)) / med * 100
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--rounds", type=int, default=5)
@@ -249,23 +269,17 @@ def main():
     if not ok:
         sys.exit("results disagree: no timing")
 
-    times = {key: {"pin": [], "rd": [], "merged": []} for key in robots}
     opts = ["--samples", str(args.samples)]
-    for r in range(args.rounds):
-        for key in robots:
-            urdf, mfile, sfile, _, merged = files[key]
-            sides = [("pin", [pin_exe, mfile, sfile, os.devnull, *opts]),
-                     ("rd", [rd_exe, urdf, sfile, os.devnull, *opts])]
-            if args.merged:
-                sides.append(("merged", [rd_exe, merged, sfile, os.devnull, *opts]))
-            for side, cmd in (sides if r % 2 == 0 else sides[::-1]):
-                times[key][side].append(timed(cmd))
-        print(f"round {r + 1}/{args.rounds} done", flush=True)
 
-    def stat(rounds, name):
-        v = [t[name] for t in rounds]
-        med = statistics.median(v)
-        return med, (max(v) - min(v)) / med * 100
+    def sides(key):
+        urdf, mfile, sfile, _, merged = files[key]
+        out = [("pin", [pin_exe, mfile, sfile, os.devnull, *opts]), ("rd", [rd_exe, urdf, sfile, os.devnull, *opts])]
+        if args.merged:
+            out.append(("merged", [rd_exe, merged, sfile, os.devnull, *opts]))
+        return out
+
+    times = interleaved(args.rounds, robots, sides)
+    stat = round_stat
 
     print()
     extra = " robodyn merged ns | ratio merged |" if args.merged else ""
@@ -273,7 +287,7 @@ def main():
     print("|---|---|---|---|---|---|" + ("---|---|" if args.merged else ""))
     for key in robots:
         nv = files[key][3]
-        rd, pn, rdm = times[key]["rd"], times[key]["pin"], times[key]["merged"]
+        rd, pn, rdm = times[key]["rd"], times[key]["pin"], times[key].get("merged")
         for label, rname, pnames in [
             ("inverse dynamics (rnea)", "rnea", ["rnea"]),
             ("inertia matrix, full (crba + lower fill)", "crba_full", ["crba_full_local", "crba_full_world"]),
