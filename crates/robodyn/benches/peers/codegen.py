@@ -19,7 +19,6 @@ CppADCodeGen, on UR5 and Panda (fixed base). NOT run by CI.
    same states; then interleaved rounds pinned to one core; medians as in run.py.
 """
 
-import argparse
 import json
 import os
 import subprocess
@@ -154,10 +153,7 @@ def check(robot):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--rounds", type=int, default=5)
-    ap.add_argument("--samples", type=int, default=15)
-    ap.add_argument("--robots", default="ur5,panda")
+    ap = peers.arg_parser(__doc__, "ur5,panda")
     ap.add_argument("--cflags", default="-O3 -march=native", help="flags of every generated C file")
     args = ap.parse_args()
     import pinocchio as pin

@@ -220,11 +220,17 @@ def round_stat(rounds, name):
     return med, (max(v) - min(v)) / med * 100
 
 
+def arg_parser(doc, robots):
+    """Options shared by run.py and codegen.py."""
+    ap = argparse.ArgumentParser(description=doc, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--rounds", type=int, default=5, help="interleaved rounds")
+    ap.add_argument("--samples", type=int, default=15, help="samples per timing in each round")
+    ap.add_argument("--robots", default=robots, help="comma-separated, among " + ", ".join(ROBOTS))
+    return ap
+
+
 def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--rounds", type=int, default=5)
-    ap.add_argument("--samples", type=int, default=15)
-    ap.add_argument("--robots", default="ur5,panda,talos")
+    ap = arg_parser(__doc__, "ur5,panda,talos")
     ap.add_argument("--codegen", action="store_true", help="also the generated-code comparison (codegen.py)")
     ap.add_argument("--merged", action="store_true",
                     help="also time robodyn on the URDF rewritten with fixed joints merged (experiment)")
