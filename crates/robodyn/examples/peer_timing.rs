@@ -13,11 +13,10 @@
 //! samples is printed (the same protocol as `pinocchio_peer.cpp`).
 
 use nalgebra::DMatrix;
-use robodyn::algorithms::direct_dynamics::{ddm_aba, ddm_composite, DirectWorkspace};
-use robodyn::algorithms::inertia_matrix::{inertia_matrix_into, InertiaWorkspace};
-use robodyn::algorithms::inverse_dynamics::rnea;
 use robodyn::model::param;
-use robodyn::{Robot, Workspace};
+use robodyn::{
+    direct_dynamics_into, inertia_matrix_into, inverse_dynamics_into, Data, Method, Robot,
+};
 use std::fmt::Write as _;
 use std::hint::black_box;
 use std::path::Path;
@@ -28,7 +27,7 @@ use median::time;
 
 type Error = Box<dyn std::error::Error>;
 
-/// One state in robodyn's joint order (NL entries; fixed frames 0).
+/// One state over robodyn's movable joints (its joint vectors).
 struct State {
     q: Vec<f64>,
     qd: Vec<f64>,
@@ -48,17 +47,15 @@ fn load_robot(path: &Path) -> Result<Robot, Error> {
     Ok(robot.with_standard_parameters(&k)?)
 }
 
-/// Index in robodyn's state vectors (j - 1) of each joint named in the states file.
+/// Entry in robodyn's joint vectors of each joint named in the states file.
 fn joint_indices(robot: &Robot, names: &[&str]) -> Result<Vec<usize>, Error> {
+    let c = robot.coordinates();
     names
         .iter()
         .map(|n| {
-            (1..=robot.nl())
-                .find(|&j| robot.frame(j).name == *n && robot.frame(j).joint.is_movable())
-                .map(|j| j - 1)
-                .ok_or_else(|| {
-                    format!("joint {n} is not a movable joint of the robodyn model").into()
-                })
+            c.index_of(n).ok_or_else(|| {
+                format!("joint {n} is not a movable joint of the robodyn model").into()
+            })
         })
         .collect()
 }
@@ -71,6 +68,9 @@ fn read_states(robot: &Robot, path: &Path) -> Result<(Vec<usize>, Vec<State>), E
     let names: Vec<&str> = header.split_whitespace().skip(1).collect();
     let idx = joint_indices(robot, &names)?;
     let nv = idx.len();
+    if nv != robot.dof() {
+        return Err(format!("{nv} joints in the states, robodyn has {}", robot.dof()).into());
+    }
     let mut states = Vec::new();
     for line in lines.filter(|l| !l.trim().is_empty()) {
         let x: Vec<f64> = line
@@ -81,7 +81,7 @@ fn read_states(robot: &Robot, path: &Path) -> Result<(Vec<usize>, Vec<State>), E
             return Err(format!("state line with {} numbers, {} expected", x.len(), 4 * nv).into());
         }
         let scatter = |part: usize| {
-            let mut v = vec![0.0; robot.nl()];
+            let mut v = vec![0.0; nv];
             for (k, &i) in idx.iter().enumerate() {
                 v[i] = x[part * nv + k];
             }
@@ -112,13 +112,12 @@ fn main() -> Result<(), Error> {
     }
     let robot = load_robot(Path::new(&args[1]))?;
     let (idx, states) = read_states(&robot, Path::new(&args[2]))?;
-    let model = robot.numeric();
-    let nl = robot.nl();
-    let mut ws = Workspace::new(model);
-    let mut iws = InertiaWorkspace::new(model);
-    let mut dws = DirectWorkspace::new(model);
-    let mut a = DMatrix::zeros(nl, nl);
-    let mut out = vec![0.0; nl];
+    let n = robot.dof();
+    let env = robot.environment().clone();
+    let mut data = Data::new(&robot);
+    let mut a = DMatrix::zeros(n, n);
+    let mut out = vec![0.0; n];
+    let (cmp, aba) = (Method::Composite, Method::ArticulatedBody);
 
     let mut text = String::new();
     let put = |text: &mut String, tag: &str, v: &[f64]| {
@@ -129,9 +128,9 @@ fn main() -> Result<(), Error> {
         text.push('\n');
     };
     for s in &states {
-        rnea(model, &mut ws, &s.q, &s.qd, &s.qdd, &mut out);
+        inverse_dynamics_into(&robot, &mut data, &env, &s.q, &s.qd, &s.qdd, &mut out)?;
         put(&mut text, "rnea", &out);
-        inertia_matrix_into(model, &mut iws, &s.q, &mut a);
+        inertia_matrix_into(&robot, &mut data, &s.q, &mut a)?;
         text.push_str("crba");
         for &r in &idx {
             for &c in &idx {
@@ -139,27 +138,38 @@ fn main() -> Result<(), Error> {
             }
         }
         text.push('\n');
-        ddm_aba(model, &mut dws, &s.q, &s.qd, &s.tau, &mut out)?;
+        direct_dynamics_into(&robot, &mut data, &env, &s.q, &s.qd, &s.tau, aba, &mut out)?;
         put(&mut text, "aba", &out);
-        ddm_composite(model, &mut dws, &s.q, &s.qd, &s.tau, &mut out)?;
+        direct_dynamics_into(&robot, &mut data, &env, &s.q, &s.qd, &s.tau, cmp, &mut out)?;
         put(&mut text, "composite", &out);
     }
     std::fs::write(&args[3], text)?;
 
     time("rnea", &states, samples, target_us, |s| {
-        rnea(model, &mut ws, black_box(&s.q), &s.qd, &s.qdd, &mut out);
+        inverse_dynamics_into(
+            &robot,
+            &mut data,
+            &env,
+            black_box(&s.q),
+            &s.qd,
+            &s.qdd,
+            &mut out,
+        )
+        .unwrap();
         black_box(&out);
     });
     time("crba_full", &states, samples, target_us, |s| {
-        inertia_matrix_into(model, &mut iws, black_box(&s.q), &mut a);
+        inertia_matrix_into(&robot, &mut data, black_box(&s.q), &mut a).unwrap();
         black_box(&a);
     });
     time("aba", &states, samples, target_us, |s| {
-        ddm_aba(model, &mut dws, black_box(&s.q), &s.qd, &s.tau, &mut out).unwrap();
+        let q = black_box(&s.q);
+        direct_dynamics_into(&robot, &mut data, &env, q, &s.qd, &s.tau, aba, &mut out).unwrap();
         black_box(&out);
     });
     time("composite", &states, samples, target_us, |s| {
-        ddm_composite(model, &mut dws, black_box(&s.q), &s.qd, &s.tau, &mut out).unwrap();
+        let q = black_box(&s.q);
+        direct_dynamics_into(&robot, &mut data, &env, q, &s.qd, &s.tau, cmp, &mut out).unwrap();
         black_box(&out);
     });
     Ok(())
