@@ -74,6 +74,7 @@
 #![warn(missing_docs)]
 
 pub mod algorithms;
+pub mod batch;
 #[cfg(feature = "codegen")]
 #[allow(missing_docs)] // documented by the code-generation work (issue 14.8)
 pub mod codegen;
@@ -108,6 +109,7 @@ pub use algorithms::inertia_matrix::{
 };
 pub use algorithms::inverse_dynamics::{inverse_dynamics, inverse_dynamics_into};
 pub use algorithms::regressor::{regressor, regressor_into, wrench_torques, wrench_torques_into};
+pub use batch::{direct_dynamics_batch, inverse_dynamics_batch, regressor_batch};
 pub use data::Data;
 pub use error::{Error, Result};
 pub use model::{BaseMotion, Coordinates, DynModel, Environment, Robot, RobotDescription, Wrench};
