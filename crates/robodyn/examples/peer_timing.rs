@@ -11,6 +11,9 @@
 //! (the agreement check) and prints `time <algorithm> <median ns per call>` lines: a sample times
 //! loops over all states, repeated so that it lasts about T microseconds; the median over the
 //! samples is printed (the same protocol as `pinocchio_peer.cpp`).
+//!
+//! `peer_timing --batch URDF N` times `inverse_dynamics_batch` on N random states with a rayon
+//! pool of 1 and of 2 threads (median of 7 runs each) and prints their ratio.
 
 use nalgebra::DMatrix;
 use robodyn::model::param;
@@ -97,8 +100,52 @@ fn read_states(robot: &Robot, path: &Path) -> Result<(Vec<usize>, Vec<State>), E
     Ok((idx, states))
 }
 
+/// `--batch URDF N`: batch inverse dynamics of N random states on 1 and 2 threads.
+fn batch(path: &Path, rows: usize) -> Result<(), Error> {
+    use rand::Rng;
+    let robot = load_robot(path)?;
+    let n = robot.dof();
+    let mut r = robodyn::testing::rng(1);
+    let mut v = |s: f64| {
+        (0..rows * n)
+            .map(|_| r.random_range(-s..s))
+            .collect::<Vec<f64>>()
+    };
+    let (q, qd, qdd) = (v(3.0), v(2.0), v(5.0));
+    let mut tau = vec![0.0; rows * n];
+    let env = robot.environment();
+    let mut med = Vec::new();
+    for threads in [1, 2] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()?;
+        let mut ms: Vec<f64> = (0..7)
+            .map(|_| {
+                let t = std::time::Instant::now();
+                pool.install(|| {
+                    robodyn::inverse_dynamics_batch(&robot, env, black_box(&q), &qd, &qdd, &mut tau)
+                })
+                .unwrap();
+                black_box(&tau);
+                t.elapsed().as_secs_f64() * 1e3
+            })
+            .collect();
+        ms.sort_by(f64::total_cmp);
+        println!(
+            "batch idm {rows} states, {threads} thread(s): median {:.2} ms",
+            ms[3]
+        );
+        med.push(ms[3]);
+    }
+    println!("speedup 2 threads / 1 thread: {:.2}", med[0] / med[1]);
+    Ok(())
+}
+
 fn main() -> Result<(), Error> {
     let args: Vec<String> = std::env::args().collect();
+    if args.len() == 4 && args[1] == "--batch" {
+        return batch(Path::new(&args[2]), args[3].parse()?);
+    }
     if args.len() < 4 {
         return Err("usage: peer_timing URDF STATES RESULTS [--samples N] [--target-us T]".into());
     }
