@@ -348,3 +348,16 @@ pub fn conditioning_json(c: &robodyn::Conditioning) -> serde_json::Map<String, s
     o.insert("singularity_warning".into(), serde_json::json!(c.warning));
     o
 }
+
+/// Column `i` (q, qd, qdd or tau) of the states as one row-major N x n slice: the layout of the
+/// library's batch functions (`robodyn::batch`).
+pub fn state_column(states: &[[Vec<f64>; 3]], i: usize) -> Vec<f64> {
+    states.iter().flat_map(|s| s[i].iter().copied()).collect()
+}
+
+/// The `count` rows of n entries of a row-major result.
+pub fn result_rows(flat: &[f64], n: usize, count: usize) -> Vec<Vec<f64>> {
+    (0..count)
+        .map(|s| flat[s * n..(s + 1) * n].to_vec())
+        .collect()
+}

@@ -37,6 +37,9 @@ pub struct Data<T: DynScalar = f64> {
     pub(crate) mc: Vec<T>,
     /// A(q) (NL x NL), then its L'DL factors.
     pub(crate) a: DMatrix<T>,
+    /// A(q) and its L'DL factors for the model of the dynamic recursions (N x N over the
+    /// movable joints, [`Robot::dynamic`]).
+    pub(crate) a_dyn: DMatrix<T>,
     /// Articulated bodies: gamma_j, J*_j, beta*_j, u_j = J*_j a_j, H_j, Gamma_j minus friction,
     /// classical accelerations [Vd_j; wd_j].
     pub(crate) gamma: Vec<Vector6<T>>,
@@ -52,7 +55,6 @@ pub struct Data<T: DynScalar = f64> {
     pub(crate) q: Vec<T>,
     pub(crate) qd: Vec<T>,
     pub(crate) qdd: Vec<T>,
-    pub(crate) tau: Vec<T>,
     pub(crate) h: Vec<T>,
     pub(crate) zeros: Vec<T>,
 }
@@ -60,7 +62,10 @@ pub struct Data<T: DynScalar = f64> {
 impl Data<f64> {
     /// The buffers of `robot`'s algorithms.
     pub fn new(robot: &Robot) -> Data<f64> {
-        Data::from_model(robot.numeric())
+        let mut d = Data::from_model(robot.numeric());
+        let n = robot.dynamic().nl;
+        d.a_dyn = DMatrix::zeros(n, n);
+        d
     }
 
     /// Error unless this data was made for a model of `robot`'s size ([`Error::Dimension`]).
@@ -106,6 +111,7 @@ impl<T: DynScalar> Data<T> {
             msc: v(),
             mc: vec![T::zero(); nl + 1],
             a: DMatrix::from_element(nl, nl, T::zero()),
+            a_dyn: DMatrix::from_element(0, 0, T::zero()),
             gamma: v6(),
             art_inertia: vec![Matrix6::zeros(); nl + 1],
             art_bias: v6(),
@@ -117,7 +123,6 @@ impl<T: DynScalar> Data<T> {
             q: z(),
             qd: z(),
             qdd: z(),
-            tau: z(),
             h: z(),
             zeros: z(),
         }

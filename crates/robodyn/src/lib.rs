@@ -74,6 +74,7 @@
 #![deny(missing_docs)]
 
 pub mod algorithms;
+pub mod batch;
 #[cfg(feature = "codegen")]
 pub mod codegen;
 pub mod data;
@@ -105,6 +106,7 @@ pub use algorithms::inertia_matrix::{
 };
 pub use algorithms::inverse_dynamics::{inverse_dynamics, inverse_dynamics_into};
 pub use algorithms::regressor::{regressor, regressor_into, wrench_torques, wrench_torques_into};
+pub use batch::{direct_dynamics_batch, inverse_dynamics_batch, regressor_batch};
 pub use data::Data;
 pub use error::{Error, Result};
 pub use model::{BaseMotion, Coordinates, DynModel, Environment, Robot, RobotDescription, Wrench};

@@ -7,11 +7,11 @@
 //! or `--guess`); rows near a singularity are flagged on stderr and in JSON.
 
 use crate::common::{
-    conditioning_json, read_joint_states, start_branch, warn_conditioning, CliResult, NamesArg,
-    RobotArgs, TableOutput,
+    conditioning_json, read_joint_states, result_rows, start_branch, state_column,
+    warn_conditioning, CliResult, NamesArg, RobotArgs, TableOutput,
 };
 use robodyn::{
-    closed_direct_dynamics_into, direct_dynamics_into, ClosedChain, ClosedData, Data, Method,
+    closed_direct_dynamics_into, direct_dynamics_batch, ClosedChain, ClosedData, Method,
 };
 use std::path::PathBuf;
 
@@ -77,24 +77,13 @@ pub fn run(a: Args) -> CliResult {
         a.names,
         "movable joints",
     )?;
-    let mut data = Data::new(&robot);
+    // every row at once over the cores (the library's batch; errors name their row)
+    let (n, col) = (coords.len(), |i| state_column(&states, i));
+    let mut qdd = vec![0.0; states.len() * n];
     let env = robot.environment();
-    let mut rows = Vec::with_capacity(states.len());
-    for (k, [q, qd, tau]) in states.iter().enumerate() {
-        let mut qdd = vec![0.0; coords.len()];
-        direct_dynamics_into(
-            &robot,
-            &mut data,
-            env,
-            q,
-            qd,
-            tau,
-            a.method.into(),
-            &mut qdd,
-        )
-        .map_err(|e| e.in_row(k + 1))?;
-        rows.push(qdd);
-    }
+    let method = a.method.into();
+    direct_dynamics_batch(&robot, env, &col(0), &col(1), &col(2), method, &mut qdd)?;
+    let rows = result_rows(&qdd, n, states.len());
     a.out.write(&a.names.columns("qdd", coords), &rows)
 }
 

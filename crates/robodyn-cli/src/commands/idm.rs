@@ -7,10 +7,10 @@
 //! robot's `assembly` or `--guess`); rows near a singularity are flagged on stderr and in JSON.
 
 use crate::common::{
-    conditioning_json, read_joint_states, start_branch, warn_conditioning, CliResult, NamesArg,
-    RobotArgs, TableOutput,
+    conditioning_json, read_joint_states, result_rows, start_branch, state_column,
+    warn_conditioning, CliResult, NamesArg, RobotArgs, TableOutput,
 };
-use robodyn::{closed_inverse_dynamics_into, inverse_dynamics_into, ClosedChain, ClosedData, Data};
+use robodyn::{closed_inverse_dynamics_into, inverse_dynamics_batch, ClosedChain, ClosedData};
 use std::path::PathBuf;
 
 #[derive(clap::Args, Debug)]
@@ -55,15 +55,12 @@ pub fn run(a: Args) -> CliResult {
         a.names,
         "movable joints",
     )?;
-    let mut data = Data::new(&robot);
+    // every row at once over the cores (the library's batch; errors name their row)
+    let (n, col) = (coords.len(), |i| state_column(&states, i));
+    let mut tau = vec![0.0; states.len() * n];
     let env = robot.environment();
-    let mut rows = Vec::with_capacity(states.len());
-    for (k, [q, qd, qdd]) in states.iter().enumerate() {
-        let mut tau = vec![0.0; coords.len()];
-        inverse_dynamics_into(&robot, &mut data, env, q, qd, qdd, &mut tau)
-            .map_err(|e| e.in_row(k + 1))?;
-        rows.push(tau);
-    }
+    inverse_dynamics_batch(&robot, env, &col(0), &col(1), &col(2), &mut tau)?;
+    let rows = result_rows(&tau, n, states.len());
     a.out.write(&a.names.columns("tau", coords), &rows)
 }
 

@@ -8,13 +8,12 @@
 //! every loop (the numerical method is then the arbiter).
 
 use crate::common::{
-    read_joint_states, warn_conditioning, CliResult, NamesArg, RobotArgs, TableOutput,
+    read_joint_states, state_column, warn_conditioning, CliResult, NamesArg, RobotArgs, TableOutput,
 };
 use robodyn::algorithms::regressor::{
     base_columns, standard_columns, ParameterSelection, RotorMode, ZeroParameters, PARAMS_PER_LINK,
 };
-use robodyn::{closed_regressor_into, regressor_into, wrench_torques_into};
-use robodyn::{ClosedChain, ClosedData, Data};
+use robodyn::{closed_regressor_into, regressor_batch, ClosedChain, ClosedData};
 use std::path::PathBuf;
 
 #[derive(clap::Args, Debug)]
@@ -75,32 +74,53 @@ pub fn run(a: Args) -> CliResult {
         "joints",
     )?;
     let n = coords.len();
-    let mut phi = nalgebra::DMatrix::zeros(n, PARAMS_PER_LINK * nl);
+    let cols = PARAMS_PER_LINK * nl;
+    let mut phi = nalgebra::DMatrix::zeros(n, cols);
     let mut tau_e = vec![0.0; n];
     let env = robot.environment();
     let mut rows = Vec::new();
-    let mut tree_data = Data::new(&robot);
     let mut closed = match &chain {
         Some(c) => Some((c, ClosedData::new(c), c.assembly_branch()?)),
         None => None,
     };
+    // trees: every row at once over the cores (the library's batch; errors name their row),
+    // row-major Phi of every state; closed chains: one state at a time into the first slot
+    let count = if closed.is_none() { states.len() } else { 1 };
+    let mut phi_all = vec![0.0; count * n * cols];
+    let mut tau_e_all = vec![0.0; count * n];
+    if closed.is_none() {
+        let col = |i| state_column(&states, i);
+        regressor_batch(
+            &robot,
+            env,
+            &col(0),
+            &col(1),
+            &col(2),
+            &mut phi_all,
+            &mut tau_e_all,
+        )?;
+    }
     for (s, [q, qd, qdd]) in states.iter().enumerate() {
-        match &mut closed {
+        let slot = match &mut closed {
             // Gamma_cl rows (10.40): G^T Phi and G^T Gamma_e, actuated-joint order
             Some((c, d, b)) => {
                 let cond = closed_regressor_into(c, d, b, env, [q, qd, qdd], &mut phi, &mut tau_e)
                     .map_err(|e| e.in_row(s + 1))?;
                 warn_conditioning(c, s + 1, states.len(), &cond);
+                for k in 0..n {
+                    for c in 0..cols {
+                        phi_all[k * cols + c] = phi[(k, c)];
+                    }
+                }
+                tau_e_all.copy_from_slice(&tau_e);
+                0
             }
-            None => {
-                regressor_into(&robot, &mut tree_data, env, q, qd, qdd, &mut phi)
-                    .and_then(|()| wrench_torques_into(&robot, &mut tree_data, env, q, &mut tau_e))
-                    .map_err(|e| e.in_row(s + 1))?;
-            }
-        }
+            None => s,
+        };
         for k in 0..n {
-            let mut row = vec![(s + 1) as f64, coords.frame(k) as f64, tau_e[k]];
-            row.extend(columns.indices.iter().map(|&c| phi[(k, c)]));
+            let r = slot * n + k;
+            let mut row = vec![(s + 1) as f64, coords.frame(k) as f64, tau_e_all[r]];
+            row.extend(columns.indices.iter().map(|&c| phi_all[r * cols + c]));
             rows.push(row);
         }
     }

@@ -14,7 +14,7 @@
 //! [`Error::Singular`] naming the joint, never a NaN.
 
 use crate::algorithms::inertia_matrix::composite_inertia_matrix;
-use crate::algorithms::inverse_dynamics::{rnea_with_environment, tree_vector_map};
+use crate::algorithms::inverse_dynamics::{folded_wrench, rnea_with_environment, tree_vector_map};
 use crate::data::Data;
 use crate::error::{Error, Result};
 use crate::model::{DynModel, Environment, JointType, Robot};
@@ -153,7 +153,15 @@ pub fn ddm_composite(
     tau: &[f64],
     qdd: &mut [f64],
 ) -> Result<()> {
-    let mut a = std::mem::replace(&mut ws.a, DMatrix::zeros(0, 0));
+    // A in the buffer of its size: NL x NL for the full model, N x N for the model of the
+    // dynamic recursions (sized here at the first call of a Data made for another model)
+    let n = model.nl;
+    let full = ws.a.nrows() == n;
+    let slot = if full { &mut ws.a } else { &mut ws.a_dyn };
+    let mut a = std::mem::replace(slot, DMatrix::zeros(0, 0));
+    if a.shape() != (n, n) {
+        a = DMatrix::zeros(n, n);
+    }
     let mut h = std::mem::take(&mut ws.h);
     let z = std::mem::take(&mut ws.zeros);
     composite_inertia_matrix(model, ws, q, &mut a);
@@ -165,7 +173,11 @@ pub fn ddm_composite(
         }
         ltdl_solve(model, &a, qdd);
     }
-    ws.a = a;
+    if full {
+        ws.a = a;
+    } else {
+        ws.a_dyn = a;
+    }
     ws.h = h;
     ws.zeros = z;
     r?;
@@ -285,7 +297,7 @@ pub fn ddm_aba(
         ia.fixed_view_mut::<3, 3>(0, 3).copy_from(&(-sm));
         ia.fixed_view_mut::<3, 3>(3, 0).copy_from(&sm);
         ia.fixed_view_mut::<3, 3>(3, 3).copy_from(&l.inertia);
-        let e = env.wrench(j);
+        let e = env.wrench(model.wrench_link(j));
         let f = w.cross(&w.cross(&l.ms)) + e.force;
         let m = w.cross(&(l.inertia * w)) + e.moment;
         b.art_bias[j] = Vector6::new(f.x, f.y, f.z, m.x, m.y, m.z);
@@ -301,6 +313,11 @@ pub fn ddm_aba(
             .max(l.mass.abs())
             .max(l.inertia.trace().abs())
             .max(l.ia.abs());
+    }
+    for fl in &model.folded {
+        if let Some((f, m)) = folded_wrench(fl, env) {
+            b.art_bias[fl.host] += Vector6::new(f.x, f.y, f.z, m.x, m.y, m.z);
+        }
     }
     // Backward: articulated inertias.
     for k in (1..=n).rev() {

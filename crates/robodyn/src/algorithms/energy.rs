@@ -170,6 +170,17 @@ pub fn convert_model<T: DynScalar>(m: &DynModel<f64>) -> DynModel<T> {
             })
             .collect(),
         env: convert_environment(&m.env),
+        link_of: m.link_of.clone(),
+        folded: m
+            .folded
+            .iter()
+            .map(|fl| crate::model::FoldedLink {
+                host: fl.host,
+                link: fl.link,
+                rot: fl.rot.map(f),
+                pos: map3(&fl.pos),
+            })
+            .collect(),
     }
 }
 

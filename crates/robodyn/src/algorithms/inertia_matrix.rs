@@ -9,21 +9,18 @@
 //! Ia_j is on the diagonal. Written once over [`DynScalar`]: the symbolic generator runs it on
 //! expressions.
 
-use crate::algorithms::inverse_dynamics::{
-    check_state, on_tree_arrays, rnea_with_environment, tree_vector_map,
-};
+use crate::algorithms::inverse_dynamics::{check_state, rnea_with_environment, tree_vector_map};
 use crate::data::Data;
 use crate::error::Result;
-use crate::model::{DynModel, Environment, JointType, Robot};
+use crate::model::{inertia_to_antecedent, DynModel, Environment, JointType, Robot};
 use crate::scalar::DynScalar;
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 
 /// Composite links (backward recursion j = NL..1): jJ^c, jMS^c, M^c of every link about its own
 /// origin, and iA_j, iP_j, in the buffers of `ws` (kernel, tree array q).
 ///
-/// Moving the inertia (J, MS, M) of a body from R_k to R_i with R = iA_k, p = iP_k, m = R MS
-/// (parallel-axis theorem with J = integral of -skew(r)^2 dm, r = p + s):
-/// J' = R J R' + M (p'p I - p p') + 2 (p'm) I - m p' - p m',  MS' = m + M p,  M' = M.
+/// Composite link k is moved to its antecedent by [`inertia_to_antecedent`] (parallel-axis
+/// theorem).
 pub fn composite_links<T: DynScalar>(model: &DynModel<T>, ws: &mut Data<T>, q: &[T]) {
     for j in 1..=model.nl {
         let (rot, pos) = model.frame(j).transform(&q[j - 1]);
@@ -41,19 +38,9 @@ pub fn composite_links<T: DynScalar>(model: &DynModel<T>, ws: &mut Data<T>, q: &
         if i == 0 {
             continue;
         }
-        let r = &ws.rot[k];
-        let p = &ws.pos[k];
+        let (jk, ms) =
+            inertia_to_antecedent(&ws.rot[k], &ws.pos[k], &ws.jc[k], &ws.msc[k], &ws.mc[k]);
         let mk = ws.mc[k].clone();
-        let m = r * &ws.msc[k];
-        let pm = p.dot(&m);
-        let pp = p.dot(p);
-        let ident = Matrix3::<T>::identity();
-        let jk = r * &ws.jc[k] * r.transpose()
-            + (&ident * pp - p * p.transpose()) * mk.clone()
-            + &ident * (pm.clone() + pm)
-            - &m * p.transpose()
-            - p * m.transpose();
-        let ms = m + p * mk.clone();
         ws.jc[i] += jk;
         ws.msc[i] += ms;
         ws.mc[i] += mk;
@@ -163,23 +150,9 @@ pub fn inertia_matrix_into(
             format!("{n} x {n} over {}", c.describe("movable joints")),
         ));
     }
-    let model = robot.numeric();
-    on_tree_arrays(robot, data, [q, q, q], |data, q, _, _| {
-        let mut full = std::mem::replace(&mut data.a, DMatrix::zeros(0, 0));
-        composite_inertia_matrix(model, data, q, &mut full);
-        gather_matrix(c.frames(), &full, a);
-        data.a = full;
-    });
+    // the model of the dynamic recursions: its A is the matrix over the movable joints
+    composite_inertia_matrix(robot.dynamic(), data, q, a);
     Ok(())
-}
-
-/// out[(r, c)] = full[(j_r - 1, j_c - 1)] for the joints `js`.
-pub(crate) fn gather_matrix(js: &[usize], full: &DMatrix<f64>, out: &mut DMatrix<f64>) {
-    for (c, &jc) in js.iter().enumerate() {
-        for (r, &jr) in js.iter().enumerate() {
-            out[(r, c)] = full[(jr - 1, jc - 1)];
-        }
-    }
 }
 
 /// A(q) (N x N over the movable joints); checks its input and allocates.

@@ -10,7 +10,7 @@
 
 use crate::data::Data;
 use crate::error::Result;
-use crate::model::{DynModel, Environment, JointType, Robot};
+use crate::model::{DynModel, Environment, FoldedLink, JointType, Robot};
 use crate::scalar::DynScalar;
 use nalgebra::{DVector, Matrix3, Vector3};
 
@@ -261,7 +261,7 @@ pub(crate) fn forward_pass<T: DynScalar>(
         // (10.8): M = J wd + w x (J w) + MS x vd
         let m = euler_moment(&l.inertia, &l.inertia_diff, &wd, &p, &sq, &u) + l.ms.cross(&vd);
         ws.u[j] = u;
-        let e = env.wrench(j);
+        let e = env.wrench(model.wrench_link(j));
         ws.f[j] = name3(f + &e.force, "F", j);
         ws.m[j] = name3(m + &e.moment, "No", j);
         ws.rot[j] = rot;
@@ -270,6 +270,40 @@ pub(crate) fn forward_pass<T: DynScalar>(
         ws.wd[j] = wd;
         ws.vd[j] = vd;
     }
+    add_folded_wrenches(model, env, &mut ws.f, &mut ws.m);
+}
+
+/// Carry the external wrenches of the links folded into movable links ([`DynModel::folded`])
+/// onto their host, into the force and moment buffers `f`, `m` (indexed by link).
+pub(crate) fn add_folded_wrenches<T: DynScalar>(
+    model: &DynModel<T>,
+    env: &Environment<T>,
+    f: &mut [Vector3<T>],
+    m: &mut [Vector3<T>],
+) {
+    for fl in &model.folded {
+        if let Some((fh, mh)) = folded_wrench(fl, env) {
+            f[fl.host] += fh;
+            m[fl.host] += mh;
+        }
+    }
+}
+
+/// The external wrench of a folded link moved onto its host (about O_h, in R_h):
+/// hA_k f_k and hA_k m_k + hP_k x (hA_k f_k) (eqs 10.10–10.11 for a rigid attachment); None for
+/// a zero wrench.
+#[inline]
+pub(crate) fn folded_wrench<T: DynScalar>(
+    fl: &FoldedLink<T>,
+    env: &Environment<T>,
+) -> Option<(Vector3<T>, Vector3<T>)> {
+    let e = env.wrench(fl.link);
+    if e.force.iter().chain(e.moment.iter()).all(|x| x.is_zero()) {
+        return None;
+    }
+    let fh = &fl.rot * &e.force;
+    let mh = &fl.rot * &e.moment + fl.pos.cross(&fh);
+    Some((fh, mh))
 }
 
 /// Backward recursion (eqs 10.9–10.12) after [`forward_recursion`]: accumulates the wrenches
@@ -415,8 +449,8 @@ pub(crate) fn on_tree_arrays<R>(
 
 /// The frame of the checked tree functions that map joint vectors to a joint vector: check the
 /// inputs `x` (named `names`), the data, the environment and the output's length; run `kernel`
-/// on tree arrays (scattered from the movable joints when some frames are fixed) writing a tree
-/// array; gather it into `out`. Allocation-free.
+/// on the model of the dynamic recursions ([`Robot::dynamic`], fixed frames folded out), whose
+/// tree arrays are the joint vectors themselves. Allocation-free.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn tree_vector_map<R>(
     robot: &Robot,
@@ -430,16 +464,10 @@ pub(crate) fn tree_vector_map<R>(
 ) -> Result<R> {
     check_state(robot, data, names, x)?;
     env.check(robot.nl())?;
-    let c = robot.coordinates();
-    c.check_output(out_name, out, "movable joints")?;
-    let model = robot.numeric();
-    Ok(on_tree_arrays(robot, data, x, |data, a, b, d| {
-        let mut t = std::mem::take(&mut data.tau);
-        let r = kernel(model, data, a, b, d, &mut t);
-        c.gather(&t, out);
-        data.tau = t;
-        r
-    }))
+    robot
+        .coordinates()
+        .check_output(out_name, out, "movable joints")?;
+    Ok(kernel(robot.dynamic(), data, x[0], x[1], x[2], out))
 }
 
 /// Inverse dynamic model (eqs 10.3–10.12) into `tau`: the joint torques (N m) / forces (N) of the

@@ -21,7 +21,9 @@ use crate::model::{
 };
 use nalgebra::{DMatrix, Matrix3, SMatrix, Vector3};
 
-use super::inverse_dynamics::{check_state, forward_pass, on_tree_arrays, tree_vector_map};
+use super::inverse_dynamics::{
+    add_folded_wrenches, check_state, forward_pass, on_tree_arrays, tree_vector_map,
+};
 
 /// Number of standard parameters per link.
 pub const PARAMS_PER_LINK: usize = 13;
@@ -263,9 +265,11 @@ pub fn tree_wrench_torques(
         let (rot, pos) = model.frame(j).transform(&q[j - 1]);
         ws.rot[j] = rot;
         ws.pos[j] = pos;
-        ws.f[j] = env.wrench(j).force;
-        ws.m[j] = env.wrench(j).moment;
+        let e = env.wrench(model.wrench_link(j));
+        ws.f[j] = e.force;
+        ws.m[j] = e.moment;
     }
+    add_folded_wrenches(model, env, &mut ws.f, &mut ws.m);
     for j in (1..=nl).rev() {
         let fr = model.frame(j);
         tau[j - 1] = match fr.joint {

@@ -121,6 +121,64 @@ pub struct DynModel<T: DynScalar> {
     /// The description's gravity, base motion and external wrenches (the default per-call
     /// inputs).
     pub env: Environment<T>,
+    /// Description link number of each link, whose external wrench (in the per-call
+    /// [`Environment`], indexed by description link) the link carries. Empty: link j is link j.
+    /// Set by [`DynModel::fold_fixed`].
+    pub link_of: Vec<usize>,
+    /// Links of the description behind fixed frames whose body is folded into a movable
+    /// ancestor ([`DynModel::fold_fixed`]): their external wrench is carried onto it each call.
+    pub folded: Vec<FoldedLink<T>>,
+}
+
+/// A link rigidly attached (through fixed frames only) to a movable link of a folded model.
+#[derive(Clone, Debug)]
+pub struct FoldedLink<T: DynScalar> {
+    /// The movable link (index in the folded model) that carries it.
+    pub host: usize,
+    /// Its link number in the description (the index of its wrench in an [`Environment`]).
+    pub link: usize,
+    /// hA_k: its orientation in the host's frame.
+    pub rot: Matrix3<T>,
+    /// hP_k: its origin in the host's frame.
+    pub pos: Vector3<T>,
+}
+
+/// Move the inertia (J about O_k, MS, M; components in R_k) of a body rigidly attached to frame
+/// R_i, with R = iA_k and p = iP_k, into R_i about O_i (parallel-axis theorem with
+/// J = integral of -skew(r)^2 dm, r = p + s, m = R MS):
+/// J' = R J R' + M (p'p I - p p') + 2 (p'm) I - m p' - p m',  MS' = m + M p,  M' = M.
+/// Returns (J', MS'); the symmetric J' is computed on its upper triangle.
+#[inline]
+pub fn inertia_to_antecedent<T: DynScalar>(
+    r: &Matrix3<T>,
+    p: &Vector3<T>,
+    j: &Matrix3<T>,
+    ms: &Vector3<T>,
+    mass: &T,
+) -> (Matrix3<T>, Vector3<T>) {
+    let m = r * ms;
+    let pm = p.dot(&m);
+    let diag = mass.clone() * p.dot(p) + pm.clone() + pm;
+    let rj = r * j;
+    let mut out = Matrix3::zeros();
+    for a in 0..3 {
+        for b in a..3 {
+            let mut v = rj[(a, 0)].clone() * r[(b, 0)].clone()
+                + rj[(a, 1)].clone() * r[(b, 1)].clone()
+                + rj[(a, 2)].clone() * r[(b, 2)].clone()
+                - (p[a].clone() * p[b].clone()) * mass.clone()
+                - m[a].clone() * p[b].clone()
+                - p[a].clone() * m[b].clone();
+            if a == b {
+                v += diag.clone();
+            } else {
+                out[(b, a)] = v.clone();
+            }
+            out[(a, b)] = v;
+        }
+    }
+    let ms_out = m + p * mass.clone();
+    (out, ms_out)
 }
 
 impl<T: DynScalar> DynModel<T> {
@@ -174,6 +232,18 @@ impl<T: DynScalar> DynModel<T> {
             frames,
             links,
             env,
+            link_of: Vec::new(),
+            folded: Vec::new(),
+        }
+    }
+
+    /// The description link whose external wrench link j carries (see [`Self::link_of`]).
+    #[inline]
+    pub fn wrench_link(&self, j: usize) -> usize {
+        if self.link_of.is_empty() {
+            j
+        } else {
+            self.link_of[j - 1]
         }
     }
 
@@ -187,5 +257,93 @@ impl<T: DynScalar> DynModel<T> {
     #[inline]
     pub fn link(&self, j: usize) -> &LinkConstants<T> {
         &self.links[j - 1]
+    }
+}
+
+impl DynModel<f64> {
+    /// The model of the dynamic recursions: fixed frames out. Its links are the movable tree
+    /// joints 1..NL in frame order (link k is the k-th movable joint, so its tree arrays are
+    /// the public joint vectors); the constant placement of the fixed frames between a movable
+    /// joint and its nearest movable ancestor is composed into the joint's constants, and the
+    /// body of every link behind fixed frames is added to its nearest movable ancestor's body
+    /// by the exact rigid-body transfer ([`inertia_to_antecedent`]). Links rigidly attached to
+    /// the base are dropped: no joint carries them. Cut-joint frames (NL+1..NF) are not part of
+    /// it (the tree recursions never use them).
+    ///
+    /// Rotor inertia and friction of a fixed frame are ignored, as in the full model (no joint
+    /// variable). External wrenches stay indexed by description link ([`Self::link_of`],
+    /// [`Self::folded`]), so the per-call [`Environment`] is the description's.
+    pub fn fold_fixed(&self) -> DynModel<f64> {
+        let nl = self.nl;
+        // red[j]: index of movable frame j in the folded model; 0 for the base
+        let mut red = vec![0; nl + 1];
+        // for a fixed frame j: (h, hA_j, hP_j) with h its nearest movable ancestor (or 0)
+        let mut place: Vec<Option<(usize, Matrix3<f64>, Vector3<f64>)>> = vec![None; nl + 1];
+        let mut frames = Vec::new();
+        let mut links: Vec<LinkConstants<f64>> = Vec::new();
+        let mut link_of = Vec::new();
+        // the placement of frame i's origin and axes in its nearest movable ancestor h
+        let carried =
+            |place: &[Option<(usize, Matrix3<f64>, Vector3<f64>)>], i: usize| match &place[i] {
+                Some((h, r, p)) => (*h, Some((*r, *p))),
+                None => (i, None),
+            };
+        for j in 1..=nl {
+            let fr = self.frame(j);
+            let (h, pre) = carried(&place, fr.ant);
+            if fr.joint.is_movable() {
+                let mut c = fr.clone();
+                c.ant = red[h];
+                if let Some((r, p)) = pre {
+                    c.pre_pos = p + r * c.pre_pos;
+                    c.pre_rot = r * c.pre_rot;
+                }
+                frames.push(c);
+                links.push(self.link(j).clone());
+                link_of.push(j);
+                red[j] = frames.len();
+            } else {
+                let (r, p) = fr.transform(&0.0);
+                place[j] = Some(match pre {
+                    Some((ra, pa)) => (h, ra * r, pa + ra * p),
+                    None => (h, r, p),
+                });
+            }
+        }
+        let mut folded = Vec::new();
+        for j in 1..=nl {
+            let Some((h, r, p)) = &place[j] else { continue };
+            if *h == 0 {
+                continue;
+            }
+            let l = self.link(j);
+            let (jj, ms) = inertia_to_antecedent(r, p, &l.inertia, &l.ms, &l.mass);
+            let host = &mut links[red[*h] - 1];
+            host.inertia += jj;
+            host.ms += ms;
+            host.mass += l.mass;
+            folded.push(FoldedLink {
+                host: red[*h],
+                link: j,
+                rot: *r,
+                pos: *p,
+            });
+        }
+        for l in links.iter_mut() {
+            let i = &l.inertia;
+            l.inertia_diff = Vector3::new(
+                i[(2, 2)] - i[(1, 1)],
+                i[(0, 0)] - i[(2, 2)],
+                i[(1, 1)] - i[(0, 0)],
+            );
+        }
+        DynModel {
+            nl: frames.len(),
+            frames,
+            links,
+            env: self.env.clone(),
+            link_of,
+            folded,
+        }
     }
 }

@@ -126,14 +126,6 @@ impl Coordinates {
         }
     }
 
-    /// Read the entries from a tree array.
-    #[inline]
-    pub(crate) fn gather(&self, tree: &[f64], v: &mut [f64]) {
-        for (&j, x) in self.frames.iter().zip(v.iter_mut()) {
-            *x = tree[j - 1];
-        }
-    }
-
     /// True when the entries are exactly the tree joints 1..NL (no scatter needed).
     #[inline]
     pub(crate) fn is_identity(&self) -> bool {

@@ -8,7 +8,7 @@ mod description;
 mod environment;
 mod structure;
 
-pub use constants::{DynModel, FrameConstants, LinkConstants};
+pub use constants::{inertia_to_antecedent, DynModel, FoldedLink, FrameConstants, LinkConstants};
 pub use coordinates::Coordinates;
 pub use description::{
     param, FrameDesc, JointLimits, JointType, LinkDesc, RobotDescription, Transmission,
@@ -28,6 +28,8 @@ pub struct Robot {
     desc: RobotDescription,
     structure: Structure,
     numeric: DynModel<f64>,
+    /// `numeric` with the fixed frames folded out ([`DynModel::fold_fixed`]).
+    dynamic: DynModel<f64>,
     coords: Coordinates,
 }
 
@@ -232,10 +234,12 @@ impl Robot {
             .map(|&j| desc.frame(j).name.clone())
             .collect();
         let coords = Coordinates::new(movable, names, desc.nl);
+        let dynamic = numeric.fold_fixed();
         Ok(Robot {
             desc,
             structure,
             numeric,
+            dynamic,
             coords,
         })
     }
@@ -282,10 +286,20 @@ impl Robot {
         &self.structure
     }
 
-    /// The numeric model the algorithms run on.
+    /// The numeric model of the tree: every frame 1..NF, tree arrays of NL entries (joint j at
+    /// index j-1). Geometry, loop closure, the regressor and the closed chains run on it.
     #[inline]
     pub fn numeric(&self) -> &DynModel<f64> {
         &self.numeric
+    }
+
+    /// The numeric model of the dynamic recursions (Newton–Euler, composite links, L'DL,
+    /// articulated bodies): the movable joints only, fixed frames folded into their movable
+    /// ancestor ([`DynModel::fold_fixed`]). Its tree arrays are the public joint vectors
+    /// (link k is `coordinates().frame(k - 1)`); the per-call [`Environment`] is the same.
+    #[inline]
+    pub fn dynamic(&self) -> &DynModel<f64> {
+        &self.dynamic
     }
 
     /// The robot's name.

@@ -1,0 +1,223 @@
+//! robodyn side of the side-by-side benchmark against Pinocchio (`benches/peers/run.py`; not run
+//! by CI). Every call into robodyn is in this file.
+//!
+//! ```text
+//! cargo run --release --example peer_timing -- URDF STATES RESULTS [--samples N] [--target-us T]
+//! ```
+//!
+//! Loads the URDF with robodyn's loader, zeroes the rotor inertias and friction (Pinocchio's
+//! algorithms have neither), reads the states written by `run.py` (joints named as in the URDF,
+//! in Pinocchio's order), writes every algorithm's result on every state to RESULTS in that order
+//! (the agreement check) and prints `time <algorithm> <median ns per call>` lines: a sample times
+//! loops over all states, repeated so that it lasts about T microseconds; the median over the
+//! samples is printed (the same protocol as `pinocchio_peer.cpp`).
+//!
+//! `peer_timing --batch URDF N` times `inverse_dynamics_batch` on N random states with a rayon
+//! pool of 1 and of 2 threads (median of 7 runs each) and prints their ratio.
+
+use nalgebra::DMatrix;
+use robodyn::model::param;
+use robodyn::{
+    direct_dynamics_into, inertia_matrix_into, inverse_dynamics_into, Data, Method, Robot,
+};
+use std::fmt::Write as _;
+use std::hint::black_box;
+use std::path::Path;
+
+#[path = "../benches/peers/median.rs"]
+mod median;
+use median::time;
+
+type Error = Box<dyn std::error::Error>;
+
+/// One state over robodyn's movable joints (its joint vectors).
+struct State {
+    q: Vec<f64>,
+    qd: Vec<f64>,
+    qdd: Vec<f64>,
+    tau: Vec<f64>,
+}
+
+/// The robot with rotor inertia and friction set to zero.
+fn load_robot(path: &Path) -> Result<Robot, Error> {
+    let robot = robodyn::io::load(path)?;
+    let mut k = robot.standard_parameters();
+    for link in k.chunks_mut(13) {
+        link[param::IA] = 0.0;
+        link[param::FS] = 0.0;
+        link[param::FV] = 0.0;
+    }
+    Ok(robot.with_standard_parameters(&k)?)
+}
+
+/// Entry in robodyn's joint vectors of each joint named in the states file.
+fn joint_indices(robot: &Robot, names: &[&str]) -> Result<Vec<usize>, Error> {
+    let c = robot.coordinates();
+    names
+        .iter()
+        .map(|n| {
+            c.index_of(n).ok_or_else(|| {
+                format!("joint {n} is not a movable joint of the robodyn model").into()
+            })
+        })
+        .collect()
+}
+
+/// States file: a line `names <joint>...`, then one line per state: q, v, a, tau (nv each).
+fn read_states(robot: &Robot, path: &Path) -> Result<(Vec<usize>, Vec<State>), Error> {
+    let text = std::fs::read_to_string(path)?;
+    let mut lines = text.lines();
+    let header = lines.next().ok_or("empty states file")?;
+    let names: Vec<&str> = header.split_whitespace().skip(1).collect();
+    let idx = joint_indices(robot, &names)?;
+    let nv = idx.len();
+    if nv != robot.dof() {
+        return Err(format!("{nv} joints in the states, robodyn has {}", robot.dof()).into());
+    }
+    let mut states = Vec::new();
+    for line in lines.filter(|l| !l.trim().is_empty()) {
+        let x: Vec<f64> = line
+            .split_whitespace()
+            .map(str::parse)
+            .collect::<Result<_, _>>()?;
+        if x.len() != 4 * nv {
+            return Err(format!("state line with {} numbers, {} expected", x.len(), 4 * nv).into());
+        }
+        let scatter = |part: usize| {
+            let mut v = vec![0.0; nv];
+            for (k, &i) in idx.iter().enumerate() {
+                v[i] = x[part * nv + k];
+            }
+            v
+        };
+        states.push(State {
+            q: scatter(0),
+            qd: scatter(1),
+            qdd: scatter(2),
+            tau: scatter(3),
+        });
+    }
+    Ok((idx, states))
+}
+
+/// `--batch URDF N`: batch inverse dynamics of N random states on 1 and 2 threads.
+fn batch(path: &Path, rows: usize) -> Result<(), Error> {
+    use rand::Rng;
+    let robot = load_robot(path)?;
+    let n = robot.dof();
+    let mut r = robodyn::testing::rng(1);
+    let mut v = |s: f64| {
+        (0..rows * n)
+            .map(|_| r.random_range(-s..s))
+            .collect::<Vec<f64>>()
+    };
+    let (q, qd, qdd) = (v(3.0), v(2.0), v(5.0));
+    let mut tau = vec![0.0; rows * n];
+    let env = robot.environment();
+    let mut med = Vec::new();
+    for threads in [1, 2] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()?;
+        let mut ms: Vec<f64> = (0..7)
+            .map(|_| {
+                let t = std::time::Instant::now();
+                pool.install(|| {
+                    robodyn::inverse_dynamics_batch(&robot, env, black_box(&q), &qd, &qdd, &mut tau)
+                })
+                .unwrap();
+                black_box(&tau);
+                t.elapsed().as_secs_f64() * 1e3
+            })
+            .collect();
+        ms.sort_by(f64::total_cmp);
+        println!(
+            "batch idm {rows} states, {threads} thread(s): median {:.2} ms",
+            ms[3]
+        );
+        med.push(ms[3]);
+    }
+    println!("speedup 2 threads / 1 thread: {:.2}", med[0] / med[1]);
+    Ok(())
+}
+
+fn main() -> Result<(), Error> {
+    let args: Vec<String> = std::env::args().collect();
+    if args.len() == 4 && args[1] == "--batch" {
+        return batch(Path::new(&args[2]), args[3].parse()?);
+    }
+    if args.len() < 4 {
+        return Err("usage: peer_timing URDF STATES RESULTS [--samples N] [--target-us T]".into());
+    }
+    let (mut samples, mut target_us) = (21usize, 400.0);
+    for kv in args[4..].chunks(2) {
+        match (kv[0].as_str(), kv.get(1)) {
+            ("--samples", Some(v)) => samples = v.parse()?,
+            ("--target-us", Some(v)) => target_us = v.parse()?,
+            _ => return Err(format!("unknown option {}", kv[0]).into()),
+        }
+    }
+    let robot = load_robot(Path::new(&args[1]))?;
+    let (idx, states) = read_states(&robot, Path::new(&args[2]))?;
+    let n = robot.dof();
+    let env = robot.environment().clone();
+    let mut data = Data::new(&robot);
+    let mut a = DMatrix::zeros(n, n);
+    let mut out = vec![0.0; n];
+    let (cmp, aba) = (Method::Composite, Method::ArticulatedBody);
+
+    let mut text = String::new();
+    let put = |text: &mut String, tag: &str, v: &[f64]| {
+        text.push_str(tag);
+        for &i in &idx {
+            write!(text, " {:e}", v[i]).unwrap();
+        }
+        text.push('\n');
+    };
+    for s in &states {
+        inverse_dynamics_into(&robot, &mut data, &env, &s.q, &s.qd, &s.qdd, &mut out)?;
+        put(&mut text, "rnea", &out);
+        inertia_matrix_into(&robot, &mut data, &s.q, &mut a)?;
+        text.push_str("crba");
+        for &r in &idx {
+            for &c in &idx {
+                write!(text, " {:e}", a[(r, c)])?;
+            }
+        }
+        text.push('\n');
+        direct_dynamics_into(&robot, &mut data, &env, &s.q, &s.qd, &s.tau, aba, &mut out)?;
+        put(&mut text, "aba", &out);
+        direct_dynamics_into(&robot, &mut data, &env, &s.q, &s.qd, &s.tau, cmp, &mut out)?;
+        put(&mut text, "composite", &out);
+    }
+    std::fs::write(&args[3], text)?;
+
+    time("rnea", &states, samples, target_us, |s| {
+        inverse_dynamics_into(
+            &robot,
+            &mut data,
+            &env,
+            black_box(&s.q),
+            &s.qd,
+            &s.qdd,
+            &mut out,
+        )
+        .unwrap();
+        black_box(&out);
+    });
+    time("crba_full", &states, samples, target_us, |s| {
+        inertia_matrix_into(&robot, &mut data, black_box(&s.q), &mut a).unwrap();
+        black_box(&a);
+    });
+    time("aba", &states, samples, target_us, |s| {
+        let q = black_box(&s.q);
+        direct_dynamics_into(&robot, &mut data, &env, q, &s.qd, &s.tau, aba, &mut out).unwrap();
+        black_box(&out);
+    });
+    time("composite", &states, samples, target_us, |s| {
+        let q = black_box(&s.q);
+        direct_dynamics_into(&robot, &mut data, &env, q, &s.qd, &s.tau, cmp, &mut out).unwrap();
+        black_box(&out);
+    });
+    Ok(())
+}
