@@ -12,8 +12,8 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use robodyn::algorithms::regressor::PARAMS_PER_LINK;
 use robodyn::{
-    closed_direct_dynamics_into, closed_inverse_dynamics_into, closed_regressor_into,
-    loop_closure, loop_closure_into, Branch, ClosedData, Conditioning,
+    closed_direct_dynamics_into, closed_inverse_dynamics_into, closed_regressor_into, loop_closure,
+    loop_closure_into, Branch, ClosedData, Conditioning,
 };
 use std::sync::{Arc, Mutex};
 
@@ -49,7 +49,12 @@ impl ClosedChain {
         f: F,
     ) -> PyResult<Bound<'py, PyAny>>
     where
-        F: Fn(&robodyn::ClosedChain, &mut Tracker, [&[f64]; 3], &mut [f64]) -> robodyn::Result<Conditioning>
+        F: Fn(
+                &robodyn::ClosedChain,
+                &mut Tracker,
+                [&[f64]; 3],
+                &mut [f64],
+            ) -> robodyn::Result<Conditioning>
             + Send
             + Sync,
     {
@@ -64,25 +69,36 @@ impl ClosedChain {
         let k = st.data.len();
         let rows = st.count();
         let (v, warn) = py
-            .detach(|| -> robodyn::Result<(Vec<f64>, Option<(usize, Conditioning)>)> {
-                let mut t = self.tracker.lock().unwrap();
-                let mut out = vec![0.0; rows * width];
-                let mut warn: Option<(usize, Conditioning)> = None;
-                for r in 0..rows {
-                    let x: [&[f64]; 3] =
-                        std::array::from_fn(|i| if i < k { st.row(i, r) } else { &[][..] });
-                    let c = f(chain, &mut t, x, &mut out[r * width..(r + 1) * width])
-                        .map_err(|e| if st.rows.is_some() { e.in_row(r + 1) } else { e })?;
-                    let worse = match &warn {
-                        None => true,
-                        Some((_, w)) => c.wp < w.wp || c.a_cl.unwrap_or(1.0) < w.a_cl.unwrap_or(1.0),
-                    };
-                    if c.warning && worse {
-                        warn = Some((r, c));
+            .detach(
+                || -> robodyn::Result<(Vec<f64>, Option<(usize, Conditioning)>)> {
+                    let mut t = self.tracker.lock().unwrap();
+                    let mut out = vec![0.0; rows * width];
+                    let mut warn: Option<(usize, Conditioning)> = None;
+                    for r in 0..rows {
+                        let x: [&[f64]; 3] =
+                            std::array::from_fn(|i| if i < k { st.row(i, r) } else { &[][..] });
+                        let c = f(chain, &mut t, x, &mut out[r * width..(r + 1) * width]).map_err(
+                            |e| {
+                                if st.rows.is_some() {
+                                    e.in_row(r + 1)
+                                } else {
+                                    e
+                                }
+                            },
+                        )?;
+                        let worse = match &warn {
+                            None => true,
+                            Some((_, w)) => {
+                                c.wp < w.wp || c.a_cl.unwrap_or(1.0) < w.a_cl.unwrap_or(1.0)
+                            }
+                        };
+                        if c.warning && worse {
+                            warn = Some((r, c));
+                        }
                     }
-                }
-                Ok((out, warn))
-            })
+                    Ok((out, warn))
+                },
+            )
             .py()?;
         if let Some((r, c)) = warn {
             let at = if st.rows.is_some() {
@@ -182,7 +198,12 @@ impl ClosedChain {
 
     /// Put the tracker back on the assembly branch (or on the branch through (q_a, q_p_guess)).
     #[pyo3(signature = (q_a=None, q_p_guess=None))]
-    fn reset(&self, py: Python<'_>, q_a: Option<Vec<f64>>, q_p_guess: Option<Vec<f64>>) -> PyResult<()> {
+    fn reset(
+        &self,
+        py: Python<'_>,
+        q_a: Option<Vec<f64>>,
+        q_p_guess: Option<Vec<f64>>,
+    ) -> PyResult<()> {
         let chain = &self.chain;
         let b = py
             .detach(|| match (q_a, q_p_guess) {
@@ -198,7 +219,11 @@ impl ClosedChain {
     }
 
     /// Loop closure: the passive tree variables q_p for the actuated q_a, (p,) or (N, p).
-    fn solve_loops<'py>(&self, py: Python<'py>, q_a: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+    fn solve_loops<'py>(
+        &self,
+        py: Python<'py>,
+        q_a: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
         let p = self.chain.n_equations();
         self.eval(py, &[("q_a", Some(q_a))], &[p], |c, t, x, o| {
             loop_closure_into(c, &mut t.data, &mut t.branch, x[0], o)
@@ -349,8 +374,9 @@ impl ClosedChain {
         let n = self.chain.dof();
         let branch = self.tracker.lock().unwrap().branch.clone();
         let q0 = q0.unwrap_or_else(|| branch.q_a().to_vec());
-        let mut dynamics = robodyn::simulation::ClosedChainDynamics::new((*self.chain).clone(), branch)
-            .with_coulomb_smoothing(coulomb_smoothing);
+        let mut dynamics =
+            robodyn::simulation::ClosedChainDynamics::new((*self.chain).clone(), branch)
+                .with_coulomb_smoothing(coulomb_smoothing);
         let args = crate::models::SimArgs {
             duration,
             q0,

@@ -7,7 +7,12 @@ use pyo3::prelude::*;
 use robodyn::error::Location;
 use robodyn::Error;
 
-create_exception!(robodyn, RobodynError, PyException, "Base class of every robodyn error.");
+create_exception!(
+    robodyn,
+    RobodynError,
+    PyException,
+    "Base class of every robodyn error."
+);
 create_exception!(
     robodyn,
     RobotFileError,
@@ -68,10 +73,16 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
     m.add("Error", py.get_type::<RobodynError>())?;
     m.add("RobotFileError", py.get_type::<RobotFileError>())?;
-    m.add("PhysicalParameterError", py.get_type::<PhysicalParameterError>())?;
+    m.add(
+        "PhysicalParameterError",
+        py.get_type::<PhysicalParameterError>(),
+    )?;
     m.add("DimensionError", py.get_type::<DimensionError>())?;
     m.add("NotFiniteError", py.get_type::<NotFiniteError>())?;
-    m.add("SingularConfiguration", py.get_type::<SingularConfiguration>())?;
+    m.add(
+        "SingularConfiguration",
+        py.get_type::<SingularConfiguration>(),
+    )?;
     m.add("LoopClosureError", py.get_type::<LoopClosureError>())?;
     m.add("BranchLost", py.get_type::<BranchLost>())?;
     m.add("InputError", py.get_type::<InputError>())?;
@@ -93,9 +104,23 @@ fn build(py: Python<'_>, e: Error) -> PyErr {
     };
     let mut attrs: Vec<(&str, Py<PyAny>)> = Vec::new();
     let loc = |l: &Location, attrs: &mut Vec<(&str, Py<PyAny>)>| {
-        attrs.push(("file", l.file.clone().into_pyobject(py).unwrap().into_any().unbind()));
-        attrs.push(("line", l.line.into_pyobject(py).unwrap().into_any().unbind()));
-        attrs.push(("column", l.column.into_pyobject(py).unwrap().into_any().unbind()));
+        attrs.push((
+            "file",
+            l.file
+                .clone()
+                .into_pyobject(py)
+                .unwrap()
+                .into_any()
+                .unbind(),
+        ));
+        attrs.push((
+            "line",
+            l.line.into_pyobject(py).unwrap().into_any().unbind(),
+        ));
+        attrs.push((
+            "column",
+            l.column.into_pyobject(py).unwrap().into_any().unbind(),
+        ));
     };
     let s = |x: &str| x.into_pyobject(py).unwrap().into_any().unbind();
     let f = |x: f64| x.into_pyobject(py).unwrap().into_any().unbind();

@@ -31,7 +31,10 @@ fn load(path: PathBuf, values: Option<&Bound<'_, pyo3::types::PyDict>>) -> PyRes
 #[pymodule]
 fn _robodyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     errors::register(m)?;
-    m.add("SingularityWarning", m.py().get_type::<closed::SingularityWarning>())?;
+    m.add(
+        "SingularityWarning",
+        m.py().get_type::<closed::SingularityWarning>(),
+    )?;
     m.add_class::<robot::Robot>()?;
     m.add_class::<closed::ClosedChain>()?;
     m.add_class::<models::BaseParameters>()?;

@@ -93,7 +93,11 @@ impl BaseParameters {
             regrouped: s.base.iter().map(|b| b.regrouped).collect(),
             equations: s.base.iter().map(|b| b.equation.clone()).collect(),
             values: s.base.iter().map(|b| b.value).collect(),
-            columns: s.columns.iter().map(|&i| s.names.name(i).to_string()).collect(),
+            columns: s
+                .columns
+                .iter()
+                .map(|&i| s.names.name(i).to_string())
+                .collect(),
             coefficients,
             no_effect: s.no_effect.clone(),
             grouped: s.grouped.clone(),
@@ -407,7 +411,12 @@ pub fn run_simulation<'py>(
         }
         Some(t) if t.is_instance_of::<PyTuple>() => {
             let (times, values): (Bound<PyAny>, Bound<PyAny>) = t.extract()?;
-            let times: Vec<f64> = crate::arrays::float_array(&times)?.readonly().as_array().iter().copied().collect();
+            let times: Vec<f64> = crate::arrays::float_array(&times)?
+                .readonly()
+                .as_array()
+                .iter()
+                .copied()
+                .collect();
             let values = crate::arrays::float_array(&values)?;
             let shape = values.shape().to_vec();
             if shape.len() != 2 || shape[1] != n || shape[0] != times.len() {
@@ -421,7 +430,12 @@ pub fn run_simulation<'py>(
             TorqueInput::Series(TimeSeries::new(times, rows).py()?)
         }
         Some(t) => {
-            let v: Vec<f64> = crate::arrays::float_array(t)?.readonly().as_array().iter().copied().collect();
+            let v: Vec<f64> = crate::arrays::float_array(t)?
+                .readonly()
+                .as_array()
+                .iter()
+                .copied()
+                .collect();
             TorqueInput::Constant(v)
         }
     };
@@ -442,7 +456,17 @@ pub fn run_simulation<'py>(
     };
     let mut rec = Recorder::default();
     let result = match &callback {
-        None => py.detach(|| sim(dynamics, &input, &a.q0, &a.qd0, &opts, &mut rec, &mut |_| {})),
+        None => py.detach(|| {
+            sim(
+                dynamics,
+                &input,
+                &a.q0,
+                &a.qd0,
+                &opts,
+                &mut rec,
+                &mut |_| {},
+            )
+        }),
         Some(f) => {
             let mut cb = Callback {
                 inner: dynamics,
@@ -469,17 +493,29 @@ pub fn run_simulation<'py>(
     let rows = rec.rows.len();
     let col = |c: usize| -> Vec<f64> { rec.rows.iter().map(|r| r[c]).collect() };
     let block = |c0: usize| -> Vec<f64> {
-        rec.rows.iter().flat_map(|r| r[c0..c0 + n].iter().copied()).collect()
+        rec.rows
+            .iter()
+            .flat_map(|r| r[c0..c0 + n].iter().copied())
+            .collect()
     };
     out.set_item("t", PyArray1::from_vec(py, col(0)))?;
     for (k, name) in ["q", "qd", "qdd", "tau"].iter().enumerate() {
-        out.set_item(*name, PyArray1::from_vec(py, block(1 + k * n)).reshape([rows, n])?)?;
+        out.set_item(
+            *name,
+            PyArray1::from_vec(py, block(1 + k * n)).reshape([rows, n])?,
+        )?;
     }
     out.set_item("energy", PyArray1::from_vec(py, col(1 + 4 * n)))?;
     for (k, h) in rec.headers.iter().enumerate().skip(2 + 4 * n) {
         out.set_item(h, PyArray1::from_vec(py, col(k)))?;
     }
-    out.set_item("joint_labels", rec.headers[1..1 + n].iter().map(|h| h[1..].to_string()).collect::<Vec<_>>())?;
+    out.set_item(
+        "joint_labels",
+        rec.headers[1..1 + n]
+            .iter()
+            .map(|h| h[1..].to_string())
+            .collect::<Vec<_>>(),
+    )?;
     Ok(out)
 }
 

@@ -8,8 +8,8 @@ use nalgebra::DMatrix;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use robodyn::algorithms::regressor::{
-    base_columns, regressor_into, standard_columns, ParameterSelection, RotorMode,
-    ZeroParameters, PARAMS_PER_LINK,
+    base_columns, regressor_into, standard_columns, ParameterSelection, RotorMode, ZeroParameters,
+    PARAMS_PER_LINK,
 };
 use robodyn::{
     direct_dynamics_into, h_vector_into, inertia_matrix_into, inverse_dynamics_into, Data, Method,
@@ -97,11 +97,7 @@ impl Robot {
         self.inner.read().unwrap().clone()
     }
 
-    fn with_work<T>(
-        &self,
-        robot: &Arc<robodyn::Robot>,
-        f: impl FnOnce(&mut Work) -> T,
-    ) -> T {
+    fn with_work<T>(&self, robot: &Arc<robodyn::Robot>, f: impl FnOnce(&mut Work) -> T) -> T {
         if let Ok(mut g) = self.cache.try_lock() {
             match g.as_mut() {
                 Some((r, w)) if Arc::ptr_eq(r, robot) => return f(w),
@@ -168,9 +164,7 @@ impl Robot {
             Some(n) => {
                 let r: &robodyn::Robot = robot;
                 let v = py
-                    .detach(|| {
-                        run_rows(n, width, || Work::new(r), |w, i, o| f(r, w, row(i), o))
-                    })
+                    .detach(|| run_rows(n, width, || Work::new(r), |w, i, o| f(r, w, row(i), o)))
                     .py()?;
                 Ok((v, Some(n)))
             }
@@ -374,8 +368,7 @@ impl Robot {
     #[getter]
     fn parameter_names(&self) -> Vec<String> {
         let r = self.model();
-        let names =
-            robodyn::algorithms::base_parameters::ParameterNames::of(r.description());
+        let names = robodyn::algorithms::base_parameters::ParameterNames::of(r.description());
         (0..PARAMS_PER_LINK * r.nl())
             .map(|k| names.name(k).to_string())
             .collect()
@@ -432,7 +425,9 @@ impl Robot {
             py,
             &[("q", Some(q)), ("qd", qd), ("qdd", qdd)],
             &[n],
-            |r, w, x, o| inverse_dynamics_into(r, &mut w.data, r.environment(), x[0], x[1], x[2], o),
+            |r, w, x, o| {
+                inverse_dynamics_into(r, &mut w.data, r.environment(), x[0], x[1], x[2], o)
+            },
         )
     }
 
@@ -478,7 +473,9 @@ impl Robot {
             py,
             &[("q", Some(q)), ("qd", qd), ("tau", tau)],
             &[n],
-            move |r, w, x, o| direct_dynamics_into(r, &mut w.data, r.environment(), x[0], x[1], x[2], m, o),
+            move |r, w, x, o| {
+                direct_dynamics_into(r, &mut w.data, r.environment(), x[0], x[1], x[2], m, o)
+            },
         )
     }
 
@@ -526,7 +523,9 @@ impl Robot {
         rotor: &str,
         seed: u64,
     ) -> PyResult<Vec<String>> {
-        Ok(self.columns(&self.model(), columns, friction, rotor, seed)?.1)
+        Ok(self
+            .columns(&self.model(), columns, friction, rotor, seed)?
+            .1)
     }
 
     /// Regressor Phi with Gamma = Phi K (+ external-wrench torques): (n, p) for one state,
@@ -550,11 +549,9 @@ impl Robot {
         let n = robot.dof();
         let p = cols.len();
         let nk = PARAMS_PER_LINK * robot.nl();
-        let st = states(
-            &[("q", Some(q)), ("qd", qd), ("qdd", qdd)],
-            n,
-            &|| Self::joint_text(&robot),
-        )?;
+        let st = states(&[("q", Some(q)), ("qd", qd), ("qdd", qdd)], n, &|| {
+            Self::joint_text(&robot)
+        })?;
         let (v, rows) = self.run(py, &robot, &st, n * p, |r, w, x, o| {
             let (data, phi) = w.split(n, nk);
             regressor_into(r, data, r.environment(), x[0], x[1], x[2], phi)?;
