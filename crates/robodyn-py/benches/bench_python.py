@@ -24,14 +24,17 @@ import robodyn
 ERD = pathlib.Path(os.path.dirname(os.path.dirname(cmeel.__file__))) / "cmeel.prefix" / "share" / "example-robot-data" / "robots"
 
 
-def per_call(f, calls, repeat):
-    times = []
+def per_call(fs, calls, repeat):
+    """Median seconds per call of each function; the runs alternate between the functions so
+    that a change of the machine's load hits both alike."""
+    times = [[] for _ in fs]
     for _ in range(repeat):
-        t0 = time.perf_counter()
-        for _ in range(calls):
-            f()
-        times.append((time.perf_counter() - t0) / calls)
-    return statistics.median(times)
+        for k, f in enumerate(fs):
+            t0 = time.perf_counter()
+            for _ in range(calls):
+                f()
+            times[k].append((time.perf_counter() - t0) / calls)
+    return [statistics.median(t) for t in times]
 
 
 def main():
@@ -53,8 +56,7 @@ def main():
     assert not model.damping.any() and not model.friction.any()
     assert np.allclose(robot.idm(q, qd, qdd), pin.rnea(model, data, q, qd, qdd), atol=1e-10)
 
-    t_rd = per_call(lambda: robot.idm(q, qd, qdd), a.calls, a.repeat)
-    t_pin = per_call(lambda: pin.rnea(model, data, q, qd, qdd), a.calls, a.repeat)
+    t_rd, t_pin = per_call([lambda: robot.idm(q, qd, qdd), lambda: pin.rnea(model, data, q, qd, qdd)], a.calls, a.repeat)
     print(f"one state, UR5: robodyn.idm {t_rd * 1e6:.2f} us/call, pin.rnea {t_pin * 1e6:.2f} us/call, "
           f"ratio {t_rd / t_pin:.2f}")
 
