@@ -40,6 +40,9 @@ pub struct ClosedChain {
     source: Option<std::path::PathBuf>,
 }
 
+/// Results of the rows, and the worst-conditioned row that warned (0-based).
+type RowsAndWorst = (Vec<f64>, Option<(usize, Conditioning)>);
+
 impl ClosedChain {
     fn eval<'py, F>(
         &self,
@@ -69,36 +72,33 @@ impl ClosedChain {
         let k = st.data.len();
         let rows = st.count();
         let (v, warn) = py
-            .detach(
-                || -> robodyn::Result<(Vec<f64>, Option<(usize, Conditioning)>)> {
-                    let mut t = self.tracker.lock().unwrap();
-                    let mut out = vec![0.0; rows * width];
-                    let mut warn: Option<(usize, Conditioning)> = None;
-                    for r in 0..rows {
-                        let x: [&[f64]; 3] =
-                            std::array::from_fn(|i| if i < k { st.row(i, r) } else { &[][..] });
-                        let c = f(chain, &mut t, x, &mut out[r * width..(r + 1) * width]).map_err(
-                            |e| {
-                                if st.rows.is_some() {
-                                    e.in_row(r + 1)
-                                } else {
-                                    e
-                                }
-                            },
-                        )?;
-                        let worse = match &warn {
-                            None => true,
-                            Some((_, w)) => {
-                                c.wp < w.wp || c.a_cl.unwrap_or(1.0) < w.a_cl.unwrap_or(1.0)
+            .detach(|| -> robodyn::Result<RowsAndWorst> {
+                let mut t = self.tracker.lock().unwrap();
+                let mut out = vec![0.0; rows * width];
+                let mut warn: Option<(usize, Conditioning)> = None;
+                for r in 0..rows {
+                    let x: [&[f64]; 3] =
+                        std::array::from_fn(|i| if i < k { st.row(i, r) } else { &[][..] });
+                    let c =
+                        f(chain, &mut t, x, &mut out[r * width..(r + 1) * width]).map_err(|e| {
+                            if st.rows.is_some() {
+                                e.in_row(r + 1)
+                            } else {
+                                e
                             }
-                        };
-                        if c.warning && worse {
-                            warn = Some((r, c));
+                        })?;
+                    let worse = match &warn {
+                        None => true,
+                        Some((_, w)) => {
+                            c.wp < w.wp || c.a_cl.unwrap_or(1.0) < w.a_cl.unwrap_or(1.0)
                         }
+                    };
+                    if c.warning && worse {
+                        warn = Some((r, c));
                     }
-                    Ok((out, warn))
-                },
-            )
+                }
+                Ok((out, warn))
+            })
             .py()?;
         if let Some((r, c)) = warn {
             let at = if st.rows.is_some() {
