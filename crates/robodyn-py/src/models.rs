@@ -1,0 +1,529 @@
+//! Base parameters, code generation and simulation for Python.
+
+use crate::errors::{InputError, IntoPy};
+use crate::robot::{parse_method, parse_rotor, Robot};
+use numpy::{PyArray1, PyArray2, PyArrayMethods, PyUntypedArrayMethods};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyTuple};
+use robodyn::algorithms::base_parameters::symbolic::standard_index;
+use robodyn::algorithms::base_parameters::{
+    compare_methods, numeric_base_parameters_auto, standard_values, symbolic_base_parameters,
+    NumericOptions, ParameterNames, Summary,
+};
+use robodyn::algorithms::regressor::{parameter_name, ParameterSelection};
+use robodyn::codegen::{generate as gen, BaseParameters as GenBase, GenOptions, ModelKind};
+use robodyn::simulation::{
+    simulate as sim, Dynamics, Integrator, Recorder, SimOptions, TimeSeries, TorqueInput,
+    TreeDynamics,
+};
+use robodyn_symbolic::{emit, Lang};
+use std::collections::HashMap;
+
+/// Base inertial parameters of a robot by one method (§10.2.4, §10.3.4–10.3.6).
+#[pyclass(module = "robodyn", frozen, get_all)]
+pub struct BaseParameters {
+    /// "symbolic" or "numeric".
+    pub method: String,
+    /// Names of the base parameters (the robot's names, `R` suffix when grouped: `XXR2`).
+    pub names: Vec<String>,
+    /// Their indices in K (13 per link, 0-based).
+    pub indices: Vec<usize>,
+    /// Whether each is a combination of standard parameters.
+    pub regrouped: Vec<bool>,
+    /// Grouping equations (right-hand sides) as text in the robot's names.
+    pub equations: Vec<String>,
+    /// Values for the robot's numbers (None where a parameter involved has no value).
+    pub values: Vec<Option<f64>>,
+    /// Names of the standard parameters of the model (selected and existing): the columns of
+    /// `coefficients`.
+    pub columns: Vec<String>,
+    /// Coefficient table (n_base x len(columns)): K_base = coefficients @ K[columns] for the
+    /// robot's geometry (None when a geometry symbol has no value).
+    pub coefficients: Option<Py<PyAny>>,
+    /// Parameters with no effect on the dynamics.
+    pub no_effect: Vec<String>,
+    /// Parameters grouped into base parameters.
+    pub grouped: Vec<String>,
+    /// Notes (method details, loops, comparison of the methods).
+    pub notes: Vec<String>,
+    /// The per-link table like Table 10.2 (rows of strings).
+    pub table: Vec<Vec<String>>,
+    /// The report as text (what `robodyn base-params` prints).
+    pub report: String,
+    /// The report as JSON text (the CLI's `--format json`).
+    pub json: String,
+}
+
+#[pymethods]
+impl BaseParameters {
+    fn __len__(&self) -> usize {
+        self.names.len()
+    }
+    fn __repr__(&self) -> String {
+        format!(
+            "BaseParameters(method={:?}, count={}, names={:?})",
+            self.method,
+            self.names.len(),
+            self.names
+        )
+    }
+}
+
+impl BaseParameters {
+    fn from_summary(
+        py: Python<'_>,
+        s: &Summary,
+        coefficients: Option<Vec<Vec<f64>>>,
+    ) -> PyResult<BaseParameters> {
+        let coefficients = match coefficients {
+            Some(rows) if !rows.is_empty() => {
+                Some(PyArray2::from_vec2(py, &rows)?.into_any().unbind())
+            }
+            Some(_) => Some(
+                PyArray2::<f64>::zeros(py, [0, s.columns.len()], false)
+                    .into_any()
+                    .unbind(),
+            ),
+            None => None,
+        };
+        Ok(BaseParameters {
+            method: s.method.to_string(),
+            names: s.base.iter().map(|b| b.name.clone()).collect(),
+            indices: s.base.iter().map(|b| b.index).collect(),
+            regrouped: s.base.iter().map(|b| b.regrouped).collect(),
+            equations: s.base.iter().map(|b| b.equation.clone()).collect(),
+            values: s.base.iter().map(|b| b.value).collect(),
+            columns: s
+                .columns
+                .iter()
+                .map(|&i| s.names.name(i).to_string())
+                .collect(),
+            coefficients,
+            no_effect: s.no_effect.clone(),
+            grouped: s.grouped.clone(),
+            notes: s.notes.clone(),
+            table: s.table(),
+            report: robodyn::report::base_parameters::text(s),
+            json: serde_json::to_string_pretty(&robodyn::report::base_parameters::json(s))
+                .unwrap_or_default(),
+        })
+    }
+}
+
+/// Base parameters of `robot` (see `Robot.base_parameters`).
+pub fn base_parameters(
+    py: Python<'_>,
+    robot: &Robot,
+    method: &str,
+    friction: bool,
+    rotor: &str,
+    zeros: Option<&str>,
+    seed: u64,
+) -> PyResult<BaseParameters> {
+    let (symbolic, numeric) = match method {
+        "symbolic" => (true, false),
+        "numeric" => (false, true),
+        "both" => (true, true),
+        _ => {
+            return Err(InputError::new_err(format!(
+                "method = {method:?}: expected \"symbolic\", \"numeric\" or \"both\""
+            )))
+        }
+    };
+    let model = robot.model();
+    let desc = model.description();
+    let sel = ParameterSelection::from_description(desc, parse_rotor(rotor)?, friction)
+        .with_zero_parameters(desc, robot.zeros(zeros)?);
+    let names = ParameterNames::of(desc);
+    let (summary, coef) = py
+        .detach(|| -> robodyn::Result<(Summary, Option<Vec<Vec<f64>>>)> {
+            let sb = symbolic
+                .then(|| symbolic_base_parameters(desc, &sel))
+                .transpose()?;
+            let nb = numeric
+                .then(|| {
+                    let opt = NumericOptions {
+                        selection: sel.clone(),
+                        samples: None,
+                        seed,
+                    };
+                    numeric_base_parameters_auto(&model, &opt)
+                })
+                .transpose()?;
+            let mut s = match (&sb, &nb) {
+                (Some(sb), _) => Summary::from_symbolic(desc, sb, &names),
+                (None, Some((nb, _))) => {
+                    Summary::from_numeric(desc, nb, &names, &standard_values(desc))
+                }
+                _ => unreachable!("a method is chosen"),
+            };
+            if let Some((nb, start)) = &nb {
+                if let Some(start) = start {
+                    s.notes.push(format!("closed chain: {}", start.describe()));
+                }
+                if let Some(sb) = &sb {
+                    s.add_comparison(&compare_methods(sb, nb, &names));
+                }
+            }
+            let position: HashMap<usize, usize> =
+                s.columns.iter().enumerate().map(|(c, &i)| (i, c)).collect();
+            let coef = match (&sb, &nb) {
+                // K_base = K1 + beta K2
+                (None, Some((nb, _))) => Some(
+                    (0..nb.count())
+                        .map(|r| {
+                            let mut row = vec![0.0; s.columns.len()];
+                            if let Some(&c) = position.get(&nb.base[r]) {
+                                row[c] = 1.0;
+                            }
+                            for (g, &i) in nb.grouped.iter().enumerate() {
+                                if let Some(&c) = position.get(&i) {
+                                    row[c] += nb.beta[(r, g)];
+                                }
+                            }
+                            row
+                        })
+                        .collect(),
+                ),
+                // the equations are linear in the standard parameters: the coefficient of
+                // column c is the equation at K = e_c
+                (Some(sb), _) => sb
+                    .equations
+                    .iter()
+                    .map(|eq| {
+                        s.columns
+                            .iter()
+                            .map(|&c| {
+                                let unit = parameter_name(c);
+                                eq.eval(&|name: &str| {
+                                    if name == unit {
+                                        Some(1.0)
+                                    } else if standard_index(name, desc.nl).is_some() {
+                                        Some(0.0)
+                                    } else {
+                                        desc.symbols.get(name).copied()
+                                    }
+                                })
+                                .ok()
+                            })
+                            .collect::<Option<Vec<f64>>>()
+                    })
+                    .collect::<Option<Vec<_>>>(),
+                _ => None,
+            };
+            Ok((s, coef))
+        })
+        .py()?;
+    BaseParameters::from_summary(py, &summary, coef)
+}
+
+/// A generated customized model.
+#[pyclass(module = "robodyn", frozen, get_all)]
+pub struct Generated {
+    /// Function name.
+    pub name: String,
+    /// The code (or SYMORO-style text / LaTeX).
+    pub code: String,
+    /// Multiplications and divisions.
+    pub multiplications: usize,
+    /// Additions and subtractions.
+    pub additions: usize,
+    /// Elementary function calls (sin, cos...).
+    pub functions: usize,
+}
+
+#[pymethods]
+impl Generated {
+    fn __repr__(&self) -> String {
+        format!(
+            "Generated({:?}, {} multiplications, {} additions)",
+            self.name, self.multiplications, self.additions
+        )
+    }
+    fn __str__(&self) -> String {
+        self.code.clone()
+    }
+}
+
+/// Customized symbolic model of `robot` (see `Robot.generate`).
+#[allow(clippy::too_many_arguments)]
+pub fn generate(
+    py: Python<'_>,
+    robot: &robodyn::Robot,
+    model: &str,
+    lang: &str,
+    params: &str,
+    symmetric: bool,
+    friction: bool,
+    rotor: bool,
+    numeric: bool,
+    name: Option<String>,
+) -> PyResult<Generated> {
+    let kind = match model {
+        "idm" => ModelKind::Idm,
+        "inertia" => ModelKind::Inertia,
+        "h" => ModelKind::H,
+        "ddm" => ModelKind::Ddm,
+        "closed" => ModelKind::Closed,
+        "w" => ModelKind::W,
+        _ => {
+            return Err(InputError::new_err(format!(
+                "model = {model:?}: expected idm, inertia, h, ddm, closed or w"
+            )))
+        }
+    };
+    let lang = match lang {
+        "text" => Lang::Text,
+        "latex" => Lang::Latex,
+        "rust" => Lang::Rust,
+        "c" => Lang::C,
+        "python" => Lang::Python,
+        "julia" => Lang::Julia,
+        "matlab" => Lang::Matlab,
+        _ => {
+            return Err(InputError::new_err(format!(
+                "lang = {lang:?}: expected text, latex, rust, c, python, julia or matlab"
+            )))
+        }
+    };
+    let desc = robot.description();
+    let base = match params {
+        "standard" => None,
+        "base" => Some(GenBase::symbolic(desc, rotor, friction).py()?),
+        _ => {
+            return Err(InputError::new_err(format!(
+                "params = {params:?}: expected \"standard\" or \"base\""
+            )))
+        }
+    };
+    let opt = GenOptions {
+        model: kind,
+        numeric,
+        symmetric,
+        friction,
+        rotor,
+        base,
+        g: None,
+        name,
+        optimize: true,
+    };
+    let prog = py.detach(|| gen(desc, &opt)).py()?;
+    let c = prog.count();
+    Ok(Generated {
+        code: emit(&prog, lang),
+        name: prog.name.clone(),
+        multiplications: c.mul,
+        additions: c.add,
+        functions: c.func,
+    })
+}
+
+/// Torques from a Python callable `torque(t, q, qd) -> tau` around another system.
+struct Callback<'a> {
+    inner: &'a mut (dyn Dynamics + Send),
+    f: Py<PyAny>,
+    tau: Vec<f64>,
+    error: Option<PyErr>,
+}
+
+fn call_torque(f: &Py<PyAny>, t: f64, q: &[f64], qd: &[f64], out: &mut [f64]) -> PyResult<()> {
+    Python::attach(|py| {
+        let r = f.call1(
+            py,
+            (t, PyArray1::from_slice(py, q), PyArray1::from_slice(py, qd)),
+        )?;
+        let v: Vec<f64> = crate::arrays::float_array(r.bind(py))?
+            .readonly()
+            .as_array()
+            .iter()
+            .copied()
+            .collect();
+        if v.len() != out.len() {
+            return Err(crate::errors::DimensionError::new_err(format!(
+                "the torque callback returned {} values, {} expected",
+                v.len(),
+                out.len()
+            )));
+        }
+        out.copy_from_slice(&v);
+        Ok(())
+    })
+}
+
+impl Dynamics for Callback<'_> {
+    fn dof(&self) -> usize {
+        self.inner.dof()
+    }
+    fn labels(&self) -> Vec<String> {
+        self.inner.labels()
+    }
+    fn accel(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        _tau: &[f64],
+        qdd: &mut [f64],
+    ) -> robodyn::Result<()> {
+        if let Err(e) = call_torque(&self.f, t, q, qd, &mut self.tau) {
+            self.error = Some(e);
+            return Err(robodyn::Error::Input("the torque callback failed".into()));
+        }
+        self.inner.accel(t, q, qd, &self.tau, qdd)
+    }
+    fn energy(&mut self, q: &[f64], qd: &[f64]) -> robodyn::Result<f64> {
+        self.inner.energy(q, qd)
+    }
+    fn extra_columns(&self) -> Vec<String> {
+        self.inner.extra_columns()
+    }
+    fn extra_values(&mut self, q: &[f64], qd: &[f64], out: &mut [f64]) -> robodyn::Result<()> {
+        self.inner.extra_values(q, qd, out)
+    }
+}
+
+/// Simulation settings shared by trees and closed chains.
+pub struct SimArgs<'py> {
+    pub duration: f64,
+    pub q0: Vec<f64>,
+    pub qd0: Vec<f64>,
+    pub torque: Option<Bound<'py, PyAny>>,
+    pub dt: Option<f64>,
+    pub rtol: f64,
+    pub atol: f64,
+    pub output_dt: f64,
+    pub max_steps: Option<usize>,
+}
+
+/// Run a simulation of `dynamics` and return the trajectory as a dict of arrays.
+pub fn run_simulation<'py>(
+    py: Python<'py>,
+    dynamics: &mut (dyn Dynamics + Send),
+    a: SimArgs<'py>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let n = dynamics.dof();
+    let mut callback = None;
+    let input = match &a.torque {
+        None => TorqueInput::Constant(vec![0.0; n]),
+        Some(t) if t.is_callable() => {
+            callback = Some(t.clone().unbind());
+            TorqueInput::Constant(vec![0.0; n])
+        }
+        Some(t) if t.is_instance_of::<PyTuple>() => {
+            let (times, values): (Bound<PyAny>, Bound<PyAny>) = t.extract()?;
+            let times: Vec<f64> = crate::arrays::float_array(&times)?
+                .readonly()
+                .as_array()
+                .iter()
+                .copied()
+                .collect();
+            let values = crate::arrays::float_array(&values)?;
+            let shape = values.shape().to_vec();
+            if shape.len() != 2 || shape[1] != n || shape[0] != times.len() {
+                return Err(crate::errors::DimensionError::new_err(format!(
+                    "torque = (times, values): values has shape {shape:?}, expected ({}, {n})",
+                    times.len()
+                )));
+            }
+            let flat: Vec<f64> = values.readonly().as_array().iter().copied().collect();
+            let rows = flat.chunks(n).map(|c| c.to_vec()).collect();
+            TorqueInput::Series(TimeSeries::new(times, rows).py()?)
+        }
+        Some(t) => {
+            let v: Vec<f64> = crate::arrays::float_array(t)?
+                .readonly()
+                .as_array()
+                .iter()
+                .copied()
+                .collect();
+            TorqueInput::Constant(v)
+        }
+    };
+    let integrator = match a.dt {
+        Some(dt) => Integrator::Rk4 { dt },
+        None => Integrator::Dopri5 {
+            rtol: a.rtol,
+            atol: a.atol,
+            h0: None,
+            h_max: None,
+        },
+    };
+    let opts = SimOptions {
+        duration: a.duration,
+        integrator,
+        output_dt: a.output_dt,
+        max_steps: a.max_steps,
+    };
+    let mut rec = Recorder::default();
+    let result = match &callback {
+        None => py.detach(|| {
+            sim(
+                dynamics,
+                &input,
+                &a.q0,
+                &a.qd0,
+                &opts,
+                &mut rec,
+                &mut |_| {},
+            )
+        }),
+        Some(f) => {
+            let mut cb = Callback {
+                inner: dynamics,
+                f: f.clone_ref(py),
+                tau: vec![0.0; n],
+                error: None,
+            };
+            let r = py.detach(|| sim(&mut cb, &input, &a.q0, &a.qd0, &opts, &mut rec, &mut |_| {}));
+            if let Some(e) = cb.error.take() {
+                return Err(e);
+            }
+            // the recorded torques are the callback's at each output row
+            for row in rec.rows.iter_mut() {
+                let (t, rest) = row.split_at_mut(1);
+                let (q, rest) = rest.split_at_mut(n);
+                let (qd, rest) = rest.split_at_mut(n);
+                call_torque(f, t[0], q, qd, &mut rest[n..2 * n])?;
+            }
+            r
+        }
+    };
+    result.py()?;
+    let out = PyDict::new(py);
+    let rows = rec.rows.len();
+    let col = |c: usize| -> Vec<f64> { rec.rows.iter().map(|r| r[c]).collect() };
+    let block = |c0: usize| -> Vec<f64> {
+        rec.rows
+            .iter()
+            .flat_map(|r| r[c0..c0 + n].iter().copied())
+            .collect()
+    };
+    out.set_item("t", PyArray1::from_vec(py, col(0)))?;
+    for (k, name) in ["q", "qd", "qdd", "tau"].iter().enumerate() {
+        out.set_item(
+            *name,
+            PyArray1::from_vec(py, block(1 + k * n)).reshape([rows, n])?,
+        )?;
+    }
+    out.set_item("energy", PyArray1::from_vec(py, col(1 + 4 * n)))?;
+    for (k, h) in rec.headers.iter().enumerate().skip(2 + 4 * n) {
+        out.set_item(h, PyArray1::from_vec(py, col(k)))?;
+    }
+    out.set_item(
+        "joint_labels",
+        rec.headers[1..1 + n]
+            .iter()
+            .map(|h| h[1..].to_string())
+            .collect::<Vec<_>>(),
+    )?;
+    Ok(out)
+}
+
+/// A tree's simulated system.
+pub fn tree_dynamics<'a>(
+    robot: &'a robodyn::Robot,
+    method: &str,
+    coulomb_smoothing: Option<f64>,
+) -> PyResult<TreeDynamics<'a>> {
+    Ok(TreeDynamics::new(robot, parse_method(method)?).with_coulomb_smoothing(coulomb_smoothing))
+}
