@@ -1,6 +1,18 @@
 //! `robodyn`: dynamic models of tree and closed-chain robots from the command line.
 //! Argument parsing and formatting only; the models live in the `robodyn` library.
 
+/// `writeln!` into a `String` (output is built in memory and written once by
+/// `common::print_out`, so a closed pipe is an error, not a panic).
+macro_rules! outln {
+    ($s:expr) => {
+        $s.push('\n')
+    };
+    ($s:expr, $($t:tt)*) => {{
+        use std::fmt::Write as _;
+        let _ = writeln!($s, $($t)*);
+    }};
+}
+
 mod commands;
 mod common;
 
@@ -62,6 +74,10 @@ fn main() {
         Command::Excite(a) => commands::excite::run(a),
     };
     if let Err(e) = result {
+        // `robodyn ... | head -1`: the reader has all it wanted; end quietly
+        if common::is_broken_pipe(e.as_ref()) {
+            std::process::exit(0);
+        }
         eprintln!("robodyn: error: {e}");
         std::process::exit(1);
     }

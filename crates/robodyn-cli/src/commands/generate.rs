@@ -72,18 +72,17 @@ pub struct Args {
     /// Function name in the generated code.
     #[arg(long)]
     pub name: Option<String>,
-    /// Output file (default: standard output).
+    /// Output file (default or `-`: standard output).
     #[arg(long)]
     pub output: Option<PathBuf>,
 }
 
 pub fn run(a: Args) -> CliResult {
-    let mut desc = robodyn::io::load_description(&a.robot)?;
     let rargs = crate::common::RobotArgs {
         robot: a.robot.clone(),
         set: a.set.clone(),
     };
-    desc.symbols.extend(rargs.overrides()?);
+    let (desc, _) = rargs.description()?;
     let base = match a.params {
         Params::Standard => None,
         Params::Base => match &a.base_file {
@@ -129,10 +128,7 @@ pub fn run(a: Args) -> CliResult {
         Language::Matlab => Lang::Matlab,
     };
     let text = emit(&prog, lang);
-    match &a.output {
-        Some(p) => std::fs::write(p, text).map_err(|e| format!("{}: {e}", p.display()))?,
-        None => print!("{text}"),
-    }
+    crate::common::write_text(a.output.as_deref(), &text)?;
     let c = prog.count();
     eprintln!(
         "{}: {} multiplications, {} additions",

@@ -16,7 +16,7 @@ pub use input::{TimeSeries, TorqueInput};
 pub use integrators::{Integrator, Ode, Stats, Stepper};
 #[cfg(feature = "plot")]
 pub use output::plot_svg;
-pub use output::{CsvSink, Recorder, Tee, TrajectorySink};
+pub use output::{format_number, CsvSink, Recorder, Tee, TrajectorySink};
 
 use crate::algorithms::direct_dynamics::{ddm, Method};
 use crate::data::Data;
