@@ -21,7 +21,9 @@ pub struct RobotArgs {
 }
 
 /// The symbols a description uses or gives a value to.
-pub fn known_symbols(desc: &robodyn::model::RobotDescription) -> std::collections::BTreeSet<String> {
+pub fn known_symbols(
+    desc: &robodyn::model::RobotDescription,
+) -> std::collections::BTreeSet<String> {
     let mut known: std::collections::BTreeSet<String> = desc.symbols.keys().cloned().collect();
     let mut add = |e: &robodyn::Expr| {
         e.for_each_symbol(&mut |s| {
@@ -62,7 +64,9 @@ impl RobotArgs {
 
     /// Load the robot's description with the `--set` values (each must name a symbol the file
     /// uses).
-    pub fn description(&self) -> CliResult<(robodyn::model::RobotDescription, robodyn::io::SourceMap)> {
+    pub fn description(
+        &self,
+    ) -> CliResult<(robodyn::model::RobotDescription, robodyn::io::SourceMap)> {
         let (mut desc, map) = robodyn::io::load_description_mapped(&self.robot)?;
         let o = self.overrides()?;
         check_overrides(&desc, &o)?;
@@ -472,12 +476,7 @@ pub fn read_joint_states(
             .rows
             .iter()
             .map(|r| {
-                std::array::from_fn(|i| {
-                    cols[i]
-                        .iter()
-                        .map(|c| c.map_or(0.0, |c| r[c]))
-                        .collect()
-                })
+                std::array::from_fn(|i| cols[i].iter().map(|c| c.map_or(0.0, |c| r[c])).collect())
             })
             .collect();
         return Ok((states, carried));

@@ -16,7 +16,7 @@ macro_rules! outln {
 mod commands;
 mod common;
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 
 #[derive(Parser)]
 #[command(
@@ -49,7 +49,7 @@ enum Command {
     Ddm(commands::ddm::Args),
     /// Simulate the direct dynamic model under a torque input; CSV trajectory and SVG plot.
     Simulate(commands::simulate::Args),
-    /// Customized symbolic models (idm, inertia, h, ddm, closed) as text, LaTeX or code.
+    /// Customized symbolic models (idm, inertia, h, ddm, closed, w) as text, LaTeX or code.
     Generate(commands::generate::Args),
     /// Identify base parameters, friction and drive parameters from a measured log.
     Identify(commands::identify::Args),
@@ -57,8 +57,15 @@ enum Command {
     Excite(commands::excite::Args),
 }
 
+/// Printed after every command's `--help`: the units of every value and column.
+const UNITS: &str = "Units (SI): q<j> rad (revolute) or m (prismatic); qd<j> rad/s or m/s; \
+qdd<j> rad/s^2 or m/s^2; tau<j> N m or N; t s; energy J; robot file: lengths m, masses kg, first \
+moments kg m, inertias kg m^2, FS N m or N, FV N m s/rad or N s/m, gravity m/s^2. \
+`-` as a file is standard input/output. Conventions: docs/cli.md.";
+
 fn main() {
-    let cli = Cli::parse();
+    let command = Cli::command().mut_subcommands(|c| c.after_help(UNITS));
+    let cli = Cli::from_arg_matches(&command.get_matches()).unwrap_or_else(|e| e.exit());
     let result = match cli.command {
         Command::Info(a) => commands::info::run(a),
         Command::Idm(a) => commands::idm::run(a),

@@ -3,8 +3,8 @@
 //! `--jacobian` W = d q_p / d q_a (10.30).
 
 use crate::common::{
-    format_number, print_out,
-    conditioning_json, parse_list, start_branch, warn_conditioning, CliResult, RobotArgs,
+    conditioning_json, format_number, parse_list, print_out, start_branch, warn_conditioning,
+    CliResult, RobotArgs,
 };
 use robodyn::{loop_closure, ClosedChain};
 use serde_json::json;
@@ -78,7 +78,8 @@ pub fn run(a: Args) -> CliResult {
             outln!(out, "{}", serde_json::to_string_pretty(&o)?);
         }
         Format::Text => {
-            outln!(out, 
+            outln!(
+                out,
                 "{}: {} loop(s), N = {} actuated, p = {} passive tree joints",
                 robot.name(),
                 cuts.len(),
@@ -96,7 +97,8 @@ pub fn run(a: Args) -> CliResult {
             list(&mut out, pas, q_p);
             outln!(out, "cut joints q_c:");
             list(&mut out, &cuts, q_c);
-            outln!(out, 
+            outln!(
+                out,
                 "closure residual {:.3e}; {}",
                 s.residual,
                 s.conditioning.describe(cc.limits())
@@ -110,7 +112,11 @@ pub fn run(a: Args) -> CliResult {
                 outln!(out, "       {}", cols.join(" "));
                 for (r, j) in pas.iter().enumerate() {
                     // (+ 0.0 turns -0 into 0)
-                    let v: Vec<String> = w.row(r).iter().map(|x| format!("{:>14.6e}", x + 0.0)).collect();
+                    let v: Vec<String> = w
+                        .row(r)
+                        .iter()
+                        .map(|x| format!("{:>14.6e}", x + 0.0))
+                        .collect();
                     outln!(out, "  {:<5}{}", format!("q{j}"), v.join(" "));
                 }
             }

@@ -221,28 +221,38 @@ pub fn run(a: Args) -> CliResult {
     let mut out = String::new();
     match a.format {
         Format::Text => {
-            outln!(out, 
+            outln!(
+                out,
                 "{}: excitation trajectory, {} harmonics, period {} s, {} parameters",
                 access.name(),
                 a.harmonics,
                 a.period,
                 params.count()
             );
-            outln!(out, 
+            outln!(out,
                 "condition number of W (unit columns, {} samples): {:.4} (best random start {:.4}; \
                  {} evaluations)",
                 a.samples, d.condition, d.initial_condition, d.evaluations
             );
-            outln!(out, 
+            outln!(
+                out,
                 "scaled to the {} limit of joint {}",
-                d.binding.what, joints[d.binding.joint]
+                d.binding.what,
+                joints[d.binding.joint]
             );
-            outln!(out, "  joint  max|q-start|       max|qd|      max|qdd|      max|tau|");
+            outln!(
+                out,
+                "  joint  max|q-start|       max|qd|      max|qdd|      max|tau|"
+            );
             for (k, j) in joints.iter().enumerate() {
                 let p = d.peaks[k];
-                outln!(out, 
+                outln!(
+                    out,
                     "  {j:<5} {:>13.5} {:>13.5} {:>13.5} {:>13.5}",
-                    p[0], p[1], p[2], p[3]
+                    p[0],
+                    p[1],
+                    p[2],
+                    p[3]
                 );
             }
         }

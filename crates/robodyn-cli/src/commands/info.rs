@@ -107,7 +107,8 @@ fn role(d: &RobotDescription, j: usize) -> &'static str {
 
 fn text(d: &RobotDescription, s: &robodyn::model::Structure) -> String {
     let mut out = String::new();
-    outln!(out, 
+    outln!(
+        out,
         "{}: {} structure, NL = {}, NJ = {}, NF = {}",
         d.name,
         s.kind,
@@ -164,7 +165,7 @@ fn text(d: &RobotDescription, s: &robodyn::model::Structure) -> String {
     } else {
         outln!(out, "loops:");
         for (l, lp) in s.loops.iter().enumerate() {
-            outln!(out, 
+            outln!(out,
                 "  loop {}: cut joint {} joins link {} and link {} (twin frame {}), root {}, branches {:?} / {:?}",
                 l + 1, lp.cut, lp.link_i, lp.link_j, lp.twin, lp.root, lp.branch_i, lp.branch_j
             );
@@ -178,7 +179,8 @@ fn text(d: &RobotDescription, s: &robodyn::model::Structure) -> String {
         .filter(|&j| !d.frame(j).actuated && d.frame(j).joint.is_movable())
         .map(|j| j.to_string())
         .collect();
-    outln!(out, 
+    outln!(
+        out,
         "actuated joints: {}",
         if act.is_empty() {
             "none".into()
@@ -186,7 +188,8 @@ fn text(d: &RobotDescription, s: &robodyn::model::Structure) -> String {
             act.join(", ")
         }
     );
-    outln!(out, 
+    outln!(
+        out,
         "passive tree joints: {}",
         if pas.is_empty() {
             "none".into()
