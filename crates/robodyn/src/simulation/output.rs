@@ -172,7 +172,7 @@ const SCALE: u32 = 4;
 #[cfg(feature = "plot")]
 fn tick_label(v: f64, span: f64) -> String {
     let v = if v.abs() < 1e-9 * span { 0.0 } else { v };
-    if span >= 1e-2 && span < 1e5 {
+    if (1e-2..1e5).contains(&span) {
         let decimals = (1.0 - span.log10().floor()).clamp(0.0, 6.0) as usize;
         format!("{v:.decimals$}")
     } else if v == 0.0 {
@@ -212,6 +212,10 @@ fn stop_reason(e: &str) -> String {
     }
 }
 
+/// A named curve: a column's header and its values.
+#[cfg(feature = "plot")]
+type Series = (String, Vec<f64>);
+
 /// Colour k of n series: the ten "tab10" colours, or n evenly spaced hues when there are more
 /// (no colour repeats).
 #[cfg(feature = "plot")]
@@ -233,7 +237,7 @@ fn series_color(k: usize, n: usize) -> plotters::style::RGBColor {
         let (r, g, b) = TAB10[k];
         RGBColor(r, g, b)
     } else {
-        let l = if k % 2 == 0 { 0.38 } else { 0.55 };
+        let l = if k.is_multiple_of(2) { 0.38 } else { 0.55 };
         let c = HSLColor(k as f64 / n as f64, 0.75, l);
         use plotters::style::Color;
         let (r, g, b) = c.rgb();
@@ -293,7 +297,7 @@ pub fn plot_svg(path: &Path, rec: &Recorder, info: &PlotInfo) -> Result<()> {
     let sf = f64::from(SCALE);
     let font = |size: f64| ("sans-serif", size * sf);
     let (w, panel_h) = (1100u32, 300u32);
-    let mut panels: Vec<(&str, &str, &[(String, Vec<f64>)])> = Vec::new();
+    let mut panels: Vec<(&str, &str, &[Series])> = Vec::new();
     if !revolute.is_empty() {
         panels.push(("joint positions, revolute joints", "q [rad]", &revolute));
     }
