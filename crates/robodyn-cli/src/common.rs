@@ -11,36 +11,74 @@ pub type CliResult<T = ()> = Result<T, Box<dyn std::error::Error>>;
 /// The robot file and symbol overrides.
 #[derive(Args, Debug, Clone)]
 pub struct RobotArgs {
-    /// Robot file (.toml, .par or .urdf).
+    /// Robot file (.toml, .par or .urdf; `-` reads standard input, format recognized from the
+    /// text).
     pub robot: PathBuf,
-    /// Give or override a symbol value, e.g. `--set d3=0.6` (repeatable).
+    /// Give or override a symbol value, e.g. `--set d3=0.6` or `--set D3=pi/8` (repeatable; the
+    /// symbol must be one the file uses, the value a constant expression as for `--q`).
     #[arg(long = "set", value_name = "NAME=VALUE")]
     pub set: Vec<String>,
 }
 
+/// The symbols a description uses or gives a value to.
+pub fn known_symbols(
+    desc: &robodyn::model::RobotDescription,
+) -> std::collections::BTreeSet<String> {
+    let mut known: std::collections::BTreeSet<String> = desc.symbols.keys().cloned().collect();
+    let mut add = |e: &robodyn::Expr| {
+        e.for_each_symbol(&mut |s| {
+            known.insert(s.to_string());
+        })
+    };
+    for f in &desc.frames {
+        for e in f.geometric() {
+            add(e);
+        }
+    }
+    for l in &desc.links {
+        l.params.iter().chain(&l.wrench).for_each(&mut add);
+    }
+    for v in [&desc.gravity, &desc.w0, &desc.wp0, &desc.v0, &desc.vp0] {
+        v.iter().for_each(&mut add);
+    }
+    known
+}
+
 impl RobotArgs {
+    /// The `--set` values (names not yet checked against a robot: see [`check_overrides`]).
     pub fn overrides(&self) -> CliResult<BTreeMap<String, f64>> {
         let mut m = BTreeMap::new();
         for s in &self.set {
             let (k, v) = s
                 .split_once('=')
                 .ok_or_else(|| format!("--set {s}: expected NAME=VALUE"))?;
-            let x: f64 = v
-                .trim()
-                .parse()
-                .map_err(|_| format!("--set {s}: `{v}` is not a number"))?;
-            if !x.is_finite() {
-                return Err(format!("--set {s}: value is not finite").into());
+            let k = k.trim();
+            if k.is_empty() {
+                return Err(format!("--set {s}: the symbol name is missing (NAME=VALUE)").into());
             }
-            m.insert(k.trim().to_string(), x);
+            let x = parse_value(v).map_err(|e| format!("--set {s}: {e}"))?;
+            m.insert(k.to_string(), x);
         }
         Ok(m)
+    }
+
+    /// Load the robot's description with the `--set` values (each must name a symbol the file
+    /// uses).
+    pub fn description(
+        &self,
+    ) -> CliResult<(robodyn::model::RobotDescription, robodyn::io::SourceMap)> {
+        let (mut desc, map) = robodyn::io::load_description_mapped(&self.robot)?;
+        let o = self.overrides()?;
+        check_overrides(&desc, &o)?;
+        desc.symbols.extend(o);
+        Ok((desc, map))
     }
 
     /// Load and validate the robot (all symbols need values). A motor-joint transmission with
     /// nonzero motor drive parameters is refused: only `identify` and `excite` apply it.
     pub fn load(&self) -> CliResult<Robot> {
-        let robot = robodyn::io::load_with(&self.robot, &self.overrides()?)?;
+        let (desc, map) = self.description()?;
+        let robot = Robot::new(desc).map_err(|e| map.locate(e))?;
         if let Some(t) = &robot.description().transmission {
             let k = robot.standard_parameters();
             let identity = t.matrix.iter().enumerate().all(|(r, row)| {
@@ -66,16 +104,48 @@ impl RobotArgs {
     }
 }
 
-/// Parse a comma-separated list of numbers (`--q 0.1,0.2,...`).
+/// `--set` names must be symbols of the robot (a misspelt `d3` for `D3` would be ignored).
+pub fn check_overrides(
+    desc: &robodyn::model::RobotDescription,
+    o: &BTreeMap<String, f64>,
+) -> CliResult {
+    let known = known_symbols(desc);
+    for k in o.keys() {
+        if !known.contains(k) {
+            let list: Vec<&str> = known.iter().map(String::as_str).collect();
+            return Err(format!(
+                "--set {k}=...: the robot has no symbol `{k}` (its symbols: {})",
+                if list.is_empty() {
+                    "none".to_string()
+                } else {
+                    list.join(", ")
+                }
+            )
+            .into());
+        }
+    }
+    Ok(())
+}
+
+/// One value of the command line: a number or a constant expression (`pi/8`, `-1e-3`), finite.
+/// The same parser serves `--set`, `--q` and every other list.
+pub fn parse_value(t: &str) -> Result<f64, String> {
+    let t = t.trim();
+    let e = robodyn::Expr::parse(t).map_err(|e| format!("`{t}` is not a number: {e}"))?;
+    let x = e
+        .eval(&|_| None)
+        .map_err(|e| format!("`{t}` is not a constant number: {e}"))?;
+    if x.is_finite() {
+        Ok(x)
+    } else {
+        Err(format!("`{t}` is not finite"))
+    }
+}
+
+/// Parse a comma-separated list of numbers (`--q 0.1,0.2,...`), each by [`parse_value`].
 pub fn parse_list(name: &str, s: &str) -> CliResult<Vec<f64>> {
     s.split(',')
-        .map(|t| {
-            let t = t.trim();
-            robodyn::Expr::parse(t)
-                .ok()
-                .and_then(|e| e.eval(&|_| None).ok())
-                .ok_or_else(|| format!("--{name}: `{t}` is not a number").into())
-        })
+        .map(|t| parse_value(t).map_err(|e| format!("--{name}: {e}").into()))
         .collect()
 }
 
@@ -88,9 +158,16 @@ pub struct Table {
 
 impl Table {
     /// Read a state table (the library's reader: a repeated column, a short row or a field
-    /// that is not a finite number is an error with its line).
+    /// that is not a finite number is an error with its line); `-` is standard input.
     pub fn read(path: &Path) -> CliResult<Table> {
-        let t = robodyn::io::table::Table::read(path)?;
+        let t = if robodyn::io::is_stdio(path) {
+            let mut b = Vec::new();
+            std::io::Read::read_to_end(&mut std::io::stdin().lock(), &mut b)
+                .map_err(|e| format!("<stdin>: {e}"))?;
+            robodyn::io::table::Table::parse(&b, "<stdin>")?
+        } else {
+            robodyn::io::table::Table::read(path)?
+        };
         Ok(Table {
             headers: t.headers,
             rows: t.rows,
@@ -107,7 +184,6 @@ impl Table {
     }
 
     /// Index of a column if present.
-    #[allow(dead_code)]
     pub fn find(&self, name: &str) -> Option<usize> {
         self.headers.iter().position(|h| h == name)
     }
@@ -124,7 +200,7 @@ pub enum TableFormat {
 /// Where and how a command writes its table (`--output`, `--format`).
 #[derive(Args, Debug, Clone)]
 pub struct TableOutput {
-    /// Output file (default: standard output).
+    /// Output file (default or `-`: standard output).
     #[arg(long)]
     pub output: Option<PathBuf>,
     #[arg(long, value_enum, default_value = "csv")]
@@ -173,17 +249,13 @@ pub fn write_table_with(
     rows: &[Vec<f64>],
     json_extra: &[serde_json::Map<String, serde_json::Value>],
 ) -> CliResult {
-    let mut out: Box<dyn Write> = match path {
-        Some(p) => Box::new(std::io::BufWriter::new(
-            std::fs::File::create(p).map_err(|e| format!("{}: {e}", p.display()))?,
-        )),
-        None => Box::new(std::io::stdout().lock()),
-    };
+    check_finite(headers, rows)?;
+    let mut out = create_output(path)?;
     match format {
         TableFormat::Csv => {
             writeln!(out, "{}", headers.join(","))?;
             for r in rows {
-                let line: Vec<String> = r.iter().map(|x| format!("{x:.12e}")).collect();
+                let line: Vec<String> = r.iter().map(|&x| format_number(x)).collect();
                 writeln!(out, "{}", line.join(","))?;
             }
         }
@@ -207,7 +279,79 @@ pub fn write_table_with(
             writeln!(out)?;
         }
     }
+    out.flush()?;
     Ok(())
+}
+
+pub use robodyn::simulation::format_number;
+
+/// A result that is not a finite number is an error, never printed (a velocity of 1e200 or a
+/// gravity of 1e308 overflows the model).
+pub fn check_finite(headers: &[String], rows: &[Vec<f64>]) -> CliResult {
+    for (k, r) in rows.iter().enumerate() {
+        if let Some((c, x)) = r.iter().enumerate().find(|(_, x)| !x.is_finite()) {
+            return Err(format!(
+                "{}{} = {x}: the result is not a finite number (an input, a symbol value or the \
+                 gravity is too large for the model's arithmetic); nothing was written",
+                if rows.len() > 1 {
+                    format!("row {}: ", k + 1)
+                } else {
+                    String::new()
+                },
+                headers.get(c).map_or("a value", String::as_str)
+            )
+            .into());
+        }
+    }
+    Ok(())
+}
+
+/// An output file, or standard output for `None` or `-`.
+pub fn create_output(path: Option<&Path>) -> CliResult<Box<dyn Write>> {
+    Ok(match path {
+        Some(p) if !robodyn::io::is_stdio(p) => Box::new(std::io::BufWriter::new(
+            std::fs::File::create(p).map_err(|e| format!("{}: {e}", p.display()))?,
+        )),
+        _ => Box::new(std::io::BufWriter::new(std::io::stdout().lock())),
+    })
+}
+
+/// Write text to a file, or to standard output for `None` or `-`.
+pub fn write_text(path: Option<&Path>, text: &str) -> CliResult {
+    match path {
+        Some(p) if !robodyn::io::is_stdio(p) => {
+            std::fs::write(p, text).map_err(|e| format!("{}: {e}", p.display()).into())
+        }
+        _ => print_out(text),
+    }
+}
+
+/// Write text to standard output (a closed pipe is an error [`is_broken_pipe`] recognizes).
+pub fn print_out(text: &str) -> CliResult {
+    let mut out = std::io::stdout().lock();
+    out.write_all(text.as_bytes())?;
+    out.flush()?;
+    Ok(())
+}
+
+/// Whether an error is a write to a closed pipe (`robodyn ... | head -1`): the command then
+/// ends quietly.
+pub fn is_broken_pipe(e: &(dyn std::error::Error + 'static)) -> bool {
+    let mut cur = Some(e);
+    while let Some(e) = cur {
+        if let Some(io) = e.downcast_ref::<std::io::Error>() {
+            if io.kind() == std::io::ErrorKind::BrokenPipe {
+                return true;
+            }
+        }
+        if let Some(robodyn::Error::Io { source, .. }) = e.downcast_ref::<robodyn::Error>() {
+            if source.kind() == std::io::ErrorKind::BrokenPipe {
+                return true;
+            }
+        }
+        cur = e.source();
+    }
+    false
 }
 
 /// How joint columns are named.
@@ -249,9 +393,35 @@ impl NamesArg {
 /// One state per row: three per-joint columns (e.g. `q qd qdd` or `q qd tau`) over `coords`.
 pub type States = Vec<[Vec<f64>; 3]>;
 
-/// Read states over `coords` from a CSV file (`input`, columns named by `names`) or from the
-/// comma lists of the command line (`lists`, the first one required, the others default to
-/// zeros). `what` names the joints in messages ("movable joints", "actuated joints").
+/// The columns of an `--input` table that are not inputs (`t`, labels...), carried through to
+/// the output in front of the results.
+#[derive(Default)]
+pub struct Carried {
+    pub headers: Vec<String>,
+    pub rows: Vec<Vec<f64>>,
+}
+
+impl Carried {
+    /// The output's headers and rows: the carried columns, then `headers`/`rows`.
+    pub fn prepend(&self, headers: &[String], rows: Vec<Vec<f64>>) -> (Vec<String>, Vec<Vec<f64>>) {
+        if self.headers.is_empty() {
+            return (headers.to_vec(), rows);
+        }
+        let h = self.headers.iter().chain(headers).cloned().collect();
+        let r = rows
+            .into_iter()
+            .zip(&self.rows)
+            .map(|(r, c)| c.iter().copied().chain(r).collect())
+            .collect();
+        (h, r)
+    }
+}
+
+/// Read states over `coords` from a CSV file (`input`, `-` for standard input, columns named by
+/// `names`) or from the comma lists of the command line (`lists`). In both, the first quantity
+/// (`q`) is required and the others default to zeros when absent (all their columns absent); the
+/// missing columns are reported together. `what` names the joints in messages ("movable
+/// joints", "actuated joints").
 pub fn read_joint_states(
     input: Option<&Path>,
     prefixes: [&str; 3],
@@ -259,24 +429,57 @@ pub fn read_joint_states(
     coords: &robodyn::Coordinates,
     names: NamesArg,
     what: &str,
-) -> CliResult<States> {
+) -> CliResult<(States, Carried)> {
     let n = coords.len();
     if let Some(path) = input {
         let t = Table::read(path)?;
-        let cols: Vec<[usize; 3]> = (0..n)
-            .map(|k| {
-                Ok([
-                    t.column(&names.column(prefixes[0], coords, k))?,
-                    t.column(&names.column(prefixes[1], coords, k))?,
-                    t.column(&names.column(prefixes[2], coords, k))?,
-                ])
-            })
-            .collect::<CliResult<_>>()?;
-        return Ok(t
+        let mut cols: [Vec<Option<usize>>; 3] = Default::default();
+        let mut missing = Vec::new();
+        for (i, prefix) in prefixes.iter().enumerate() {
+            let wanted: Vec<String> = (0..n).map(|k| names.column(prefix, coords, k)).collect();
+            cols[i] = wanted.iter().map(|w| t.find(w)).collect();
+            // q is required; qd, qdd (tau) may be absent altogether (zeros), not in part
+            if i == 0 || cols[i].iter().any(Option::is_some) {
+                missing.extend(
+                    wanted
+                        .iter()
+                        .zip(&cols[i])
+                        .filter(|(_, c)| c.is_none())
+                        .map(|(w, _)| format!("`{w}`")),
+                );
+            }
+        }
+        if !missing.is_empty() {
+            return Err(format!(
+                "{}: missing column{} {} (the {what} are {:?}; {} columns default to zero only \
+                 when all of them are absent)",
+                t.file,
+                if missing.len() > 1 { "s" } else { "" },
+                missing.join(", "),
+                coords.frames(),
+                prefixes[1..].join("/")
+            )
+            .into());
+        }
+        let used: std::collections::BTreeSet<usize> =
+            cols.iter().flatten().flatten().copied().collect();
+        let kept: Vec<usize> = (0..t.headers.len()).filter(|c| !used.contains(c)).collect();
+        let carried = Carried {
+            headers: kept.iter().map(|&c| t.headers[c].clone()).collect(),
+            rows: t
+                .rows
+                .iter()
+                .map(|r| kept.iter().map(|&c| r[c]).collect())
+                .collect(),
+        };
+        let states = t
             .rows
             .iter()
-            .map(|r| std::array::from_fn(|i| cols.iter().map(|c| r[c[i]]).collect()))
-            .collect());
+            .map(|r| {
+                std::array::from_fn(|i| cols[i].iter().map(|c| c.map_or(0.0, |c| r[c])).collect())
+            })
+            .collect();
+        return Ok((states, carried));
     }
     if lists[0].is_none() {
         return Err(format!(
@@ -301,7 +504,7 @@ pub fn read_joint_states(
             s[k] = vals;
         }
     }
-    Ok(vec![s])
+    Ok((vec![s], Carried::default()))
 }
 
 /// The branch tracker of a closed chain: from `--guess` (q_p at the first q_a) when given, else

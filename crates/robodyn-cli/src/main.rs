@@ -1,10 +1,22 @@
 //! `robodyn`: dynamic models of tree and closed-chain robots from the command line.
 //! Argument parsing and formatting only; the models live in the `robodyn` library.
 
+/// `writeln!` into a `String` (output is built in memory and written once by
+/// `common::print_out`, so a closed pipe is an error, not a panic).
+macro_rules! outln {
+    ($s:expr) => {
+        $s.push('\n')
+    };
+    ($s:expr, $($t:tt)*) => {{
+        use std::fmt::Write as _;
+        let _ = writeln!($s, $($t)*);
+    }};
+}
+
 mod commands;
 mod common;
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 
 #[derive(Parser)]
 #[command(
@@ -37,7 +49,7 @@ enum Command {
     Ddm(commands::ddm::Args),
     /// Simulate the direct dynamic model under a torque input; CSV trajectory and SVG plot.
     Simulate(commands::simulate::Args),
-    /// Customized symbolic models (idm, inertia, h, ddm, closed) as text, LaTeX or code.
+    /// Customized symbolic models (idm, inertia, h, ddm, closed, w) as text, LaTeX or code.
     Generate(commands::generate::Args),
     /// Identify base parameters, friction and drive parameters from a measured log.
     Identify(commands::identify::Args),
@@ -45,8 +57,15 @@ enum Command {
     Excite(commands::excite::Args),
 }
 
+/// Printed after every command's `--help`: the units of every value and column.
+const UNITS: &str = "Units (SI): q<j> rad (revolute) or m (prismatic); qd<j> rad/s or m/s; \
+qdd<j> rad/s^2 or m/s^2; tau<j> N m or N; t s; energy J; robot file: lengths m, masses kg, first \
+moments kg m, inertias kg m^2, FS N m or N, FV N m s/rad or N s/m, gravity m/s^2. \
+`-` as a file is standard input/output. Conventions: docs/cli.md.";
+
 fn main() {
-    let cli = Cli::parse();
+    let command = Cli::command().mut_subcommands(|c| c.after_help(UNITS));
+    let cli = Cli::from_arg_matches(&command.get_matches()).unwrap_or_else(|e| e.exit());
     let result = match cli.command {
         Command::Info(a) => commands::info::run(a),
         Command::Idm(a) => commands::idm::run(a),
@@ -62,6 +81,10 @@ fn main() {
         Command::Excite(a) => commands::excite::run(a),
     };
     if let Err(e) = result {
+        // `robodyn ... | head -1`: the reader has all it wanted; end quietly
+        if common::is_broken_pipe(e.as_ref()) {
+            std::process::exit(0);
+        }
         eprintln!("robodyn: error: {e}");
         std::process::exit(1);
     }

@@ -10,7 +10,7 @@ use robodyn::algorithms::base_parameters::{
     compare_methods, numeric_base_parameters_auto, standard_values, symbolic_base_parameters,
     NumericOptions, ParameterNames, Summary,
 };
-use robodyn::algorithms::regressor::{parameter_name, ParameterSelection};
+use robodyn::algorithms::regressor::{parameter_name, ParameterSelection, ZeroParameters};
 use robodyn::codegen::{generate as gen, BaseParameters as GenBase, GenOptions, ModelKind};
 use robodyn::simulation::{
     simulate as sim, Dynamics, Integrator, Recorder, SimOptions, TimeSeries, TorqueInput,
@@ -258,6 +258,7 @@ pub fn generate(
     rotor: bool,
     numeric: bool,
     name: Option<String>,
+    zeros: ZeroParameters,
 ) -> PyResult<Generated> {
     let kind = match model {
         "idm" => ModelKind::Idm,
@@ -306,6 +307,7 @@ pub fn generate(
         g: None,
         name,
         optimize: true,
+        zeros,
     };
     let prog = py.detach(|| gen(desc, &opt)).py()?;
     let c = prog.count();

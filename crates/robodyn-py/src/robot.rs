@@ -606,6 +606,7 @@ impl Robot {
             rotor,
             numeric,
             name,
+            self.zeros(None)?,
         )
     }
 

@@ -615,14 +615,43 @@ fn plot_is_written() {
         &opts,
     );
     let path = tmp("plot.svg");
-    plot_svg(&path, &rec).unwrap();
+    let info = robodyn::simulation::PlotInfo {
+        title: "robot6: zero torques".into(),
+        stopped: None,
+        prismatic: Vec::new(),
+    };
+    plot_svg(&path, &rec, &info).unwrap();
     let svg = std::fs::read_to_string(&path).unwrap();
     assert!(svg.starts_with("<svg"));
-    // one 2-px curve per joint plus the energy curve (axes and legend lines are 1 px)
-    assert_eq!(svg.matches("stroke-width=\"2\"").count(), n + 1);
-    assert!(svg.contains("total energy"));
+    // drawn at 4x (curves of 2 displayed px are 8 canvas units, axes 4, legend keys 12): one
+    // curve per joint plus the energy change
+    assert_eq!(svg.matches("stroke-width=\"8\"").count(), n + 1);
+    assert!(svg.contains("width=\"1100\""), "displayed size");
+    for want in ["robot6: zero torques", "q [rad]", "E - E(0) [J]", "t [s]"] {
+        assert!(svg.contains(want), "{want}");
+    }
+    // a legend entry per joint
+    for j in 1..=n {
+        assert!(
+            svg.lines().any(|l| l.trim() == format!("q{j}")),
+            "legend q{j}"
+        );
+    }
+    assert!(!svg.contains("stopped early"));
+    let stopped = robodyn::simulation::PlotInfo {
+        stopped: Some("simulation stopped at t = 0.5: step size underflow".into()),
+        ..info
+    };
+    plot_svg(&path, &rec, &stopped).unwrap();
+    let svg = std::fs::read_to_string(&path).unwrap();
+    assert!(svg.contains("stopped early at t = 0.5: step size underflow"));
     std::fs::remove_file(&path).ok();
-    assert!(plot_svg(&path, &Recorder::default()).is_err());
+    assert!(plot_svg(
+        &path,
+        &Recorder::default(),
+        &robodyn::simulation::PlotInfo::default()
+    )
+    .is_err());
 }
 
 /// Strong Coulomb friction on a robot at rest: with the exact sign the sticking joints chatter
@@ -663,10 +692,7 @@ fn coulomb_sticking_needs_smoothing() {
         &mut |_| {},
     )
     .unwrap_err();
-    assert!(
-        e.to_string().contains("more than 20000 integration steps"),
-        "{e}"
-    );
+    assert!(e.to_string().contains("max_steps = 20000"), "{e}");
     let mut smooth =
         TreeDynamics::new(&robot, Method::ArticulatedBody).with_coulomb_smoothing(Some(1e-2));
     let mut rec = Recorder::default();

@@ -72,8 +72,7 @@ pub struct Args {
 }
 
 pub fn run(a: Args) -> CliResult {
-    let mut desc = robodyn::io::load_description(&a.robot.robot)?;
-    desc.symbols.extend(a.robot.overrides()?);
+    let (desc, _) = a.robot.description()?;
     let rotor = match a.rotor {
         Rotor::Actuated => RotorMode::Actuated,
         Rotor::All => RotorMode::All,
@@ -152,11 +151,11 @@ pub fn run(a: Args) -> CliResult {
             ));
         }
     }
-    match a.format {
-        Format::Text => print!("{}", write::text(&report)),
-        Format::Latex => print!("{}", write::latex(&report)),
-        Format::Json => println!("{}", serde_json::to_string_pretty(&write::json(&report))?),
-    }
+    crate::common::print_out(&match a.format {
+        Format::Text => write::text(&report),
+        Format::Latex => write::latex(&report),
+        Format::Json => format!("{}\n", serde_json::to_string_pretty(&write::json(&report))?),
+    })?;
     if let Some(path) = &a.write_robot {
         let values: Vec<f64> = report
             .base

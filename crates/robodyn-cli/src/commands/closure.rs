@@ -3,7 +3,8 @@
 //! `--jacobian` W = d q_p / d q_a (10.30).
 
 use crate::common::{
-    conditioning_json, parse_list, start_branch, warn_conditioning, CliResult, RobotArgs,
+    conditioning_json, format_number, parse_list, print_out, start_branch, warn_conditioning,
+    CliResult, RobotArgs,
 };
 use robodyn::{loop_closure, ClosedChain};
 use serde_json::json;
@@ -45,6 +46,7 @@ pub fn run(a: Args) -> CliResult {
     let pas = cc.passive_coordinates().frames();
     let cuts: Vec<usize> = cc.loops().iter().map(|l| l.topology.cut).collect();
     let (q_p, q_c) = (s.q_p.as_slice(), s.q_c.as_slice());
+    let mut out = String::new();
     match a.format {
         Format::Json => {
             let named = |js: &[usize], v: &[f64]| -> serde_json::Map<String, serde_json::Value> {
@@ -73,28 +75,30 @@ pub fn run(a: Args) -> CliResult {
                     "values": rows,
                 });
             }
-            println!("{}", serde_json::to_string_pretty(&o)?);
+            outln!(out, "{}", serde_json::to_string_pretty(&o)?);
         }
         Format::Text => {
-            println!(
+            outln!(
+                out,
                 "{}: {} loop(s), N = {} actuated, p = {} passive tree joints",
                 robot.name(),
                 cuts.len(),
                 act.len(),
                 pas.len()
             );
-            let list = |js: &[usize], v: &[f64]| {
+            let list = |out: &mut String, js: &[usize], v: &[f64]| {
                 for (j, x) in js.iter().zip(v) {
-                    println!("  q{j:<3} = {x:>20.12e}");
+                    outln!(out, "  q{j:<3} = {:>24}", format_number(*x));
                 }
             };
-            println!("actuated q_a:");
-            list(act, &qa);
-            println!("passive q_p:");
-            list(pas, q_p);
-            println!("cut joints q_c:");
-            list(&cuts, q_c);
-            println!(
+            outln!(out, "actuated q_a:");
+            list(&mut out, act, &qa);
+            outln!(out, "passive q_p:");
+            list(&mut out, pas, q_p);
+            outln!(out, "cut joints q_c:");
+            list(&mut out, &cuts, q_c);
+            outln!(
+                out,
                 "closure residual {:.3e}; {}",
                 s.residual,
                 s.conditioning.describe(cc.limits())
@@ -104,14 +108,19 @@ pub fn run(a: Args) -> CliResult {
                     .iter()
                     .map(|j| format!("{:>14}", format!("q{j}")))
                     .collect();
-                println!("W = d q_p / d q_a (10.30):");
-                println!("       {}", cols.join(" "));
+                outln!(out, "W = d q_p / d q_a (10.30):");
+                outln!(out, "       {}", cols.join(" "));
                 for (r, j) in pas.iter().enumerate() {
-                    let v: Vec<String> = w.row(r).iter().map(|x| format!("{x:>14.6e}")).collect();
-                    println!("  {:<5}{}", format!("q{j}"), v.join(" "));
+                    // (+ 0.0 turns -0 into 0)
+                    let v: Vec<String> = w
+                        .row(r)
+                        .iter()
+                        .map(|x| format!("{:>14.6e}", x + 0.0))
+                        .collect();
+                    outln!(out, "  {:<5}{}", format!("q{j}"), v.join(" "));
                 }
             }
         }
     }
-    Ok(())
+    print_out(&out)
 }

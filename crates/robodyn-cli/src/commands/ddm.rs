@@ -69,7 +69,7 @@ pub fn run(a: Args) -> CliResult {
         return run_closed(a, robot);
     }
     let coords = robot.coordinates();
-    let states = read_joint_states(
+    let (states, carried) = read_joint_states(
         a.input.as_deref(),
         ["q", "qd", "tau"],
         [a.q.as_deref(), a.qd.as_deref(), a.tau.as_deref()],
@@ -84,7 +84,8 @@ pub fn run(a: Args) -> CliResult {
     let method = a.method.into();
     direct_dynamics_batch(&robot, env, &col(0), &col(1), &col(2), method, &mut qdd)?;
     let rows = result_rows(&qdd, n, states.len());
-    a.out.write(&a.names.columns("qdd", coords), &rows)
+    let (headers, rows) = carried.prepend(&a.names.columns("qdd", coords), rows);
+    a.out.write(&headers, &rows)
 }
 
 /// Closed chains: columns q<j>, qd<j>, tau<j> of the actuated joints in, qdd<j> of the actuated
@@ -92,7 +93,7 @@ pub fn run(a: Args) -> CliResult {
 fn run_closed(a: Args, robot: robodyn::Robot) -> CliResult {
     let chain = ClosedChain::new(&robot)?;
     let coords = chain.coordinates();
-    let states = read_joint_states(
+    let (states, carried) = read_joint_states(
         a.input.as_deref(),
         ["q", "qd", "tau"],
         [a.q.as_deref(), a.qd.as_deref(), a.tau.as_deref()],
@@ -101,7 +102,8 @@ fn run_closed(a: Args, robot: robodyn::Robot) -> CliResult {
         "actuated joints (closed chain)",
     )?;
     let Some(first) = states.first() else {
-        return a.out.write(&a.names.columns("qdd", coords), &[]);
+        let (headers, _) = carried.prepend(&a.names.columns("qdd", coords), vec![]);
+        return a.out.write(&headers, &[]);
     };
     let mut branch = start_branch(&chain, &first[0], a.guess.as_deref())?;
     let mut data = ClosedData::new(&chain);
@@ -116,6 +118,6 @@ fn run_closed(a: Args, robot: robodyn::Robot) -> CliResult {
         rows.push(qdd);
         extra.push(conditioning_json(&c));
     }
-    a.out
-        .write_with(&a.names.columns("qdd", coords), &rows, &extra)
+    let (headers, rows) = carried.prepend(&a.names.columns("qdd", coords), rows);
+    a.out.write_with(&headers, &rows, &extra)
 }

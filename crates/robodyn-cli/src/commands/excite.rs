@@ -3,9 +3,10 @@
 //! condition number of the base-parameter observation matrix under position, velocity,
 //! acceleration and torque limits, starting and ending at rest.
 
+use crate::common::format_number;
 use crate::common::{parse_list, CliResult, RobotArgs};
 use robodyn::identification::excitation::{design, DesignOptions, Limits};
-use robodyn::identification::model_access::{load_description, ModelAccess};
+use robodyn::identification::model_access::ModelAccess;
 use robodyn::identification::parameters::{ParameterModel, ParameterOptions};
 use robodyn::identification::report::plot_panels;
 use robodyn::identification::Rotors;
@@ -96,7 +97,7 @@ fn per_joint(name: &str, s: Option<&str>, n: usize) -> CliResult<Option<Vec<f64>
 }
 
 pub fn run(a: Args) -> CliResult {
-    let desc = load_description(&a.robot.robot, &a.robot.overrides()?)?;
+    let desc = a.robot.description()?.0;
     let mut access = ModelAccess::new(desc)?;
     let joints = access.actuated_joints().to_vec();
     let n = joints.len();
@@ -161,9 +162,7 @@ pub fn run(a: Args) -> CliResult {
     }
     // CSV
     let rows = (a.period * a.periods as f64 * a.rate).round() as usize;
-    let mut out = std::io::BufWriter::new(
-        std::fs::File::create(&a.output).map_err(|e| format!("{}: {e}", a.output.display()))?,
-    );
+    let mut out = crate::common::create_output(Some(&a.output))?;
     let mut header = vec!["t".to_string()];
     for p in ["q", "qd", "qdd"] {
         header.extend(joints.iter().map(|j| format!("{p}{j}")));
@@ -174,10 +173,10 @@ pub fn run(a: Args) -> CliResult {
     for k in 0..=rows {
         let t = k as f64 / a.rate;
         let s = d.trajectory.eval(t % a.period);
-        let mut line = vec![format!("{t:.9e}")];
+        let mut line = vec![format_number(t)];
         for (v, ser) in s.iter().zip(series.iter_mut()) {
             for j in 0..n {
-                line.push(format!("{:.12e}", v[j]));
+                line.push(format_number(v[j]));
                 ser[j].push(v[j]);
             }
         }
@@ -219,34 +218,46 @@ pub fn run(a: Args) -> CliResult {
         )?;
         eprintln!("wrote {}", p.display());
     }
+    let mut out = String::new();
     match a.format {
         Format::Text => {
-            println!(
+            outln!(
+                out,
                 "{}: excitation trajectory, {} harmonics, period {} s, {} parameters",
                 access.name(),
                 a.harmonics,
                 a.period,
                 params.count()
             );
-            println!(
+            outln!(out,
                 "condition number of W (unit columns, {} samples): {:.4} (best random start {:.4}; \
                  {} evaluations)",
                 a.samples, d.condition, d.initial_condition, d.evaluations
             );
-            println!(
+            outln!(
+                out,
                 "scaled to the {} limit of joint {}",
-                d.binding.what, joints[d.binding.joint]
+                d.binding.what,
+                joints[d.binding.joint]
             );
-            println!("  joint  max|q-start|       max|qd|      max|qdd|      max|tau|");
+            outln!(
+                out,
+                "  joint  max|q-start|       max|qd|      max|qdd|      max|tau|"
+            );
             for (k, j) in joints.iter().enumerate() {
                 let p = d.peaks[k];
-                println!(
+                outln!(
+                    out,
                     "  {j:<5} {:>13.5} {:>13.5} {:>13.5} {:>13.5}",
-                    p[0], p[1], p[2], p[3]
+                    p[0],
+                    p[1],
+                    p[2],
+                    p[3]
                 );
             }
         }
-        Format::Json => println!(
+        Format::Json => outln!(
+            out,
             "{}",
             serde_json::to_string_pretty(&json!({
                 "robot": access.name(),
@@ -264,5 +275,5 @@ pub fn run(a: Args) -> CliResult {
             }))?
         ),
     }
-    Ok(())
+    crate::common::print_out(&out)
 }

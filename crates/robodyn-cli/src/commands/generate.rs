@@ -73,18 +73,17 @@ pub struct Args {
     /// Function name in the generated code.
     #[arg(long)]
     pub name: Option<String>,
-    /// Output file (default: standard output).
+    /// Output file (default or `-`: standard output).
     #[arg(long)]
     pub output: Option<PathBuf>,
 }
 
 pub fn run(a: Args) -> CliResult {
-    let mut desc = robodyn::io::load_description(&a.robot)?;
     let rargs = crate::common::RobotArgs {
         robot: a.robot.clone(),
         set: a.set.clone(),
     };
-    desc.symbols.extend(rargs.overrides()?);
+    let (desc, _) = rargs.description()?;
     // a literal 0 in a SYMORO .par: the parameter does not exist (as in base-params, regressor)
     let zeros = ZeroParameters::for_path(&a.robot);
     let base = match a.params {
@@ -123,7 +122,28 @@ pub fn run(a: Args) -> CliResult {
         optimize: true,
         zeros,
     };
-    let prog = generate(&desc, &opt)?;
+    let n = desc
+        .frames
+        .iter()
+        .take(desc.nl)
+        .filter(|f| f.joint.sigma() != 2)
+        .count();
+    if matches!(a.model, Model::Ddm) && n > DDM_JOINTS_NOTE {
+        eprintln!(
+            "robodyn: note: the symbolic direct dynamic model of {n} joints writes out the L'DL \
+             factorization of A(q), whose expressions grow much faster than the joints (minutes \
+             and GB beyond ~{DDM_JOINTS_NOTE} joints); `--model inertia` and `--model h` with a \
+             numeric solve, or the numeric `robodyn ddm`/`simulate`, stay linear"
+        );
+    }
+    let spinner = working(format!(
+        "generating {} of {} ({n} joints)",
+        format!("{:?}", a.model).to_lowercase(),
+        desc.name
+    ));
+    let prog = generate(&desc, &opt);
+    spinner.finish_and_clear();
+    let prog = prog?;
     let lang = match a.lang {
         Language::Text => Lang::Text,
         Language::Latex => Lang::Latex,
@@ -134,16 +154,32 @@ pub fn run(a: Args) -> CliResult {
         Language::Matlab => Lang::Matlab,
     };
     let text = emit(&prog, lang);
-    match &a.output {
-        Some(p) => std::fs::write(p, text).map_err(|e| format!("{}: {e}", p.display()))?,
-        None => print!("{text}"),
-    }
+    crate::common::write_text(a.output.as_deref(), &text)?;
     let c = prog.count();
     eprintln!(
         "{}: {} multiplications, {} additions",
         prog.name, c.mul, c.add
     );
     Ok(())
+}
+
+/// Beyond this many movable joints `--model ddm` says that it may take long.
+const DDM_JOINTS_NOTE: usize = 12;
+
+/// A spinner with the elapsed time on a terminal's standard error, so a long generation says
+/// what it does (nothing when standard error is not a terminal).
+fn working(what: String) -> indicatif::ProgressBar {
+    use std::io::IsTerminal;
+    if !std::io::stderr().is_terminal() {
+        return indicatif::ProgressBar::hidden();
+    }
+    let bar = indicatif::ProgressBar::new_spinner();
+    if let Ok(style) = indicatif::ProgressStyle::with_template("{spinner} {msg} ({elapsed})") {
+        bar.set_style(style);
+    }
+    bar.set_message(what);
+    bar.enable_steady_tick(std::time::Duration::from_millis(200));
+    bar
 }
 
 /// The function name: `--name`, or for MATLAB, which calls a function file by its file name, the

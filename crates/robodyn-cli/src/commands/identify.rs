@@ -5,7 +5,7 @@
 
 use crate::common::{parse_list, CliResult, RobotArgs};
 use robodyn::identification::data::{CsvLog, JointLabels};
-use robodyn::identification::model_access::{load_description, save_description, ModelAccess};
+use robodyn::identification::model_access::{save_description, ModelAccess};
 use robodyn::identification::parameters::ParameterOptions;
 use robodyn::identification::{identify, report, EssentialOptions, Estimator, Options, Rotors};
 use std::path::PathBuf;
@@ -136,7 +136,7 @@ fn parse_validation(s: &str) -> CliResult<Option<(f64, f64)>> {
 }
 
 pub fn run(a: Args) -> CliResult {
-    let desc = load_description(&a.robot.robot, &a.robot.overrides()?)?;
+    let desc = a.robot.description()?.0;
     let mut access = ModelAccess::new(desc)?;
     let labels = JointLabels {
         numbers: access.actuated_joints().to_vec(),
@@ -188,10 +188,7 @@ pub fn run(a: Args) -> CliResult {
         Format::Json => format!("{}\n", serde_json::to_string_pretty(&report::to_json(&id))?),
         Format::Csv => report::to_csv(&id),
     };
-    match &a.output {
-        Some(p) => std::fs::write(p, &text).map_err(|e| format!("{}: {e}", p.display()))?,
-        None => print!("{text}"),
-    }
+    crate::common::write_text(a.output.as_deref(), &text)?;
     if let Some(p) = &a.plot {
         report::plot_fit(p, &id)?;
         eprintln!("wrote {}", p.display());

@@ -47,7 +47,7 @@ pub fn run(a: Args) -> CliResult {
         return run_closed(a, robot);
     }
     let coords = robot.coordinates();
-    let states = read_joint_states(
+    let (states, carried) = read_joint_states(
         a.input.as_deref(),
         ["q", "qd", "qdd"],
         [a.q.as_deref(), a.qd.as_deref(), a.qdd.as_deref()],
@@ -61,7 +61,8 @@ pub fn run(a: Args) -> CliResult {
     let env = robot.environment();
     inverse_dynamics_batch(&robot, env, &col(0), &col(1), &col(2), &mut tau)?;
     let rows = result_rows(&tau, n, states.len());
-    a.out.write(&a.names.columns("tau", coords), &rows)
+    let (headers, rows) = carried.prepend(&a.names.columns("tau", coords), rows);
+    a.out.write(&headers, &rows)
 }
 
 /// Closed chains: columns of the actuated joints in, tau<j> of the actuated joints out, every
@@ -69,7 +70,7 @@ pub fn run(a: Args) -> CliResult {
 fn run_closed(a: Args, robot: robodyn::Robot) -> CliResult {
     let chain = ClosedChain::new(&robot)?;
     let coords = chain.coordinates();
-    let states = read_joint_states(
+    let (states, carried) = read_joint_states(
         a.input.as_deref(),
         ["q", "qd", "qdd"],
         [a.q.as_deref(), a.qd.as_deref(), a.qdd.as_deref()],
@@ -78,7 +79,8 @@ fn run_closed(a: Args, robot: robodyn::Robot) -> CliResult {
         "actuated joints (closed chain)",
     )?;
     let Some(first) = states.first() else {
-        return a.out.write(&a.names.columns("tau", coords), &[]);
+        let (headers, _) = carried.prepend(&a.names.columns("tau", coords), vec![]);
+        return a.out.write(&headers, &[]);
     };
     let mut branch = start_branch(&chain, &first[0], a.guess.as_deref())?;
     let mut data = ClosedData::new(&chain);
@@ -93,6 +95,6 @@ fn run_closed(a: Args, robot: robodyn::Robot) -> CliResult {
         rows.push(tau);
         extra.push(conditioning_json(&c));
     }
-    a.out
-        .write_with(&a.names.columns("tau", coords), &rows, &extra)
+    let (headers, rows) = carried.prepend(&a.names.columns("tau", coords), rows);
+    a.out.write_with(&headers, &rows, &extra)
 }

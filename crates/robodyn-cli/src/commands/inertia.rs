@@ -3,7 +3,6 @@
 
 use crate::common::{parse_list, write_table, CliResult, RobotArgs, TableFormat};
 use robodyn::inertia_matrix;
-use std::io::Write;
 use std::path::PathBuf;
 
 #[derive(clap::Args, Debug)]
@@ -39,14 +38,9 @@ pub fn run(a: Args) -> CliResult {
         }
         TableFormat::Json => {
             let v = serde_json::json!({ "joints": joints, "q": q, "A": rows });
+            crate::common::check_finite(&["A".to_string()], &rows)?;
             let text = serde_json::to_string_pretty(&v)?;
-            match &a.output {
-                Some(p) => {
-                    std::fs::write(p, text + "\n").map_err(|e| format!("{}: {e}", p.display()))?
-                }
-                None => writeln!(std::io::stdout().lock(), "{text}")?,
-            }
-            Ok(())
+            crate::common::write_text(a.output.as_deref(), &(text + "\n"))
         }
     }
 }

@@ -25,11 +25,11 @@ pub enum Format {
 pub fn run(a: Args) -> CliResult {
     let desc = robodyn::io::load_description(&a.robot)?;
     let s = validate_structure(&desc)?;
-    match a.format {
-        Format::Json => println!("{}", serde_json::to_string_pretty(&to_json(&desc, &s))?),
-        Format::Text => print_text(&desc, &s),
-    }
-    Ok(())
+    let text = match a.format {
+        Format::Json => format!("{}\n", serde_json::to_string_pretty(&to_json(&desc, &s))?),
+        Format::Text => text(&desc, &s),
+    };
+    crate::common::print_out(&text)
 }
 
 fn joint_kind(d: &RobotDescription, j: usize) -> &'static str {
@@ -144,8 +144,10 @@ fn role(d: &RobotDescription, j: usize) -> &'static str {
     }
 }
 
-fn print_text(d: &RobotDescription, s: &robodyn::model::Structure) {
-    println!(
+fn text(d: &RobotDescription, s: &robodyn::model::Structure) -> String {
+    let mut out = String::new();
+    outln!(
+        out,
         "{}: {} structure, NL = {}, NJ = {}, NF = {}",
         d.name,
         s.kind,
@@ -154,11 +156,11 @@ fn print_text(d: &RobotDescription, s: &robodyn::model::Structure) {
         d.nf()
     );
     for n in &d.notes {
-        println!("  note: {n}");
+        outln!(out, "  note: {n}");
     }
-    let g: Vec<String> = d.gravity.iter().map(|e| e.to_string()).collect();
-    println!("gravity: [{}]", g.join(", "));
-    println!();
+    let g: Vec<String> = d.gravity.iter().map(expr).collect();
+    outln!(out, "gravity: [{}]", g.join(", "));
+    outln!(out);
     let mut rows = vec![[
         "j", "name", "a(j)", "sigma", "mu", "gamma", "b", "alpha", "d", "theta", "r", "role",
     ]
@@ -180,26 +182,29 @@ fn print_text(d: &RobotDescription, s: &robodyn::model::Structure) {
             };
             r.push(match var {
                 Some(v) if e.is_zero() => v,
-                Some(v) => (robodyn::Expr::symbol(v) + (*e).clone()).to_string(),
-                None => e.to_string(),
+                Some(v) if expr(e) == e.to_string() => {
+                    (robodyn::Expr::symbol(v) + (*e).clone()).to_string()
+                }
+                Some(v) => format!("{v} + {}", expr(e)).replace("+ -", "- "),
+                None => expr(e),
             });
         }
         r.push(role(d, i + 1).into());
         rows.push(r);
     }
-    print_rows(&rows);
-    println!();
-    println!("main branches:");
+    print_rows(&mut out, &rows);
+    outln!(out);
+    outln!(out, "main branches:");
     for b in &s.main_branches {
         let p: Vec<String> = b.iter().map(|x| x.to_string()).collect();
-        println!("  0 - {}", p.join(" - "));
+        outln!(out, "  0 - {}", p.join(" - "));
     }
     if s.loops.is_empty() {
-        println!("loops: none");
+        outln!(out, "loops: none");
     } else {
-        println!("loops:");
+        outln!(out, "loops:");
         for (l, lp) in s.loops.iter().enumerate() {
-            println!(
+            outln!(out,
                 "  loop {}: cut joint {} joins link {} and link {} (twin frame {}), root {}, branches {:?} / {:?}",
                 l + 1, lp.cut, lp.link_i, lp.link_j, lp.twin, lp.root, lp.branch_i, lp.branch_j
             );
@@ -216,7 +221,8 @@ fn print_text(d: &RobotDescription, s: &robodyn::model::Structure) {
         .filter(|&j| !d.frame(j).actuated && d.frame(j).joint.is_movable())
         .map(|j| j.to_string())
         .collect();
-    println!(
+    outln!(
+        out,
         "actuated joints: {}",
         if act.is_empty() {
             "none".into()
@@ -224,7 +230,8 @@ fn print_text(d: &RobotDescription, s: &robodyn::model::Structure) {
             act.join(", ")
         }
     );
-    println!(
+    outln!(
+        out,
         "passive tree joints: {}",
         if pas.is_empty() {
             "none".into()
@@ -232,9 +239,51 @@ fn print_text(d: &RobotDescription, s: &robodyn::model::Structure) {
             pas.join(", ")
         }
     );
+    if !d.limits.is_empty() {
+        outln!(out);
+        outln!(out, "joint limits (rad, rad/s, rad/s^2, N m for revolute joints; m, m/s, m/s^2, N for prismatic):");
+        for (j, l) in &d.limits {
+            let mut parts = Vec::new();
+            if let (Some(a), Some(b)) = (l.q_min, l.q_max) {
+                parts.push(format!("q in [{}, {}]", short(a), short(b)));
+            }
+            for (name, v) in [("|qd|", l.qd), ("|qdd|", l.qdd), ("|tau|", l.tau)] {
+                if let Some(v) = v {
+                    parts.push(format!("{name} <= {}", short(v)));
+                }
+            }
+            outln!(out, "  {j} ({}): {}", d.frame(*j).name, parts.join(", "));
+        }
+    }
+    out
 }
 
-fn print_rows(rows: &[Vec<String>]) {
+/// A number for reading: the shortest decimal within 1e-12 (relative) of `x`, so that float
+/// noise of an import (`0.22094100000000003`) reads `0.220941`.
+fn short(x: f64) -> String {
+    for p in 0..16 {
+        let y: f64 = format!("{x:.p$e}").parse().unwrap_or(x);
+        if (y - x).abs() <= 1e-12 * x.abs() {
+            return crate::common::format_number(y);
+        }
+    }
+    crate::common::format_number(x)
+}
+
+/// An expression for reading: a number (`0.22094100000000003`, `-981/100`) by [`short`], an
+/// expression with symbols or constants such as `pi/2` as written.
+fn expr(e: &robodyn::Expr) -> String {
+    let s = e.to_string();
+    if s.bytes().any(|b| b.is_ascii_alphabetic() && b != b'e') {
+        return s;
+    }
+    match e.eval(&|_| None) {
+        Ok(x) => short(x),
+        Err(_) => s,
+    }
+}
+
+fn print_rows(out: &mut String, rows: &[Vec<String>]) {
     let n = rows[0].len();
     let w: Vec<usize> = (0..n)
         .map(|c| rows.iter().map(|r| r[c].chars().count()).max().unwrap_or(0))
@@ -245,6 +294,6 @@ fn print_rows(rows: &[Vec<String>]) {
             .enumerate()
             .map(|(c, x)| format!("{x:<width$}", width = w[c]))
             .collect();
-        println!("{}", line.join("  ").trim_end());
+        outln!(out, "{}", line.join("  ").trim_end());
     }
 }

@@ -65,7 +65,7 @@ pub fn run(a: Args) -> CliResult {
         Some(c) => c.coordinates(),
         None => robot.coordinates(),
     };
-    let states = read_joint_states(
+    let (states, carried) = read_joint_states(
         Some(&a.input),
         ["q", "qd", "qdd"],
         [None; 3],
@@ -119,14 +119,17 @@ pub fn run(a: Args) -> CliResult {
         };
         for k in 0..n {
             let r = slot * n + k;
-            let mut row = vec![(s + 1) as f64, coords.frame(k) as f64, tau_e_all[r]];
+            let mut row = carried.rows.get(s).cloned().unwrap_or_default();
+            row.extend([(s + 1) as f64, coords.frame(k) as f64, tau_e_all[r]]);
             row.extend(columns.indices.iter().map(|&c| phi_all[r * cols + c]));
             rows.push(row);
         }
     }
-    let headers: Vec<String> = ["state", "joint", "tau_e"]
+    let headers: Vec<String> = carried
+        .headers
         .iter()
-        .map(|s| s.to_string())
+        .cloned()
+        .chain(["state", "joint", "tau_e"].iter().map(|s| s.to_string()))
         .chain(columns.names)
         .collect();
     a.out.write(&headers, &rows)

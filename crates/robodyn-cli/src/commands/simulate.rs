@@ -7,11 +7,11 @@
 //! with the extra columns `closure_residual` and the passive joints' q<j>.
 
 use crate::commands::ddm::MethodArg;
-use crate::common::{parse_list, CliResult, RobotArgs, Table};
+use crate::common::{create_output, format_number, parse_list, CliResult, RobotArgs, Table};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use robodyn::simulation::{
-    plot_svg, simulate, ClosedChainDynamics, CsvSink, Dynamics, Integrator, Recorder, SimOptions,
-    Tee, TimeSeries, TorqueInput, TreeDynamics,
+    plot_svg, simulate, ClosedChainDynamics, CsvSink, Dynamics, Integrator, PlotInfo, Recorder,
+    SimOptions, Tee, TimeSeries, TorqueInput, TrajectorySink, TreeDynamics,
 };
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -68,13 +68,89 @@ pub struct Args {
     /// Stop after this many integration steps.
     #[arg(long, default_value_t = 5_000_000)]
     pub max_steps: usize,
-    /// Trajectory CSV: t, q<j>, qd<j>, qdd<j>, tau<j>, energy (closed chains: then
+    /// Trajectory CSV (`-`: standard output): t [s], q<j> [rad or m], qd<j> [rad/s or m/s],
+    /// qdd<j> [rad/s^2 or m/s^2], tau<j> [N m or N], energy [J] (closed chains: then
     /// closure_residual and the passive q<j>).
     #[arg(long)]
     pub output: PathBuf,
-    /// SVG plot of the joint positions and the total energy.
+    /// SVG plot: joint positions (revolute and prismatic in separate panels), and the energy
+    /// drift E - E(0) [J].
     #[arg(long)]
     pub plot: Option<PathBuf>,
+    /// Stop the run when a joint crosses a limit of the robot file (position, speed or torque;
+    /// by default a crossing is reported as a warning and the run goes on).
+    #[arg(long)]
+    pub stop_at_limits: bool,
+}
+
+/// Checks every trajectory row against the robot's joint limits: the first crossing of each
+/// joint and kind is remembered (and stops the run with `--stop-at-limits`).
+struct LimitWatch<'a> {
+    sink: &'a mut dyn TrajectorySink,
+    /// (column, joint, what, low, high, unit)
+    checks: Vec<(usize, usize, &'static str, f64, f64, &'static str)>,
+    limits: &'a std::collections::BTreeMap<usize, robodyn::model::JointLimits>,
+    units: Vec<(usize, bool)>,
+    crossed: Vec<String>,
+    seen: std::collections::BTreeSet<(usize, &'static str)>,
+    stop: bool,
+}
+
+impl TrajectorySink for LimitWatch<'_> {
+    fn begin(&mut self, headers: &[String]) -> robodyn::Result<()> {
+        for (c, h) in headers.iter().enumerate() {
+            for (prefix, what) in [("qd", "speed"), ("tau", "torque"), ("q", "position")] {
+                let Some(j) = h.strip_prefix(prefix).and_then(|s| s.parse::<usize>().ok()) else {
+                    continue;
+                };
+                let Some(l) = self.limits.get(&j) else {
+                    break;
+                };
+                let prismatic = self.units.iter().any(|&(k, p)| k == j && p);
+                let (lo, hi, unit) = match what {
+                    "position" => (l.q_min, l.q_max, if prismatic { "m" } else { "rad" }),
+                    "speed" => (
+                        l.qd.map(|x| -x),
+                        l.qd,
+                        if prismatic { "m/s" } else { "rad/s" },
+                    ),
+                    _ => (
+                        l.tau.map(|x| -x),
+                        l.tau,
+                        if prismatic { "N" } else { "N m" },
+                    ),
+                };
+                if let (Some(lo), Some(hi)) = (lo, hi) {
+                    self.checks.push((c, j, what, lo, hi, unit));
+                }
+                break;
+            }
+        }
+        self.sink.begin(headers)
+    }
+    fn row(&mut self, values: &[f64]) -> robodyn::Result<()> {
+        self.sink.row(values)?;
+        for &(c, j, what, lo, hi, unit) in &self.checks {
+            let x = values[c];
+            if (x < lo || x > hi) && self.seen.insert((j, what)) {
+                let m = format!(
+                    "joint {j} crosses its {what} limit at t = {} s: {} {unit} outside [{}, {}]",
+                    format_number(values[0]),
+                    format_number(x),
+                    format_number(lo),
+                    format_number(hi)
+                );
+                if self.stop {
+                    return Err(robodyn::Error::Numerical(format!("{m} (--stop-at-limits)")));
+                }
+                self.crossed.push(m);
+            }
+        }
+        Ok(())
+    }
+    fn finish(&mut self) -> robodyn::Result<()> {
+        self.sink.finish()
+    }
 }
 
 fn joint_values(
@@ -151,11 +227,35 @@ fn read_series(
     Ok((s, with_optional))
 }
 
-pub fn run(a: Args) -> CliResult {
-    let robot = a.robot.load()?;
+/// The numeric options, checked before any file is touched.
+fn check_options(a: &Args) -> CliResult {
+    let positive = |name: &str, v: Option<f64>| -> CliResult {
+        match v {
+            Some(x) if !(x.is_finite() && x > 0.0) => {
+                Err(format!("--{name} {x}: must be a positive finite number").into())
+            }
+            _ => Ok(()),
+        }
+    };
+    positive("duration", Some(a.duration))?;
+    positive("dt", a.dt)?;
+    positive("output-step", a.output_step)?;
+    if a.dt.is_none() {
+        positive("rtol", Some(a.rtol))?;
+        positive("atol", Some(a.atol))?;
+    }
+    if a.max_steps == 0 {
+        return Err("--max-steps 0: must be at least 1".into());
+    }
     if !(a.coulomb_smoothing.is_finite() && a.coulomb_smoothing >= 0.0) {
         return Err("--coulomb-smoothing must be a finite number >= 0".into());
     }
+    Ok(())
+}
+
+pub fn run(a: Args) -> CliResult {
+    check_options(&a)?;
+    let robot = a.robot.load()?;
     let smoothing = Some(a.coulomb_smoothing);
     let (mut dynamics, joints, what, q0_default): (Box<dyn Dynamics + '_>, _, _, _) =
         if robot.is_tree() {
@@ -220,7 +320,15 @@ pub fn run(a: Args) -> CliResult {
         output_dt: a.output_step.or(a.dt).unwrap_or(0.01),
         max_steps: Some(a.max_steps),
     };
-    let mut csv = CsvSink::create(&a.output)?;
+    integrator.validate()?;
+    input.validate(n)?;
+    let to_stdout = robodyn::io::is_stdio(&a.output);
+    let out_name = if to_stdout {
+        "standard output".to_string()
+    } else {
+        a.output.display().to_string()
+    };
+    let mut csv = CsvSink::new(create_output(Some(&a.output))?, out_name.clone());
     let mut rec = Recorder::default();
     let bar = if std::io::stderr().is_terminal() {
         ProgressBar::with_draw_target(Some(1000), ProgressDrawTarget::stderr())
@@ -238,43 +346,69 @@ pub fn run(a: Args) -> CliResult {
         bar.set_position(((t / duration) * 1000.0).round() as u64);
         bar.set_message(format!("{t:.3}"));
     };
-    let result = if a.plot.is_some() {
-        simulate(
-            dynamics.as_mut(),
-            &input,
-            &q0,
-            &qd0,
-            &opts,
-            &mut Tee(&mut csv, &mut rec),
-            &mut progress,
-        )
-    } else {
-        simulate(
-            dynamics.as_mut(),
-            &input,
-            &q0,
-            &qd0,
-            &opts,
-            &mut csv,
-            &mut progress,
-        )
+    let prismatic: Vec<(usize, bool)> = (1..=robot.nl())
+        .map(|j| (j, robot.description().frame(j).joint.sigma() == 1))
+        .collect();
+    let mut tee;
+    let mut watch = LimitWatch {
+        sink: if a.plot.is_some() {
+            tee = Tee(&mut csv, &mut rec);
+            &mut tee
+        } else {
+            &mut csv
+        },
+        checks: Vec::new(),
+        limits: &robot.description().limits,
+        units: prismatic,
+        crossed: Vec::new(),
+        seen: Default::default(),
+        stop: a.stop_at_limits,
     };
+    let result = simulate(
+        dynamics.as_mut(),
+        &input,
+        &q0,
+        &qd0,
+        &opts,
+        &mut watch,
+        &mut progress,
+    );
     bar.finish_and_clear();
+    // `--output - | head`: the reader has what it wanted; end quietly
+    if let Err(e) = &result {
+        if crate::common::is_broken_pipe(e) {
+            return Ok(());
+        }
+    }
+    for m in &watch.crossed {
+        eprintln!("robodyn: warning: {m}");
+    }
+    if !watch.crossed.is_empty() {
+        eprintln!(
+            "robodyn: warning: the simulation does not enforce joint limits (--stop-at-limits \
+             stops the run at the first crossing)"
+        );
+    }
+    drop(watch);
     drop(csv);
+    let stopped = result.as_ref().err().map(|e| e.to_string());
     let plotted = match (&a.plot, &result) {
-        (Some(p), _) if !rec.rows.is_empty() => Some(plot_svg(p, &rec)),
+        (Some(p), _) if !rec.rows.is_empty() => Some(plot_svg(
+            p,
+            &rec,
+            &PlotInfo {
+                title: plot_title(&robot, &a),
+                stopped,
+                prismatic: prismatic_labels(&robot),
+            },
+        )),
         _ => None,
     };
     match result {
         Ok(s) => {
             eprintln!(
                 "simulated {} s: {} rows in {}, {} steps ({} rejected), {} model evaluations",
-                s.t_end,
-                s.rows,
-                a.output.display(),
-                s.stats.accepted,
-                s.stats.rejected,
-                s.stats.evaluations
+                s.t_end, s.rows, out_name, s.stats.accepted, s.stats.rejected, s.stats.evaluations
             );
             if let Some(r) = plotted {
                 r?;
@@ -283,7 +417,7 @@ pub fn run(a: Args) -> CliResult {
         }
         Err(e) => Err(format!(
             "{e}\n  the trajectory computed up to the stop is in {}{}",
-            a.output.display(),
+            out_name,
             match (&a.plot, plotted) {
                 (Some(p), Some(Ok(()))) => format!(", its plot in {}", p.display()),
                 _ => String::new(),
@@ -291,4 +425,34 @@ pub fn run(a: Args) -> CliResult {
         )
         .into()),
     }
+}
+
+/// Plot title: the robot and the conditions of the run.
+fn plot_title(robot: &robodyn::Robot, a: &Args) -> String {
+    let input = if a.track.is_some() {
+        "PD tracking"
+    } else if a.torque_csv.is_some() {
+        "torque series"
+    } else if a.torque.is_some() {
+        "constant torques"
+    } else {
+        "zero torques"
+    };
+    let scheme = match a.dt {
+        Some(dt) => format!("RK4, dt = {} s", format_number(dt)),
+        None => format!(
+            "Dormand-Prince 5(4), rtol {}, atol {}",
+            format_number(a.rtol),
+            format_number(a.atol)
+        ),
+    };
+    format!("{}: {input}, {scheme}", robot.name())
+}
+
+/// Labels (frame numbers, as in the q<j> columns) of the prismatic joints.
+fn prismatic_labels(robot: &robodyn::Robot) -> Vec<String> {
+    (1..=robot.description().nj)
+        .filter(|&j| robot.description().frame(j).joint.sigma() == 1)
+        .map(|j| j.to_string())
+        .collect()
 }

@@ -88,9 +88,39 @@ impl Format {
     }
 }
 
-/// Read a text file (see [`decode_text`]).
+impl Format {
+    /// Format of a robot file's text (for a file read from standard input): URDF when it starts
+    /// with `<`, TOML when a line starts a `[[frame]]` or `[[link]]` table, otherwise `.par`.
+    pub fn sniff(text: &str) -> Format {
+        let t = text.trim_start_matches('\u{feff}').trim_start();
+        if t.starts_with('<') {
+            Format::Urdf
+        } else if t.lines().any(|l| {
+            let l = l.trim_start();
+            l.starts_with("[[frame]]") || l.starts_with("[[link]]")
+        }) {
+            Format::Toml
+        } else {
+            Format::Par
+        }
+    }
+}
+
+/// Whether a path names standard input/output (`-`).
+pub fn is_stdio(path: &Path) -> bool {
+    path.as_os_str() == "-"
+}
+
+/// Read a text file (see [`decode_text`]); `-` is standard input.
 fn read(path: &Path) -> Result<String> {
-    let bytes = std::fs::read(path).map_err(|e| Error::io(path.display().to_string(), e))?;
+    let bytes = if is_stdio(path) {
+        let mut b = Vec::new();
+        std::io::Read::read_to_end(&mut std::io::stdin().lock(), &mut b)
+            .map_err(|e| Error::io("<stdin>", e))?;
+        b
+    } else {
+        std::fs::read(path).map_err(|e| Error::io(path.display().to_string(), e))?
+    };
     Ok(decode_text(bytes))
 }
 
@@ -105,11 +135,16 @@ pub fn decode_text(bytes: Vec<u8>) -> String {
 
 /// Read a robot description from a file, with the positions of its entries. The map's
 /// [`SourceMap::warnings`] hold what the reader noticed and the physical-consistency check
-/// ([`physical_consistency`]) found, with their lines.
+/// ([`physical_consistency`]) found, with their lines. The path `-` reads standard input, the
+/// format found by [`Format::sniff`].
 pub fn load_description_mapped(path: &Path) -> Result<(RobotDescription, SourceMap)> {
     let text = read(path)?;
-    let file = path.display().to_string();
-    let (desc, mut map) = match Format::from_path(path)? {
+    let (file, format) = if is_stdio(path) {
+        ("<stdin>".to_string(), Format::sniff(&text))
+    } else {
+        (path.display().to_string(), Format::from_path(path)?)
+    };
+    let (desc, mut map) = match format {
         Format::Toml => toml_format::parse_description(&text, Some(&file)),
         Format::Par => par::parse_description(&text, Some(&file)),
         Format::Urdf => urdf::parse_description(&text, Some(&file)),

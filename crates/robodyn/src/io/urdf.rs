@@ -26,7 +26,7 @@
 use crate::error::{Error, Item, Location, Result};
 use crate::io::source::LineIndex;
 use crate::io::{SourceMap, Warning};
-use crate::model::{param, FrameDesc, JointType, LinkDesc, RobotDescription};
+use crate::model::{param, FrameDesc, JointLimits, JointType, LinkDesc, RobotDescription};
 use nalgebra::{Matrix3, Rotation3, Translation3, UnitQuaternion, Vector3};
 use robodyn_symbolic::Expr;
 use std::collections::HashMap;
@@ -205,6 +205,7 @@ struct UJoint<'a> {
     mimic: Option<UMimic<'a>>,
     damping: f64,
     friction: f64,
+    limits: Option<JointLimits>,
 }
 
 /// `<mimic joint multiplier offset>`: q = multiplier * q_joint + offset.
@@ -422,8 +423,40 @@ fn read_joints<'a>(
                 friction = ctx.number(dn, s, &format!("{what}, friction"))?;
             }
         }
+        // <limit lower upper velocity effort>: position limits of revolute and prismatic joints
+        // (not continuous), when lower < upper; speed and effort when positive (URDF writes 0
+        // for "not given")
+        let limits = match child(n, "limit") {
+            Some(ln) if joint != JointType::Fixed => {
+                let w = format!("{what}, <limit>");
+                let get = |a: &str| -> Result<Option<f64>> {
+                    ln.attribute(a)
+                        .map(|t| ctx.number(ln, t, &format!("{w}: {a}")))
+                        .transpose()
+                };
+                let (lo, hi) = (get("lower")?, get("upper")?);
+                let positional = kind != "continuous";
+                let (q_min, q_max) = match (lo, hi) {
+                    (Some(a), Some(b)) if positional && a < b => (Some(a), Some(b)),
+                    (None, Some(b)) if positional && b > 0.0 => (Some(0.0), Some(b)),
+                    (Some(a), None) if positional && a < 0.0 => (Some(a), Some(0.0)),
+                    _ => (None, None),
+                };
+                let positive = |v: Option<f64>| v.filter(|&x| x > 0.0);
+                let l = JointLimits {
+                    q_min,
+                    q_max,
+                    qd: positive(get("velocity")?),
+                    qdd: None,
+                    tau: positive(get("effort")?),
+                };
+                (l != JointLimits::default()).then_some(l)
+            }
+            _ => None,
+        };
         joint_names.insert(name.clone(), joints.len());
         joints.push(UJoint {
+            limits,
             origin: origin(ctx, n, &what)?,
             name,
             node: n,
@@ -553,6 +586,7 @@ fn build(
     let mut frames: Vec<FrameDesc> = Vec::with_capacity(order.len());
     let mut dlinks: Vec<LinkDesc> = Vec::with_capacity(order.len());
     let mut notes = Vec::new();
+    let mut limits = Vec::new();
     let mut map = SourceMap::default();
     map.file = ctx.file.map(str::to_string);
     let mut number_of_link: Vec<usize> = vec![0; links.len()]; // URDF link -> our link number
@@ -605,6 +639,9 @@ fn build(
         }
         frames.push(frame_of(jt.name.clone(), i, jt.joint, &t));
         let j = frames.len();
+        if let Some(l) = &jt.limits {
+            limits.push((j, l.clone()));
+        }
         c_of.push(s.inverse());
         number_of_link[jt.child] = j;
         map.set_frame(j, None, ctx.line(jt.node));
@@ -665,6 +702,7 @@ fn build(
     desc.frames = frames;
     desc.links = dlinks;
     desc.notes = notes;
+    desc.limits = limits.into_iter().collect();
     desc.gravity = [Expr::zero(), Expr::zero(), Expr::num(-9.81)];
     desc.notes.insert(
         0,

@@ -177,8 +177,10 @@ impl Stepper {
         match self.max_steps {
             Some(m) if self.stats.accepted + self.stats.rejected >= m => {
                 Err(Error::Numerical(format!(
-                    "more than {m} integration steps: the motion is too stiff for the \
-                     tolerances (e.g. Coulomb friction sticking; smooth it or raise the limit)"
+                    "stopped by the step limit (max_steps = {m} integration steps, {} accepted \
+                     and {} rejected): raise the limit, or if it is already large the motion is \
+                     too stiff for the tolerances (e.g. Coulomb friction sticking: smooth it)",
+                    self.stats.accepted, self.stats.rejected
                 )))
             }
             _ => Ok(()),

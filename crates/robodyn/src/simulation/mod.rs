@@ -65,9 +65,9 @@ pub mod output;
 pub use closed::ClosedChainDynamics;
 pub use input::{TimeSeries, TorqueInput};
 pub use integrators::{Integrator, Ode, Stats, Stepper};
+pub use output::{format_number, CsvSink, Recorder, Tee, TrajectorySink};
 #[cfg(feature = "plot")]
-pub use output::plot_svg;
-pub use output::{CsvSink, Recorder, Tee, TrajectorySink};
+pub use output::{plot_svg, PlotInfo};
 
 use crate::algorithms::direct_dynamics::{ddm, Method};
 use crate::data::Data;
