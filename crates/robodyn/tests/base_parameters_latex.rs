@@ -54,7 +54,7 @@ fn base_parameter_latex_typesets() {
     if !common::tool_available(
         "pdflatex",
         &["--version"],
-        "ROBODYN_REQUIRE_LATEX",
+        "latex",
         "base-parameter LaTeX (Debian package texlive-latex-base)",
     ) {
         return;

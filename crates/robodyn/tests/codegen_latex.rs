@@ -26,7 +26,7 @@ fn generated_latex_typesets() {
     let pdflatex = common::tool_available(
         "pdflatex",
         &["--version"],
-        "ROBODYN_REQUIRE_LATEX",
+        "latex",
         "generated LaTeX (Debian package texlive-latex-base)",
     );
     if !pdflatex {
