@@ -377,21 +377,23 @@ impl Expr {
         let mut index: HashMap<Expr, usize> = HashMap::new();
         let push = |e: &Expr, parts: &mut Vec<(Expr, Coef)>, index: &mut HashMap<Expr, usize>| {
             let (c, rest) = e.split_coefficient();
-            let found = if parts.len() < LINEAR_SEARCH {
+            // the index is empty (linear search) or complete: it is built whole when the
+            // sum reaches LINEAR_SEARCH parts (a partial index missed like terms)
+            let found = if index.is_empty() {
                 parts.iter().position(|(r, _)| *r == rest)
             } else {
-                if index.is_empty() {
-                    index.extend(parts.iter().enumerate().map(|(i, (r, _))| (r.clone(), i)));
-                }
                 index.get(&rest).copied()
             };
             match found {
                 Some(i) => parts[i].1 = parts[i].1.add(c),
                 None => {
-                    if !index.is_empty() || parts.len() + 1 >= LINEAR_SEARCH {
+                    if !index.is_empty() {
                         index.insert(rest.clone(), parts.len());
                     }
                     parts.push((rest, c));
+                    if index.is_empty() && parts.len() >= LINEAR_SEARCH {
+                        index.extend(parts.iter().enumerate().map(|(i, (r, _))| (r.clone(), i)));
+                    }
                 }
             }
         };
@@ -483,17 +485,13 @@ impl Expr {
                         Node::Pow(b, n) => (b.clone(), *n),
                         _ => (f.clone(), 1),
                     };
-                    let found = if bases.len() < LINEAR_SEARCH {
+                    // empty (linear search) or complete index, as in `sum`
+                    let found = if index.is_empty() {
                         bases.iter().position(|(x, _)| *x == b)
                     } else {
-                        if index.is_empty() {
-                            index
-                                .extend(bases.iter().enumerate().map(|(i, (x, _))| (x.clone(), i)));
-                        }
                         index.get(&b).copied()
                     };
-                    // an exponent that would overflow stays a separate factor
-                    // an exponent beyond MAX_POWER stays a separate factor
+                    // an exponent that would overflow or exceed MAX_POWER stays a separate factor
                     let merged = found.and_then(|i| {
                         let s = bases[i].1.checked_add(n)?;
                         (s.abs() <= MAX_POWER).then_some((i, s))
@@ -501,10 +499,16 @@ impl Expr {
                     match merged {
                         Some((i, s)) => bases[i].1 = s,
                         None => {
-                            if !index.is_empty() || bases.len() + 1 >= LINEAR_SEARCH {
+                            if !index.is_empty() {
                                 index.entry(b.clone()).or_insert(bases.len());
                             }
                             bases.push((b, n));
+                            if index.is_empty() && bases.len() >= LINEAR_SEARCH {
+                                // first occurrence of each base wins, as `position` finds it
+                                for (i, (x, _)) in bases.iter().enumerate() {
+                                    index.entry(x.clone()).or_insert(i);
+                                }
+                            }
                         }
                     }
                 }
@@ -725,7 +729,9 @@ impl Expr {
     }
 
     /// Expand products of sums (distributes multiplication over addition, positive integer powers
-    /// of sums included).
+    /// of sums included). A product or power whose expansion would exceed [`EXPAND_TERMS`]
+    /// terms is kept as it is (its factors expanded): the result is always equal to `self`, and
+    /// a file's `(a + b + ... + h)^54` cannot take minutes and gigabytes.
     pub fn expand(&self) -> Expr {
         grow(|| self.expand_node())
     }
@@ -734,14 +740,26 @@ impl Expr {
         match self.node() {
             Node::Add(v) => Expr::sum(v.iter().map(Expr::expand)),
             Node::Mul(v) => {
+                let factors: Vec<Expr> = v.iter().map(Expr::expand).collect();
+                let mut size = 1usize;
+                for f in &factors {
+                    size = size.saturating_mul(term_count(f));
+                }
+                if size > EXPAND_TERMS {
+                    return Expr::product(factors);
+                }
                 let mut acc = Expr::one();
-                for f in v {
-                    acc = distribute(&acc, &f.expand());
+                for f in &factors {
+                    acc = distribute(&acc, f);
                 }
                 acc
             }
             Node::Pow(b, n) if *n > 1 => {
                 let b = b.expand();
+                let k = term_count(&b);
+                if k > 1 && k.checked_pow(*n as u32).is_none_or(|t| t > EXPAND_TERMS) {
+                    return b.powi(*n);
+                }
                 if matches!(b.node(), Node::Add(_)) {
                     // multiplied out term by term: a product of equal sums would fold back
                     // into the power
@@ -758,6 +776,17 @@ impl Expr {
             Node::Atan2(y, x) => Expr::atan2(y.expand(), x.expand()),
             _ => self.clone(),
         }
+    }
+}
+
+/// Largest number of term products an expansion multiplies out (see [`Expr::expand`]).
+pub const EXPAND_TERMS: usize = 100_000;
+
+/// Number of terms of an expanded expression (1 unless it is a sum).
+fn term_count(e: &Expr) -> usize {
+    match e.node() {
+        Node::Add(t) => t.len(),
+        _ => 1,
     }
 }
 

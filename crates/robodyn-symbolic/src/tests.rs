@@ -117,3 +117,37 @@ fn canonical_forms_print_and_read_back() {
     assert!(Expr::parse("tan(pi/2)").is_err());
     assert!(Expr::parse("1e999").is_err());
 }
+
+#[test]
+fn like_terms_collect_beyond_the_linear_search() {
+    // 20 distinct terms, then each again: the index built at 16 parts must hold all of them
+    // (a fuzzer finding: `- a2 - a2` printed instead of `- 2*a2`)
+    let names: Vec<String> = (0..20).map(|i| format!("s{i}")).collect();
+    let terms = names.iter().chain(&names).map(|n| Expr::symbol(n));
+    let e = Expr::sum(terms);
+    let expected = Expr::sum(names.iter().map(|n| Expr::int(2) * Expr::symbol(n)));
+    assert_eq!(e, expected, "{e}");
+    assert_eq!(e.to_string().matches("s7").count(), 1, "{e}");
+    let f = Expr::product(names.iter().chain(&names).map(|n| Expr::symbol(n)));
+    assert_eq!(f.to_string().matches("s19").count(), 1, "{f}");
+    assert!(f.to_string().contains("s19^2"), "{f}");
+    // and the fuzzer's input prints stably
+    let text = "t/s/i+sr-xH-aqs-Xa-q-ss-p-H-xsa-r-X/s/i+q-x+i+q-xq-q+ax-a2+ax-a2";
+    let once = p(text).to_string();
+    assert_eq!(p(&once).to_string(), once);
+    assert!(once.contains("2*a2"), "{once}");
+}
+
+#[test]
+fn expansion_is_bounded() {
+    // a fuzzer finding: a 62-character expression whose expansion took 33 s and 370 MB
+    let e = p("(a+b+c+d+e+f+g+h)^54*(x+y)");
+    let x = e.expand();
+    // kept as a power (too many terms), still the same value
+    let env = |s: &str| Some(0.01 * s.as_bytes()[0] as f64);
+    let (v, w) = (e.eval(&env).unwrap(), x.eval(&env).unwrap());
+    assert!((v - w).abs() <= 1e-12 * v.abs(), "{v} {w}");
+    assert!(x.to_string().contains("^54"), "{x}");
+    // small ones still multiply out
+    assert_eq!(p("(a+b)^2").expand(), p("a^2 + 2*a*b + b^2"));
+}

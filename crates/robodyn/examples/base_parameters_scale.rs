@@ -1,6 +1,8 @@
 //! Growth of the numerical base-parameter method with the robot's size.
 //!
-//!     cargo run --release -p robodyn --example base_parameters_scale -- N [write FILE.toml]
+//! ```text
+//!  cargo run --release -p robodyn --example base_parameters_scale -- N [write FILE.toml]
+//! ```
 //!
 //! Builds a random tree of N links (`robodyn::testing::random_tree`, seed 13) and runs the
 //! numerical method with the selection of `robodyn base-params --method numeric` (rotor

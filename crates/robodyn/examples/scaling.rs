@@ -3,7 +3,9 @@
 //! symbolic inertial parameters), written as a TOML file, read back, and its inverse (and, up to
 //! 100 links, direct) dynamic model generated as C.
 //!
-//!     cargo run --release -p robodyn --example scaling [-- 10 50 100 200 500 2000]
+//! ```text
+//!  cargo run --release -p robodyn --example scaling [-- 10 50 100 200 500 2000]
+//! ```
 //!
 //! Prints one row per size: file size, load time, generation times and operation counts, and the
 //! ratio of each time to the previous row's (linear growth gives the ratio of the sizes).

@@ -9,7 +9,9 @@
 //! the operation counts, fewest base-model additions first, and marks the rows that are at or
 //! below the book in both cells:
 //!
-//!     cargo run --release -p robodyn --example table_10_3_simplified
+//! ```text
+//!  cargo run --release -p robodyn --example table_10_3_simplified
+//! ```
 //!
 //! See docs/models/generated-code.md for what the sweep shows.
 

@@ -2,8 +2,10 @@
 //! 2017): a link's standard parameters are those of a rigid body with a non-negative mass
 //! density iff its pseudo-inertia matrix
 //!
-//!     J_j = [ Sigma  h ]      Sigma = tr(I)/2 1 - I,  h = (MX, MY, MZ),  m = M,
-//!           [ h^T    m ]
+//! ```text
+//!  J_j = [ Sigma  h ]      Sigma = tr(I)/2 1 - I,  h = (MX, MY, MZ),  m = M,
+//!        [ h^T    m ]
+//! ```
 //!
 //! (I the inertia tensor about O_j in R_j, Sigma = int r r^T dm) is positive semidefinite; this
 //! implies m >= 0 and the triangle inequalities of the principal moments. With rotor inertias

@@ -1,8 +1,10 @@
 //! Excitation trajectories (Swevers, Ganseman, Tükel, De Schutter, Van Brussel 1997): a finite
 //! Fourier series per joint,
 //!
-//!     q_j(t) = q0_j + sum_{l=1..L} a_jl / (w l) sin(w l t) - b_jl / (w l) cos(w l t),
-//!     w = 2 pi / T,
+//! ```text
+//!  q_j(t) = q0_j + sum_{l=1..L} a_jl / (w l) sin(w l t) - b_jl / (w l) cos(w l t),
+//!  w = 2 pi / T,
+//! ```
 //!
 //! periodic by construction, at rest at t = 0 and t = T (qd = sum_l a_jl = 0 and
 //! qdd = w sum_l l b_jl = 0: the last harmonic's a_jL, b_jL are fixed by the others), starting
