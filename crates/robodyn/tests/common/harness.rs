@@ -32,9 +32,35 @@ pub const KEYS: &[&str] = &["octave", "latex", "numpy", "pinocchio", "shared"];
 static SKIPPED: Mutex<Vec<(String, String)>> = Mutex::new(Vec::new());
 static SUMMARY: Once = Once::new();
 
-/// Whether `ROBODYN_REQUIRE` requires the optional check `key` (an unknown key there fails).
+/// The environment variables of the earlier schemes, each replaced by `ROBODYN_REQUIRE` (or by
+/// the default, which skips visibly): one set is refused with the replacement, so that a CI
+/// configuration that still sets it does not silently stop requiring the check.
+pub const LEGACY: &[(&str, &str)] = &[
+    ("ROBODYN_REQUIRE_OCTAVE", "ROBODYN_REQUIRE=octave"),
+    ("ROBODYN_REQUIRE_LATEX", "ROBODYN_REQUIRE=latex"),
+    ("ROBODYN_REQUIRE_PINOCCHIO", "ROBODYN_REQUIRE=pinocchio"),
+    ("ROBODYN_REQUIRE_NUMPY", "ROBODYN_REQUIRE=numpy"),
+    (
+        "ROBODYN_ALLOW_MISSING_SHARED",
+        "nothing (a missing shared/ is skipped visibly unless ROBODYN_REQUIRE names `shared`)",
+    ),
+    (
+        "ROBODYN_SKIP_EXTERNAL",
+        "nothing (a missing shared/ is skipped visibly unless ROBODYN_REQUIRE names `shared`)",
+    ),
+];
+
+/// Whether `ROBODYN_REQUIRE` requires the optional check `key`. An unknown key there, or a
+/// variable of [`LEGACY`], fails.
 pub fn required(key: &str) -> bool {
     assert!(KEYS.contains(&key), "unknown optional check {key:?}");
+    for (old, new) in LEGACY {
+        assert!(
+            std::env::var_os(old).is_none(),
+            "{old} is no longer read: use {new} (ROBODYN_REQUIRE=all requires every optional \
+             check; the README's test section)"
+        );
+    }
     let Ok(list) = std::env::var("ROBODYN_REQUIRE") else {
         return false;
     };
@@ -148,20 +174,30 @@ pub fn shared(sub: &str, what: &str) -> Option<PathBuf> {
 }
 
 /// The guard of `tests/all.rs` (its text `all_rs`): every `tests/*.rs` file of the crate at
-/// `manifest_dir` is one of its modules (`#[path = "FILE.rs"]`), so none is silently left out.
+/// `manifest_dir` is one of its modules (`#[path = "FILE.rs"]` then `mod FILE;`), so none is
+/// silently left out. The failure says which lines to add, and where.
 pub fn every_test_file_is_a_module(manifest_dir: &str, all_rs: &str) {
     let dir = Path::new(manifest_dir).join("tests");
-    let mut missing = Vec::new();
-    for entry in std::fs::read_dir(&dir).unwrap() {
-        let name = entry.unwrap().file_name().to_string_lossy().into_owned();
-        let line = format!("#[path = \"{name}\"]");
-        if name.ends_with(".rs") && name != "all.rs" && !all_rs.lines().any(|l| l.trim() == line) {
-            missing.push(name);
+    let mut names: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".rs") && n != "all.rs")
+        .collect();
+    names.sort();
+    let lines: Vec<&str> = all_rs.lines().map(str::trim).collect();
+    let mut missing = String::new();
+    for name in &names {
+        let stem = &name[..name.len() - 3];
+        let path = format!("#[path = \"{name}\"]");
+        let module = format!("mod {stem};");
+        if !lines.windows(2).any(|w| w[0] == path && w[1] == module) {
+            missing += &format!("{path}\n{module}\n");
         }
     }
     assert!(
         missing.is_empty(),
-        "{missing:?} not compiled: add `#[path = \"FILE.rs\"] mod FILE;` to {}",
+        "test files not compiled (never run): add these lines to {} among the other \
+         `#[path]` modules (alphabetical order), before the guard test:\n\n{missing}",
         dir.join("all.rs").display()
     );
 }

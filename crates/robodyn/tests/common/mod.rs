@@ -49,13 +49,8 @@ pub fn cases() -> Vec<Loaded> {
 }
 
 /// Whether an external program the tests run (GNU Octave, pdflatex) works here: `program args`
-/// exits with success. Without it the optional check `need` (a key of `crate::harness::KEYS`;
-/// a legacy `ROBODYN_REQUIRE_KEY` name is read as `key`) is skipped visibly, or fails where
-/// `ROBODYN_REQUIRE` requires it (CI).
-pub fn tool_available(program: &str, args: &[&str], need: &str, what: &str) -> bool {
-    let key = need
-        .strip_prefix("ROBODYN_REQUIRE_")
-        .unwrap_or(need)
-        .to_lowercase();
-    crate::harness::tool(&key, program, args, what)
+/// exits with success. Without it the optional check `key` (of `crate::harness::KEYS`) is
+/// skipped visibly, or fails where `ROBODYN_REQUIRE` requires it (CI).
+pub fn tool_available(program: &str, args: &[&str], key: &str, what: &str) -> bool {
+    crate::harness::tool(key, program, args, what)
 }
