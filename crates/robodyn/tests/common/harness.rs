@@ -33,8 +33,8 @@ static SKIPPED: Mutex<Vec<(String, String)>> = Mutex::new(Vec::new());
 static SUMMARY: Once = Once::new();
 
 /// The environment variables of the earlier schemes, each replaced by `ROBODYN_REQUIRE` (or by
-/// the default, which skips visibly): one set is refused with the replacement, so that a CI
-/// configuration that still sets it does not silently stop requiring the check.
+/// the default, which skips visibly): a skip while one is set fails, naming the replacement, so
+/// that a CI configuration that still sets it does not silently stop requiring the check.
 pub const LEGACY: &[(&str, &str)] = &[
     ("ROBODYN_REQUIRE_OCTAVE", "ROBODYN_REQUIRE=octave"),
     ("ROBODYN_REQUIRE_LATEX", "ROBODYN_REQUIRE=latex"),
@@ -50,8 +50,8 @@ pub const LEGACY: &[(&str, &str)] = &[
     ),
 ];
 
-/// Whether `ROBODYN_REQUIRE` requires the optional check `key`. An unknown key there, or a
-/// variable of [`LEGACY`], fails.
+/// Whether `ROBODYN_REQUIRE` requires the optional check `key` (asked when it would be skipped).
+/// An unknown key there, or a variable of [`LEGACY`], fails.
 pub fn required(key: &str) -> bool {
     assert!(KEYS.contains(&key), "unknown optional check {key:?}");
     for (old, new) in LEGACY {
