@@ -517,16 +517,22 @@ impl Expr {
                 return Expr::zero();
             }
         }
+        // powi may turn a factor into another base (sqrt(T)^2 = T, to merge with a T^-1 of the
+        // same product), a number (sqrt(2)^2) or a product: then the factors are folded again
+        let mut rebased = false;
         let mut out: Vec<Expr> = bases
             .into_iter()
             .filter(|(_, n)| *n != 0)
-            .map(|(b, n)| b.powi(n))
+            .map(|(b, n)| {
+                let p = b.powi(n);
+                rebased |= match p.node() {
+                    Node::Pow(x, _) => *x != b,
+                    _ => p != b,
+                };
+                p
+            })
             .collect();
-        // powi may have produced numbers (e.g. (pi)^0 handled above, sqrt(2)^2 below): refold
-        if out
-            .iter()
-            .any(|e| e.is_number() || matches!(e.node(), Node::Mul(_)))
-        {
+        if rebased {
             return Expr::product(out.into_iter().chain(std::iter::once(coef.to_expr())));
         }
         out.sort_by(cmp_factors);
@@ -566,6 +572,12 @@ impl Expr {
             },
             Node::Mul(v) => Expr::product(v.iter().map(|f| f.powi(n))),
             Node::Func(Func::Sqrt, a) if n % 2 == 0 => a.powi(n / 2),
+            // sqrt(a)^(2k+1) = a^k sqrt(a), sqrt(a)^-(2k+1) = a^-k / sqrt(a) (k >= 1): so that the
+            // a^k merges with other powers of a in a product
+            Node::Func(Func::Sqrt, a) if n.abs() >= 3 => {
+                let k = n / 2;
+                Expr::product([a.powi(k), self.powi(n - 2 * k)])
+            }
             _ => Expr::new(Node::Pow(self.clone(), n)),
         }
     }

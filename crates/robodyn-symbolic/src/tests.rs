@@ -151,3 +151,18 @@ fn expansion_is_bounded() {
     // small ones still multiply out
     assert_eq!(p("(a+b)^2").expand(), p("a^2 + 2*a*b + b^2"));
 }
+
+#[test]
+fn a_power_of_a_square_root_merges_with_its_base() {
+    // a fuzzer finding: sqrt(T)*sqrt(T)/T printed as `T/(2*T)` once and `1/2` after a re-parse
+    assert_eq!(p("sqrt(T)*sqrt(T)/T"), Expr::one());
+    assert_eq!(p("T^-1*sqrt(T)^2"), Expr::one());
+    assert_eq!(p("sqrt(T)^3/T").to_string(), p("sqrt(T)").to_string());
+    let text = "12980---T**.5/-T*.5*---T**.5";
+    assert_eq!(
+        p(text),
+        Expr::rational(num_rational::Rational64::new(25959, 2))
+    );
+    let once = p(text).to_string();
+    assert_eq!(p(&once).to_string(), once);
+}
