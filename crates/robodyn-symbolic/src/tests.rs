@@ -123,12 +123,12 @@ fn like_terms_collect_beyond_the_linear_search() {
     // 20 distinct terms, then each again: the index built at 16 parts must hold all of them
     // (a fuzzer finding: `- a2 - a2` printed instead of `- 2*a2`)
     let names: Vec<String> = (0..20).map(|i| format!("s{i}")).collect();
-    let terms = names.iter().chain(&names).map(|n| Expr::symbol(n));
+    let terms = names.iter().chain(&names).map(Expr::symbol);
     let e = Expr::sum(terms);
     let expected = Expr::sum(names.iter().map(|n| Expr::int(2) * Expr::symbol(n)));
     assert_eq!(e, expected, "{e}");
     assert_eq!(e.to_string().matches("s7").count(), 1, "{e}");
-    let f = Expr::product(names.iter().chain(&names).map(|n| Expr::symbol(n)));
+    let f = Expr::product(names.iter().chain(&names).map(Expr::symbol));
     assert_eq!(f.to_string().matches("s19").count(), 1, "{f}");
     assert!(f.to_string().contains("s19^2"), "{f}");
     // and the fuzzer's input prints stably
