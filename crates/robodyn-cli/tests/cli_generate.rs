@@ -8,14 +8,6 @@ mod common;
 use common::{octave_available, octave_eval, robot, run, tmp};
 use std::process::Command;
 
-fn has_numpy() -> bool {
-    Command::new("python3")
-        .args(["-c", "import numpy"])
-        .status()
-        .map(|s| s.success())
-        .unwrap_or(false)
-}
-
 /// Run a generated Python function `name` with the given argument vectors; its outputs.
 fn run_python(file: &std::path::Path, name: &str, args: &[Vec<f64>]) -> Vec<f64> {
     let list: Vec<String> = args
@@ -78,8 +70,7 @@ fn generated_closed_models_agree_with_the_cli() {
                 .collect()
         })
         .collect();
-    if !has_numpy() {
-        eprintln!("python3 with numpy not available: generated Python not executed");
+    if !crate::harness::numpy("generated Python not executed") {
         return;
     }
     let out = tmp("generate", "fivebar.py");

@@ -2,7 +2,7 @@
 //! legend, grouping equations broken between terms, values) of the SR400 (Table 10.2, with the
 //! comparison comment), the RX-90 and the Orthoglide (its own names: `MR11` is link 1's)
 //! go through pdflatex in a minimal document (amsmath) with no error and no overfull line.
-//! `.ci/run` installs pdflatex and sets ROBODYN_REQUIRE_LATEX=1 (a missing install fails there).
+//! `.ci/run` installs pdflatex and sets ROBODYN_REQUIRE=all (a missing install fails there).
 
 mod common;
 
@@ -54,7 +54,7 @@ fn base_parameter_latex_typesets() {
     if !common::tool_available(
         "pdflatex",
         &["--version"],
-        "ROBODYN_REQUIRE_LATEX",
+        "latex",
         "base-parameter LaTeX (Debian package texlive-latex-base)",
     ) {
         return;

@@ -195,34 +195,10 @@ fn singular_configurations_are_reported() {
     assert!(!far.conditioning.warning, "{:?}", far.conditioning);
 }
 
-/// `shared/cases/external` next to the repository (walking up from the crate), if present.
-fn external_cases() -> Option<PathBuf> {
-    let mut dir = Path::new(env!("CARGO_MANIFEST_DIR")).to_path_buf();
-    loop {
-        let c = dir.join("shared/cases/external");
-        if c.is_dir() {
-            return Some(c);
-        }
-        if !dir.pop() {
-            return None;
-        }
-    }
-}
-
-/// The external case files are required unless `ROBODYN_SKIP_EXTERNAL` is set: a missing
-/// `shared/` fails the test instead of passing silently.
+/// `shared/cases/external` next to the repository, or a visible skip of `what` (the optional
+/// check `shared`, required by CI: `tests/common/harness.rs`).
 fn external_or_skip(what: &str) -> Option<PathBuf> {
-    let found = external_cases();
-    if found.is_none() {
-        assert!(
-            std::env::var("ROBODYN_SKIP_EXTERNAL").is_ok(),
-            "shared/cases/external not found above {}: {what} cannot run (set \
-             ROBODYN_SKIP_EXTERNAL=1 to skip it knowingly)",
-            env!("CARGO_MANIFEST_DIR")
-        );
-        eprintln!("SKIPPED (ROBODYN_SKIP_EXTERNAL): {what}");
-    }
-    found
+    crate::harness::shared("cases/external", what)
 }
 
 /// OpenSYMORO's SR400 `.par` with numbers: the bundled SR400's lengths, random physically

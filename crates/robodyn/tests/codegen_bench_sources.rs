@@ -1,5 +1,5 @@
 //! The generated sources included by `benches/generated.rs` are up to date with the generator.
-//! Regenerate with `ROBODYN_BLESS=1 cargo test -p robodyn --test codegen_bench_sources`.
+//! Regenerate with `ROBODYN_BLESS=1 cargo test --release -p robodyn --test all -- codegen_bench_sources::`.
 
 mod robots {
     include!(concat!(
@@ -43,7 +43,7 @@ fn bench_sources_are_current() {
         }
         assert!(
             committed == fresh,
-            "{} is stale: regenerate with ROBODYN_BLESS=1 cargo test -p robodyn --test codegen_bench_sources",
+            "{} is stale: regenerate with ROBODYN_BLESS=1 cargo test --release -p robodyn --test all -- codegen_bench_sources::",
             path.display()
         );
     }

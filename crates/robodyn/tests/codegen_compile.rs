@@ -607,13 +607,7 @@ fn interpreted_and_python_agree() {
         })
         .collect();
     check(&cases, &outs, "interpreted");
-    let has_numpy = Command::new("python3")
-        .args(["-c", "import numpy"])
-        .status()
-        .map(|s| s.success())
-        .unwrap_or(false);
-    if !has_numpy {
-        eprintln!("python3 with numpy not available: Python emitter not executed");
+    if !crate::harness::numpy("Python emitter not executed") {
         return;
     }
     let dir = tmp_dir("py");
@@ -672,13 +666,13 @@ fn interpreted_and_python_agree() {
 
 /// The MATLAB emitter: every program written as a function file `NAME.m` and run by GNU Octave
 /// on the same states agrees with the numeric models. `.ci/run` installs Octave and sets
-/// ROBODYN_REQUIRE_OCTAVE=1, so that a missing install fails there instead of skipping.
+/// ROBODYN_REQUIRE=all, so that a missing install fails there instead of skipping.
 #[test]
 fn matlab_code_runs_in_octave_and_agrees() {
     let octave = common::tool_available(
         "octave-cli",
         &["--norc", "--quiet", "--eval", "exit(0)"],
-        "ROBODYN_REQUIRE_OCTAVE",
+        "octave",
         "generated MATLAB (Debian package `octave`)",
     );
     if !octave {

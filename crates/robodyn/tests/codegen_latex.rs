@@ -1,7 +1,7 @@
 //! The LaTeX emitter writes valid LaTeX: the equations of every bundled robot (its idm, and for
 //! the closed ones Gamma_cl and W) are typeset by pdflatex in a minimal document (amsmath), with
 //! no error, and the rows fit the text width (long sums are broken between terms). `.ci/run` installs pdflatex (Debian's texlive-latex-base) and sets
-//! ROBODYN_REQUIRE_LATEX=1, so that a missing install fails there instead of skipping.
+//! ROBODYN_REQUIRE=all, so that a missing install fails there instead of skipping.
 
 mod common;
 
@@ -26,7 +26,7 @@ fn generated_latex_typesets() {
     let pdflatex = common::tool_available(
         "pdflatex",
         &["--version"],
-        "ROBODYN_REQUIRE_LATEX",
+        "latex",
         "generated LaTeX (Debian package texlive-latex-base)",
     );
     if !pdflatex {

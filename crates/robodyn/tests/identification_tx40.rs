@@ -1,39 +1,19 @@
 //! Identification on real data: a Stäubli TX40 log (45,000 samples at 5 kHz, joint side,
 //! coupled wrist), read in place from the project's shared data (`shared/data/tx40/`, found by
-//! walking up from this crate). Without it the test FAILS, unless
-//! ROBODYN_ALLOW_MISSING_SHARED=1 is set (then it says SKIPPED on stderr and passes).
+//! walking up from this crate). Without it the test is skipped visibly, or
+//! fails where `ROBODYN_REQUIRE` requires the `shared` check (CI: `tests/common/harness.rs`).
 
 use robodyn::identification::data::{CsvLog, JointLabels};
 use robodyn::identification::model_access::{load_description, ModelAccess};
 use robodyn::identification::{identify, Options};
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
-
-/// `shared/data/tx40` in the first ancestor of this crate that has `shared/data`.
-fn tx40_dir() -> Option<PathBuf> {
-    let mut dir = Some(Path::new(env!("CARGO_MANIFEST_DIR")));
-    while let Some(d) = dir {
-        if d.join("shared/data").is_dir() {
-            return Some(d.join("shared/data/tx40"));
-        }
-        dir = d.parent();
-    }
-    None
-}
+use std::path::PathBuf;
 
 fn data() -> Option<PathBuf> {
-    let found = tx40_dir()
-        .map(|d| d.join("tx40_joint.csv"))
-        .filter(|p| p.is_file());
-    if found.is_none() {
-        let msg = "shared/data/tx40/tx40_joint.csv not found above CARGO_MANIFEST_DIR";
-        assert!(
-            std::env::var("ROBODYN_ALLOW_MISSING_SHARED").is_ok_and(|v| v == "1"),
-            "{msg} (set ROBODYN_ALLOW_MISSING_SHARED=1 to skip)"
-        );
-        eprintln!("SKIPPED: {msg}");
-    }
-    found
+    crate::harness::shared(
+        "data/tx40/tx40_joint.csv",
+        "identification on the real TX40 log",
+    )
 }
 
 /// The README's command: WLS, constant offsets, validation on 60..80 % of the log. The real

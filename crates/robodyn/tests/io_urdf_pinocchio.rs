@@ -2,8 +2,8 @@
 //! `pinocchio.rnea` (an independent implementation) to 1e-9 relative on random states.
 //!
 //! Needs `python3` with `pin` and `example-robot-data` (`pip install pin example-robot-data`,
-//! done by `.ci/run`, which sets ROBODYN_REQUIRE_PINOCCHIO=1 so that a missing install fails
-//! instead of skipping). `ROBODYN_PYTHON` selects the interpreter.
+//! done by `.ci/run`, which sets ROBODYN_REQUIRE=all so that a missing install fails instead
+//! of skipping). `ROBODYN_PYTHON` selects the interpreter.
 
 use robodyn::algorithms::inverse_dynamics::inverse_dynamics;
 use robodyn::model::param;
@@ -33,11 +33,11 @@ fn robots_dir() -> Option<PathBuf> {
         _ => None,
     };
     if found.is_none() {
-        let msg = "pinocchio / example-robot-data not found: pip install pin example-robot-data";
-        if std::env::var("ROBODYN_REQUIRE_PINOCCHIO").is_ok() {
-            panic!("{msg}");
-        }
-        eprintln!("SKIPPED: {msg}");
+        crate::harness::skip(
+            "pinocchio",
+            "pinocchio / example-robot-data not found (pip install pin example-robot-data): \
+             real URDFs vs pinocchio.rnea not checked",
+        );
     }
     found
 }

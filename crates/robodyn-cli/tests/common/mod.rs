@@ -45,20 +45,15 @@ pub fn csv(text: &str) -> (Vec<String>, Vec<Vec<f64>>) {
     (head, rows)
 }
 
-/// Whether GNU Octave (`octave-cli`) runs here. Without it a test that needs it skips with a
-/// message, except where ROBODYN_REQUIRE_OCTAVE is set (CI installs Octave): there it fails.
+/// Whether GNU Octave (`octave-cli`) runs here; without it the optional check `octave` is skipped
+/// visibly, or fails where `ROBODYN_REQUIRE` requires it (CI): `crate::harness`.
 pub fn octave_available() -> bool {
-    let ok = Command::new("octave-cli")
-        .args(["--norc", "--quiet", "--eval", "exit(0)"])
-        .output()
-        .map(|o| o.status.success())
-        .unwrap_or(false);
-    if !ok {
-        let msg = "octave-cli not found (Debian package `octave`): generated MATLAB not executed";
-        assert!(std::env::var("ROBODYN_REQUIRE_OCTAVE").is_err(), "{msg}");
-        eprintln!("SKIPPED: {msg}");
-    }
-    ok
+    crate::harness::tool(
+        "octave",
+        "octave-cli",
+        &["--norc", "--quiet", "--eval", "exit(0)"],
+        "generated MATLAB (Debian package `octave`)",
+    )
 }
 
 /// Run `octave-cli --eval CODE` in `dir`, assert success, return standard output.

@@ -1,5 +1,5 @@
 //! Bundled closed robots and the slider-crank fixture, shared by the closed-chain tests; the
-//! check for the external programs some tests run.
+//! check for the external programs some tests run (`crate::harness`).
 #![allow(dead_code)]
 
 use robodyn::Robot;
@@ -49,19 +49,8 @@ pub fn cases() -> Vec<Loaded> {
 }
 
 /// Whether an external program the tests run (GNU Octave, pdflatex) works here: `program args`
-/// exits with success. Without it a test skips with a message saying what is not checked, except
-/// where the environment variable `require` is set (CI installs the program): there it fails.
-pub fn tool_available(program: &str, args: &[&str], require: &str, what: &str) -> bool {
-    let ok = std::process::Command::new(program)
-        .args(args)
-        .stdin(std::process::Stdio::null())
-        .output()
-        .map(|o| o.status.success())
-        .unwrap_or(false);
-    if !ok {
-        let msg = format!("{program} not found: {what} not checked");
-        assert!(std::env::var(require).is_err(), "{msg} ({require} is set)");
-        eprintln!("SKIPPED: {msg}");
-    }
-    ok
+/// exits with success. Without it the optional check `key` (of `crate::harness::KEYS`) is
+/// skipped visibly, or fails where `ROBODYN_REQUIRE` requires it (CI).
+pub fn tool_available(program: &str, args: &[&str], key: &str, what: &str) -> bool {
+    crate::harness::tool(key, program, args, what)
 }

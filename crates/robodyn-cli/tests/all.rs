@@ -1,0 +1,35 @@
+//! Every integration test of `robodyn-cli` in ONE test binary: each `tests/*.rs` file is a module
+//! here, left where it is. One binary builds and links far faster than one per file (see the
+//! README's test section); `every_test_file_is_a_module` fails when a `tests/*.rs` file is not
+//! listed below. One file's tests: `cargo test --release -p robodyn-cli --test all -- FILE::`.
+// each file keeps its own `mod common;`, as when it was a test binary of its own
+#![allow(clippy::duplicate_mod)]
+
+/// Visible skips of the optional checks, and the guard below.
+#[path = "../../robodyn/tests/common/harness.rs"]
+pub mod harness;
+
+#[path = "cli_bad_input.rs"]
+mod cli_bad_input;
+#[path = "cli_base_params_closed.rs"]
+mod cli_base_params_closed;
+#[path = "cli_closed.rs"]
+mod cli_closed;
+#[path = "cli_closed_rows.rs"]
+mod cli_closed_rows;
+#[path = "cli_conventions.rs"]
+mod cli_conventions;
+#[path = "cli_generate.rs"]
+mod cli_generate;
+#[path = "cli_identify.rs"]
+mod cli_identify;
+#[path = "cli_info.rs"]
+mod cli_info;
+#[path = "cli_info_assembly.rs"]
+mod cli_info_assembly;
+
+/// The guard: a `tests/*.rs` file that is not a module above would never be compiled or run.
+#[test]
+fn every_test_file_is_a_module() {
+    harness::every_test_file_is_a_module(env!("CARGO_MANIFEST_DIR"), include_str!("all.rs"));
+}
