@@ -92,15 +92,15 @@ fn for_each_state<S: Send>(
                 for i in 0..ROWS_PER_TASK.min(rows - first) {
                     let row = first + i;
                     let o = (&mut x[i * w1..(i + 1) * w1], &mut y[i * w2..(i + 1) * w2]);
-                    f(data, s, row, o).map_err(|e| (row, e))?;
+                    f(data, s, row, o).map_err(|e| (row, Box::new(e)))?;
                 }
                 Ok(())
             },
         )
-        .filter_map(|r: std::result::Result<(), (usize, Error)>| r.err())
+        .filter_map(|r: std::result::Result<(), (usize, Box<Error>)>| r.err())
         .min_by_key(|(row, _)| *row);
     match first_error {
-        Some((row, e)) => Err(e.in_row(row + 1)),
+        Some((row, e)) => Err((*e).in_row(row + 1)),
         None => Ok(()),
     }
 }

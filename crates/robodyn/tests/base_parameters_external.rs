@@ -433,15 +433,8 @@ impl DocTable {
 
 /// The loaded description of an external file, or `None` (with the skip rule of the suite)
 /// when `shared/` is missing.
-fn external_description(file: &str) -> Option<(PathBuf, robodyn::RobotDescription)> {
-    let Some(dir) = external_dir() else {
-        assert_eq!(
-            std::env::var("ROBODYN_ALLOW_MISSING_SHARED").as_deref(),
-            Ok("1"),
-            "shared/cases/external not found"
-        );
-        return None;
-    };
+fn external_description(file: &str) -> Option<(std::path::PathBuf, robodyn::RobotDescription)> {
+    let dir = crate::harness::shared("cases/external", file)?;
     let path = dir.join(file);
     let desc = robodyn::io::load_description(&path).unwrap_or_else(|e| panic!("{file}: {e}"));
     Some((path, desc))

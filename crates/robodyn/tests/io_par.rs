@@ -362,3 +362,38 @@ fn joint_variables_are_read_as_symoro_reads_them() {
     let m = err(&format!("{HEAD}is_floating = True\n"));
     assert!(m.contains("floating (free) base is not supported"), "{m}");
 }
+
+#[test]
+fn joint_limits_travel_in_a_comment() {
+    let d = parse(&format!(
+        "{HEAD}(* robodyn limits q_min: 1 = -pi; 3 = -0.5 *)\n(* robodyn limits q_max: 1 = pi *)\n\
+         (* robodyn limits qdd: 2 = 20 *)\n(* robodyn limits qd: 2 = 2.5 *)\n(* robodyn limits tau: 3 = 40 *)\n"
+    ))
+    .unwrap();
+    let l1 = &d.limits[&1];
+    assert_eq!(
+        (l1.q_min, l1.q_max),
+        (Some(-std::f64::consts::PI), Some(std::f64::consts::PI))
+    );
+    assert_eq!((d.limits[&2].qd, d.limits[&2].qdd), (Some(2.5), Some(20.0)));
+    assert_eq!(
+        (d.limits[&3].q_min, d.limits[&3].tau),
+        (Some(-0.5), Some(40.0))
+    );
+    // written back as the same comments
+    let (back, _) = par::parse_description(&par::write_description(&d), None).unwrap();
+    assert_eq!(back.limits, d.limits);
+    let m = err(&format!("{HEAD}(* robodyn limits qd: 2 = -1 *)\n"));
+    assert!(
+        m.starts_with("test.par:5:") && m.contains("positive"),
+        "{m}"
+    );
+    let m = err(&format!("{HEAD}(* robodyn limits speed: 2 = 1 *)\n"));
+    assert!(m.contains("`speed` is not one of"), "{m}");
+    let m = err(&format!("{HEAD}(* robodyn limits tau: 9 = 1 *)\n"));
+    assert!(m.contains("frame 9"), "{m}");
+    let m = err(&format!(
+        "{HEAD}(* robodyn limits q_min: 1 = 1 *)\n(* robodyn limits q_max: 1 = -1 *)\n"
+    ));
+    assert!(m.contains("not an interval"), "{m}");
+}

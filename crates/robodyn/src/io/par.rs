@@ -23,8 +23,9 @@
 //! SYMORO files carry no numeric values for their symbols. Our writer stores them in a comment
 //! SYMORO ignores, `(* robodyn values: d2 = 0.15; d3 = 0.6 *)`, which our reader reads back (as
 //! it does `(* robodyn frame names: ... *)`, `(* robodyn link names: ... *)`,
-//! `(* robodyn note: ... *)`, `(* robodyn name: ... *)` and `(* robodyn assembly: ... *)`), so
-//! that `.par -> .toml -> .par` round-trips. A name or note that `;`, a new line, `*` or a quote
+//! `(* robodyn note: ... *)`, `(* robodyn name: ... *)`, `(* robodyn assembly: ... *)` and the
+//! joint limits `(* robodyn limits q_min: 1 = -3.14; ... *)` (likewise `q_max`, `qd`, `qdd`,
+//! `tau`, by frame number)), so that `.par -> .toml -> .par` round-trips. A name or note that `;`, a new line, `*` or a quote
 //! would break is written as a quoted string with backslash escapes.
 //!
 //! Reading is linear in the file size: positions come from a [`LineIndex`], and the counts are
@@ -364,7 +365,13 @@ struct Extras {
     /// `(* robodyn name: ... *)`, which wins over SYMORO's `Robotname` comment.
     robodyn_name: Option<String>,
     assembly: BTreeMap<usize, (f64, usize)>,
+    /// `(* robodyn limits KIND: j = value; ... *)`: (frame, kind) -> (value, position).
+    limits: BTreeMap<(usize, &'static str), (f64, usize)>,
 }
+
+/// The kinds of `robodyn limits` comments, as `JointLimits` fields (`qdd` before `qd`: the
+/// comment's head is matched by prefix).
+const LIMIT_KINDS: [&str; 5] = ["q_min", "q_max", "qdd", "qd", "tau"];
 
 /// Parse SYMORO's `Robotname = '...'` comment and the `robodyn ...:` blocks of our own comments.
 fn parse_robodyn_comment(
@@ -397,10 +404,29 @@ fn parse_robodyn_comment(
         "link names",
         "note",
         "assembly",
+        "limits",
         "name",
     ]
     .into_iter()
     .find(|k| h.starts_with(k));
+    let limit_kind = match kind {
+        Some("limits") => {
+            let which = h["limits".len()..].trim();
+            match LIMIT_KINDS.into_iter().find(|k| *k == which) {
+                Some(k) => Some(k),
+                None => {
+                    return Err(ctx.err(
+                        at,
+                        format!(
+                            "robodyn limits: `{which}` is not one of {}",
+                            LIMIT_KINDS.join(", ")
+                        ),
+                    ))
+                }
+            }
+        }
+        _ => None,
+    };
     let text_of = |v: &str, v_at: usize, what: &str| -> Result<String> {
         uncomment_text(v).ok_or_else(|| {
             ctx.err(
@@ -431,7 +457,25 @@ fn parse_robodyn_comment(
                 let raw = &item[eq + 1..];
                 let v = raw.trim();
                 let v_at = item_at + eq + 1 + (raw.len() - raw.trim_start().len());
-                if kind == "assembly" {
+                if let Some(lk) = limit_kind {
+                    let j: usize = k.parse().map_err(|_| {
+                        ctx.err(
+                            item_at,
+                            format!("robodyn limits {lk}: `{k}` is not a frame number"),
+                        )
+                    })?;
+                    let x = ctx
+                        .expr(&format!("{lk} limit of q{k}"), v, v_at)?
+                        .eval(&|_| None)
+                        .map_err(|e| ctx.err(v_at, format!("{lk} limit of q{k}: {e}")))?;
+                    if !x.is_finite() || (lk != "q_min" && lk != "q_max" && x <= 0.0) {
+                        return Err(ctx.err(
+                            v_at,
+                            format!("{lk} limit of q{k}: {x} is not a finite positive limit"),
+                        ));
+                    }
+                    ex.limits.insert((j, lk), (x, item_at));
+                } else if kind == "assembly" {
                     let j: usize = k.parse().map_err(|_| {
                         ctx.err(
                             item_at,
@@ -725,6 +769,33 @@ pub fn parse_description(text: &str, file: Option<&str>) -> Result<(RobotDescrip
     for (j, n) in std::mem::take(&mut ex.link_names) {
         if (1..=nl).contains(&j) {
             desc.links[j - 1].name = n;
+        }
+    }
+    for (&(j, kind), &(x, at)) in &ex.limits {
+        if !(1..=nf).contains(&j) {
+            return Err(ctx.err(
+                at,
+                format!("robodyn limits {kind}: frame {j} is not a frame 1..{nf}"),
+            ));
+        }
+        let l = desc.limits.entry(j).or_default();
+        match kind {
+            "q_min" => l.q_min = Some(x),
+            "q_max" => l.q_max = Some(x),
+            "qd" => l.qd = Some(x),
+            "qdd" => l.qdd = Some(x),
+            _ => l.tau = Some(x),
+        }
+    }
+    for (&j, l) in &desc.limits {
+        if let (Some(a), Some(b)) = (l.q_min, l.q_max) {
+            if a > b {
+                let at = ex.limits[&(j, "q_min")].1;
+                return Err(ctx.err(
+                    at,
+                    format!("robodyn limits: q{j} in [{a}, {b}] is not an interval [min, max]"),
+                ));
+            }
         }
     }
     if !ex.assembly.is_empty() {
@@ -1206,6 +1277,28 @@ pub fn write_description(desc: &RobotDescription) -> String {
             .map(|(i, l)| format!("{} = {}", i + 1, comment_text(&l.name)))
             .collect();
         s.push_str(&format!("(* robodyn link names: {} *)\n", items.join("; ")));
+    }
+    for kind in LIMIT_KINDS {
+        let items: Vec<String> = desc
+            .limits
+            .iter()
+            .filter_map(|(j, l)| {
+                let x = match kind {
+                    "q_min" => l.q_min,
+                    "q_max" => l.q_max,
+                    "qd" => l.qd,
+                    "qdd" => l.qdd,
+                    _ => l.tau,
+                }?;
+                Some(format!("{j} = {x:?}"))
+            })
+            .collect();
+        if !items.is_empty() {
+            s.push_str(&format!(
+                "(* robodyn limits {kind}: {} *)\n",
+                items.join("; ")
+            ));
+        }
     }
     if let Some(q) = &desc.assembly {
         let items: Vec<String> = q

@@ -278,16 +278,15 @@ impl DynModel<f64> {
         // red[j]: index of movable frame j in the folded model; 0 for the base
         let mut red = vec![0; nl + 1];
         // for a fixed frame j: (h, hA_j, hP_j) with h its nearest movable ancestor (or 0)
-        let mut place: Vec<Option<(usize, Matrix3<f64>, Vector3<f64>)>> = vec![None; nl + 1];
+        let mut place: Vec<Placement> = vec![None; nl + 1];
         let mut frames = Vec::new();
         let mut links: Vec<LinkConstants<f64>> = Vec::new();
         let mut link_of = Vec::new();
         // the placement of frame i's origin and axes in its nearest movable ancestor h
-        let carried =
-            |place: &[Option<(usize, Matrix3<f64>, Vector3<f64>)>], i: usize| match &place[i] {
-                Some((h, r, p)) => (*h, Some((*r, *p))),
-                None => (i, None),
-            };
+        let carried = |place: &[Placement], i: usize| match &place[i] {
+            Some((h, r, p)) => (*h, Some((*r, *p))),
+            None => (i, None),
+        };
         for j in 1..=nl {
             let fr = self.frame(j);
             let (h, pre) = carried(&place, fr.ant);
@@ -347,3 +346,6 @@ impl DynModel<f64> {
         }
     }
 }
+
+/// Placement of a fixed frame in its nearest movable ancestor h: (h, hA_j, hP_j).
+type Placement = Option<(usize, Matrix3<f64>, Vector3<f64>)>;
