@@ -52,7 +52,7 @@ def test_closed_idm_matches_the_cli(name, tmp_path):
         w = csv.writer(f)
         w.writerow([f"{p}{j}" for p in ["q", "qd", "qdd"] for j in frames])
         for r in range(len(qa)):
-            w.writerow([repr(x) for x in np.concatenate([qa[r], qd[r], qdd[r]])])
+            w.writerow([repr(float(x)) for x in np.concatenate([qa[r], qd[r], qdd[r]])])
     out = tmp_path / "tau.csv"
     subprocess.run(cli() + ["idm", str(robot_path(name)), "--input", str(inp), "--output", str(out)], check=True, cwd=ROOT)
     with open(out) as f:
