@@ -167,9 +167,9 @@ pub fn output<'py>(
 ) -> PyResult<Bound<'py, PyAny>> {
     let mut shape: Vec<usize> = rows.into_iter().collect();
     shape.extend_from_slice(shape_one);
-    let a = PyArray1::from_vec(py, v);
     if shape.len() == 1 {
-        return Ok(a.into_any());
+        // one state: a copy into a NumPy-owned array is cheaper than handing the Vec over
+        return Ok(PyArray1::from_slice(py, &v).into_any());
     }
-    Ok(a.reshape(shape)?.into_any())
+    Ok(PyArray1::from_vec(py, v).reshape(shape)?.into_any())
 }
