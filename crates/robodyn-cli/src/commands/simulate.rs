@@ -305,15 +305,7 @@ pub fn run(a: Args) -> CliResult {
             None,
         )?)
     };
-    let integrator = match a.dt {
-        Some(dt) => Integrator::Rk4 { dt },
-        None => Integrator::Dopri5 {
-            rtol: a.rtol,
-            atol: a.atol,
-            h0: None,
-            h_max: None,
-        },
-    };
+    let integrator = Integrator::fixed_or_adaptive(a.dt, a.rtol, a.atol);
     let opts = SimOptions {
         duration: a.duration,
         integrator,

@@ -37,6 +37,20 @@ pub enum Integrator {
 }
 
 impl Integrator {
+    /// RK4 with step `dt` when one is given, else Dormand–Prince 5(4) with `rtol`, `atol` and an
+    /// automatic first step (the choice of `simulate` and of the Python package).
+    pub fn fixed_or_adaptive(dt: Option<f64>, rtol: f64, atol: f64) -> Integrator {
+        match dt {
+            Some(dt) => Integrator::Rk4 { dt },
+            None => Integrator::Dopri5 {
+                rtol,
+                atol,
+                h0: None,
+                h_max: None,
+            },
+        }
+    }
+
     /// Check the parameters (positive, finite).
     pub fn validate(&self) -> Result<()> {
         let bad = |name: &str, v: f64| {
