@@ -111,11 +111,15 @@ fn tree_cases(desc: &RobotDescription, numeric: bool, seed: u64, tag: &str) -> V
     // idm
     let prog = gen(ModelKind::Idm);
     let p = parameter_values(&prog, &env);
+    // joint arrays of the generated code: the movable joints in frame order (as the library's)
     let pick = |v: &[f64]| joints.iter().map(|&j| v[j - 1]).collect::<Vec<f64>>();
+    for g in &prog.inputs[..3] {
+        assert_eq!(g.symbols.len(), joints.len(), "{tag}: {} holds the movable joints", g.name);
+    }
     cases.push(Case {
         inputs: states
             .iter()
-            .map(|[q, qd, qdd]| vec![q.clone(), qd.clone(), qdd.clone(), p.clone()])
+            .map(|[q, qd, qdd]| vec![pick(q), pick(qd), pick(qdd), p.clone()])
             .collect(),
         expected: states
             .iter()
@@ -133,9 +137,9 @@ fn tree_cases(desc: &RobotDescription, numeric: bool, seed: u64, tag: &str) -> V
                 .iter()
                 .map(|[q, qd, _]| {
                     if model == ModelKind::Inertia {
-                        vec![q.clone(), p.clone()]
+                        vec![pick(q), p.clone()]
                     } else {
-                        vec![q.clone(), qd.clone(), p.clone()]
+                        vec![pick(q), pick(qd), p.clone()]
                     }
                 })
                 .collect(),
@@ -155,7 +159,7 @@ fn tree_cases(desc: &RobotDescription, numeric: bool, seed: u64, tag: &str) -> V
             .iter()
             .map(|[q, qd, qdd]| {
                 let tau = numeric_rnea(&robot, q, qd, qdd);
-                vec![q.clone(), qd.clone(), tau, p.clone()]
+                vec![pick(q), pick(qd), pick(&tau), p.clone()]
             })
             .collect(),
         expected: states.iter().map(|[_, _, qdd]| pick(qdd)).collect(),
@@ -349,6 +353,36 @@ fn all_cases() -> Vec<Case> {
         let n = 3 + 2 * k;
         let d = random_tree_description(&mut r, n, &opts);
         cases.extend(tree_cases(&d, false, seed, &format!("tree{seed}")));
+    }
+    cases.extend(fixed_frame_cases());
+    cases
+}
+
+/// Robots whose frames include fixed joints: the generated code's joint arrays hold the movable
+/// joints only (in frame order) and its fixed frames are folded into their movable ancestor; a
+/// small URDF (mount, flange, side sensor and tool fixed), a random tree with many fixed frames
+/// and external wrenches on them, and the UR10 and the Panda of example-robot-data when
+/// installed.
+fn fixed_frame_cases() -> Vec<Case> {
+    let mut cases = Vec::new();
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/fixed_frames.urdf");
+    let d = robodyn::io::load_description(&path).unwrap();
+    assert_eq!(movable(&d), [2, 4, 5]);
+    cases.extend(tree_cases(&d, false, 40, "fixed_urdf"));
+    cases.extend(tree_cases(&d, true, 41, "fixed_urdf_num"));
+    let opts = TreeOptions {
+        p_fixed: 0.4,
+        ..TreeOptions::default()
+    };
+    let d = random_tree_description(&mut rng(42), 9, &opts);
+    assert!(movable(&d).len() < d.nl, "the tree has fixed frames");
+    cases.extend(tree_cases(&d, false, 42, "tree_fixed"));
+    if let Some(dir) = common::example_robot_data("generated code of UR10 and Panda not checked") {
+        for (name, tag) in [("ur10_robot.urdf", "ur10"), ("panda.urdf", "panda")] {
+            let path = common::find_file(&dir, name).unwrap();
+            let d = robodyn::io::load_description(&path).unwrap();
+            cases.extend(tree_cases(&d, true, 43, tag));
+        }
     }
     cases
 }

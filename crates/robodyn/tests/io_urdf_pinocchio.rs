@@ -12,48 +12,12 @@ use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-fn python() -> String {
-    std::env::var("ROBODYN_PYTHON").unwrap_or_else(|_| "python3".into())
-}
+mod common;
+use common::{example_robot_data, find_file as find, python};
 
 /// The example-robot-data `robots` folder, or None (with the reason) when unavailable.
 fn robots_dir() -> Option<PathBuf> {
-    let out = Command::new(python())
-        .args([
-            "-c",
-            "import pinocchio, cmeel, os; print(os.path.join(os.path.dirname(os.path.dirname(\
-             cmeel.__file__)), 'cmeel.prefix', 'share', 'example-robot-data', 'robots'))",
-        ])
-        .output();
-    let found = match out {
-        Ok(o) if o.status.success() => {
-            let p = PathBuf::from(String::from_utf8_lossy(&o.stdout).trim());
-            p.is_dir().then_some(p)
-        }
-        _ => None,
-    };
-    if found.is_none() {
-        crate::harness::skip(
-            "pinocchio",
-            "pinocchio / example-robot-data not found (pip install pin example-robot-data): \
-             real URDFs vs pinocchio.rnea not checked",
-        );
-    }
-    found
-}
-
-fn find(dir: &Path, name: &str) -> Option<PathBuf> {
-    for e in std::fs::read_dir(dir).ok()?.flatten() {
-        let p = e.path();
-        if p.is_dir() {
-            if let Some(f) = find(&p, name) {
-                return Some(f);
-            }
-        } else if p.file_name().is_some_and(|f| f == name) {
-            return Some(p);
-        }
-    }
-    None
+    example_robot_data("real URDFs vs pinocchio.rnea not checked")
 }
 
 fn all_urdfs(dir: &Path, out: &mut Vec<PathBuf>) {

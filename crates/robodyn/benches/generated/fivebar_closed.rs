@@ -5,9 +5,9 @@
 // Gamma_cl = Gamma_a + Wa^T LAM with Wp^T LAM = -Gamma_p (eqs 10.36-10.37); Gaussian elimination with the row order of partial pivoting at the robot's reference configuration (valid while those pivots stay away from zero)
 // Operations: 69 multiplications, 46 additions (10 function calls: sin, cos, sign)
 // Inputs:
-//   q (joint positions q_j, j = 1..NL): q[0]=q1 q[1]=q2 q[2]=q3 q[3]=q4
-//   qd (joint velocities, j = 1..NL): qd[0]=QP1 qd[1]=QP2 qd[2]=QP3 qd[3]=QP4
-//   qdd (joint accelerations, j = 1..NL): qdd[0]=QDP1 qdd[1]=QDP2 qdd[2]=QDP3 qdd[3]=QDP4
+//   q (joint positions, movable joints in frame order: q<frame number>): q[0]=q1 q[1]=q2 q[2]=q3 q[3]=q4
+//   qd (joint velocities, movable joints in frame order: QP<frame number>): qd[0]=QP1 qd[1]=QP2 qd[2]=QP3 qd[3]=QP4
+//   qdd (joint accelerations, movable joints in frame order: QDP<frame number>): qdd[0]=QDP1 qdd[1]=QDP2 qdd[2]=QDP3 qdd[3]=QDP4
 //   p (parameters (geometry, inertial, drive, gravity)): 
 // Outputs: out[0]=GAMCL1 out[1]=GAMCL3
 #[allow(non_snake_case, unused_variables, unused_parens, clippy::all)]

@@ -33,7 +33,7 @@ pub fn composite_links<T: DynScalar>(model: &DynModel<T>, ws: &mut Data<T>, q: &
     }
     for k in (1..=model.nl).rev() {
         // composite link k is complete (its successors, numbered after it, are in)
-        name_composite(ws, k);
+        name_composite(model, ws, k);
         let i = model.frame(k).ant;
         if i == 0 {
             continue;
@@ -88,8 +88,10 @@ pub fn composite_inertia_matrix<T: DynScalar>(
             if T::NAMED {
                 // the wrench of column j carried to link k: named, or it would grow with the
                 // depth of the tree
-                f = f.map_with_location(|c, _, x| x.named(|| format!("AF{}_{k}_{j}", c + 1)));
-                m = m.map_with_location(|c, _, x| x.named(|| format!("AN{}_{k}_{j}", c + 1)));
+                // (by the description's link numbers)
+                let (lk, lj) = (model.wrench_link(k), model.wrench_link(j));
+                f = f.map_with_location(|c, _, x| x.named(|| format!("AF{}_{lk}_{lj}", c + 1)));
+                m = m.map_with_location(|c, _, x| x.named(|| format!("AN{}_{lk}_{lj}", c + 1)));
             }
             let joint = model.frame(k).joint;
             if joint.is_movable() {
@@ -105,20 +107,22 @@ pub fn composite_inertia_matrix<T: DynScalar>(
 /// `MSP<c><k>`, `MP<k>`), so that its expression does not grow with the size of the subtree. A
 /// no-op for `f64`.
 #[inline(always)]
-fn name_composite<T: DynScalar>(ws: &mut Data<T>, k: usize) {
+fn name_composite<T: DynScalar>(model: &DynModel<T>, ws: &mut Data<T>, k: usize) {
     if !T::NAMED {
         return;
     }
+    // names carry the description's link number
+    let n = model.wrench_link(k);
     let j = ws.jc[k].clone();
     ws.jc[k] = Matrix3::from_fn(|r, c| {
         let (r, c) = (r.min(c), r.max(c));
         j[(r, c)]
             .clone()
-            .named(|| format!("JP{}{}{k}", r + 1, c + 1))
+            .named(|| format!("JP{}{}{n}", r + 1, c + 1))
     });
     let ms = ws.msc[k].clone();
-    ws.msc[k] = Vector3::from_fn(|c, _| ms[c].clone().named(|| format!("MSP{}{k}", c + 1)));
-    ws.mc[k] = ws.mc[k].clone().named(|| format!("MP{k}"));
+    ws.msc[k] = Vector3::from_fn(|c, _| ms[c].clone().named(|| format!("MSP{}{n}", c + 1)));
+    ws.mc[k] = ws.mc[k].clone().named(|| format!("MP{n}"));
 }
 
 #[inline]

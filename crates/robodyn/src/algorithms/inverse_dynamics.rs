@@ -219,6 +219,8 @@ pub(crate) fn forward_pass<T: DynScalar>(
     let order = sharing_order(model, shared);
     for idx in 0..model.nl {
         let j = order.as_ref().map_or(idx + 1, |o| o[idx]);
+        // names of the customized model carry the description's link number
+        let n = if T::NAMED { model.wrench_link(j) } else { j };
         let fr = model.frame(j);
         let i = fr.ant;
         let (rot, pos) = fr.transform(&q[j - 1]);
@@ -226,8 +228,8 @@ pub(crate) fn forward_pass<T: DynScalar>(
         let jai = rot.transpose();
         // iU_i iP_j (10.6)
         let up = &ws.u[i] * &pos;
-        let wi = name3(&jai * &ws.w[i], "WI", j); // (10.3)
-        let vsp = name3(&ws.vd[i] + up, "VSP", j);
+        let wi = name3(&jai * &ws.w[i], "WI", n); // (10.3)
+        let vsp = name3(&ws.vd[i] + up, "VSP", n);
         let mut vd = &jai * vsp; // (10.6), first part
         let share = shared.get(j - 1).and_then(Option::as_ref);
         let (w, wd) = match share {
@@ -241,7 +243,7 @@ pub(crate) fn forward_pass<T: DynScalar>(
                     wd += cross_z(&wi, &qd[j - 1]);
                     wd.z += qdd[j - 1].clone();
                 }
-                (name3(w, "W", j), name3(wd, "WP", j))
+                (name3(w, "W", n), name3(wd, "WP", n))
             }
         };
         if fr.joint == JointType::Prismatic {
@@ -249,21 +251,21 @@ pub(crate) fn forward_pass<T: DynScalar>(
             vd += cross_z(&wi, &(qd[j - 1].clone() + qd[j - 1].clone()));
             vd.z += qdd[j - 1].clone();
         }
-        let vd = name3(vd, "VP", j);
+        let vd = name3(vd, "VP", n);
         let l = model.link(j);
         // (10.7): F = M vd + U MS
         let (p, sq) = w_products(&w);
         let u = match share {
             Some(s) => s.rot.tr_mul(&ws.u[s.link]) * &s.rot,
-            None => u_matrix(&p, &sq, &wd, j),
+            None => u_matrix(&p, &sq, &wd, n),
         };
         let f = &vd * l.mass.clone() + &u * &l.ms;
         // (10.8): M = J wd + w x (J w) + MS x vd
         let m = euler_moment(&l.inertia, &l.inertia_diff, &wd, &p, &sq, &u) + l.ms.cross(&vd);
         ws.u[j] = u;
         let e = env.wrench(model.wrench_link(j));
-        ws.f[j] = name3(f + &e.force, "F", j);
-        ws.m[j] = name3(m + &e.moment, "No", j);
+        ws.f[j] = name3(f + &e.force, "F", n);
+        ws.m[j] = name3(m + &e.moment, "No", n);
         ws.rot[j] = rot;
         ws.pos[j] = pos;
         ws.w[j] = w;
@@ -337,12 +339,13 @@ pub fn backward_recursion_sharing<T: DynScalar>(
     let order = sharing_order(model, shared);
     for idx in (0..model.nl).rev() {
         let j = order.as_ref().map_or(idx + 1, |o| o[idx]);
+        let n = if T::NAMED { model.wrench_link(j) } else { j };
         let fr = model.frame(j);
         let l = model.link(j);
         if T::NAMED {
             // total wrench on link j, complete once its children are processed
-            ws.f[j] = name3(ws.f[j].clone(), "E", j);
-            ws.m[j] = name3(ws.m[j].clone(), "N", j);
+            ws.f[j] = name3(ws.f[j].clone(), "E", n);
+            ws.m[j] = name3(ws.m[j].clone(), "N", n);
         }
         if let Some(s) = shared.get(j - 1).and_then(Option::as_ref) {
             let moved = &s.rot * &ws.m[j];
@@ -366,8 +369,8 @@ pub fn backward_recursion_sharing<T: DynScalar>(
         let i = fr.ant;
         if i > 0 {
             // (10.10), (10.11)
-            let fi = name3(&ws.rot[j] * &ws.f[j], "FDI", j);
-            let mi = name3(&ws.rot[j] * &ws.m[j] + ws.pos[j].cross(&fi), "NDI", j);
+            let fi = name3(&ws.rot[j] * &ws.f[j], "FDI", n);
+            let mi = name3(&ws.rot[j] * &ws.m[j] + ws.pos[j].cross(&fi), "NDI", n);
             ws.f[i] += fi;
             ws.m[i] += mi;
         }

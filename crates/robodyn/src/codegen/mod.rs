@@ -262,17 +262,16 @@ fn split_param(name: &str) -> Option<(&str, usize)> {
     Some((&name[..i], name[i..].parse().ok()?))
 }
 
-/// Columns c of the inertia matrix A(q) for the given joints, by the composite-link method
+/// The inertia matrix A(q) of a model's tree arrays (NL x NL), by the composite-link method
 /// (`algorithms::inertia_matrix`, generic over the scalar), rotor inertias on the diagonal.
-pub fn inertia_columns(model: &DynModel<Expr>, joints: &[usize], q: &[Expr]) -> Vec<Vec<Expr>> {
+/// Entries of two links neither of which is an ancestor of the other are structurally zero
+/// (`Expr::zero()`, never computed).
+pub fn inertia_matrix_expr(model: &DynModel<Expr>, q: &[Expr]) -> DMatrix<Expr> {
     let n = model.nl;
     let mut ws = Data::from_model(model);
     let mut a = DMatrix::from_element(n, n, Expr::zero());
     composite_inertia_matrix(model, &mut ws, q, &mut a);
-    joints
-        .iter()
-        .map(|&c| joints.iter().map(|&r| a[(r - 1, c - 1)].clone()).collect())
-        .collect()
+    a
 }
 
 pub(crate) fn pair_name(prefix: &str, i: usize, j: usize) -> String {
@@ -339,6 +338,11 @@ pub fn generate_with_progress(
     let nl = desc.nl;
     let joints = desc.movable_joints();
     let closed = matches!(opt.model, ModelKind::Closed | ModelKind::W);
+    // Tree models run on the model of the dynamic recursions (`Robot::dynamic`): fixed frames
+    // folded into their movable ancestor, so link k is the movable joint joints[k - 1] and the
+    // tree arrays are the joint vectors of the library. Closed models need the cut-joint frames
+    // and keep every frame (q of a fixed frame is never read).
+    let model = if closed { model } else { model.fold_fixed() };
     // the numeric robot of the closed models (loop closure, constant G, parallel links)
     let robot = closed.then(|| crate::Robot::new(desc.clone()));
     let form = match &robot {
@@ -364,11 +368,13 @@ pub fn generate_with_progress(
         Vec::new()
     };
     progress(&format!(
-        "recording the {} model ({nl} links)",
-        opt.model.name()
+        "recording the {} model ({} links, {} movable joints)",
+        opt.model.name(),
+        nl,
+        joints.len()
     ));
     let (outputs, assignments) = record(&reserved_names(desc, opt), || {
-        record_model(&model, opt, &form, &shared, &joints)
+        record_model(&model, opt, &form, &shared)
     });
     let outputs = outputs?;
     let mut description = describe(desc, opt);
@@ -387,7 +393,7 @@ pub fn generate_with_progress(
             .clone()
             .unwrap_or_else(|| format!("{}_{}", ident(&desc.name), opt.model.name())),
         description,
-        inputs: joint_inputs(nl, &joints, opt.model),
+        inputs: joint_inputs(&joints, opt.model),
         assignments,
         outputs,
     };
@@ -429,51 +435,53 @@ fn reserved_names(desc: &RobotDescription, opt: &GenOptions) -> Vec<String> {
     reserved
 }
 
-/// The joint-variable input arrays of a model (NL entries each; fixed frames unused).
-fn joint_inputs(nl: usize, joints: &[usize], model: ModelKind) -> Vec<InputGroup> {
-    let movable: BTreeSet<usize> = joints.iter().copied().collect();
+/// The joint-variable input arrays of a model: the movable joints in frame order (the
+/// library's joint vectors, [`crate::Robot::coordinates`]); entry k of `q` is `q<j>` with
+/// j = joints[k], the frame number.
+fn joint_inputs(joints: &[usize], model: ModelKind) -> Vec<InputGroup> {
     let group = |name: &str, kind: &str, doc: &str| InputGroup {
         name: name.into(),
-        doc: doc.into(),
-        symbols: (1..=nl)
-            .map(|j| movable.contains(&j).then(|| joint_symbol(kind, j)))
-            .collect(),
+        doc: format!("{doc}, movable joints in frame order: {kind}<frame number>"),
+        symbols: joints.iter().map(|&j| Some(joint_symbol(kind, j))).collect(),
     };
-    let mut inputs = vec![group("q", "q", "joint positions q_j, j = 1..NL")];
+    let mut inputs = vec![group("q", "q", "joint positions")];
     match model {
         ModelKind::Idm | ModelKind::Closed => {
-            inputs.push(group("qd", "QP", "joint velocities, j = 1..NL"));
-            inputs.push(group("qdd", "QDP", "joint accelerations, j = 1..NL"));
+            inputs.push(group("qd", "QP", "joint velocities"));
+            inputs.push(group("qdd", "QDP", "joint accelerations"));
         }
-        ModelKind::H => inputs.push(group("qd", "QP", "joint velocities, j = 1..NL")),
+        ModelKind::H => inputs.push(group("qd", "QP", "joint velocities")),
         ModelKind::Inertia | ModelKind::W => {}
         ModelKind::Ddm => {
-            inputs.push(group("qd", "QP", "joint velocities, j = 1..NL"));
-            inputs.push(group("gam", "GAM", "joint torques, j = 1..NL"));
+            inputs.push(group("qd", "QP", "joint velocities"));
+            inputs.push(group("gam", "GAM", "joint torques"));
         }
     }
     inputs
 }
 
-/// Run the model's recursions on symbols (inside a recording): its outputs.
+/// Run the model's recursions on symbols (inside a recording): its outputs. For the tree models
+/// `model` is folded (link k is the k-th movable joint); for the closed ones it has every frame
+/// (tree arrays indexed by frame number). Either way `wrench_link` gives the frame number.
 fn record_model(
     model: &DynModel<Expr>,
     opt: &GenOptions,
     form: &ClosedForm,
     shared: &[Option<SharedOrientation<Expr>>],
-    joints: &[usize],
 ) -> Result<Vec<Assignment>> {
     let nl = model.nl;
-    let sym = |k: &str, j: usize| Expr::symbol(joint_symbol(k, j));
-    let q: Vec<Expr> = (1..=nl).map(|j| sym("q", j)).collect();
-    let qd: Vec<Expr> = (1..=nl).map(|j| sym("QP", j)).collect();
-    let qdd: Vec<Expr> = (1..=nl).map(|j| sym("QDP", j)).collect();
+    // frame number of tree-array entry k
+    let frame = |k: usize| model.wrench_link(k + 1);
+    let sym = |kind: &str, k: usize| Expr::symbol(joint_symbol(kind, frame(k)));
+    let q: Vec<Expr> = (0..nl).map(|k| sym("q", k)).collect();
+    let qd: Vec<Expr> = (0..nl).map(|k| sym("QP", k)).collect();
+    let qdd: Vec<Expr> = (0..nl).map(|k| sym("QDP", k)).collect();
     let outputs = |prefix: &str, tau: &[Expr]| -> Vec<Assignment> {
-        joints
-            .iter()
-            .map(|&j| Assignment {
-                name: joint_symbol(prefix, j),
-                expr: tau[j - 1].clone(),
+        (0..nl)
+            .filter(|&k| model.frame(k + 1).joint.is_movable())
+            .map(|k| Assignment {
+                name: joint_symbol(prefix, frame(k)),
+                expr: tau[k].clone(),
             })
             .collect()
     };
@@ -498,13 +506,14 @@ fn record_model(
             Ok(outputs("H", &tau))
         }
         ModelKind::Inertia => {
-            let cols = inertia_columns(model, joints, &q);
+            // the folded model: every link is a movable joint
+            let a = inertia_matrix_expr(model, &q);
             let mut out = Vec::new();
-            for (a, &i) in joints.iter().enumerate() {
-                for (b, &j) in joints.iter().enumerate().take(a + 1) {
+            for i in 0..nl {
+                for j in 0..=i {
                     out.push(Assignment {
-                        name: pair_name("A", i, j),
-                        expr: cols[b][a].clone(),
+                        name: pair_name("A", frame(i), frame(j)),
+                        expr: a[(i, j)].clone(),
                     });
                 }
             }
@@ -513,41 +522,29 @@ fn record_model(
         ModelKind::Ddm => {
             let zero = vec![Expr::zero(); nl];
             rnea(model, &mut ws, &q, &qd, &zero, &mut tau);
-            let n = joints.len();
             // right-hand side Gamma - H
-            let rhs: Vec<Expr> = joints
-                .iter()
-                .map(|&j| {
-                    let h = tau[j - 1].clone().named(|| joint_symbol("H", j));
-                    (sym("GAM", j) - h).named(|| format!("BB{j}"))
+            let rhs: Vec<Expr> = (0..nl)
+                .map(|k| {
+                    let j = frame(k);
+                    let h = tau[k].clone().named(|| joint_symbol("H", j));
+                    (Expr::symbol(joint_symbol("GAM", j)) - h).named(|| format!("BB{j}"))
                 })
                 .collect();
-            let cols = inertia_columns(model, joints, &q);
-            let a: Vec<Vec<Expr>> = (0..n)
-                .map(|r| {
-                    (0..n)
-                        .map(|c| {
-                            let (r2, c2) = if r >= c { (r, c) } else { (c, r) };
-                            cols[c2][r2]
-                                .clone()
-                                .named(|| pair_name("A", joints[r2], joints[c2]))
-                        })
-                        .collect()
-                })
-                .collect();
-            let x = linear::ldl_solve(&a, &rhs, joints);
-            Ok(outputs("QDP", &scatter(joints, nl, x)))
+            let mut a = inertia_matrix_expr(model, &q);
+            for i in 0..nl {
+                for j in 0..=i {
+                    let v = a[(i, j)]
+                        .clone()
+                        .named(|| pair_name("A", frame(i), frame(j)));
+                    a[(j, i)] = v.clone();
+                    a[(i, j)] = v;
+                }
+            }
+            let parent: Vec<usize> = (1..=nl).map(|k| model.frame(k).ant).collect();
+            let labels: Vec<usize> = (0..nl).map(frame).collect();
+            Ok(outputs("QDP", &linear::ltdl_solve(a, rhs, &parent, &labels)))
         }
     }
-}
-
-/// Values of `joints` at their indices j - 1 of an NL-vector (zeros elsewhere).
-fn scatter(joints: &[usize], nl: usize, x: Vec<Expr>) -> Vec<Expr> {
-    let mut v = vec![Expr::zero(); nl];
-    for (&j, e) in joints.iter().zip(x) {
-        v[j - 1] = e;
-    }
-    v
 }
 
 /// The parameter input `p`: every symbol that is neither an input nor an intermediate.

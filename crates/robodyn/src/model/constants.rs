@@ -260,7 +260,7 @@ impl<T: DynScalar> DynModel<T> {
     }
 }
 
-impl DynModel<f64> {
+impl<T: DynScalar> DynModel<T> {
     /// The model of the dynamic recursions: fixed frames out. Its links are the movable tree
     /// joints 1..NL in frame order (link k is the k-th movable joint, so its tree arrays are
     /// the public joint vectors); the constant placement of the fixed frames between a movable
@@ -272,39 +272,39 @@ impl DynModel<f64> {
     ///
     /// Rotor inertia and friction of a fixed frame are ignored, as in the full model (no joint
     /// variable). External wrenches stay indexed by description link ([`Self::link_of`],
-    /// [`Self::folded`]), so the per-call [`Environment`] is the description's.
-    pub fn fold_fixed(&self) -> DynModel<f64> {
+    /// [`Self::folded`]), so the per-call [`Environment`] is the description's. Generic over
+    /// the scalar: the symbolic generator folds its `DynModel<Expr>` the same way.
+    pub fn fold_fixed(&self) -> DynModel<T> {
         let nl = self.nl;
         // red[j]: index of movable frame j in the folded model; 0 for the base
         let mut red = vec![0; nl + 1];
         // for a fixed frame j: (h, hA_j, hP_j) with h its nearest movable ancestor (or 0)
-        let mut place: Vec<Placement> = vec![None; nl + 1];
+        let mut place: Vec<Placement<T>> = vec![None; nl + 1];
         let mut frames = Vec::new();
-        let mut links: Vec<LinkConstants<f64>> = Vec::new();
+        let mut links: Vec<LinkConstants<T>> = Vec::new();
         let mut link_of = Vec::new();
-        // the placement of frame i's origin and axes in its nearest movable ancestor h
-        let carried = |place: &[Placement], i: usize| match &place[i] {
-            Some((h, r, p)) => (*h, Some((*r, *p))),
-            None => (i, None),
-        };
         for j in 1..=nl {
             let fr = self.frame(j);
-            let (h, pre) = carried(&place, fr.ant);
+            // the placement of the antecedent's origin and axes in its nearest movable ancestor
+            let (h, pre) = match &place[fr.ant] {
+                Some((h, r, p)) => (*h, Some((r, p))),
+                None => (fr.ant, None),
+            };
             if fr.joint.is_movable() {
                 let mut c = fr.clone();
                 c.ant = red[h];
                 if let Some((r, p)) = pre {
-                    c.pre_pos = p + r * c.pre_pos;
-                    c.pre_rot = r * c.pre_rot;
+                    c.pre_pos = p + r * &c.pre_pos;
+                    c.pre_rot = r * &c.pre_rot;
                 }
                 frames.push(c);
                 links.push(self.link(j).clone());
                 link_of.push(j);
                 red[j] = frames.len();
             } else {
-                let (r, p) = fr.transform(&0.0);
+                let (r, p) = fr.transform(&T::zero());
                 place[j] = Some(match pre {
-                    Some((ra, pa)) => (h, ra * r, pa + ra * p),
+                    Some((ra, pa)) => (h, ra * &r, pa + ra * &p),
                     None => (h, r, p),
                 });
             }
@@ -320,20 +320,20 @@ impl DynModel<f64> {
             let host = &mut links[red[*h] - 1];
             host.inertia += jj;
             host.ms += ms;
-            host.mass += l.mass;
+            host.mass += l.mass.clone();
             folded.push(FoldedLink {
                 host: red[*h],
                 link: j,
-                rot: *r,
-                pos: *p,
+                rot: r.clone(),
+                pos: p.clone(),
             });
         }
         for l in links.iter_mut() {
             let i = &l.inertia;
             l.inertia_diff = Vector3::new(
-                i[(2, 2)] - i[(1, 1)],
-                i[(0, 0)] - i[(2, 2)],
-                i[(1, 1)] - i[(0, 0)],
+                i[(2, 2)].clone() - i[(1, 1)].clone(),
+                i[(0, 0)].clone() - i[(2, 2)].clone(),
+                i[(1, 1)].clone() - i[(0, 0)].clone(),
             );
         }
         DynModel {
@@ -348,4 +348,4 @@ impl DynModel<f64> {
 }
 
 /// Placement of a fixed frame in its nearest movable ancestor h: (h, hA_j, hP_j).
-type Placement = Option<(usize, Matrix3<f64>, Vector3<f64>)>;
+type Placement<T> = Option<(usize, Matrix3<T>, Vector3<T>)>;

@@ -54,3 +54,52 @@ pub fn cases() -> Vec<Loaded> {
 pub fn tool_available(program: &str, args: &[&str], key: &str, what: &str) -> bool {
     crate::harness::tool(key, program, args, what)
 }
+
+/// The Python interpreter of the optional checks (`ROBODYN_PYTHON`, default `python3`).
+pub fn python() -> String {
+    std::env::var("ROBODYN_PYTHON").unwrap_or_else(|_| "python3".into())
+}
+
+/// The example-robot-data `robots` folder (installed with Pinocchio), or None after a visible
+/// skip of the optional check `pinocchio` saying `what` is not checked.
+pub fn example_robot_data(what: &str) -> Option<PathBuf> {
+    let out = std::process::Command::new(python())
+        .args([
+            "-c",
+            "import pinocchio, cmeel, os; print(os.path.join(os.path.dirname(os.path.dirname(\
+             cmeel.__file__)), 'cmeel.prefix', 'share', 'example-robot-data', 'robots'))",
+        ])
+        .output();
+    let found = match out {
+        Ok(o) if o.status.success() => {
+            let p = PathBuf::from(String::from_utf8_lossy(&o.stdout).trim());
+            p.is_dir().then_some(p)
+        }
+        _ => None,
+    };
+    if found.is_none() {
+        crate::harness::skip(
+            "pinocchio",
+            &format!(
+                "pinocchio / example-robot-data not found (pip install pin example-robot-data): \
+                 {what}"
+            ),
+        );
+    }
+    found
+}
+
+/// A file by name anywhere under `dir`.
+pub fn find_file(dir: &std::path::Path, name: &str) -> Option<PathBuf> {
+    for e in std::fs::read_dir(dir).ok()?.flatten() {
+        let p = e.path();
+        if p.is_dir() {
+            if let Some(f) = find_file(&p, name) {
+                return Some(f);
+            }
+        } else if p.file_name().is_some_and(|f| f == name) {
+            return Some(p);
+        }
+    }
+    None
+}
