@@ -3,7 +3,7 @@
 
 use crate::common::CliResult;
 use robodyn::algorithms::regressor::ZeroParameters;
-use robodyn::codegen::{generate, BaseParameters, GenOptions, ModelKind};
+use robodyn::codegen::{generate_with_progress, BaseParameters, GenOptions, ModelKind};
 use robodyn_symbolic::{emit, Lang};
 use std::path::PathBuf;
 
@@ -122,26 +122,33 @@ pub fn run(a: Args) -> CliResult {
         optimize: true,
         zeros,
     };
-    let n = desc
-        .frames
-        .iter()
-        .take(desc.nl)
-        .filter(|f| f.joint.sigma() != 2)
-        .count();
-    if matches!(a.model, Model::Ddm) && n > DDM_JOINTS_NOTE {
+    let n = desc.movable_joints().len();
+    // movable joints on the longest path from the base: the L'DL of the direct model walks the
+    // ancestors of each joint, so it costs about n d^2 (a serial chain: cubic)
+    let mut depth = vec![0usize; desc.nl + 1];
+    for j in 1..=desc.nl {
+        let f = desc.frame(j);
+        depth[j] = depth[f.ant] + usize::from(f.joint.is_movable());
+    }
+    let d = depth.iter().copied().max().unwrap_or(0);
+    if matches!(a.model, Model::Ddm) && d > DDM_DEPTH_NOTE {
         eprintln!(
-            "robodyn: note: the symbolic direct dynamic model of {n} joints writes out the L'DL \
-             factorization of A(q), whose expressions grow much faster than the joints (minutes \
-             and GB beyond ~{DDM_JOINTS_NOTE} joints); `--model inertia` and `--model h` with a \
-             numeric solve, or the numeric `robodyn ddm`/`simulate`, stay linear"
+            "robodyn: note: the symbolic direct dynamic model writes out the L'DL factorization \
+             of A(q) along chains of up to {d} movable joints, whose cost grows as the cube of \
+             that depth (seconds beyond ~{DDM_DEPTH_NOTE}, about 20 s for 100); `--model \
+             inertia` and `--model h` with a numeric solve, or the numeric `robodyn \
+             ddm`/`simulate`, stay linear"
         );
     }
-    let spinner = working(format!(
+    let what = format!(
         "generating {} of {} ({n} joints)",
         format!("{:?}", a.model).to_lowercase(),
         desc.name
-    ));
-    let prog = generate(&desc, &opt);
+    );
+    let spinner = working(what.clone());
+    let prog = generate_with_progress(&desc, &opt, &mut |stage| {
+        spinner.set_message(format!("{what}: {stage}"))
+    });
     spinner.finish_and_clear();
     let prog = prog?;
     let lang = match a.lang {
@@ -163,8 +170,9 @@ pub fn run(a: Args) -> CliResult {
     Ok(())
 }
 
-/// Beyond this many movable joints `--model ddm` says that it may take long.
-const DDM_JOINTS_NOTE: usize = 12;
+/// Beyond this many movable joints on one path from the base, `--model ddm` says that it may
+/// take long.
+const DDM_DEPTH_NOTE: usize = 60;
 
 /// A spinner with the elapsed time on a terminal's standard error, so a long generation says
 /// what it does (nothing when standard error is not a terminal).
