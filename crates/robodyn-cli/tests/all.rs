@@ -25,6 +25,8 @@ mod cli_generate;
 mod cli_identify;
 #[path = "cli_info.rs"]
 mod cli_info;
+#[path = "cli_simulate_names.rs"]
+mod cli_simulate_names;
 #[path = "cli_info_assembly.rs"]
 mod cli_info_assembly;
 

@@ -994,3 +994,34 @@ fn generated_w_is_the_derivative_of_loop_closure() {
         }
     }
 }
+
+/// The canonical order of expressions is total when rationals and floats meet (it compared a
+/// rational and a float as equal, which broke transitivity: sorting the terms of Talos's
+/// symbolic model, whose folded links mix URDF floats with exact constants, panicked).
+#[test]
+fn expression_order_is_total_on_mixed_numbers() {
+    use robodyn_symbolic::cmp_expr;
+    use std::cmp::Ordering;
+    let r = |n: i64, d: i64| Expr::parse(&format!("{n}/{d}")).unwrap();
+    // floats: no short decimal (Expr::num keeps those exact)
+    let f = |x: f64| Expr::num(x + 1e-13);
+    let items = [r(1, 2), f(0.25), r(3, 1), f(0.5), f(3.0), r(-7, 3), f(-2.0), r(1, 3)];
+    for a in &items {
+        for b in &items {
+            assert_eq!(cmp_expr(a, b), cmp_expr(b, a).reverse(), "{a} vs {b}");
+            // distinct numbers are never equal (equality must be transitive)
+            if cmp_expr(a, b) == Ordering::Equal {
+                assert_eq!(a.eval(&|_| None).unwrap(), b.eval(&|_| None).unwrap());
+            }
+            for c in &items {
+                if cmp_expr(a, b) == Ordering::Less && cmp_expr(b, c) == Ordering::Less {
+                    assert_eq!(cmp_expr(a, c), Ordering::Less, "{a} < {b} < {c}");
+                }
+            }
+        }
+    }
+    let mut v = items.to_vec();
+    v.sort_by(cmp_expr);
+    let values: Vec<f64> = v.iter().map(|e| e.eval(&|_| None).unwrap()).collect();
+    assert!(values.windows(2).all(|w| w[0] <= w[1]), "{values:?}");
+}

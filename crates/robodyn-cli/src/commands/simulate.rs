@@ -5,14 +5,20 @@
 //! A closed-chain robot is simulated in its actuated coordinates (columns q<j>, qd<j>, qdd<j>,
 //! tau<j> of the actuated joints; q_p re-solved at every evaluation so the loops stay closed),
 //! with the extra columns `closure_residual` and the passive joints' q<j>.
+//!
+//! Joint columns follow `--names` as in `idm`, `ddm` and `regressor`: `q3` (frame number) or
+//! `q_shoulder` (joint name), in the CSV, the `--torque-csv` / `--track` input and the plot.
 
 use crate::commands::ddm::MethodArg;
-use crate::common::{create_output, format_number, parse_list, CliResult, RobotArgs, Table};
+use crate::common::{
+    create_output, format_number, parse_list, CliResult, NamesArg, RobotArgs, Table,
+};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use robodyn::simulation::{
     plot_svg, simulate, ClosedChainDynamics, CsvSink, Dynamics, Integrator, PlotInfo, Recorder,
     SimOptions, Tee, TimeSeries, TorqueInput, TrajectorySink, TreeDynamics,
 };
+use std::collections::HashMap;
 use std::io::IsTerminal;
 use std::path::PathBuf;
 
@@ -81,6 +87,53 @@ pub struct Args {
     /// by default a crossing is reported as a warning and the run goes on).
     #[arg(long)]
     pub stop_at_limits: bool,
+    #[command(flatten)]
+    pub names: NamesArg,
+}
+
+/// Column label `<l>` of each movable joint (by frame number), so that its columns are
+/// `q<l>`, `qd<l>`, `tau<l>`: the frame number, or `_<joint name>` with `--names joint` (the
+/// rule of [`NamesArg::column`], shared with idm, ddm and regressor).
+fn joint_labels(robot: &robodyn::Robot, names: &NamesArg) -> HashMap<usize, String> {
+    let c = robot.coordinates();
+    (0..c.len())
+        .map(|k| (c.frame(k), names.column("", c, k)))
+        .collect()
+}
+
+/// The dynamics with its joint columns labelled by `--names`.
+struct Labelled<'d> {
+    inner: Box<dyn Dynamics + 'd>,
+    labels: Vec<String>,
+    extra: Vec<String>,
+}
+
+impl Dynamics for Labelled<'_> {
+    fn dof(&self) -> usize {
+        self.inner.dof()
+    }
+    fn labels(&self) -> Vec<String> {
+        self.labels.clone()
+    }
+    fn accel(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        tau: &[f64],
+        qdd: &mut [f64],
+    ) -> robodyn::Result<()> {
+        self.inner.accel(t, q, qd, tau, qdd)
+    }
+    fn energy(&mut self, q: &[f64], qd: &[f64]) -> robodyn::Result<f64> {
+        self.inner.energy(q, qd)
+    }
+    fn extra_columns(&self) -> Vec<String> {
+        self.extra.clone()
+    }
+    fn extra_values(&mut self, q: &[f64], qd: &[f64], out: &mut [f64]) -> robodyn::Result<()> {
+        self.inner.extra_values(q, qd, out)
+    }
 }
 
 /// Checks every trajectory row against the robot's joint limits: the first crossing of each
@@ -88,8 +141,11 @@ pub struct Args {
 struct LimitWatch<'a> {
     sink: &'a mut dyn TrajectorySink,
     /// (column, joint, what, low, high, unit)
-    checks: Vec<(usize, usize, &'static str, f64, f64, &'static str)>,
+    /// (column, joint as named in messages, frame number, what, low, high, unit)
+    checks: Vec<(usize, String, usize, &'static str, f64, f64, &'static str)>,
     limits: &'a std::collections::BTreeMap<usize, robodyn::model::JointLimits>,
+    /// Joint (frame number) of each label of the columns.
+    joint_of: HashMap<String, usize>,
     units: Vec<(usize, bool)>,
     crossed: Vec<String>,
     seen: std::collections::BTreeSet<(usize, &'static str)>,
@@ -100,7 +156,7 @@ impl TrajectorySink for LimitWatch<'_> {
     fn begin(&mut self, headers: &[String]) -> robodyn::Result<()> {
         for (c, h) in headers.iter().enumerate() {
             for (prefix, what) in [("qd", "speed"), ("tau", "torque"), ("q", "position")] {
-                let Some(j) = h.strip_prefix(prefix).and_then(|s| s.parse::<usize>().ok()) else {
+                let Some(&j) = h.strip_prefix(prefix).and_then(|s| self.joint_of.get(s)) else {
                     continue;
                 };
                 let Some(l) = self.limits.get(&j) else {
@@ -121,7 +177,12 @@ impl TrajectorySink for LimitWatch<'_> {
                     ),
                 };
                 if let (Some(lo), Some(hi)) = (lo, hi) {
-                    self.checks.push((c, j, what, lo, hi, unit));
+                    // `joint 5`, or `joint 5 (extend)` with --names joint
+                    let named = match h[prefix.len()..].strip_prefix('_') {
+                        Some(name) => format!("joint {j} ({name})"),
+                        None => format!("joint {j}"),
+                    };
+                    self.checks.push((c, named, j, what, lo, hi, unit));
                 }
                 break;
             }
@@ -130,11 +191,12 @@ impl TrajectorySink for LimitWatch<'_> {
     }
     fn row(&mut self, values: &[f64]) -> robodyn::Result<()> {
         self.sink.row(values)?;
-        for &(c, j, what, lo, hi, unit) in &self.checks {
+        for (c, named, j, what, lo, hi, unit) in &self.checks {
+            let (c, j, what, lo, hi, unit) = (*c, *j, *what, *lo, *hi, *unit);
             let x = values[c];
             if (x < lo || x > hi) && self.seen.insert((j, what)) {
                 let m = format!(
-                    "joint {j} crosses its {what} limit at t = {} s: {} {unit} outside [{}, {}]",
+                    "{named} crosses its {what} limit at t = {} s: {} {unit} outside [{}, {}]",
                     format_number(values[0]),
                     format_number(x),
                     format_number(lo),
@@ -184,12 +246,12 @@ fn gains(name: &str, s: &str, n: usize) -> CliResult<Vec<f64>> {
     }
 }
 
-/// Column indices of `<prefix><j>` for every joint and prefix, in order; an optional prefix
+/// Column indices of `<prefix><l>` for every joint label and prefix, in order; an optional prefix
 /// whose columns are all absent is skipped (the flag says whether all optional ones were found).
 fn series_columns(
     t: &Table,
     prefixes: &[(&str, bool)],
-    joints: &[usize],
+    joints: &[String],
 ) -> CliResult<(Vec<usize>, bool)> {
     let mut cols = Vec::new();
     let mut all_optional_present = true;
@@ -212,7 +274,7 @@ fn series_columns(
 fn read_series(
     path: &std::path::Path,
     prefixes: &[(&str, bool)],
-    joints: &[usize],
+    joints: &[String],
 ) -> CliResult<(TimeSeries, bool)> {
     let t = Table::read(path)?;
     let tc = t.column("t")?;
@@ -257,7 +319,7 @@ pub fn run(a: Args) -> CliResult {
     check_options(&a)?;
     let robot = a.robot.load()?;
     let smoothing = Some(a.coulomb_smoothing);
-    let (mut dynamics, joints, what, q0_default): (Box<dyn Dynamics + '_>, _, _, _) =
+    let (dynamics, joints, what, q0_default): (Box<dyn Dynamics + '_>, _, _, _) =
         if robot.is_tree() {
             let d = TreeDynamics::new(&robot, a.method.into()).with_coulomb_smoothing(smoothing);
             let joints = d.joints().to_vec();
@@ -284,12 +346,30 @@ pub fn run(a: Args) -> CliResult {
     if n == 0 {
         return Err("the robot has no movable joint: nothing to simulate".into());
     }
+    let label = joint_labels(&robot, &a.names);
+    let labels: Vec<String> = joints.iter().map(|j| label[j].clone()).collect();
+    // the passive joints' q<j> of a closed chain follow the same rule
+    let extra = dynamics
+        .extra_columns()
+        .into_iter()
+        .map(|h| {
+            match h.strip_prefix('q').and_then(|s| s.parse::<usize>().ok()) {
+                Some(j) if label.contains_key(&j) => format!("q{}", label[&j]),
+                _ => h,
+            }
+        })
+        .collect();
+    let mut dynamics = Labelled {
+        inner: dynamics,
+        labels: labels.clone(),
+        extra,
+    };
     let q0 = joint_values("q0", a.q0.as_deref(), &joints, what, q0_default.as_deref())?;
     let qd0 = joint_values("qd0", a.qd0.as_deref(), &joints, what, None)?;
     let input = if let Some(p) = &a.torque_csv {
-        TorqueInput::Series(read_series(p, &[("tau", false)], &joints)?.0)
+        TorqueInput::Series(read_series(p, &[("tau", false)], &labels)?.0)
     } else if let Some(p) = &a.track {
-        let (reference, with_velocity) = read_series(p, &[("q", false), ("qd", true)], &joints)?;
+        let (reference, with_velocity) = read_series(p, &[("q", false), ("qd", true)], &labels)?;
         TorqueInput::Pd {
             reference,
             with_velocity,
@@ -351,13 +431,14 @@ pub fn run(a: Args) -> CliResult {
         },
         checks: Vec::new(),
         limits: &robot.description().limits,
+        joint_of: label.iter().map(|(&j, l)| (l.clone(), j)).collect(),
         units: prismatic,
         crossed: Vec::new(),
         seen: Default::default(),
         stop: a.stop_at_limits,
     };
     let result = simulate(
-        dynamics.as_mut(),
+        &mut dynamics,
         &input,
         &q0,
         &qd0,
@@ -391,7 +472,7 @@ pub fn run(a: Args) -> CliResult {
             &PlotInfo {
                 title: plot_title(&robot, &a),
                 stopped,
-                prismatic: prismatic_labels(&robot),
+                prismatic: prismatic_labels(&robot, &label),
             },
         )),
         _ => None,
@@ -441,10 +522,10 @@ fn plot_title(robot: &robodyn::Robot, a: &Args) -> String {
     format!("{}: {input}, {scheme}", robot.name())
 }
 
-/// Labels (frame numbers, as in the q<j> columns) of the prismatic joints.
-fn prismatic_labels(robot: &robodyn::Robot) -> Vec<String> {
+/// Labels (as in the q<l> columns) of the prismatic joints.
+fn prismatic_labels(robot: &robodyn::Robot, label: &HashMap<usize, String>) -> Vec<String> {
     (1..=robot.description().nj)
         .filter(|&j| robot.description().frame(j).joint.sigma() == 1)
-        .map(|j| j.to_string())
+        .map(|j| label.get(&j).cloned().unwrap_or_else(|| j.to_string()))
         .collect()
 }

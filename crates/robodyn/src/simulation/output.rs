@@ -158,7 +158,7 @@ pub struct PlotInfo {
     /// Why the run stopped before its end (marked on the plot), if it did.
     pub stopped: Option<String>,
     /// Labels `<l>` of the prismatic joints' `q<l>` columns (plotted in metres, apart from the
-    /// revolute joints' radians).
+    /// revolute joints' radians): `3` for `q3`, `_slider` for `q_slider`.
     pub prismatic: Vec<String>,
 }
 
@@ -260,9 +260,12 @@ pub fn plot_svg(path: &Path, rec: &Recorder, info: &PlotInfo) -> Result<()> {
     if t.is_empty() {
         return Err(err("the trajectory is empty: nothing to plot".into()));
     }
+    // q<frame> or q_<joint name> (`--names joint`), not qd.. / qdd..
     let is_q = |h: &str| {
-        h.strip_prefix('q')
-            .is_some_and(|s| !s.is_empty() && s.bytes().all(|b| b.is_ascii_digit()))
+        h.strip_prefix('q').is_some_and(|s| {
+            (!s.is_empty() && s.bytes().all(|b| b.is_ascii_digit()))
+                || s.strip_prefix('_').is_some_and(|n| !n.is_empty())
+        })
     };
     let (mut revolute, mut prismatic) = (Vec::new(), Vec::new());
     for h in rec.headers.iter().filter(|h| is_q(h)) {
