@@ -357,7 +357,7 @@ pub fn is_broken_pipe(e: &(dyn std::error::Error + 'static)) -> bool {
 /// How joint columns are named.
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum Names {
-    /// By frame number: `q3`, `tau3` (the default for .toml and .par robots).
+    /// By frame number: `q3`, `tau3` (the default, for every robot format).
     #[default]
     Frame,
     /// By joint name: `q_shoulder_pan_joint` (URDF joint names; `j<frame>` when the file
