@@ -55,14 +55,15 @@ def build_cli():
 
 
 def robodyn_order(cli, urdf, names):
-    """idx[k]: robodyn index (j - 1) of Pinocchio's joint k; rank[k]: its place among movable joints."""
+    """idx[k]: index of Pinocchio's joint k in robodyn's joint arrays (the movable joints in
+    frame order, as the generated code takes them); rank[k]: its place among the outputs (the
+    same order)."""
     info = json.loads(peers.run([cli, "info", urdf, "--format", "json"], capture_output=True).stdout)
     frames = info["frames"][: info["nl"]]
     movable = [f["j"] for f in frames if f["sigma"] != 2]
     by_name = {f["name"]: f["j"] for f in frames if f["sigma"] != 2}
-    idx = [by_name[n] - 1 for n in names]
     rank = [movable.index(by_name[n]) for n in names]
-    return info["nl"], idx, rank
+    return len(movable), rank, rank
 
 
 def write_cg_states(states_path, out_path, nv, nl, idx, rank):
