@@ -1,5 +1,5 @@
-//! Small linear systems written out symbolically for a fixed size: the L D L' solution of the
-//! direct dynamic model (A symmetric positive definite) and Gaussian elimination with a row
+//! Small linear systems written out symbolically for a fixed size: the L' D L solution of the
+//! direct dynamic model along the parent array (A symmetric positive definite, branch-sparse) and Gaussian elimination with a row
 //! order fixed at generation time for the closed-chain models (Wp, not symmetric).
 
 use super::pair_name;

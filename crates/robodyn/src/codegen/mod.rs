@@ -6,9 +6,13 @@
 //!
 //! Models: the inverse dynamic model Gamma = f(q, qd, qdd) of the (equivalent) tree (eqs
 //! 10.3–10.12), the inertia matrix A(q), the vector H(q, qd), the direct dynamic model of trees
-//! (A qdd = Gamma - H solved by LDL' written out for the fixed size) and the closed-chain models
+//! (A qdd = Gamma - H solved by A = L' D L written out along the parent array) and the closed-chain models
 //! Gamma_cl = G^T Gamma_tr (10.40) and W = d q_p / d q_a (10.30), with a constant G where the
 //! loops have one and the loop-closure Jacobian written out otherwise (`closed.rs`).
+//!
+//! Joint arrays of the generated code hold the movable joints in frame order (the library's
+//! joint vectors); the tree models run on the folded model (`DynModel::fold_fixed`), names keep
+//! the frame numbers (`q<j>`, `GAM<j>`, `W<c><j>`).
 
 mod closed;
 mod linear;
@@ -590,7 +594,7 @@ fn describe(desc: &RobotDescription, opt: &GenOptions) -> Vec<String> {
         ModelKind::Idm => "customized inverse dynamic model Gamma = f(q, qd, qdd) (Newton-Euler, eqs 10.3-10.12)",
         ModelKind::Inertia => "inertia matrix A(q), lower triangle (Newton-Euler columns)",
         ModelKind::H => "vector H(q, qd) = Gamma(q, qd, 0)",
-        ModelKind::Ddm => "direct dynamic model qdd = A^-1 (Gamma - H), LDL' solution written out",
+        ModelKind::Ddm => "direct dynamic model qdd = A^-1 (Gamma - H), A = L' D L along the parent array written out",
         ModelKind::Closed => "closed-chain inverse dynamic model Gamma_cl = G^T Gamma_tr (eq 10.40), inputs are the tree state",
         ModelKind::W => "closed-chain kinematic constraint W = d q_p / d q_a = -Wp^-1 Wa (eq 10.30), inputs are the tree positions",
     };
