@@ -25,10 +25,10 @@ mod cli_generate;
 mod cli_identify;
 #[path = "cli_info.rs"]
 mod cli_info;
-#[path = "cli_simulate_names.rs"]
-mod cli_simulate_names;
 #[path = "cli_info_assembly.rs"]
 mod cli_info_assembly;
+#[path = "cli_simulate_names.rs"]
+mod cli_simulate_names;
 
 /// The guard: a `tests/*.rs` file that is not a module above would never be compiled or run.
 #[test]

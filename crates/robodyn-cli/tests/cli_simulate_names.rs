@@ -54,7 +54,10 @@ fn joint_names_name_the_trajectory_columns() {
     for n in names {
         assert!(plot.contains(&format!("q_{n}")), "legend lacks q_{n}");
     }
-    assert!(plot.contains("prismatic joints"), "q_extend is plotted in metres");
+    assert!(
+        plot.contains("prismatic joints"),
+        "q_extend is plotted in metres"
+    );
 }
 
 #[test]

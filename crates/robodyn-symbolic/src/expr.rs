@@ -989,7 +989,9 @@ fn cmp_nodes(a: &Expr, b: &Expr) -> Ordering {
         // a rational and a float: by value, then the rational first (a total order with the two
         // arms above; comparing them as equal broke transitivity and made sorting panic)
         (Node::Rational(x), Node::Float(y)) => rational_f64(x).total_cmp(y).then(Ordering::Less),
-        (Node::Float(x), Node::Rational(y)) => x.total_cmp(&rational_f64(y)).then(Ordering::Greater),
+        (Node::Float(x), Node::Rational(y)) => {
+            x.total_cmp(&rational_f64(y)).then(Ordering::Greater)
+        }
         (Node::Symbol(x), Node::Symbol(y)) => natural_cmp(x, y),
         (Node::Pow(b1, n1), Node::Pow(b2, n2)) => cmp_expr(b1, b2).then(n1.cmp(n2)),
         (Node::Func(f1, a1), Node::Func(f2, a2)) => cmp_expr(a1, a2).then(f1.cmp(f2)),

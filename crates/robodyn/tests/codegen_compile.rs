@@ -114,7 +114,12 @@ fn tree_cases(desc: &RobotDescription, numeric: bool, seed: u64, tag: &str) -> V
     // joint arrays of the generated code: the movable joints in frame order (as the library's)
     let pick = |v: &[f64]| joints.iter().map(|&j| v[j - 1]).collect::<Vec<f64>>();
     for g in &prog.inputs[..3] {
-        assert_eq!(g.symbols.len(), joints.len(), "{tag}: {} holds the movable joints", g.name);
+        assert_eq!(
+            g.symbols.len(),
+            joints.len(),
+            "{tag}: {} holds the movable joints",
+            g.name
+        );
     }
     cases.push(Case {
         inputs: states
@@ -1005,7 +1010,16 @@ fn expression_order_is_total_on_mixed_numbers() {
     let r = |n: i64, d: i64| Expr::parse(&format!("{n}/{d}")).unwrap();
     // floats: no short decimal (Expr::num keeps those exact)
     let f = |x: f64| Expr::num(x + 1e-13);
-    let items = [r(1, 2), f(0.25), r(3, 1), f(0.5), f(3.0), r(-7, 3), f(-2.0), r(1, 3)];
+    let items = [
+        r(1, 2),
+        f(0.25),
+        r(3, 1),
+        f(0.5),
+        f(3.0),
+        r(-7, 3),
+        f(-2.0),
+        r(1, 3),
+    ];
     for a in &items {
         for b in &items {
             assert_eq!(cmp_expr(a, b), cmp_expr(b, a).reverse(), "{a} vs {b}");

@@ -319,29 +319,29 @@ pub fn run(a: Args) -> CliResult {
     check_options(&a)?;
     let robot = a.robot.load()?;
     let smoothing = Some(a.coulomb_smoothing);
-    let (dynamics, joints, what, q0_default): (Box<dyn Dynamics + '_>, _, _, _) =
-        if robot.is_tree() {
-            let d = TreeDynamics::new(&robot, a.method.into()).with_coulomb_smoothing(smoothing);
-            let joints = d.joints().to_vec();
-            (Box::new(d), joints, "movable tree joints", None)
-        } else {
-            let chain = robodyn::ClosedChain::new(&robot)?;
-            let branch = chain.assembly_branch().map_err(|e| {
-                format!(
-                    "the simulation starts on the branch of the assembly configuration, which \
+    let (dynamics, joints, what, q0_default): (Box<dyn Dynamics + '_>, _, _, _) = if robot.is_tree()
+    {
+        let d = TreeDynamics::new(&robot, a.method.into()).with_coulomb_smoothing(smoothing);
+        let joints = d.joints().to_vec();
+        (Box::new(d), joints, "movable tree joints", None)
+    } else {
+        let chain = robodyn::ClosedChain::new(&robot)?;
+        let branch = chain.assembly_branch().map_err(|e| {
+            format!(
+                "the simulation starts on the branch of the assembly configuration, which \
                      cannot be used: {e}"
-                )
-            })?;
-            let q0 = branch.q_a().to_vec();
-            let d = ClosedChainDynamics::new(chain, branch).with_coulomb_smoothing(smoothing);
-            let joints = d.chain().coordinates().frames().to_vec();
-            (
-                Box::new(d),
-                joints,
-                "actuated joints (closed chain)",
-                Some(q0),
             )
-        };
+        })?;
+        let q0 = branch.q_a().to_vec();
+        let d = ClosedChainDynamics::new(chain, branch).with_coulomb_smoothing(smoothing);
+        let joints = d.chain().coordinates().frames().to_vec();
+        (
+            Box::new(d),
+            joints,
+            "actuated joints (closed chain)",
+            Some(q0),
+        )
+    };
     let n = joints.len();
     if n == 0 {
         return Err("the robot has no movable joint: nothing to simulate".into());
@@ -352,12 +352,12 @@ pub fn run(a: Args) -> CliResult {
     let extra = dynamics
         .extra_columns()
         .into_iter()
-        .map(|h| {
-            match h.strip_prefix('q').and_then(|s| s.parse::<usize>().ok()) {
+        .map(
+            |h| match h.strip_prefix('q').and_then(|s| s.parse::<usize>().ok()) {
                 Some(j) if label.contains_key(&j) => format!("q{}", label[&j]),
                 _ => h,
-            }
-        })
+            },
+        )
         .collect();
     let mut dynamics = Labelled {
         inner: dynamics,

@@ -446,7 +446,10 @@ fn joint_inputs(joints: &[usize], model: ModelKind) -> Vec<InputGroup> {
     let group = |name: &str, kind: &str, doc: &str| InputGroup {
         name: name.into(),
         doc: format!("{doc}, movable joints in frame order: {kind}<frame number>"),
-        symbols: joints.iter().map(|&j| Some(joint_symbol(kind, j))).collect(),
+        symbols: joints
+            .iter()
+            .map(|&j| Some(joint_symbol(kind, j)))
+            .collect(),
     };
     let mut inputs = vec![group("q", "q", "joint positions")];
     match model {
@@ -546,7 +549,10 @@ fn record_model(
             }
             let parent: Vec<usize> = (1..=nl).map(|k| model.frame(k).ant).collect();
             let labels: Vec<usize> = (0..nl).map(frame).collect();
-            Ok(outputs("QDP", &linear::ltdl_solve(a, rhs, &parent, &labels)))
+            Ok(outputs(
+                "QDP",
+                &linear::ltdl_solve(a, rhs, &parent, &labels),
+            ))
         }
     }
 }
