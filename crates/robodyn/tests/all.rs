@@ -63,6 +63,8 @@ mod inverse_dynamics;
 mod io_external;
 #[path = "io_hostile.rs"]
 mod io_hostile;
+#[path = "io_number_spelling.rs"]
+mod io_number_spelling;
 #[path = "io_par.rs"]
 mod io_par;
 #[path = "io_urdf.rs"]
