@@ -15,6 +15,8 @@ mod base_parameters;
 mod base_parameters_closed;
 #[path = "base_parameters_external.rs"]
 mod base_parameters_external;
+#[path = "base_parameters_float_noise.rs"]
+mod base_parameters_float_noise;
 #[path = "base_parameters_latex.rs"]
 mod base_parameters_latex;
 #[path = "base_parameters_semantics.rs"]

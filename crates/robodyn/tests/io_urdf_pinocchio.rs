@@ -17,7 +17,7 @@ fn python() -> String {
 }
 
 /// The example-robot-data `robots` folder, or None (with the reason) when unavailable.
-fn robots_dir() -> Option<PathBuf> {
+pub(crate) fn robots_dir() -> Option<PathBuf> {
     let out = Command::new(python())
         .args([
             "-c",
@@ -42,7 +42,7 @@ fn robots_dir() -> Option<PathBuf> {
     found
 }
 
-fn find(dir: &Path, name: &str) -> Option<PathBuf> {
+pub(crate) fn find(dir: &Path, name: &str) -> Option<PathBuf> {
     for e in std::fs::read_dir(dir).ok()?.flatten() {
         let p = e.path();
         if p.is_dir() {
