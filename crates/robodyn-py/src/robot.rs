@@ -2,7 +2,7 @@
 //! as methods on one state (1-D arrays) or N states (2-D arrays, evaluated over all cores with
 //! the GIL released).
 
-use crate::arrays::{output, run_rows, states, States};
+use crate::arrays::{output, states, States};
 use crate::errors::{InputError, IntoPy};
 use nalgebra::DMatrix;
 use pyo3::prelude::*;
@@ -11,6 +11,7 @@ use robodyn::algorithms::regressor::{
     base_columns, regressor_into, standard_columns, ParameterSelection, RotorMode, ZeroParameters,
     PARAMS_PER_LINK,
 };
+use robodyn::batch::for_each_row;
 use robodyn::{
     direct_dynamics_into, h_vector_into, inertia_matrix_into, inverse_dynamics_into, Data, Method,
 };
@@ -163,9 +164,17 @@ impl Robot {
             }
             Some(n) => {
                 let r: &robodyn::Robot = robot;
-                let v = py
-                    .detach(|| run_rows(n, width, || Work::new(r), |w, i, o| f(r, w, row(i), o)))
-                    .py()?;
+                let mut v = vec![0.0; n * width];
+                py.detach(|| {
+                    for_each_row(
+                        n,
+                        &mut v,
+                        width,
+                        || Work::new(r),
+                        |w, i, o| f(r, w, row(i), o),
+                    )
+                })
+                .py()?;
                 Ok((v, Some(n)))
             }
         }
