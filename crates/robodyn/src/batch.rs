@@ -31,6 +31,12 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 /// at most the cache line at a block's edge.
 pub const ROWS_PER_TASK: usize = 128;
 
+/// The number of threads a batch runs on here: the current rayon pool's (the caller's pool
+/// inside `pool.install`, else the global pool: all cores or `RAYON_NUM_THREADS`).
+pub fn threads() -> usize {
+    rayon::current_num_threads()
+}
+
 /// Number of rows N of row-major `inputs` (name, slice) of `width` entries per row, all of the
 /// same length, a multiple of `width`; [`Error::Dimension`] naming the first input that is not.
 /// A width of 0 gives 0 rows.
