@@ -62,6 +62,24 @@ pub fn parse_method(method: &str) -> PyResult<Method> {
     }
 }
 
+/// What a literal 0 means: `zeros` ("absent" or "value"), else by the file it came from.
+pub fn parse_zeros(
+    zeros: Option<&str>,
+    source: Option<&std::path::Path>,
+) -> PyResult<ZeroParameters> {
+    Ok(match zeros {
+        Some("absent") => ZeroParameters::Absent,
+        Some("value") => ZeroParameters::Value,
+        None => source.map_or(ZeroParameters::Value, ZeroParameters::for_path),
+        Some(z) => {
+            return Err(InputError::new_err(format!(
+                "zeros = {z:?}: expected \"absent\" (a literal 0 is no parameter, SYMORO's \
+                 meaning) or \"value\""
+            )))
+        }
+    })
+}
+
 pub fn parse_rotor(rotor: &str) -> PyResult<RotorMode> {
     match rotor {
         "actuated" => Ok(RotorMode::Actuated),
@@ -204,20 +222,7 @@ impl Robot {
     }
 
     pub fn zeros(&self, zeros: Option<&str>) -> PyResult<ZeroParameters> {
-        Ok(match zeros {
-            Some("absent") => ZeroParameters::Absent,
-            Some("value") => ZeroParameters::Value,
-            None => match &self.source {
-                Some(p) => ZeroParameters::for_path(p),
-                None => ZeroParameters::Value,
-            },
-            Some(z) => {
-                return Err(InputError::new_err(format!(
-                    "zeros = {z:?}: expected \"absent\" (a literal 0 is no parameter, SYMORO's \
-                     meaning) or \"value\""
-                )))
-            }
-        })
+        parse_zeros(zeros, self.source.as_deref())
     }
 
     fn with_symbols(&self, values: BTreeMap<String, f64>) -> PyResult<robodyn::Robot> {
@@ -235,7 +240,7 @@ impl Robot {
     }
 }
 
-fn kwargs_values(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<BTreeMap<String, f64>> {
+pub fn kwargs_values(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<BTreeMap<String, f64>> {
     let mut m = BTreeMap::new();
     if let Some(k) = kwargs {
         for (name, v) in k.iter() {
