@@ -254,9 +254,15 @@ pub fn write_table_with(
     match format {
         TableFormat::Csv => {
             writeln!(out, "{}", headers.join(","))?;
+            // each number written in place (no string per number or per line)
             for r in rows {
-                let line: Vec<String> = r.iter().map(|&x| format_number(x)).collect();
-                writeln!(out, "{}", line.join(","))?;
+                for (k, &x) in r.iter().enumerate() {
+                    if k > 0 {
+                        out.write_all(b",")?;
+                    }
+                    write!(out, "{}", Number(x))?;
+                }
+                out.write_all(b"\n")?;
             }
         }
         TableFormat::Json => {
@@ -284,6 +290,7 @@ pub fn write_table_with(
 }
 
 pub use robodyn::simulation::format_number;
+use robodyn::simulation::output::Number;
 
 /// A result that is not a finite number is an error, never printed (a velocity of 1e200 or a
 /// gravity of 1e308 overflows the model).
