@@ -254,9 +254,15 @@ pub fn write_table_with(
     match format {
         TableFormat::Csv => {
             writeln!(out, "{}", headers.join(","))?;
+            // each number written in place (no string per number or per line)
             for r in rows {
-                let line: Vec<String> = r.iter().map(|&x| format_number(x)).collect();
-                writeln!(out, "{}", line.join(","))?;
+                for (k, &x) in r.iter().enumerate() {
+                    if k > 0 {
+                        out.write_all(b",")?;
+                    }
+                    write!(out, "{}", Number(x))?;
+                }
+                out.write_all(b"\n")?;
             }
         }
         TableFormat::Json => {
@@ -284,6 +290,7 @@ pub fn write_table_with(
 }
 
 pub use robodyn::simulation::format_number;
+use robodyn::simulation::output::Number;
 
 /// A result that is not a finite number is an error, never printed (a velocity of 1e200 or a
 /// gravity of 1e308 overflows the model).
@@ -563,4 +570,63 @@ pub fn result_rows(flat: &[f64], n: usize, count: usize) -> Vec<Vec<f64>> {
     (0..count)
         .map(|s| flat[s * n..(s + 1) * n].to_vec())
         .collect()
+}
+
+/// `--timings` of the commands that evaluate a model on a state table.
+#[derive(Args, Debug, Clone, Copy)]
+pub struct TimingsArg {
+    /// Print on stderr how long each phase took: loading the robot, reading and parsing the
+    /// input, the model, formatting and writing the output.
+    #[arg(long)]
+    pub timings: bool,
+}
+
+/// Wall-clock time of a command's phases, printed on stderr by [`Phases::report`] when
+/// `--timings` is given.
+pub struct Phases {
+    on: bool,
+    start: std::time::Instant,
+    last: std::time::Instant,
+    done: Vec<(&'static str, std::time::Duration)>,
+}
+
+impl Phases {
+    /// Start timing (now).
+    pub fn start(arg: TimingsArg) -> Phases {
+        let now = std::time::Instant::now();
+        Phases {
+            on: arg.timings,
+            start: now,
+            last: now,
+            done: Vec::new(),
+        }
+    }
+
+    /// The time since the previous phase ended was `phase`.
+    pub fn lap(&mut self, phase: &'static str) {
+        if self.on {
+            let now = std::time::Instant::now();
+            self.done.push((phase, now - self.last));
+            self.last = now;
+        }
+    }
+
+    /// `robodyn: timings (N rows, T threads): robot 1.2 ms, read 150.0 ms, ...` on stderr.
+    pub fn report(&self, rows: usize) {
+        if !self.on {
+            return;
+        }
+        let ms = |d: std::time::Duration| format!("{:.1} ms", d.as_secs_f64() * 1e3);
+        let parts: Vec<String> = self
+            .done
+            .iter()
+            .map(|(p, d)| format!("{p} {}", ms(*d)))
+            .collect();
+        eprintln!(
+            "robodyn: timings ({rows} rows, {} threads): {}, total {}",
+            robodyn::batch::threads(),
+            parts.join(", "),
+            ms(self.start.elapsed())
+        );
+    }
 }

@@ -1,12 +1,10 @@
 //! NumPy arrays in and out: one state (1-D arrays of the vector's length) or N states (2-D
-//! arrays, one row per state), shapes checked with a message naming the expected shape, and
-//! the batch runner (rayon over the library's allocation-free `*_into` functions, one `Data`
-//! per block of rows).
+//! arrays, one row per state), shapes checked with a message naming the expected shape. N
+//! states run through the library's row runner (`robodyn::batch::for_each_row`).
 
 use crate::errors::DimensionError;
 use numpy::{PyArray1, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::prelude::*;
-use rayon::prelude::*;
 
 /// Joint-vector arguments of one call: all one state or all N states.
 pub struct States {
@@ -122,40 +120,6 @@ pub fn states(
             .collect(),
         n,
     })
-}
-
-/// Evaluate `f(data, row, out_row)` for every row, in parallel over blocks of rows with one
-/// `init()` per block (the GIL is released by the caller). Errors name the (first failing)
-/// row, 1-based.
-pub fn run_rows<D, I, F>(rows: usize, width: usize, init: I, f: F) -> robodyn::Result<Vec<f64>>
-where
-    I: Fn() -> D + Sync,
-    F: Fn(&mut D, usize, &mut [f64]) -> robodyn::Result<()> + Sync,
-{
-    let mut out = vec![0.0; rows * width];
-    if rows == 0 || width == 0 {
-        return Ok(out);
-    }
-    let threads = rayon::current_num_threads().max(1);
-    let block = rows.div_ceil(4 * threads).max(1);
-    let errors: Vec<(usize, robodyn::Error)> = out
-        .par_chunks_mut(block * width)
-        .enumerate()
-        .filter_map(|(b, chunk)| {
-            let mut d = init();
-            for (i, o) in chunk.chunks_mut(width).enumerate() {
-                let r = b * block + i;
-                if let Err(e) = f(&mut d, r, o) {
-                    return Some((r, e));
-                }
-            }
-            None
-        })
-        .collect();
-    match errors.into_iter().min_by_key(|(r, _)| *r) {
-        Some((r, e)) => Err(e.in_row(r + 1)),
-        None => Ok(out),
-    }
 }
 
 /// The output array: `shape_one` for one state, (N, *shape_one) for N states.

@@ -7,8 +7,8 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 use robodyn::algorithms::base_parameters::symbolic::standard_index;
 use robodyn::algorithms::base_parameters::{
-    compare_methods, numeric_base_parameters_auto, standard_values, symbolic_base_parameters,
-    NumericOptions, ParameterNames, Summary,
+    compare_methods, geometry_robot, numeric_base_parameters_auto, standard_values,
+    symbolic_base_parameters, NumericOptions, ParameterNames, Summary,
 };
 use robodyn::algorithms::regressor::{parameter_name, ParameterSelection, ZeroParameters};
 use robodyn::codegen::{generate as gen, BaseParameters as GenBase, GenOptions, ModelKind};
@@ -120,6 +120,56 @@ pub fn base_parameters(
     zeros: Option<&str>,
     seed: u64,
 ) -> PyResult<BaseParameters> {
+    let model = robot.model();
+    let zeros = robot.zeros(zeros)?;
+    base_parameters_of(
+        py,
+        model.description(),
+        Some(&model),
+        zeros,
+        method,
+        friction,
+        rotor,
+        seed,
+    )
+}
+
+/// `robodyn.base_parameters(path, ...)`: the base parameters of a robot file, values or not
+/// (as `robodyn base-params`): the symbolic method works on the symbols, the numerical one on
+/// the geometry with generic values for symbols without one (the count and grouping then hold
+/// for generic values, said in the notes; no coefficient table is given for such geometry).
+#[pyfunction]
+#[pyo3(name = "base_parameters", signature = (path, method="symbolic", friction=true, rotor="actuated", zeros=None, seed=1, **values))]
+#[allow(clippy::too_many_arguments)]
+pub fn base_parameters_of_file(
+    py: Python<'_>,
+    path: std::path::PathBuf,
+    method: &str,
+    friction: bool,
+    rotor: &str,
+    zeros: Option<&str>,
+    seed: u64,
+    values: Option<&Bound<'_, PyDict>>,
+) -> PyResult<BaseParameters> {
+    let mut desc = robodyn::io::load_description(&path).py()?;
+    desc.symbols.extend(crate::robot::kwargs_values(values)?);
+    let zeros = crate::robot::parse_zeros(zeros, Some(&path))?;
+    base_parameters_of(py, &desc, None, zeros, method, friction, rotor, seed)
+}
+
+/// Base parameters of `desc`; the numerical method on `model`, or (None) on its geometry with
+/// generic values for symbols without one (the CLI's `base-params`).
+#[allow(clippy::too_many_arguments)]
+fn base_parameters_of(
+    py: Python<'_>,
+    desc: &robodyn::RobotDescription,
+    model: Option<&robodyn::Robot>,
+    zeros: ZeroParameters,
+    method: &str,
+    friction: bool,
+    rotor: &str,
+    seed: u64,
+) -> PyResult<BaseParameters> {
     let (symbolic, numeric) = match method {
         "symbolic" => (true, false),
         "numeric" => (false, true),
@@ -130,16 +180,15 @@ pub fn base_parameters(
             )))
         }
     };
-    let model = robot.model();
-    let desc = model.description();
     let sel = ParameterSelection::from_description(desc, parse_rotor(rotor)?, friction)
-        .with_zero_parameters(desc, robot.zeros(zeros)?);
+        .with_zero_parameters(desc, zeros);
     let names = ParameterNames::of(desc);
     let (summary, coef) = py
         .detach(|| -> robodyn::Result<(Summary, Option<Vec<Vec<f64>>>)> {
             let sb = symbolic
                 .then(|| symbolic_base_parameters(desc, &sel))
                 .transpose()?;
+            let mut generic = Vec::new();
             let nb = numeric
                 .then(|| {
                     let opt = NumericOptions {
@@ -147,7 +196,14 @@ pub fn base_parameters(
                         samples: None,
                         seed,
                     };
-                    numeric_base_parameters_auto(&model, &opt)
+                    match model {
+                        Some(m) => numeric_base_parameters_auto(m, &opt),
+                        None => {
+                            let (g, values) = geometry_robot(desc)?;
+                            generic = values;
+                            numeric_base_parameters_auto(&g, &opt)
+                        }
+                    }
                 })
                 .transpose()?;
             let mut s = match (&sb, &nb) {
@@ -161,6 +217,18 @@ pub fn base_parameters(
                 if let Some(start) = start {
                     s.notes.push(format!("closed chain: {}", start.describe()));
                 }
+                if !generic.is_empty() {
+                    let list: Vec<String> = generic
+                        .iter()
+                        .map(|(s, v)| format!("{s} = {}", (v * 1e4).round() / 1e4))
+                        .collect();
+                    s.notes.push(format!(
+                        "symbols without value took generic values for the numerical method \
+                         ({}): the count and the grouping hold for generic values of them, not \
+                         for special ones (give values as keyword arguments)",
+                        list.join(", ")
+                    ));
+                }
                 if let Some(sb) = &sb {
                     s.add_comparison(&compare_methods(sb, nb, &names));
                 }
@@ -168,8 +236,8 @@ pub fn base_parameters(
             let position: HashMap<usize, usize> =
                 s.columns.iter().enumerate().map(|(c, &i)| (i, c)).collect();
             let coef = match (&sb, &nb) {
-                // K_base = K1 + beta K2
-                (None, Some((nb, _))) => Some(
+                // K_base = K1 + beta K2, beta for the robot's geometry (not a generic one)
+                (None, Some((nb, _))) if generic.is_empty() => Some(
                     (0..nb.count())
                         .map(|r| {
                             let mut row = vec![0.0; s.columns.len()];

@@ -2,7 +2,7 @@
 //! as methods on one state (1-D arrays) or N states (2-D arrays, evaluated over all cores with
 //! the GIL released).
 
-use crate::arrays::{output, run_rows, states, States};
+use crate::arrays::{output, states, States};
 use crate::errors::{InputError, IntoPy};
 use nalgebra::DMatrix;
 use pyo3::prelude::*;
@@ -11,6 +11,7 @@ use robodyn::algorithms::regressor::{
     base_columns, regressor_into, standard_columns, ParameterSelection, RotorMode, ZeroParameters,
     PARAMS_PER_LINK,
 };
+use robodyn::batch::for_each_row;
 use robodyn::{
     direct_dynamics_into, h_vector_into, inertia_matrix_into, inverse_dynamics_into, Data, Method,
 };
@@ -59,6 +60,24 @@ pub fn parse_method(method: &str) -> PyResult<Method> {
             "method = {method:?}: expected \"composite\" (tree L'DL of A) or \"aba\" (articulated bodies)"
         ))),
     }
+}
+
+/// What a literal 0 means: `zeros` ("absent" or "value"), else by the file it came from.
+pub fn parse_zeros(
+    zeros: Option<&str>,
+    source: Option<&std::path::Path>,
+) -> PyResult<ZeroParameters> {
+    Ok(match zeros {
+        Some("absent") => ZeroParameters::Absent,
+        Some("value") => ZeroParameters::Value,
+        None => source.map_or(ZeroParameters::Value, ZeroParameters::for_path),
+        Some(z) => {
+            return Err(InputError::new_err(format!(
+                "zeros = {z:?}: expected \"absent\" (a literal 0 is no parameter, SYMORO's \
+                 meaning) or \"value\""
+            )))
+        }
+    })
 }
 
 pub fn parse_rotor(rotor: &str) -> PyResult<RotorMode> {
@@ -163,9 +182,17 @@ impl Robot {
             }
             Some(n) => {
                 let r: &robodyn::Robot = robot;
-                let v = py
-                    .detach(|| run_rows(n, width, || Work::new(r), |w, i, o| f(r, w, row(i), o)))
-                    .py()?;
+                let mut v = vec![0.0; n * width];
+                py.detach(|| {
+                    for_each_row(
+                        n,
+                        &mut v,
+                        width,
+                        || Work::new(r),
+                        |w, i, o| f(r, w, row(i), o),
+                    )
+                })
+                .py()?;
                 Ok((v, Some(n)))
             }
         }
@@ -195,20 +222,7 @@ impl Robot {
     }
 
     pub fn zeros(&self, zeros: Option<&str>) -> PyResult<ZeroParameters> {
-        Ok(match zeros {
-            Some("absent") => ZeroParameters::Absent,
-            Some("value") => ZeroParameters::Value,
-            None => match &self.source {
-                Some(p) => ZeroParameters::for_path(p),
-                None => ZeroParameters::Value,
-            },
-            Some(z) => {
-                return Err(InputError::new_err(format!(
-                    "zeros = {z:?}: expected \"absent\" (a literal 0 is no parameter, SYMORO's \
-                     meaning) or \"value\""
-                )))
-            }
-        })
+        parse_zeros(zeros, self.source.as_deref())
     }
 
     fn with_symbols(&self, values: BTreeMap<String, f64>) -> PyResult<robodyn::Robot> {
@@ -226,7 +240,7 @@ impl Robot {
     }
 }
 
-fn kwargs_values(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<BTreeMap<String, f64>> {
+pub fn kwargs_values(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<BTreeMap<String, f64>> {
     let mut m = BTreeMap::new();
     if let Some(k) = kwargs {
         for (name, v) in k.iter() {

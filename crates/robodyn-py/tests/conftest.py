@@ -2,6 +2,7 @@
 
 import os
 import pathlib
+import shutil
 
 import numpy as np
 import pytest
@@ -26,3 +27,16 @@ def rng():
 def random_states(rng, n, rows=None):
     shape = (n,) if rows is None else (rows, n)
     return [rng.uniform(-1.0, 1.0, shape) for _ in range(3)]
+
+
+def cli():
+    """The `robodyn` binary: ROBODYN_CLI, one built in target/, else built with cargo."""
+    if os.environ.get("ROBODYN_CLI"):
+        return [os.environ["ROBODYN_CLI"]]
+    for profile in ["release", "debug"]:
+        exe = ROOT / "target" / profile / "robodyn"
+        if exe.exists():
+            return [str(exe)]
+    if shutil.which("cargo") is None:
+        pytest.skip("no robodyn binary and no cargo")
+    return ["cargo", "run", "-q", "--manifest-path", str(ROOT / "Cargo.toml"), "-p", "robodyn-cli", "--"]

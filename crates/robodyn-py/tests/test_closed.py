@@ -11,20 +11,7 @@ import numpy as np
 import pytest
 
 import robodyn
-from conftest import CLOSED, ROOT, robot_path
-
-
-def cli():
-    """The `robodyn` binary: ROBODYN_CLI, one built in target/, else built with cargo."""
-    if os.environ.get("ROBODYN_CLI"):
-        return [os.environ["ROBODYN_CLI"]]
-    for profile in ["release", "debug"]:
-        exe = ROOT / "target" / profile / "robodyn"
-        if exe.exists():
-            return [str(exe)]
-    if shutil.which("cargo") is None:
-        pytest.skip("no robodyn binary and no cargo")
-    return ["cargo", "run", "-q", "--manifest-path", str(ROOT / "Cargo.toml"), "-p", "robodyn-cli", "--"]
+from conftest import CLOSED, ROOT, cli, robot_path
 
 
 def trajectory(chain, rows=12):

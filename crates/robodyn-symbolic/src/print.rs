@@ -11,11 +11,72 @@ const PREC_POWER: u8 = 2;
 
 impl fmt::Display for Expr {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write_expr(f, self, PREC_SUM)
+        write_expr(f, self, PREC_SUM, false)
     }
 }
 
-fn write_rational(f: &mut fmt::Formatter<'_>, r: &Rational64, prec: u8) -> fmt::Result {
+/// [`Expr::decimal`]: the expression printed with decimal numbers where they are exact.
+pub struct Decimal<'a>(&'a Expr);
+
+impl fmt::Display for Decimal<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write_expr(f, self.0, PREC_SUM, true)
+    }
+}
+
+impl Expr {
+    /// The expression as a file writes it: like `Display`, except that a rational number with
+    /// a finite decimal expansion that reads back to the same rational prints as that decimal
+    /// (`0.705`, `-9.81`, not `141/200`, `-981/100`), and so does the coefficient of a product
+    /// (`0.705*d3`) unless it is `1/n` (`pi/2`, `M3/4`). Other rationals keep their exact
+    /// form (`1/3`, `2*pi/3`); floats print as their shortest round-trip digits. What prints
+    /// reads back (through [`Expr::parse`]) to the same expression.
+    pub fn decimal(&self) -> Decimal<'_> {
+        Decimal(self)
+    }
+}
+
+/// The exact decimal text of `r` when it has one that [`Expr::num`] reads back to `r` itself
+/// (a denominator 2^a 5^b, at most 9 decimals: what `Expr::num` recognizes as exact).
+pub(crate) fn exact_decimal(r: &Rational64) -> Option<String> {
+    if r.is_integer() {
+        return Some(r.numer().to_string());
+    }
+    let mut d = *r.denom();
+    let (mut twos, mut fives) = (0u32, 0u32);
+    while d % 2 == 0 {
+        d /= 2;
+        twos += 1;
+    }
+    while d % 5 == 0 {
+        d /= 5;
+        fives += 1;
+    }
+    let k = twos.max(fives);
+    if d != 1 || k > 9 {
+        return None;
+    }
+    let scaled = r.numer().checked_mul(10i64.pow(k) / r.denom())?;
+    let digits = scaled.unsigned_abs().to_string();
+    let k = k as usize;
+    let padded = format!("{digits:0>width$}", width = k + 1);
+    let (int, frac) = padded.split_at(padded.len() - k);
+    let sign = if scaled < 0 { "-" } else { "" };
+    let text = format!("{sign}{int}.{frac}");
+    let back = text.parse::<f64>().ok().map(Expr::num)?;
+    (back.as_rational() == Some(*r)).then_some(text)
+}
+
+fn write_rational(f: &mut fmt::Formatter<'_>, r: &Rational64, prec: u8, dec: bool) -> fmt::Result {
+    if dec && !r.is_integer() {
+        if let Some(text) = exact_decimal(r) {
+            return if r.is_negative() && prec > PREC_SUM {
+                write!(f, "({text})")
+            } else {
+                write!(f, "{text}")
+            };
+        }
+    }
     let needs = (r.is_negative() && prec > PREC_SUM) || (!r.is_integer() && prec > PREC_PRODUCT);
     if needs {
         write!(f, "(")?;
@@ -31,13 +92,13 @@ fn write_rational(f: &mut fmt::Formatter<'_>, r: &Rational64, prec: u8) -> fmt::
     Ok(())
 }
 
-fn write_expr(f: &mut fmt::Formatter<'_>, e: &Expr, prec: u8) -> fmt::Result {
-    grow(|| write_node(f, e, prec))
+fn write_expr(f: &mut fmt::Formatter<'_>, e: &Expr, prec: u8, dec: bool) -> fmt::Result {
+    grow(|| write_node(f, e, prec, dec))
 }
 
-fn write_node(f: &mut fmt::Formatter<'_>, e: &Expr, prec: u8) -> fmt::Result {
+fn write_node(f: &mut fmt::Formatter<'_>, e: &Expr, prec: u8, dec: bool) -> fmt::Result {
     match e.node() {
-        Node::Rational(r) => write_rational(f, r, prec),
+        Node::Rational(r) => write_rational(f, r, prec, dec),
         // Debug format: shortest digits that read back to the same float, always with a `.` or
         // an exponent, so that the parser reads it back as a float (not an exact integer)
         Node::Float(x) => {
@@ -56,7 +117,7 @@ fn write_node(f: &mut fmt::Formatter<'_>, e: &Expr, prec: u8) -> fmt::Result {
             for (i, t) in terms.iter().enumerate() {
                 let negative = term_is_negative(t);
                 if i == 0 {
-                    write_expr(f, t, PREC_SUM)?;
+                    write_expr(f, t, PREC_SUM, dec)?;
                     // a leading product with a negative coefficient prints its own minus sign
                 } else if negative {
                     write!(f, " - ")?;
@@ -67,10 +128,10 @@ fn write_node(f: &mut fmt::Formatter<'_>, e: &Expr, prec: u8) -> fmt::Result {
                     } else {
                         PREC_SUM
                     };
-                    write_expr(f, &neg, prec)?;
+                    write_expr(f, &neg, prec, dec)?;
                 } else {
                     write!(f, " + ")?;
-                    write_expr(f, t, PREC_SUM)?;
+                    write_expr(f, t, PREC_SUM, dec)?;
                 }
             }
             if prec > PREC_SUM {
@@ -78,17 +139,17 @@ fn write_node(f: &mut fmt::Formatter<'_>, e: &Expr, prec: u8) -> fmt::Result {
             }
             Ok(())
         }
-        Node::Mul(_) | Node::Pow(..) => write_product(f, e, prec),
+        Node::Mul(_) | Node::Pow(..) => write_product(f, e, prec, dec),
         Node::Func(func, a) => {
             write!(f, "{}(", func.name())?;
-            write_expr(f, a, PREC_SUM)?;
+            write_expr(f, a, PREC_SUM, dec)?;
             write!(f, ")")
         }
         Node::Atan2(y, x) => {
             write!(f, "atan2(")?;
-            write_expr(f, y, PREC_SUM)?;
+            write_expr(f, y, PREC_SUM, dec)?;
             write!(f, ", ")?;
-            write_expr(f, x, PREC_SUM)?;
+            write_expr(f, x, PREC_SUM, dec)?;
             write!(f, ")")
         }
     }
@@ -127,7 +188,7 @@ pub(crate) fn product_parts(e: &Expr) -> (Option<Expr>, Vec<Expr>, Vec<Expr>) {
     (coef, num, den)
 }
 
-fn write_product(f: &mut fmt::Formatter<'_>, e: &Expr, prec: u8) -> fmt::Result {
+fn write_product(f: &mut fmt::Formatter<'_>, e: &Expr, prec: u8, dec: bool) -> fmt::Result {
     if let Node::Pow(b, n) = e.node() {
         if *n > 0 {
             // a power as the base of a power keeps its parentheses: (x^40)^2
@@ -135,7 +196,7 @@ fn write_product(f: &mut fmt::Formatter<'_>, e: &Expr, prec: u8) -> fmt::Result 
             if wrap {
                 write!(f, "(")?;
             }
-            write_expr(f, b, PREC_POWER + 1)?;
+            write_expr(f, b, PREC_POWER + 1, dec)?;
             write!(f, "^{n}")?;
             if wrap {
                 write!(f, ")")?;
@@ -152,10 +213,16 @@ fn write_product(f: &mut fmt::Formatter<'_>, e: &Expr, prec: u8) -> fmt::Result 
             Node::Rational(r) => {
                 negative = r.is_negative();
                 let a = r.abs();
-                if !a.numer().is_one() || num.is_empty() {
+                // decimal mode: 0.705*d3, but pi/2 stays pi/2
+                let decimal = (dec && !a.numer().is_one())
+                    .then(|| exact_decimal(&a))
+                    .flatten();
+                if decimal.is_some() {
+                    num_coef = Some(Expr::rational(a));
+                } else if !a.numer().is_one() || num.is_empty() {
                     num_coef = Some(Expr::int(*a.numer()));
                 }
-                if !a.denom().is_one() {
+                if !a.denom().is_one() && decimal.is_none() {
                     den_coef = Some(*a.denom());
                 }
             }
@@ -175,14 +242,14 @@ fn write_product(f: &mut fmt::Formatter<'_>, e: &Expr, prec: u8) -> fmt::Result 
     }
     let mut first = true;
     if let Some(c) = &num_coef {
-        write_expr(f, c, PREC_PRODUCT)?;
+        write_expr(f, c, PREC_PRODUCT, dec)?;
         first = false;
     }
     for x in &num {
         if !first {
             write!(f, "*")?;
         }
-        write_expr(f, x, PREC_PRODUCT + 1)?;
+        write_expr(f, x, PREC_PRODUCT + 1, dec)?;
         first = false;
     }
     if first {
@@ -203,7 +270,7 @@ fn write_product(f: &mut fmt::Formatter<'_>, e: &Expr, prec: u8) -> fmt::Result 
             if !first {
                 write!(f, "*")?;
             }
-            write_expr(f, x, PREC_PRODUCT + 1)?;
+            write_expr(f, x, PREC_PRODUCT + 1, dec)?;
             first = false;
         }
         if den_count > 1 {

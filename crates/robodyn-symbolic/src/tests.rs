@@ -166,3 +166,35 @@ fn a_power_of_a_square_root_merges_with_its_base() {
     let once = p(text).to_string();
     assert_eq!(p(&once).to_string(), once);
 }
+
+/// Decimal printing (file writers): exact decimals for rationals that have one, the exact form
+/// otherwise, and what prints reads back to the same expression.
+#[test]
+fn decimal_printing_reads_back_to_the_same_expression() {
+    let cases = [
+        ("0.705", "0.705"),
+        ("-9.81", "-9.81"),
+        ("141/200", "0.705"),
+        ("1/3", "1/3"),
+        ("pi/2", "pi/2"),
+        ("-pi/2", "-pi/2"),
+        ("2*pi/3", "2*pi/3"),
+        ("0.705*d3 - 0.5*M3", "-M3/2 + 0.705*d3"),
+        ("d3 + 0.00002896", "0.00002896 + d3"),
+        ("1e-9", "0.000000001"),
+        // 10 decimals: Expr::num would not read it back as this rational
+        ("1/1024", "1/1024"),
+        ("0.22094100000000003", "0.22094100000000003"),
+        ("x^2*(-0.75)", "-0.75*x^2"),
+        ("x^2*(-0.25)", "-x^2/4"),
+        ("3", "3"),
+    ];
+    for (src, want) in cases {
+        let e = Expr::parse(src).unwrap();
+        let text = e.decimal().to_string();
+        assert_eq!(text, want, "{src}");
+        assert_eq!(Expr::parse(&text).unwrap(), e, "{src} -> {text}");
+    }
+    // the plain Display is unchanged (generated code and equations keep exact fractions)
+    assert_eq!(Expr::parse("0.705").unwrap().to_string(), "141/200");
+}

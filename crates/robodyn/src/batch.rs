@@ -1,8 +1,12 @@
-//! Batches of states of a tree robot spread over the cores (rayon): N states in row-major
-//! slices (state s holds entries `s * n .. (s + 1) * n`, n = [`Robot::dof`]), results in the same
-//! layout. Each worker makes its own [`Data`] once and evaluates its rows with the
-//! allocation-free `_into` functions, so the work per state allocates nothing; rows are
-//! independent, so the result does not depend on the number of threads.
+//! Batches of states spread over the cores (rayon). N states are row-major slices (state s holds
+//! entries `s * n .. (s + 1) * n`), results in the same layout.
+//!
+//! [`for_each_row`] (and [`for_each_row2`] for two outputs) is the runner every batch goes
+//! through — the tree functions below, the CLI's CSV commands and the Python package: it cuts
+//! the rows into tasks of [`ROWS_PER_TASK`], makes one scratch (a [`Data`], or whatever the
+//! evaluation needs) per task with a closure, and evaluates each row into its slice of the
+//! output, so the work per state allocates nothing; rows are independent, so the result does
+//! not depend on the number of threads, and the error reported is the lowest failing row's.
 //!
 //! The rayon pool decides the threads: the global pool (all cores, or `RAYON_NUM_THREADS`), or
 //! a pool of the caller's (`rayon::ThreadPoolBuilder::new().num_threads(1).build()?.install(..)`).
@@ -19,61 +23,120 @@ use crate::error::{Error, Result};
 use crate::model::{Environment, Robot};
 use nalgebra::DMatrix;
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
-/// States per rayon task: enough to balance two to a few dozen cores on 10^4..10^6 states, few
-/// enough that a task's `Data` is made rarely.
-const ROWS_PER_TASK: usize = 128;
+/// Rows per rayon task: enough tasks to balance two to a few dozen cores on 10^4..10^6 rows,
+/// rows enough that a task's scratch is made rarely and the task's overhead (well under a
+/// microsecond) is lost in its work. A task's output block is contiguous, so two threads share
+/// at most the cache line at a block's edge.
+pub const ROWS_PER_TASK: usize = 128;
 
-/// Number of states N of row-major inputs with `n` entries per state (all of the same length, a
-/// multiple of n).
-fn count_states(n: usize, inputs: [(&str, &[f64]); 3]) -> Result<usize> {
-    let len = inputs[0].1.len();
-    if n == 0 {
+/// The number of threads a batch runs on here: the current rayon pool's (the caller's pool
+/// inside `pool.install`, else the global pool: all cores or `RAYON_NUM_THREADS`).
+pub fn threads() -> usize {
+    rayon::current_num_threads()
+}
+
+/// Number of rows N of row-major `inputs` (name, slice) of `width` entries per row, all of the
+/// same length, a multiple of `width`; [`Error::Dimension`] naming the first input that is not.
+/// A width of 0 gives 0 rows.
+pub fn count_rows(width: usize, inputs: &[(&str, &[f64])]) -> Result<usize> {
+    let Some(&(first, v0)) = inputs.first() else {
+        return Ok(0);
+    };
+    if width == 0 {
         return Ok(0);
     }
-    for (what, v) in inputs {
-        if v.len() != len || v.len() % n != 0 {
+    let len = v0.len();
+    for &(what, v) in inputs {
+        if v.len() != len || v.len() % width != 0 {
             return Err(Error::dimension(
                 what,
-                len - len % n,
+                len - len % width,
                 v.len(),
-                format!(
-                    "N states x {n} joints, row-major, as long as `{}`",
-                    inputs[0].0
-                ),
+                format!("N rows x {width} entries, row-major, as long as `{first}`"),
             ));
         }
     }
-    Ok(len / n)
+    Ok(len / width)
 }
 
-fn check_output(what: &str, out: &[f64], expected: usize, layout: String) -> Result<()> {
+/// An output of `expected` entries (`layout` says which).
+fn check_output(
+    what: &str,
+    out: &[f64],
+    expected: usize,
+    layout: impl Fn() -> String,
+) -> Result<()> {
     if out.len() != expected {
-        return Err(Error::dimension(what, expected, out.len(), layout));
+        return Err(Error::dimension(what, expected, out.len(), layout()));
     }
     Ok(())
 }
 
-/// One state's outputs: its row of the first output and of the second.
-type Outs<'a> = (&'a mut [f64], &'a mut [f64]);
-
-/// Evaluate `f(data, scratch, s, (out1_s, out2_s))` for the `rows` states over the rayon pool,
-/// the outputs split into rows of `widths` entries; one `Data` (and `scratch`) per task. The
-/// error of the lowest failing state is returned as [`Error::Row`] (1-based), whatever the
-/// scheduling.
-fn for_each_state<S: Send>(
-    robot: &Robot,
+/// Evaluate `f(scratch, s, out_s)` for every row s in `0..rows` over the rayon pool, `out_s`
+/// being row s of `out` (`rows` x `width`, row-major). `scratch()` is called once per task (at
+/// most once per [`ROWS_PER_TASK`] rows): put there what the evaluation allocates (a
+/// [`Data::new`]), so that `f` allocates nothing. The inputs are the closure's: row s of a
+/// row-major N x n input is `&input[s * n..(s + 1) * n]` ([`count_rows`] checks their lengths).
+///
+/// Errors: [`Error::Dimension`] when `out` is not `rows * width` long; else the error of the
+/// lowest row whose `f` failed, as [`Error::Row`] (1-based), whatever the number of threads
+/// (rows after a known failure are skipped, rows before it are all evaluated). `out` is then
+/// partly written.
+///
+/// ```
+/// # use robodyn::{batch::for_each_row, inverse_dynamics_into, Data};
+/// # let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots/rx90.toml");
+/// # let robot = robodyn::io::load(std::path::Path::new(path))?;
+/// let n = robot.dof();
+/// let rows = 1000;
+/// let (q, qd, qdd) = (vec![0.1; rows * n], vec![0.0; rows * n], vec![0.0; rows * n]);
+/// let mut tau = vec![0.0; rows * n];
+/// let r = |s: usize| s * n..(s + 1) * n;
+/// for_each_row(rows, &mut tau, n, || Data::new(&robot), |data, s, tau_s| {
+///     let env = robot.environment();
+///     inverse_dynamics_into(&robot, data, env, &q[r(s)], &qd[r(s)], &qdd[r(s)], tau_s)
+/// })?;
+/// # Ok::<(), robodyn::Error>(())
+/// ```
+pub fn for_each_row<S, I, F>(
     rows: usize,
-    outs: Outs<'_>,
-    widths: (usize, usize),
-    scratch: impl Fn() -> S + Sync + Send,
-    f: impl Fn(&mut Data, &mut S, usize, Outs<'_>) -> Result<()> + Sync + Send,
-) -> Result<()> {
-    let (w1, w2) = widths;
-    // the outputs cut into the tasks' blocks of rows
+    out: &mut [f64],
+    width: usize,
+    scratch: I,
+    f: F,
+) -> Result<()>
+where
+    I: Fn() -> S + Sync + Send,
+    F: Fn(&mut S, usize, &mut [f64]) -> Result<()> + Sync + Send,
+{
+    for_each_row2(rows, (out, width), (&mut [], 0), scratch, |s, row, o, _| {
+        f(s, row, o)
+    })
+}
+
+/// [`for_each_row`] with two outputs, each given with its width: `f(scratch, s, out1_s,
+/// out2_s)` for `out1 = (slice of rows x w1, w1)` and `out2 = (slice of rows x w2, w2)`, both
+/// row-major (e.g. the regressor and the wrench torques of [`regressor_batch`]).
+pub fn for_each_row2<S, I, F>(
+    rows: usize,
+    out1: (&mut [f64], usize),
+    out2: (&mut [f64], usize),
+    scratch: I,
+    f: F,
+) -> Result<()>
+where
+    I: Fn() -> S + Sync + Send,
+    F: Fn(&mut S, usize, &mut [f64], &mut [f64]) -> Result<()> + Sync + Send,
+{
+    let ((mut a, w1), (mut b, w2)) = (out1, out2);
+    let layout = |w: usize| move || format!("{rows} rows x {w} entries, row-major");
+    check_output("output", a, rows * w1, layout(w1))?;
+    check_output("second output", b, rows * w2, layout(w2))?;
+    // the outputs cut into the tasks' contiguous blocks of rows
     let tasks = rows.div_ceil(ROWS_PER_TASK);
-    let mut blocks: Vec<Outs<'_>> = Vec::with_capacity(tasks);
-    let (mut a, mut b) = outs;
+    let mut blocks: Vec<(&mut [f64], &mut [f64])> = Vec::with_capacity(tasks);
     for t in 0..tasks {
         let k = ROWS_PER_TASK.min(rows - t * ROWS_PER_TASK);
         let (x, rest) = std::mem::take(&mut a).split_at_mut(k * w1);
@@ -82,27 +145,39 @@ fn for_each_state<S: Send>(
         b = rest;
         blocks.push((x, y));
     }
+    // the lowest failing row known so far: later tasks need not run
+    let failed = AtomicUsize::new(usize::MAX);
     let first_error = blocks
         .into_par_iter()
         .enumerate()
-        .map_init(
-            || (Data::new(robot), scratch()),
-            |(data, s), (task, (x, y))| {
-                let first = task * ROWS_PER_TASK;
-                for i in 0..ROWS_PER_TASK.min(rows - first) {
-                    let row = first + i;
-                    let o = (&mut x[i * w1..(i + 1) * w1], &mut y[i * w2..(i + 1) * w2]);
-                    f(data, s, row, o).map_err(|e| (row, Box::new(e)))?;
-                }
-                Ok(())
-            },
-        )
+        .map_init(&scratch, |s, (task, (x, y))| {
+            let first = task * ROWS_PER_TASK;
+            if first > failed.load(Ordering::Relaxed) {
+                return Ok(());
+            }
+            for i in 0..ROWS_PER_TASK.min(rows - first) {
+                let row = first + i;
+                let o1 = &mut x[i * w1..(i + 1) * w1];
+                f(s, row, o1, &mut y[i * w2..(i + 1) * w2]).map_err(|e| {
+                    failed.fetch_min(row, Ordering::Relaxed);
+                    (row, Box::new(e))
+                })?;
+            }
+            Ok(())
+        })
         .filter_map(|r: std::result::Result<(), (usize, Box<Error>)>| r.err())
         .min_by_key(|(row, _)| *row);
     match first_error {
         Some((row, e)) => Err((*e).in_row(row + 1)),
         None => Ok(()),
     }
+}
+
+/// A joint-vector output of N states: N x n.
+fn check_states(what: &str, out: &[f64], rows: usize, n: usize) -> Result<()> {
+    check_output(what, out, rows * n, || {
+        format!("{rows} states x {n} joints")
+    })
 }
 
 /// Inverse dynamic model (eqs 10.3–10.12) of N states: `q`, `qd`, `qdd` and `tau` row-major,
@@ -120,16 +195,15 @@ pub fn inverse_dynamics_batch(
     tau: &mut [f64],
 ) -> Result<()> {
     let n = robot.dof();
-    let rows = count_states(n, [("q", q), ("qd", qd), ("qdd", qdd)])?;
-    check_output("tau", tau, rows * n, format!("{rows} states x {n} joints"))?;
+    let rows = count_rows(n, &[("q", q), ("qd", qd), ("qdd", qdd)])?;
+    check_states("tau", tau, rows, n)?;
     let r = |s: usize| s * n..(s + 1) * n;
-    for_each_state(
-        robot,
+    for_each_row(
         rows,
-        (tau, &mut []),
-        (n, 0),
-        || (),
-        |data, _, s, (out, _)| {
+        tau,
+        n,
+        || Data::new(robot),
+        |data, s, out| {
             inverse_dynamics_into(robot, data, env, &q[r(s)], &qd[r(s)], &qdd[r(s)], out)
         },
     )
@@ -149,16 +223,15 @@ pub fn direct_dynamics_batch(
     qdd: &mut [f64],
 ) -> Result<()> {
     let n = robot.dof();
-    let rows = count_states(n, [("q", q), ("qd", qd), ("tau", tau)])?;
-    check_output("qdd", qdd, rows * n, format!("{rows} states x {n} joints"))?;
+    let rows = count_rows(n, &[("q", q), ("qd", qd), ("tau", tau)])?;
+    check_states("qdd", qdd, rows, n)?;
     let r = |s: usize| s * n..(s + 1) * n;
-    for_each_state(
-        robot,
+    for_each_row(
         rows,
-        (qdd, &mut []),
-        (n, 0),
-        || (),
-        |data, _, s, (out, _)| {
+        qdd,
+        n,
+        || Data::new(robot),
+        |data, s, out| {
             direct_dynamics_into(
                 robot,
                 data,
@@ -190,27 +263,18 @@ pub fn regressor_batch(
 ) -> Result<()> {
     let n = robot.dof();
     let cols = PARAMS_PER_LINK * robot.nl();
-    let rows = count_states(n, [("q", q), ("qd", qd), ("qdd", qdd)])?;
-    check_output(
-        "Phi",
-        phi,
-        rows * n * cols,
-        format!("{rows} states x {n} joints rows, {cols} columns (13 per link), row-major"),
-    )?;
-    check_output(
-        "tau_e",
-        tau_e,
-        rows * n,
-        format!("{rows} states x {n} joints"),
-    )?;
+    let rows = count_rows(n, &[("q", q), ("qd", qd), ("qdd", qdd)])?;
+    check_output("Phi", phi, rows * n * cols, || {
+        format!("{rows} states x {n} joints rows, {cols} columns (13 per link), row-major")
+    })?;
+    check_states("tau_e", tau_e, rows, n)?;
     let r = |s: usize| s * n..(s + 1) * n;
-    for_each_state(
-        robot,
+    for_each_row2(
         rows,
-        (phi, tau_e),
-        (n * cols, n),
-        || DMatrix::zeros(n, cols),
-        |data, p, s, (phi_s, tau_e_s)| {
+        (phi, n * cols),
+        (tau_e, n),
+        || (Data::new(robot), DMatrix::zeros(n, cols)),
+        |(data, p), s, phi_s, tau_e_s| {
             regressor_into(robot, data, env, &q[r(s)], &qd[r(s)], &qdd[r(s)], p)?;
             wrench_torques_into(robot, data, env, &q[r(s)], tau_e_s)?;
             for (k, row) in phi_s.chunks_mut(cols).enumerate() {

@@ -96,9 +96,10 @@ pub mod testing;
 pub(crate) mod testing;
 
 pub use algorithms::closed_chain::{
-    closed_direct_dynamics, closed_direct_dynamics_into, closed_inverse_dynamics,
-    closed_inverse_dynamics_into, closed_regressor_into, closed_state, loop_closure,
-    loop_closure_into, Branch, ClosedChain, ClosedData, Conditioning, ConditioningLimits,
+    closed_direct_dynamics, closed_direct_dynamics_into, closed_inertia_matrix_into,
+    closed_inverse_dynamics, closed_inverse_dynamics_into, closed_regressor_into, closed_state,
+    loop_closure, loop_closure_into, Branch, ClosedChain, ClosedData, Conditioning,
+    ConditioningLimits,
 };
 pub use algorithms::direct_dynamics::{direct_dynamics, direct_dynamics_into, Method};
 pub use algorithms::inertia_matrix::{

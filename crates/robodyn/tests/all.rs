@@ -15,6 +15,8 @@ mod base_parameters;
 mod base_parameters_closed;
 #[path = "base_parameters_external.rs"]
 mod base_parameters_external;
+#[path = "base_parameters_float_noise.rs"]
+mod base_parameters_float_noise;
 #[path = "base_parameters_latex.rs"]
 mod base_parameters_latex;
 #[path = "base_parameters_semantics.rs"]
@@ -63,6 +65,8 @@ mod inverse_dynamics;
 mod io_external;
 #[path = "io_hostile.rs"]
 mod io_hostile;
+#[path = "io_number_spelling.rs"]
+mod io_number_spelling;
 #[path = "io_par.rs"]
 mod io_par;
 #[path = "io_urdf.rs"]

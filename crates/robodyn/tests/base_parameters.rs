@@ -228,7 +228,7 @@ use robodyn::algorithms::base_parameters::{
 
 /// Base regressor (symbolic base set) times the symbolic grouped values against the full model
 /// on random consistent states. A mismatch names the state; returns the worst relative error.
-fn check_symbolic_reproduces(
+pub(crate) fn check_symbolic_reproduces(
     robot: &Robot,
     sb: &SymbolicBase,
     sampler: &mut dyn Sampler,

@@ -11,8 +11,9 @@ use robodyn::algorithms::closed_chain::ClosedState;
 use robodyn::algorithms::energy::{kinetic_energy, potential_energy};
 use robodyn::algorithms::inverse_dynamics::rnea;
 use robodyn::{
-    closed_direct_dynamics, closed_direct_dynamics_into, closed_inverse_dynamics, closed_state,
-    loop_closure, Branch, ClosedChain, ClosedData, Error, Robot,
+    closed_direct_dynamics, closed_direct_dynamics_into, closed_inertia_matrix_into,
+    closed_inverse_dynamics, closed_state, loop_closure, Branch, ClosedChain, ClosedData, Error,
+    Robot,
 };
 use std::f64::consts::{FRAC_PI_2, PI};
 
@@ -146,6 +147,12 @@ fn kinetic_energy_matches_a_cl() {
             let qdv = DVector::from_column_slice(&qd);
             let ke_a = 0.5 * qdv.dot(&(&ddm.a_cl * &qdv));
             let (ke, _) = energy(&r, &ddm.state);
+            // the inertia matrix alone (10.46), on its own tracker: the direct model's A_cl
+            let mut a_cl = DMatrix::zeros(qa.len(), qa.len());
+            let mut data = ClosedData::new(&cc);
+            closed_inertia_matrix_into(&cc, &mut data, &mut at(&cc, &qa, &qp), &qa, &mut a_cl)
+                .unwrap();
+            assert_eq!(a_cl, ddm.a_cl, "{name}: closed_inertia_matrix_into");
             let e = (ke - ke_a).abs() / ke.abs().max(1e-3);
             worst = worst.max(e);
             assert!(

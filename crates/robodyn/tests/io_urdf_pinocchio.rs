@@ -13,10 +13,11 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 mod common;
-use common::{example_robot_data, find_file as find, python};
+pub(crate) use common::find_file as find;
+use common::{example_robot_data, python};
 
 /// The example-robot-data `robots` folder, or None (with the reason) when unavailable.
-fn robots_dir() -> Option<PathBuf> {
+pub(crate) fn robots_dir() -> Option<PathBuf> {
     example_robot_data("real URDFs vs pinocchio.rnea not checked")
 }
 

@@ -228,3 +228,64 @@ fn closed_chain_steady_state_allocates_nothing() {
         );
     }
 }
+
+/// The batch row runner allocates nothing per row: on every thread, between the end of one row
+/// and the start of the next, the only allocations are a new task's scratch (one `Data` per
+/// task of `ROWS_PER_TASK` rows), so at most one row in a task's worth sees any.
+#[test]
+fn batch_runner_allocates_nothing_per_row() {
+    use robodyn::batch::{for_each_row, ROWS_PER_TASK};
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    thread_local! {
+        static LAST_ROW_END: Cell<Option<usize>> = const { Cell::new(None) };
+    }
+    let robot = random_tree(&mut testing::rng(7), 9, &TreeOptions::default());
+    let n = robot.dof();
+    let rows = 40 * ROWS_PER_TASK;
+    let mut rng = testing::rng(8);
+    let states: Vec<f64> = (0..rows)
+        .flat_map(|_| random_state(&mut rng, n).concat())
+        .collect();
+    let env = robot.environment();
+    for threads in [1, 2] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        let rows_after_allocation = AtomicUsize::new(0);
+        let mut tau = vec![0.0; rows * n];
+        pool.install(|| {
+            for_each_row(
+                rows,
+                &mut tau,
+                n,
+                || Data::new(&robot),
+                |data, s, out| {
+                    let now = allocations();
+                    if LAST_ROW_END.get().is_some_and(|end| end != now) {
+                        rows_after_allocation.fetch_add(1, Ordering::Relaxed);
+                    }
+                    let x = &states[s * 3 * n..(s + 1) * 3 * n];
+                    inverse_dynamics_into(
+                        &robot,
+                        data,
+                        env,
+                        &x[..n],
+                        &x[n..2 * n],
+                        &x[2 * n..],
+                        out,
+                    )?;
+                    LAST_ROW_END.set(Some(allocations()));
+                    Ok(())
+                },
+            )
+        })
+        .unwrap();
+        let seen = rows_after_allocation.into_inner();
+        assert!(
+            seen <= rows / ROWS_PER_TASK,
+            "{threads} threads: {seen} of {rows} rows followed an allocation (tasks: {})",
+            rows / ROWS_PER_TASK
+        );
+    }
+}

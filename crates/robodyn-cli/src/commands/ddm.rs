@@ -8,7 +8,7 @@
 
 use crate::common::{
     conditioning_json, read_joint_states, result_rows, start_branch, state_column,
-    warn_conditioning, CliResult, NamesArg, RobotArgs, TableOutput,
+    warn_conditioning, CliResult, NamesArg, Phases, RobotArgs, TableOutput, TimingsArg,
 };
 use robodyn::{
     closed_direct_dynamics_into, direct_dynamics_batch, ClosedChain, ClosedData, Method,
@@ -61,12 +61,16 @@ pub struct Args {
     /// (passive tree joints in order) instead of the robot's `assembly`.
     #[arg(long, allow_hyphen_values = true)]
     pub guess: Option<String>,
+    #[command(flatten)]
+    pub timings: TimingsArg,
 }
 
 pub fn run(a: Args) -> CliResult {
+    let mut t = Phases::start(a.timings);
     let robot = a.robot.load()?;
+    t.lap("robot");
     if !robot.is_tree() {
-        return run_closed(a, robot);
+        return run_closed(a, robot, t);
     }
     let coords = robot.coordinates();
     let (states, carried) = read_joint_states(
@@ -77,20 +81,25 @@ pub fn run(a: Args) -> CliResult {
         a.names,
         "movable joints",
     )?;
+    t.lap("read");
     // every row at once over the cores (the library's batch; errors name their row)
     let (n, col) = (coords.len(), |i| state_column(&states, i));
     let mut qdd = vec![0.0; states.len() * n];
     let env = robot.environment();
     let method = a.method.into();
     direct_dynamics_batch(&robot, env, &col(0), &col(1), &col(2), method, &mut qdd)?;
+    t.lap("model");
     let rows = result_rows(&qdd, n, states.len());
     let (headers, rows) = carried.prepend(&a.names.columns("qdd", coords), rows);
-    a.out.write(&headers, &rows)
+    a.out.write(&headers, &rows)?;
+    t.lap("write");
+    t.report(states.len());
+    Ok(())
 }
 
 /// Closed chains: columns q<j>, qd<j>, tau<j> of the actuated joints in, qdd<j> of the actuated
 /// joints out (the `--method` is the closed-chain model's A_cl, H_cl), every row on the branch.
-fn run_closed(a: Args, robot: robodyn::Robot) -> CliResult {
+fn run_closed(a: Args, robot: robodyn::Robot, mut t: Phases) -> CliResult {
     let chain = ClosedChain::new(&robot)?;
     let coords = chain.coordinates();
     let (states, carried) = read_joint_states(
@@ -101,6 +110,7 @@ fn run_closed(a: Args, robot: robodyn::Robot) -> CliResult {
         a.names,
         "actuated joints (closed chain)",
     )?;
+    t.lap("read");
     let Some(first) = states.first() else {
         let (headers, _) = carried.prepend(&a.names.columns("qdd", coords), vec![]);
         return a.out.write(&headers, &[]);
@@ -118,6 +128,10 @@ fn run_closed(a: Args, robot: robodyn::Robot) -> CliResult {
         rows.push(qdd);
         extra.push(conditioning_json(&c));
     }
+    t.lap("model");
     let (headers, rows) = carried.prepend(&a.names.columns("qdd", coords), rows);
-    a.out.write_with(&headers, &rows, &extra)
+    a.out.write_with(&headers, &rows, &extra)?;
+    t.lap("write");
+    t.report(states.len());
+    Ok(())
 }

@@ -8,7 +8,7 @@
 
 use crate::common::{
     conditioning_json, read_joint_states, result_rows, start_branch, state_column,
-    warn_conditioning, CliResult, NamesArg, RobotArgs, TableOutput,
+    warn_conditioning, CliResult, NamesArg, Phases, RobotArgs, TableOutput, TimingsArg,
 };
 use robodyn::{closed_inverse_dynamics_into, inverse_dynamics_batch, ClosedChain, ClosedData};
 use std::path::PathBuf;
@@ -39,12 +39,16 @@ pub struct Args {
     /// (passive tree joints in order) instead of the robot's `assembly`.
     #[arg(long, allow_hyphen_values = true)]
     pub guess: Option<String>,
+    #[command(flatten)]
+    pub timings: TimingsArg,
 }
 
 pub fn run(a: Args) -> CliResult {
+    let mut t = Phases::start(a.timings);
     let robot = a.robot.load()?;
+    t.lap("robot");
     if !robot.is_tree() {
-        return run_closed(a, robot);
+        return run_closed(a, robot, t);
     }
     let coords = robot.coordinates();
     let (states, carried) = read_joint_states(
@@ -55,19 +59,24 @@ pub fn run(a: Args) -> CliResult {
         a.names,
         "movable joints",
     )?;
+    t.lap("read");
     // every row at once over the cores (the library's batch; errors name their row)
     let (n, col) = (coords.len(), |i| state_column(&states, i));
     let mut tau = vec![0.0; states.len() * n];
     let env = robot.environment();
     inverse_dynamics_batch(&robot, env, &col(0), &col(1), &col(2), &mut tau)?;
+    t.lap("model");
     let rows = result_rows(&tau, n, states.len());
     let (headers, rows) = carried.prepend(&a.names.columns("tau", coords), rows);
-    a.out.write(&headers, &rows)
+    a.out.write(&headers, &rows)?;
+    t.lap("write");
+    t.report(states.len());
+    Ok(())
 }
 
 /// Closed chains: columns of the actuated joints in, tau<j> of the actuated joints out, every
 /// row on the branch tracker (library: continuation from the previous row).
-fn run_closed(a: Args, robot: robodyn::Robot) -> CliResult {
+fn run_closed(a: Args, robot: robodyn::Robot, mut t: Phases) -> CliResult {
     let chain = ClosedChain::new(&robot)?;
     let coords = chain.coordinates();
     let (states, carried) = read_joint_states(
@@ -78,6 +87,7 @@ fn run_closed(a: Args, robot: robodyn::Robot) -> CliResult {
         a.names,
         "actuated joints (closed chain)",
     )?;
+    t.lap("read");
     let Some(first) = states.first() else {
         let (headers, _) = carried.prepend(&a.names.columns("tau", coords), vec![]);
         return a.out.write(&headers, &[]);
@@ -95,6 +105,10 @@ fn run_closed(a: Args, robot: robodyn::Robot) -> CliResult {
         rows.push(tau);
         extra.push(conditioning_json(&c));
     }
+    t.lap("model");
     let (headers, rows) = carried.prepend(&a.names.columns("tau", coords), rows);
-    a.out.write_with(&headers, &rows, &extra)
+    a.out.write_with(&headers, &rows, &extra)?;
+    t.lap("write");
+    t.report(states.len());
+    Ok(())
 }

@@ -57,7 +57,7 @@ fn to_json(d: &RobotDescription, s: &robodyn::model::Structure) -> serde_json::V
                 "role": role(d, i + 1),
             });
             for (k, e) in f.geometric().iter().enumerate() {
-                o[GEOMETRIC_PARAMETERS[k]] = json!(e.to_string());
+                o[GEOMETRIC_PARAMETERS[k]] = json!(e.decimal().to_string());
             }
             o
         })
@@ -69,10 +69,10 @@ fn to_json(d: &RobotDescription, s: &robodyn::model::Structure) -> serde_json::V
         .map(|(i, l)| {
             let mut o = json!({ "j": i + 1, "name": l.name });
             for (k, e) in l.params.iter().enumerate() {
-                o[STANDARD_PARAMETERS[k]] = json!(e.to_string());
+                o[STANDARD_PARAMETERS[k]] = json!(e.decimal().to_string());
             }
             for (k, e) in l.wrench.iter().enumerate() {
-                o[robodyn::model::WRENCH_COMPONENTS[k]] = json!(e.to_string());
+                o[robodyn::model::WRENCH_COMPONENTS[k]] = json!(e.decimal().to_string());
             }
             o
         })
@@ -83,7 +83,7 @@ fn to_json(d: &RobotDescription, s: &robodyn::model::Structure) -> serde_json::V
         "nl": d.nl,
         "nj": d.nj,
         "nf": d.nf(),
-        "gravity": d.gravity.iter().map(|e| e.to_string()).collect::<Vec<_>>(),
+        "gravity": d.gravity.iter().map(|e| e.decimal().to_string()).collect::<Vec<_>>(),
         "symbols": d.symbols,
         "frames": frames,
         "links": links,
@@ -182,9 +182,10 @@ fn text(d: &RobotDescription, s: &robodyn::model::Structure) -> String {
             };
             r.push(match var {
                 Some(v) if e.is_zero() => v,
-                Some(v) if expr(e) == e.to_string() => {
-                    (robodyn::Expr::symbol(v) + (*e).clone()).to_string()
-                }
+                Some(v) if expr(e) == e.decimal().to_string() => (robodyn::Expr::symbol(v)
+                    + (*e).clone())
+                .decimal()
+                .to_string(),
                 Some(v) => format!("{v} + {}", expr(e)).replace("+ -", "- "),
                 None => expr(e),
             });
@@ -270,11 +271,14 @@ fn short(x: f64) -> String {
     crate::common::format_number(x)
 }
 
-/// An expression for reading: a number (`0.22094100000000003`, `-981/100`) by [`short`], an
-/// expression with symbols or constants such as `pi/2` as written.
+/// An expression for reading: a float (`0.22094100000000003`) by [`short`], a rational by its
+/// exact decimal (`-9.81`) or, without one, as written (`1/3`), an expression with symbols or
+/// constants such as `pi/2` as written.
 fn expr(e: &robodyn::Expr) -> String {
-    let s = e.to_string();
-    if s.bytes().any(|b| b.is_ascii_alphabetic() && b != b'e') {
+    let s = e.decimal().to_string();
+    if s.bytes()
+        .any(|b| (b.is_ascii_alphabetic() && b != b'e') || b == b'/')
+    {
         return s;
     }
     match e.eval(&|_| None) {

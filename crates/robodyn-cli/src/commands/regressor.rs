@@ -8,7 +8,8 @@
 //! every loop (the numerical method is then the arbiter).
 
 use crate::common::{
-    read_joint_states, state_column, warn_conditioning, CliResult, NamesArg, RobotArgs, TableOutput,
+    read_joint_states, state_column, warn_conditioning, CliResult, NamesArg, Phases, RobotArgs,
+    TableOutput, TimingsArg,
 };
 use robodyn::algorithms::regressor::{
     base_columns, standard_columns, ParameterSelection, RotorMode, ZeroParameters, PARAMS_PER_LINK,
@@ -37,9 +38,12 @@ pub struct Args {
     pub out: TableOutput,
     #[command(flatten)]
     pub names: NamesArg,
+    #[command(flatten)]
+    pub timings: TimingsArg,
 }
 
 pub fn run(a: Args) -> CliResult {
+    let mut t = Phases::start(a.timings);
     let robot = a.robot.load()?;
     let nl = robot.nl();
     // a literal 0 in a SYMORO file means the parameter does not exist (docs/robot-format.md)
@@ -65,6 +69,7 @@ pub fn run(a: Args) -> CliResult {
         Some(c) => c.coordinates(),
         None => robot.coordinates(),
     };
+    t.lap("robot");
     let (states, carried) = read_joint_states(
         Some(&a.input),
         ["q", "qd", "qdd"],
@@ -73,6 +78,7 @@ pub fn run(a: Args) -> CliResult {
         a.names,
         "joints",
     )?;
+    t.lap("read");
     let n = coords.len();
     let cols = PARAMS_PER_LINK * nl;
     let mut phi = nalgebra::DMatrix::zeros(n, cols);
@@ -132,5 +138,9 @@ pub fn run(a: Args) -> CliResult {
         .chain(["state", "joint", "tau_e"].iter().map(|s| s.to_string()))
         .chain(columns.names)
         .collect();
-    a.out.write(&headers, &rows)
+    t.lap("model");
+    a.out.write(&headers, &rows)?;
+    t.lap("write");
+    t.report(states.len());
+    Ok(())
 }

@@ -26,6 +26,7 @@ from ._robodyn import (
     SingularConfiguration,
     SingularityWarning,
     __version__,
+    base_parameters,
     load,
 )
 
@@ -46,5 +47,6 @@ __all__ = [
     "SingularConfiguration",
     "SingularityWarning",
     "__version__",
+    "base_parameters",
     "load",
 ]

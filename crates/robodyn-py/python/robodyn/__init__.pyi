@@ -69,7 +69,16 @@ class SingularityWarning(UserWarning):
 def load(path: Union[str, PathLike], **values: float) -> Robot:
     """Read a robot file (TOML, SYMORO .par or URDF, by extension); ``values`` give or change
     symbol values (``robodyn.load("robots/sr400.toml", d3=0.6)``). Raises RobotFileError with
-    the file and line of a bad entry."""
+    the file and line of a bad entry; for a file whose symbols lack values (a SYMORO file of
+    symbols only) the message lists them: give them as keyword arguments, or use
+    ``base_parameters(path)``, which needs none."""
+
+def base_parameters(path: Union[str, PathLike], method: str = "symbolic", friction: bool = True, rotor: str = "actuated", zeros: Optional[str] = None, seed: int = 1, **values: float) -> BaseParameters:
+    """Base inertial parameters of a robot file, with or without numeric values (the CLI's
+    ``robodyn base-params``): method "symbolic" works on the symbols; "numeric" and "both" take
+    generic values for geometry symbols without one (said in ``notes``: the count and grouping
+    then hold for generic geometry, and ``coefficients`` is None). ``values`` give symbol values.
+    For a loaded robot, ``Robot.base_parameters`` is the same on its values."""
 
 class Robot:
     """A robot model: a tree, or the equivalent tree of a closed chain (use ``ClosedChain(robot)``

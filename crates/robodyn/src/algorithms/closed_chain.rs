@@ -668,6 +668,17 @@ impl ClosedChain {
         }
     }
 
+    /// A_tr (composite links, into `d.tree.a`) at `d.q_tr` and A_cl = G^T A_tr G (10.46) into
+    /// `d.a_cl`, G of the tracker's point (small products written out: nalgebra's gemm packs its
+    /// operands on the heap).
+    fn a_cl_into(&self, d: &mut ClosedData) {
+        let mut a_tr = std::mem::replace(&mut d.tree.a, DMatrix::zeros(0, 0));
+        composite_inertia_matrix(self.robot().numeric(), &mut d.tree, &d.q_tr, &mut a_tr);
+        mul_into(&a_tr, &d.g, &mut d.ag);
+        tr_mul_into(&d.g, &d.ag, &mut d.a_cl);
+        d.tree.a = a_tr;
+    }
+
     fn direct_into(
         &self,
         d: &mut ClosedData,
@@ -687,9 +698,9 @@ impl ClosedChain {
         d.zeros_n = z;
         r?;
         let model = self.robot().numeric();
-        // A_tr by composite links, H_tr = Γ_tr(q, qd, 0) (10.32)
-        let mut a_tr = std::mem::replace(&mut d.tree.a, DMatrix::zeros(0, 0));
-        composite_inertia_matrix(model, &mut d.tree, &d.q_tr, &mut a_tr);
+        // A_tr by composite links and A_cl = G^T A_tr G (10.46); H_tr = Γ_tr(q, qd, 0) (10.32)
+        self.a_cl_into(d);
+        let a_tr = std::mem::replace(&mut d.tree.a, DMatrix::zeros(0, 0));
         let z = std::mem::take(&mut d.tree.zeros);
         rnea_with_environment(
             model,
@@ -707,10 +718,7 @@ impl ClosedChain {
                 d.tau_tr[j - 1] -= model.link(j).fs * (s.sign() - (s / v).tanh());
             }
         }
-        // (10.46): A_cl = G^T A_tr G; (10.47): H_cl = G^T (H_tr + A_tr qdd0)
-        // (small products written out: nalgebra's gemm packs its operands on the heap)
-        mul_into(&a_tr, &d.g, &mut d.ag);
-        tr_mul_into(&d.g, &d.ag, &mut d.a_cl);
+        // (10.47): H_cl = G^T (H_tr + A_tr qdd0)
         for r in 0..d.nl {
             let mut v = d.tau_tr[r];
             for c in 0..d.nl {
@@ -1064,6 +1072,37 @@ pub fn closed_inverse_dynamics(
         gamma_cl_lagrange,
         state,
     })
+}
+
+/// Inertia matrix of the closed chain, A_cl = G^T A_tr G (10.46), N x N over the actuated
+/// joints, at `q_a`: the loops closed on the branch tracker (continued from its point), A_tr by
+/// composite links at the consistent tree configuration. Allocation-free; errors as
+/// [`closed_direct_dynamics_into`] for the closure.
+pub fn closed_inertia_matrix_into(
+    chain: &ClosedChain,
+    data: &mut ClosedData,
+    branch: &mut Branch,
+    q_a: &[f64],
+    a_cl: &mut DMatrix<f64>,
+) -> Result<Conditioning> {
+    chain.check_data(data, branch)?;
+    chain.coords.check("q_a", q_a, "actuated joints")?;
+    let n = chain.dof();
+    if a_cl.shape() != (n, n) {
+        return Err(Error::dimension(
+            "A_cl",
+            n * n,
+            a_cl.len(),
+            format!("{n} x {n} (actuated joints)"),
+        ));
+    }
+    chain.track(data, branch, q_a)?;
+    chain
+        .closure
+        .assemble(&branch.q_a, &branch.q_p, &mut data.q_tr);
+    chain.a_cl_into(data);
+    a_cl.copy_from(&data.a_cl);
+    Ok(chain.conditioning(branch, None))
 }
 
 /// Closed-chain direct dynamic model into `qdd_a`: qdd_a = A_cl^-1 (Γ_cl - H_cl) (10.46–10.48,

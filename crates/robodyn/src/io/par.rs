@@ -1179,19 +1179,21 @@ pub fn write_description(desc: &RobotDescription) -> String {
                     if e.is_zero() {
                         format!("{pre}{j}")
                     } else {
-                        (Expr::symbol(format!("{pre}{j}")) + e.clone()).to_string()
+                        (Expr::symbol(format!("{pre}{j}")) + e.clone())
+                            .decimal()
+                            .to_string()
                     }
                 };
                 match *p {
-                    "b" => f.b.to_string(),
-                    "d" => f.d.to_string(),
-                    "gamma" => f.gamma.to_string(),
-                    "alpha" => f.alpha.to_string(),
+                    "b" => f.b.decimal().to_string(),
+                    "d" => f.d.decimal().to_string(),
+                    "gamma" => f.gamma.decimal().to_string(),
+                    "alpha" => f.alpha.decimal().to_string(),
                     "mu" => u8::from(f.actuated).to_string(),
                     "r" if f.joint == JointType::Prismatic && j <= desc.nj => var(pri, &f.r),
-                    "r" => f.r.to_string(),
+                    "r" => f.r.decimal().to_string(),
                     _ if f.joint == JointType::Revolute && j <= desc.nj => var(rev, &f.theta),
-                    _ => f.theta.to_string(),
+                    _ => f.theta.decimal().to_string(),
                 }
             })
             .collect();
@@ -1210,13 +1212,13 @@ pub fn write_description(desc: &RobotDescription) -> String {
             .into_iter()
             .chain(desc.links.iter().map(|l| {
                 match STANDARD_PARAMETERS.iter().position(|p| *p == name) {
-                    Some(k) => l.params[k].to_string(),
+                    Some(k) => l.params[k].decimal().to_string(),
                     None => {
                         let k = WRENCH_COMPONENTS
                             .iter()
                             .position(|p| *p == name)
                             .expect("known");
-                        l.wrench[k].to_string()
+                        l.wrench[k].decimal().to_string()
                     }
                 }
             }))
@@ -1237,14 +1239,19 @@ pub fn write_description(desc: &RobotDescription) -> String {
     ] {
         s.push_str(&format!(
             "{name} = {}\n",
-            list(v.iter().map(|e| e.to_string()).collect())
+            list(v.iter().map(|e| e.decimal().to_string()).collect())
         ));
     }
     s.push_str("\n(* Matrix Z *)\nZ = {1,0,0,0,0,1,0,0,0,0,1,0,0,0,0,1}\n");
     s.push_str("\n(* Acceleration of gravity *)\n");
     s.push_str(&format!(
         "G = {}\n",
-        list(desc.gravity.iter().map(|e| e.to_string()).collect())
+        list(
+            desc.gravity
+                .iter()
+                .map(|e| e.decimal().to_string())
+                .collect()
+        )
     ));
     let default_frame = |j: usize, n: &str| n == format!("j{j}");
     if desc

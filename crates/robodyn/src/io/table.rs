@@ -62,17 +62,24 @@ impl Table {
             }
         }
         let mut rows = Vec::new();
-        for rec in rdr.records() {
-            let rec = rec.map_err(csv_err)?;
+        // one record reused for every row (no allocation per row but the row itself), fields
+        // as bytes: a number is ASCII, anything else is refused below with its text
+        let mut rec = csv::ByteRecord::new();
+        while rdr.read_byte_record(&mut rec).map_err(csv_err)? {
+            rec.trim();
             let line = rec.position().map(|p| p.line());
             let mut row = Vec::with_capacity(headers.len());
             for (k, field) in rec.iter().enumerate() {
-                let x: f64 = field.parse().map_err(|_| {
-                    err(
-                        line,
-                        format!("column `{}`: `{field}` is not a number", headers[k]),
-                    )
-                })?;
+                let text = || String::from_utf8_lossy(field);
+                let x: f64 = std::str::from_utf8(field)
+                    .ok()
+                    .and_then(|f| f.parse().ok())
+                    .ok_or_else(|| {
+                        err(
+                            line,
+                            format!("column `{}`: `{}` is not a number", headers[k], text()),
+                        )
+                    })?;
                 if !x.is_finite() {
                     return Err(err(
                         line,

@@ -15,7 +15,7 @@ use crate::model::{
     GEOMETRIC_PARAMETERS, STANDARD_PARAMETERS, WRENCH_COMPONENTS,
 };
 use crate::Robot;
-use robodyn_symbolic::Expr;
+use robodyn_symbolic::{Expr, Node};
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::ops::Range;
@@ -656,13 +656,21 @@ fn toml_string(s: &str) -> String {
     toml::Value::String(s.to_string()).to_string()
 }
 
-/// A value: a number as a TOML number (exact integers as integers), otherwise the expression
-/// as a string.
+/// A value as it reads back to the same expression: an integer as a TOML integer, a float or
+/// a rational with an exact decimal (`0.705`, read as 141/200) as a TOML float, anything else
+/// (`1/3`, `pi/2`, `d3 + 0.1`) as an expression string, decimals where they are exact.
 fn fmt_value(e: &Expr) -> String {
-    match e.as_f64() {
-        Some(x) if e.as_rational().is_some_and(|r| r.is_integer()) => format!("{x}"),
-        Some(x) => format!("{x:?}"),
-        None => toml_string(&e.to_string()),
+    match e.node() {
+        Node::Rational(r) if r.is_integer() => r.numer().to_string(),
+        Node::Float(x) => format!("{x:?}"),
+        _ => {
+            let t = e.decimal().to_string();
+            if e.is_number() && t.parse::<f64>().is_ok() {
+                t
+            } else {
+                toml_string(&t)
+            }
+        }
     }
 }
 

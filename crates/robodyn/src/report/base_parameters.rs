@@ -158,8 +158,12 @@ pub fn latex(r: &Summary) -> String {
         }
         s.push_str("\\end{tabular}}\n");
     }
+    // visible in the document (the tolerance applied to float terms is one of them)
     for n in &r.notes {
-        s.push_str(&format!("% Note: {n}\n"));
+        let t = latex_text(n)
+            .replace('^', "\\textasciicircum{}")
+            .replace('~', "\\textasciitilde{}");
+        s.push_str(&format!("\n\\noindent{{\\small Note: {t}}}\\par\n"));
     }
     s
 }

@@ -22,14 +22,26 @@ pub trait TrajectorySink {
 /// 49 digits), whole numbers below 1e15 as integers (`1`, `-3`), and `0` for both zeros (no `-0`).
 /// Non-finite values are `NaN`, `inf`, `-inf`.
 pub fn format_number(x: f64) -> String {
-    if x == 0.0 {
-        "0".into()
-    } else if x.fract() == 0.0 && x.abs() < 1e15 {
-        format!("{}", x as i64)
-    } else {
-        // Debug is Display's shortest round-trip digits, switching to an exponent for very
-        // small and very large magnitudes
-        format!("{x:?}")
+    Number(x).to_string()
+}
+
+/// [`format_number`] as a `Display`, written in place (`write!(out, "{}", Number(x))`: no
+/// allocation per number).
+#[derive(Clone, Copy, Debug)]
+pub struct Number(pub f64);
+
+impl std::fmt::Display for Number {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let x = self.0;
+        if x == 0.0 {
+            f.write_str("0")
+        } else if x.fract() == 0.0 && x.abs() < 1e15 {
+            write!(f, "{}", x as i64)
+        } else {
+            // Debug is Display's shortest round-trip digits, switching to an exponent for very
+            // small and very large magnitudes
+            write!(f, "{x:?}")
+        }
     }
 }
 

@@ -50,7 +50,9 @@ pub use numeric::{
     numeric_base_parameters, ConsistentSample, NumericBase, NumericOptions, Sampler, TreeSampler,
 };
 pub use summary::{base_robot, compare_methods, standard_values, MethodComparison, Summary};
-pub use symbolic::{collect_by_coefficient, symbolic_base_parameters, SymbolicBase};
+pub use symbolic::{
+    collect_by_coefficient, symbolic_base_parameters, SymbolicBase, FLOAT_TERM_TOLERANCE,
+};
 
 use crate::error::{Error, Result};
 use crate::model::{JointType, Robot, RobotDescription};

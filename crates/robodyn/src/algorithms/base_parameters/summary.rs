@@ -105,10 +105,13 @@ impl Summary {
         }
         if sb.dropped_float_terms > 0 {
             notes.push(format!(
-                "{} grouping term(s) with a float coefficient below {:e} times the largest \
-                 coefficient of their equation were taken as 0 (rounding of the file's floats)",
+                "{} grouping term(s) with a float coefficient below the tolerance {:e} L^k were \
+                 taken as 0 (rounding noise of the file's floats; L = {} m the robot's largest \
+                 length, k the length power the coefficient's unit has; exact coefficients are \
+                 never dropped)",
                 sb.dropped_float_terms,
-                super::symbolic::FLOAT_TERM_TOLERANCE
+                super::symbolic::FLOAT_TERM_TOLERANCE,
+                short((sb.length_scale * 1e6).round() / 1e6)
             ));
         }
         Summary {

@@ -81,39 +81,114 @@ pub struct SymbolicBase {
     pub parallelograms: Vec<usize>,
     /// Terms dropped as rounding noise of the file's floats ([`FLOAT_TERM_TOLERANCE`]).
     pub dropped_float_terms: usize,
+    /// The robot's length scale L (m) the float terms were measured against: the largest
+    /// |b|, |d|, |r| of its frames (1 when every length is 0). See [`FLOAT_TERM_TOLERANCE`].
+    pub length_scale: f64,
 }
 
-/// A term of a grouping equation whose coefficient is a float (inexact: the file gave floats,
-/// as a URDF does) below this fraction of the largest coefficient of its equation is rounding
-/// noise of the geometry (e.g. 2.4e-23*YY5 from cos(pi/2) computed in floats) and is dropped.
-/// Exact coefficients are never dropped.
+/// Relative tolerance below which a grouping term with a float coefficient is rounding noise.
+///
+/// Which scale: a term `c*P` in the equation of a base parameter `T` has a coefficient with the
+/// unit m^(n_T - n_P), n the length power of a parameter's unit (kg m^2 for XX..ZZ and a
+/// revolute IA: 2; kg m for MX, MY, MZ: 1; kg for M and a prismatic IA: 0; friction: 0). The
+/// term is noise when its float coefficient (times the values of the geometric symbols it
+/// carries) satisfies |c| < tol * L^(n_T - n_P), L the robot's largest length
+/// ([`SymbolicBase::length_scale`]). The test is unit-free: the same robot in mm drops the same
+/// terms.
+///
+/// Why 1e-12 (first principles): every coefficient is a polynomial in the rotation entries
+/// (cos, sin of the file's angles, |entry| <= 1) and in lengths (|length| <= L), of degree
+/// n_T - n_P in the lengths; divided by L^(n_T - n_P) it is a sum of products of numbers of
+/// magnitude <= 1. An angle read as a float carries a relative error u = 2^-53 = 1.1e-16, so
+/// an entry that is exactly 0 (cos(pi/2)) comes out as ~6e-17 and every entry carries an
+/// absolute error of a few u; one transfer of a parameter to the antecedent (R J R^T, P P^T:
+/// sums of at most 9 products of two entries) adds ~20 u, and a parameter grouped across k
+/// links has gone through k transfers. A coefficient that is exactly 0 therefore comes out
+/// below ~20 k u * (number of grouped parameters summed, <= 13 per link) ~ 1e-13 for the
+/// chains of real robots (k <= 30): 1e-12 = 9000 u leaves an order of magnitude of margin,
+/// while a real coefficient is a length ratio or an angle the file gives to far fewer
+/// digits (1e-12 of a 1 m robot is a picometre). Not noise, and kept: a file's own rounding
+/// of an angle, e.g. the UR URDFs' `1.57079632679` for pi/2 (cos = 4.9e-12): that is the
+/// geometry the file describes. Exact coefficients (rationals, symbols, `pi/2`) are never
+/// dropped: the tolerance applies to float coefficients only.
 pub const FLOAT_TERM_TOLERANCE: f64 = 1e-12;
 
-/// `e` (expanded) without its float-noise terms, and how many were dropped.
-fn drop_float_noise(e: Expr) -> (Expr, usize) {
+/// Length power n of a parameter's unit (kg m^n): XX..ZZ 2, MX..MZ 1, M 0; IA 2 on a revolute
+/// joint, 0 on a prismatic one; FS, FV 0 (never grouped with the inertial ones).
+fn length_power(p: usize, joint: JointType) -> i32 {
+    match p {
+        XX..=ZZ => 2,
+        MX..=MZ => 1,
+        IA if joint == JointType::Revolute => 2,
+        _ => 0,
+    }
+}
+
+/// The robot's length scale: largest |b|, |d|, |r| of its frames (symbols at their values or
+/// generic values), 1 when every length is 0.
+fn length_scale(desc: &RobotDescription) -> f64 {
+    let env = |s: &str| Some(symbol_value(desc, s));
+    let l = desc
+        .frames
+        .iter()
+        .flat_map(|f| [&f.b, &f.d, &f.r])
+        .filter_map(|e| e.eval(&env).ok())
+        .fold(0.0f64, |m, x| m.max(x.abs()));
+    if l > 0.0 {
+        l
+    } else {
+        1.0
+    }
+}
+
+/// The value of a geometric symbol for the numeric decisions: the file's, else a generic one.
+fn symbol_value(desc: &RobotDescription, s: &str) -> f64 {
+    desc.symbols
+        .get(s)
+        .copied()
+        .unwrap_or_else(|| generic_value(s))
+}
+
+/// `e` (expanded, the equation of base parameter `target`) without its float-noise terms (see
+/// [`FLOAT_TERM_TOLERANCE`] for the scale), and how many were dropped.
+fn drop_float_noise(e: Expr, target: usize, desc: &RobotDescription, scale: f64) -> (Expr, usize) {
     let terms: Vec<Expr> = match e.node() {
         Node::Add(v) => v.clone(),
         _ => return (e, 0),
     };
-    let coef = |t: &Expr| -> (f64, bool) {
-        match t.node() {
-            Node::Mul(f) => match f[0].node() {
-                Node::Float(x) => (*x, true),
-                _ => (f[0].as_f64().unwrap_or(1.0), false),
-            },
-            Node::Float(x) => (*x, true),
-            _ => (t.as_f64().unwrap_or(1.0), false),
+    let nl = desc.nl;
+    let power = |k: usize| {
+        let j = k / PARAMS_PER_LINK + 1;
+        length_power(k % PARAMS_PER_LINK, desc.frame(j).joint)
+    };
+    let n_target = power(target);
+    let env = |s: &str| Some(symbol_value(desc, s));
+    // noise: a float leading coefficient, one parameter, |coefficient| < tol L^(n_T - n_P)
+    let is_noise = |t: &Expr| -> bool {
+        let Node::Mul(f) = t.node() else {
+            return false;
+        };
+        if !matches!(f[0].node(), Node::Float(_)) {
+            return false;
+        }
+        let params: Vec<usize> = f[1..]
+            .iter()
+            .filter_map(|x| x.as_symbol().and_then(|s| standard_index(s, nl)))
+            .collect();
+        let [param] = params[..] else {
+            return false;
+        };
+        let geometric = Expr::product(
+            f.iter()
+                .filter(|x| x.as_symbol().and_then(|s| standard_index(s, nl)).is_none())
+                .cloned(),
+        );
+        match geometric.eval(&env) {
+            Ok(c) => c.abs() < FLOAT_TERM_TOLERANCE * scale.powi(n_target - power(param)),
+            Err(_) => false,
         }
     };
-    let largest = terms.iter().map(|t| coef(t).0.abs()).fold(0.0, f64::max);
-    let keep: Vec<Expr> = terms
-        .iter()
-        .filter(|t| {
-            let (c, float) = coef(t);
-            !(float && c.abs() < FLOAT_TERM_TOLERANCE * largest)
-        })
-        .cloned()
-        .collect();
+    let keep: Vec<Expr> = terms.iter().filter(|t| !is_noise(t)).cloned().collect();
     let dropped = terms.len() - keep.len();
     if dropped == 0 {
         (e, 0)
@@ -182,14 +257,7 @@ pub fn generic_value(name: &str) -> f64 {
 
 impl Geo {
     fn new(desc: &RobotDescription, ant: &[usize]) -> Result<Geo> {
-        let env = |s: &str| {
-            Some(
-                desc.symbols
-                    .get(s)
-                    .copied()
-                    .unwrap_or_else(|| generic_value(s)),
-            )
-        };
+        let env = |s: &str| Some(symbol_value(desc, s));
         let ev = |e: &Expr| -> Result<f64> {
             e.eval(&env)
                 .map_err(|err| Error::Input(format!("cannot evaluate `{e}`: {err}")))
@@ -726,7 +794,7 @@ pub fn symbolic_base_parameters(
             rules_5_6(&ctx, j, &mut s);
         }
     }
-    Ok(s.finish(sel, unhandled_loops, &parallelograms))
+    Ok(s.finish(desc, sel, unhandled_loops, &parallelograms))
 }
 
 /// The standard parameter symbols (`XX2`, `M3`...) are the unknowns of the equations: a
@@ -777,6 +845,7 @@ impl State {
     /// Base parameters: the live parameters whose expression is not zero.
     fn finish(
         self,
+        desc: &RobotDescription,
         sel: &ParameterSelection,
         unhandled_loops: Vec<usize>,
         parallelograms: &[(Parallelogram, crate::model::ClosedLoop)],
@@ -787,12 +856,14 @@ impl State {
         let mut equations = Vec::new();
         let mut used = BTreeSet::new();
         let mut dropped_float_terms = 0;
+        let scale = length_scale(desc);
         for j in 1..=nl {
             for p in 0..PARAMS_PER_LINK {
                 if !self.alive[j - 1][p] {
                     continue;
                 }
-                let (e, dropped) = drop_float_noise(self.get(j, p).expand());
+                let target = PARAMS_PER_LINK * (j - 1) + p;
+                let (e, dropped) = drop_float_noise(self.get(j, p).expand(), target, desc, scale);
                 dropped_float_terms += dropped;
                 if e.is_zero() {
                     continue;
@@ -826,6 +897,7 @@ impl State {
             unhandled_loops,
             parallelograms: parallelograms.iter().map(|(p, _)| p.cut).collect(),
             dropped_float_terms,
+            length_scale: scale,
         }
     }
 }
