@@ -26,7 +26,9 @@ pub struct FrameConstants<T: DynScalar> {
 }
 
 impl<T: DynScalar> FrameConstants<T> {
-    /// Build from the six geometric parameters, already in scalar `T`.
+    /// Build from the six geometric parameters, already in scalar `T`. The placement of a fixed
+    /// frame is constant: it is composed into `pre_rot`, `pre_pos` here (theta0 = r0 = 0), so
+    /// that [`Self::transform`] returns it without a sine, a cosine or a product.
     pub fn new(ant: usize, joint: JointType, g: [T; 6]) -> Self {
         let [gamma, b, alpha, d, theta, r] = g;
         let (cg, sg, ca, sa) = (gamma.cos(), gamma.sin(), alpha.cos(), alpha.sin());
@@ -36,14 +38,22 @@ impl<T: DynScalar> FrameConstants<T> {
         let rx = Matrix3::new(o(), z(), z(), z(), ca.clone(), -sa.clone(), z(), sa, ca);
         let pre_rot = &rz * rx;
         let pre_pos = &rz * Vector3::new(d, z(), b);
-        FrameConstants {
+        let mut fc = FrameConstants {
             ant,
             joint,
             pre_rot,
             pre_pos,
             theta0: theta,
             r0: r,
+        };
+        if joint == JointType::Fixed {
+            let (rot, pos) = fc.transform_at(fc.theta0.clone(), fc.r0.clone());
+            fc.pre_rot = rot;
+            fc.pre_pos = pos;
+            fc.theta0 = z();
+            fc.r0 = z();
         }
+        fc
     }
 
     /// iA_j and iP_j for joint value q (eq 10.18 for the position).
@@ -52,20 +62,25 @@ impl<T: DynScalar> FrameConstants<T> {
         let (theta, r) = match self.joint {
             JointType::Revolute => (self.theta0.clone() + q.clone(), self.r0.clone()),
             JointType::Prismatic => (self.theta0.clone(), self.r0.clone() + q.clone()),
-            JointType::Fixed => (self.theta0.clone(), self.r0.clone()),
+            // composed into pre_rot, pre_pos by `new`
+            JointType::Fixed => return (self.pre_rot.clone(), self.pre_pos.clone()),
         };
         self.transform_at(theta, r)
     }
 
-    /// iA_j and iP_j for explicit theta and r.
+    /// iA_j and iP_j for explicit theta and r. pre_rot Rz(theta) column by column: with x, y, z
+    /// the columns of pre_rot it is [c x + s y, c y - s x, z] (12 products, not the 27 of a
+    /// general 3x3 product).
     #[inline]
     pub fn transform_at(&self, theta: T, r: T) -> (Matrix3<T>, Vector3<T>) {
         let (c, s) = (theta.cos(), theta.sin());
-        let z = T::zero;
-        let rz = Matrix3::new(c.clone(), -s.clone(), z(), s, c, z(), z(), z(), T::one());
-        let rot = &self.pre_rot * rz;
-        let pos = &self.pre_pos + self.pre_rot.column(2) * r;
-        (rot, pos)
+        let p = &self.pre_rot;
+        let col = |k: usize| Vector3::new(p[(0, k)].clone(), p[(1, k)].clone(), p[(2, k)].clone());
+        let (x, y, z) = (col(0), col(1), col(2));
+        let cx = &x * c.clone() + &y * s.clone();
+        let cy = y * c - x * s;
+        let pos = &self.pre_pos + &z * r;
+        (Matrix3::from_columns(&[cx, cy, z]), pos)
     }
 }
 
@@ -109,6 +124,72 @@ impl<T: DynScalar> LinkConstants<T> {
     }
 }
 
+/// Index arrays of a model's tree that the kernels walk instead of the frame structs, derived
+/// once from the antecedents ([`DynModel::build`], [`DynModel::fold_fixed`]).
+#[derive(Clone, Debug, Default)]
+pub struct TreeIndex {
+    /// lambda(j) for j = 1..NL (index 0 unused): the nearest movable proper ancestor of link j,
+    /// 0 when none (the parent array of the tree of movable joints, which is the tree of A).
+    pub movable_parent: Vec<usize>,
+    /// Link j is movable (index 0: the base, false).
+    pub movable: Vec<bool>,
+    /// The movable links in depth-first preorder from the base, children by increasing number:
+    /// the movable links of the subtree of any link are a contiguous range of it.
+    pub preorder: Vec<usize>,
+    /// `preorder[subtree[j].0..subtree[j].1]`: the movable links of link j's subtree (j and its
+    /// successors); j itself first when it is movable.
+    pub subtree: Vec<(usize, usize)>,
+    /// Every link movable and a(j) = j - 1 (a serial chain): every entry of A is an
+    /// ancestor-descendant pair, so the inertia matrix writes all of them.
+    pub serial: bool,
+}
+
+impl TreeIndex {
+    /// From the antecedents and joint types of frames 1..NL (`frames[j - 1]`).
+    pub fn new<T: DynScalar>(frames: &[FrameConstants<T>], nl: usize) -> TreeIndex {
+        let mut movable = vec![false; nl + 1];
+        let mut movable_parent = vec![0; nl + 1];
+        let mut children = vec![Vec::new(); nl + 1];
+        for j in 1..=nl {
+            let f = &frames[j - 1];
+            movable[j] = f.joint.is_movable();
+            let i = f.ant;
+            movable_parent[j] = if i == 0 || movable[i] {
+                i
+            } else {
+                movable_parent[i]
+            };
+            children[i].push(j);
+        }
+        let mut preorder = Vec::with_capacity(nl);
+        let mut subtree = vec![(0, 0); nl + 1];
+        // iterative depth-first walk: (link, children visited)
+        let mut stack = vec![(0usize, 0usize)];
+        while let Some((j, c)) = stack.pop() {
+            if c == 0 {
+                subtree[j].0 = preorder.len();
+                if movable[j] {
+                    preorder.push(j);
+                }
+            }
+            if let Some(&k) = children[j].get(c) {
+                stack.push((j, c + 1));
+                stack.push((k, 0));
+            } else {
+                subtree[j].1 = preorder.len();
+            }
+        }
+        let serial = (1..=nl).all(|j| movable[j] && frames[j - 1].ant == j - 1);
+        TreeIndex {
+            movable_parent,
+            movable,
+            preorder,
+            subtree,
+            serial,
+        }
+    }
+}
+
 /// All constants of a robot in scalar `T`: the generic layer the recursions run on.
 #[derive(Clone, Debug)]
 pub struct DynModel<T: DynScalar> {
@@ -128,6 +209,9 @@ pub struct DynModel<T: DynScalar> {
     /// Links of the description behind fixed frames whose body is folded into a movable
     /// ancestor ([`DynModel::fold_fixed`]): their external wrench is carried onto it each call.
     pub folded: Vec<FoldedLink<T>>,
+    /// Index arrays of the tree (movable parents, preorder, subtrees). Derived from `frames`:
+    /// rebuild it with [`TreeIndex::new`] after changing an antecedent or a joint type.
+    pub index: TreeIndex,
 }
 
 /// A link rigidly attached (through fixed frames only) to a movable link of a folded model.
@@ -189,7 +273,7 @@ impl<T: DynScalar> DynModel<T> {
         mut geo: impl FnMut(&Expr) -> T,
         mut link: impl FnMut(usize, usize, &Expr) -> T,
     ) -> Self {
-        let frames = desc
+        let frames: Vec<_> = desc
             .frames
             .iter()
             .map(|f| FrameConstants::new(f.ant, f.joint, f.geometric().map(&mut geo)))
@@ -229,6 +313,7 @@ impl<T: DynScalar> DynModel<T> {
         }
         DynModel {
             nl: desc.nl,
+            index: TreeIndex::new(&frames, desc.nl),
             frames,
             links,
             env,
@@ -338,6 +423,7 @@ impl DynModel<f64> {
         }
         DynModel {
             nl: frames.len(),
+            index: TreeIndex::new(&frames, frames.len()),
             frames,
             links,
             env: self.env.clone(),
