@@ -287,7 +287,7 @@ pub fn ddm_aba(
     for j in 1..=n {
         let fr = model.frame(j);
         let i = fr.ant;
-        let (rot, pos) = fr.transform(&q[j - 1]);
+        let (rot, pos) = fr.placement(&q[j - 1]);
         let rt = rot.transpose();
         let wi = rt * b.w[i];
         let wpos = b.w[i].cross(&b.w[i].cross(&pos));

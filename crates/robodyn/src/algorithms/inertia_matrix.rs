@@ -9,7 +9,7 @@
 //! Ia_j is on the diagonal. Written once over [`DynScalar`]: the symbolic generator runs it on
 //! expressions.
 
-use crate::algorithms::inverse_dynamics::{check_state, rnea_with_environment, tree_vector_map};
+use crate::algorithms::inverse_dynamics::{rnea_with_environment, tree_vector_map};
 use crate::data::{with_data, Data};
 use crate::error::Result;
 use crate::model::{inertia_to_antecedent, DynModel, Environment, JointType, Robot};
@@ -32,7 +32,7 @@ pub fn composite_links<T: DynScalar>(model: &DynModel<T>, ws: &mut Data<T>, q: &
 /// iA_j, iP_j of every link and the composite buffers initialized with the link's own inertia.
 fn link_placements<T: DynScalar>(model: &DynModel<T>, ws: &mut Data<T>, q: &[T]) {
     for j in 1..=model.nl {
-        let (rot, pos) = model.frame(j).transform(&q[j - 1]);
+        let (rot, pos) = model.frame(j).placement(&q[j - 1]);
         ws.rot[j] = rot;
         ws.pos[j] = pos;
         let l = model.link(j);
@@ -174,8 +174,9 @@ pub fn inertia_matrix_into(
     q: &[f64],
     a: &mut DMatrix<f64>,
 ) -> Result<()> {
-    check_state(robot, data, ["q", "q", "q"], [q, q, q])?;
+    data.check(robot)?;
     let c = robot.coordinates();
+    c.check("q", q, "movable joints")?;
     let n = c.len();
     if a.shape() != (n, n) {
         return Err(crate::Error::dimension(

@@ -221,7 +221,7 @@ pub(crate) fn forward_pass<T: DynScalar>(
         let j = order.as_ref().map_or(idx + 1, |o| o[idx]);
         let fr = model.frame(j);
         let i = fr.ant;
-        let (rot, pos) = fr.transform(&q[j - 1]);
+        let (rot, pos) = fr.placement(&q[j - 1]);
         // jA_i = (iA_j)^T
         let jai = rot.transpose();
         // iU_i iP_j (10.6)

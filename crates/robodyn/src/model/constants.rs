@@ -56,24 +56,53 @@ impl<T: DynScalar> FrameConstants<T> {
         fc
     }
 
-    /// iA_j and iP_j for joint value q (eq 10.18 for the position).
+    /// iA_j and iP_j for joint value q (eq 10.18 for the position), with the platform's sin and
+    /// cos: the geometric models (forward kinematics, loop closure) use it.
     #[inline]
     pub fn transform(&self, q: &T) -> (Matrix3<T>, Vector3<T>) {
-        let (theta, r) = match self.joint {
-            JointType::Revolute => (self.theta0.clone() + q.clone(), self.r0.clone()),
-            JointType::Prismatic => (self.theta0.clone(), self.r0.clone() + q.clone()),
+        match self.variables(q) {
+            Some((theta, r)) => self.transform_at(theta, r),
             // composed into pre_rot, pre_pos by `new`
-            JointType::Fixed => return (self.pre_rot.clone(), self.pre_pos.clone()),
-        };
-        self.transform_at(theta, r)
+            None => (self.pre_rot.clone(), self.pre_pos.clone()),
+        }
     }
 
-    /// iA_j and iP_j for explicit theta and r. pre_rot Rz(theta) column by column: with x, y, z
-    /// the columns of pre_rot it is [c x + s y, c y - s x, z] (12 products, not the 27 of a
-    /// general 3x3 product).
+    /// [`Self::transform`] for the dynamic recursions (Newton–Euler, composite links, articulated
+    /// bodies): sin and cos from one argument reduction ([`DynScalar::sin_cos`]), within an ulp
+    /// of the platform's and about 40 % cheaper, once per joint per call.
+    #[inline]
+    pub fn placement(&self, q: &T) -> (Matrix3<T>, Vector3<T>) {
+        match self.variables(q) {
+            Some((theta, r)) => {
+                let (s, c) = theta.sin_cos();
+                self.rotated(s, c, r)
+            }
+            None => (self.pre_rot.clone(), self.pre_pos.clone()),
+        }
+    }
+
+    /// (theta, r) for joint value q; None for a fixed frame (its placement is constant).
+    #[inline]
+    fn variables(&self, q: &T) -> Option<(T, T)> {
+        match self.joint {
+            JointType::Revolute => Some((self.theta0.clone() + q.clone(), self.r0.clone())),
+            JointType::Prismatic => Some((self.theta0.clone(), self.r0.clone() + q.clone())),
+            JointType::Fixed => None,
+        }
+    }
+
+    /// iA_j and iP_j for explicit theta and r.
     #[inline]
     pub fn transform_at(&self, theta: T, r: T) -> (Matrix3<T>, Vector3<T>) {
-        let (c, s) = (theta.cos(), theta.sin());
+        let c = theta.cos();
+        self.rotated(theta.sin(), c, r)
+    }
+
+    /// pre_rot Rz(theta), pre_pos + pre_rot [0 0 r] from s = sin(theta), c = cos(theta), column
+    /// by column: with x, y, z the columns of pre_rot, pre_rot Rz(theta) = [c x + s y, c y - s x,
+    /// z] (12 products, not the 27 of a general 3x3 product).
+    #[inline]
+    fn rotated(&self, s: T, c: T, r: T) -> (Matrix3<T>, Vector3<T>) {
         let p = &self.pre_rot;
         let col = |k: usize| Vector3::new(p[(0, k)].clone(), p[(1, k)].clone(), p[(2, k)].clone());
         let (x, y, z) = (col(0), col(1), col(2));
