@@ -270,8 +270,10 @@ pub fn inertia_to_antecedent<T: DynScalar>(
     mass: &T,
 ) -> (Matrix3<T>, Vector3<T>) {
     let m = r * ms;
-    let pm = p.dot(&m);
-    let diag = mass.clone() * p.dot(p) + pm.clone() + pm;
+    // with u = m + M p (= MS'): M p p' + m p' + p m' = p u' + m p' and
+    // M p'p + 2 p'm = p'(u + m)
+    let u = &m + p * mass.clone();
+    let diag = p.dot(&(&u + &m));
     let rj = r * j;
     let mut out = Matrix3::zeros();
     for a in 0..3 {
@@ -279,9 +281,8 @@ pub fn inertia_to_antecedent<T: DynScalar>(
             let mut v = rj[(a, 0)].clone() * r[(b, 0)].clone()
                 + rj[(a, 1)].clone() * r[(b, 1)].clone()
                 + rj[(a, 2)].clone() * r[(b, 2)].clone()
-                - (p[a].clone() * p[b].clone()) * mass.clone()
-                - m[a].clone() * p[b].clone()
-                - p[a].clone() * m[b].clone();
+                - p[a].clone() * u[b].clone()
+                - m[a].clone() * p[b].clone();
             if a == b {
                 v += diag.clone();
             } else {
@@ -290,8 +291,7 @@ pub fn inertia_to_antecedent<T: DynScalar>(
             out[(a, b)] = v;
         }
     }
-    let ms_out = m + p * mass.clone();
-    (out, ms_out)
+    (out, u)
 }
 
 impl<T: DynScalar> DynModel<T> {
