@@ -7,6 +7,7 @@ use crate::error::{Error, Result};
 use crate::model::{DynModel, Robot};
 use crate::scalar::DynScalar;
 use nalgebra::{DMatrix, Matrix3, Matrix6, Vector3, Vector6};
+use std::cell::RefCell;
 
 /// Buffers of the tree algorithms (Newton–Euler, composite links, inertia matrix, H,
 /// articulated bodies, regressor) for one model. Index j of a per-link buffer holds link/frame
@@ -35,6 +36,10 @@ pub struct Data<T: DynScalar = f64> {
     pub(crate) jc: Vec<Matrix3<T>>,
     pub(crate) msc: Vec<Vector3<T>>,
     pub(crate) mc: Vec<T>,
+    /// Column wrenches of the inertia matrix (force, moment), indexed by preorder position
+    /// ([`crate::model::TreeIndex::preorder`]).
+    pub(crate) col_f: Vec<Vector3<T>>,
+    pub(crate) col_m: Vec<Vector3<T>>,
     /// A(q) (NL x NL), then its L'DL factors.
     pub(crate) a: DMatrix<T>,
     /// A(q) and its L'DL factors for the model of the dynamic recursions (N x N over the
@@ -87,6 +92,39 @@ impl Data<f64> {
     }
 }
 
+thread_local! {
+    /// The [`Data`] of the allocating convenience functions on this thread (see [`with_data`]).
+    static SCRATCH: RefCell<Option<Data>> = const { RefCell::new(None) };
+}
+
+/// Run `f` with a [`Data`] that fits `robot`: the allocating convenience functions
+/// (`inverse_dynamics`, `inertia_matrix`, `direct_dynamics`, ...) use it instead of building a
+/// whole `Data` per call. One `Data` is kept per thread and rebuilt only when a robot of another
+/// size comes ([`Data::check`]; the sizes are all a `Data` depends on: it holds no result a later
+/// call reads, and the topology is in the model), so several robots on one thread stay correct
+/// and a thread alternating between robots of different sizes only pays the allocation it paid
+/// before. A re-entrant call (from inside `f`) gets a fresh `Data`. The kept `Data` lives until
+/// the thread ends (its size is that of the last robot: O(NL^2) for A).
+pub(crate) fn with_data<R>(robot: &Robot, f: impl FnOnce(&mut Data) -> R) -> R {
+    // `f` runs outside the borrow of the cell, so a re-entrant call finds it empty
+    let taken = SCRATCH
+        .try_with(|c| c.try_borrow_mut().ok().and_then(|mut c| c.take()))
+        .ok()
+        .flatten();
+    let mut data = match taken {
+        Some(d) if d.check(robot).is_ok() && d.a_dyn.nrows() == robot.dof() => d,
+        _ => Data::new(robot),
+    };
+    let r = f(&mut data);
+    // (after the thread's locals are destroyed, the data is simply dropped)
+    let _ = SCRATCH.try_with(|c| {
+        if let Ok(mut c) = c.try_borrow_mut() {
+            *c = Some(data);
+        }
+    });
+    r
+}
+
 impl<T: DynScalar> Data<T> {
     /// The buffers of the generic layer for a model in scalar `T` (e.g. `Expr` for the
     /// customized symbolic models).
@@ -110,6 +148,8 @@ impl<T: DynScalar> Data<T> {
             jc: vec![Matrix3::zeros(); nl + 1],
             msc: v(),
             mc: vec![T::zero(); nl + 1],
+            col_f: v(),
+            col_m: v(),
             a: DMatrix::from_element(nl, nl, T::zero()),
             a_dyn: DMatrix::from_element(0, 0, T::zero()),
             gamma: v6(),

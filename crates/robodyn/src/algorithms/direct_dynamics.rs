@@ -15,7 +15,7 @@
 
 use crate::algorithms::inertia_matrix::composite_inertia_matrix;
 use crate::algorithms::inverse_dynamics::{folded_wrench, rnea_with_environment, tree_vector_map};
-use crate::data::Data;
+use crate::data::{with_data, Data};
 use crate::error::{Error, Result};
 use crate::model::{DynModel, Environment, JointType, Robot};
 use crate::scalar::DynScalar;
@@ -54,38 +54,56 @@ fn singular(j: usize, what: &str, value: f64, scale: f64) -> Error {
     }
 }
 
-/// In-place L'DL factorization of A exploiting the tree (Featherstone's LTDL): on return the
-/// diagonal holds D and entry (i, j), j an ancestor of i, holds L_ij. Only the lower triangle is
-/// read. Rows/columns of fixed frames are skipped. Zero or negative pivot -> error naming the joint.
+/// In-place L'DL factorization of A exploiting the tree (Featherstone's LTDL), on the upper
+/// triangle: on return the diagonal holds D and entry (j, i), j a movable ancestor of i, holds
+/// L_ij. Only the upper triangle is read (A is symmetric; the lower one is left as it was), so
+/// that the entries of joint i's ancestors are one column of the column-major storage, contiguous
+/// for a serial chain. Walks the parent array of the movable joints
+/// ([`crate::model::TreeIndex::movable_parent`]); rows/columns of fixed frames are skipped. Zero
+/// or negative pivot -> error naming the joint.
 pub fn ltdl_factor(model: &DynModel<f64>, a: &mut DMatrix<f64>) -> Result<()> {
     let n = model.nl;
-    let movable = |j: usize| model.frame(j).joint.is_movable();
+    let idx = &model.index;
+    let lambda = &idx.movable_parent;
+    let h = a.as_mut_slice();
+    // entry (r, c) of links r, c (1-based) at (r - 1) + (c - 1) n
+    let at = |r: usize, c: usize| (r - 1) + (c - 1) * n;
     let scale = (1..=n)
-        .filter(|&j| movable(j))
-        .map(|j| a[(j - 1, j - 1)].abs())
+        .filter(|&j| idx.movable[j])
+        .map(|j| h[at(j, j)].abs())
         .fold(0.0, f64::max);
     for k in (1..=n).rev() {
-        if !movable(k) {
+        if !idx.movable[k] {
             continue;
         }
-        let dk = a[(k - 1, k - 1)];
+        let dk = h[at(k, k)];
         if !pivot_ok(dk, scale) {
             return Err(singular(k, "the inertia matrix A (L'DL pivot)", dk, scale));
         }
-        let mut i = model.frame(k).ant;
-        while i != 0 {
-            if movable(i) {
-                let f = a[(k - 1, i - 1)] / dk;
-                let mut j = i;
-                while j != 0 {
-                    if movable(j) {
-                        a[(i - 1, j - 1)] -= f * a[(k - 1, j - 1)];
-                    }
-                    j = model.frame(j).ant;
+        if idx.serial {
+            // ancestors of k: 1..k-1, column k rows 0..k-1; same for every ancestor i
+            let (head, tail) = h.split_at_mut((k - 1) * n);
+            let ck = &mut tail[..k - 1];
+            for i in (1..k).rev() {
+                let f = ck[i - 1] / dk;
+                let ci = &mut head[(i - 1) * n..(i - 1) * n + i];
+                for (x, y) in ci.iter_mut().zip(&ck[..i]) {
+                    *x -= f * y;
                 }
-                a[(k - 1, i - 1)] = f;
+                ck[i - 1] = f;
             }
-            i = model.frame(i).ant;
+            continue;
+        }
+        let mut i = lambda[k];
+        while i != 0 {
+            let f = h[at(i, k)] / dk;
+            let mut j = i;
+            while j != 0 {
+                h[at(j, i)] -= f * h[at(j, k)];
+                j = lambda[j];
+            }
+            h[at(i, k)] = f;
+            i = lambda[i];
         }
     }
     Ok(())
@@ -94,37 +112,36 @@ pub fn ltdl_factor(model: &DynModel<f64>, a: &mut DMatrix<f64>) -> Result<()> {
 /// Solve L'DL x = b in place after [`ltdl_factor`] (entries of fixed frames set to 0).
 pub fn ltdl_solve(model: &DynModel<f64>, a: &DMatrix<f64>, x: &mut [f64]) {
     let n = model.nl;
-    let movable = |j: usize| model.frame(j).joint.is_movable();
+    let idx = &model.index;
+    let lambda = &idx.movable_parent;
+    let h = a.as_slice();
+    let at = |r: usize, c: usize| (r - 1) + (c - 1) * n;
     for i in (1..=n).rev() {
-        if !movable(i) {
+        if !idx.movable[i] {
             x[i - 1] = 0.0;
             continue;
         }
         let xi = x[i - 1];
-        let mut j = model.frame(i).ant;
+        let mut j = lambda[i];
         while j != 0 {
-            if movable(j) {
-                x[j - 1] -= a[(i - 1, j - 1)] * xi;
-            }
-            j = model.frame(j).ant;
+            x[j - 1] -= h[at(j, i)] * xi;
+            j = lambda[j];
         }
     }
     for i in 1..=n {
-        if movable(i) {
-            x[i - 1] /= a[(i - 1, i - 1)];
+        if idx.movable[i] {
+            x[i - 1] /= h[at(i, i)];
         }
     }
     for i in 1..=n {
-        if !movable(i) {
+        if !idx.movable[i] {
             continue;
         }
-        let mut j = model.frame(i).ant;
+        let mut j = lambda[i];
         let mut s = x[i - 1];
         while j != 0 {
-            if movable(j) {
-                s -= a[(i - 1, j - 1)] * x[j - 1];
-            }
-            j = model.frame(j).ant;
+            s -= h[at(j, i)] * x[j - 1];
+            j = lambda[j];
         }
         x[i - 1] = s;
     }
@@ -270,7 +287,7 @@ pub fn ddm_aba(
     for j in 1..=n {
         let fr = model.frame(j);
         let i = fr.ant;
-        let (rot, pos) = fr.transform(&q[j - 1]);
+        let (rot, pos) = fr.placement(&q[j - 1]);
         let rt = rot.transpose();
         let wi = rt * b.w[i];
         let wpos = b.w[i].cross(&b.w[i].cross(&pos));
@@ -453,17 +470,18 @@ pub fn direct_dynamics(
     tau: &[f64],
     method: Method,
 ) -> Result<DVector<f64>> {
-    let mut data = Data::new(robot);
     let mut qdd = DVector::zeros(robot.dof());
-    direct_dynamics_into(
-        robot,
-        &mut data,
-        robot.environment(),
-        q,
-        qd,
-        tau,
-        method,
-        qdd.as_mut_slice(),
-    )?;
+    with_data(robot, |data| {
+        direct_dynamics_into(
+            robot,
+            data,
+            robot.environment(),
+            q,
+            qd,
+            tau,
+            method,
+            qdd.as_mut_slice(),
+        )
+    })?;
     Ok(qdd)
 }

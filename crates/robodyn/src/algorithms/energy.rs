@@ -171,6 +171,7 @@ pub fn convert_model<T: DynScalar>(m: &DynModel<f64>) -> DynModel<T> {
             .collect(),
         env: convert_environment(&m.env),
         link_of: m.link_of.clone(),
+        index: m.index.clone(),
         folded: m
             .folded
             .iter()

@@ -9,8 +9,8 @@
 //! Ia_j is on the diagonal. Written once over [`DynScalar`]: the symbolic generator runs it on
 //! expressions.
 
-use crate::algorithms::inverse_dynamics::{check_state, rnea_with_environment, tree_vector_map};
-use crate::data::Data;
+use crate::algorithms::inverse_dynamics::{rnea_with_environment, tree_vector_map};
+use crate::data::{with_data, Data};
 use crate::error::Result;
 use crate::model::{inertia_to_antecedent, DynModel, Environment, JointType, Robot};
 use crate::scalar::DynScalar;
@@ -22,8 +22,17 @@ use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 /// Composite link k is moved to its antecedent by [`inertia_to_antecedent`] (parallel-axis
 /// theorem).
 pub fn composite_links<T: DynScalar>(model: &DynModel<T>, ws: &mut Data<T>, q: &[T]) {
+    link_placements(model, ws, q);
+    for k in (1..=model.nl).rev() {
+        name_composite(model, ws, k);
+        add_to_antecedent(model, ws, k);
+    }
+}
+
+/// iA_j, iP_j of every link and the composite buffers initialized with the link's own inertia.
+fn link_placements<T: DynScalar>(model: &DynModel<T>, ws: &mut Data<T>, q: &[T]) {
     for j in 1..=model.nl {
-        let (rot, pos) = model.frame(j).transform(&q[j - 1]);
+        let (rot, pos) = model.frame(j).placement(&q[j - 1]);
         ws.rot[j] = rot;
         ws.pos[j] = pos;
         let l = model.link(j);
@@ -31,20 +40,21 @@ pub fn composite_links<T: DynScalar>(model: &DynModel<T>, ws: &mut Data<T>, q: &
         ws.msc[j] = l.ms.clone();
         ws.mc[j] = l.mass.clone();
     }
-    for k in (1..=model.nl).rev() {
-        // composite link k is complete (its successors, numbered after it, are in)
-        name_composite(model, ws, k);
-        let i = model.frame(k).ant;
-        if i == 0 {
-            continue;
-        }
-        let (jk, ms) =
-            inertia_to_antecedent(&ws.rot[k], &ws.pos[k], &ws.jc[k], &ws.msc[k], &ws.mc[k]);
-        let mk = ws.mc[k].clone();
-        ws.jc[i] += jk;
-        ws.msc[i] += ms;
-        ws.mc[i] += mk;
+}
+
+/// Composite link k is complete (its successors, numbered after it, are in): add it to its
+/// antecedent's.
+#[inline]
+fn add_to_antecedent<T: DynScalar>(model: &DynModel<T>, ws: &mut Data<T>, k: usize) {
+    let i = model.frame(k).ant;
+    if i == 0 {
+        return;
     }
+    let (jk, ms) = inertia_to_antecedent(&ws.rot[k], &ws.pos[k], &ws.jc[k], &ws.msc[k], &ws.mc[k]);
+    let mk = ws.mc[k].clone();
+    ws.jc[i] += jk;
+    ws.msc[i] += ms;
+    ws.mc[i] += mk;
 }
 
 /// Inertia matrix A(q) (NL x NL, tree arrays) by the composite-link method: the generic kernel,
@@ -54,6 +64,12 @@ pub fn composite_links<T: DynScalar>(model: &DynModel<T>, ws: &mut Data<T>, q: &
 /// f = z x MS^c, m = J^c z (revolute) or f = M^c z, m = MS^c x z (prismatic); A_jj is its
 /// projection on the joint axis plus Ia_j, and A_ij (= A_ji) for every ancestor i of j is the
 /// projection after transporting the wrench to R_i (eqs 10.10–10.12 with the link terms zero).
+///
+/// One backward pass k = NL..1 (as Pinocchio's CRBA): when composite link k is complete, the
+/// column wrench of k joins those of its successors (all expressed in R_k), row k of A is their
+/// projections on joint k, and then the whole subtree's column wrenches are carried to R_a(k)
+/// together ([`crate::model::TreeIndex::subtree`]: a contiguous range), independent transports
+/// rather than one dependent chain per column.
 pub fn composite_inertia_matrix<T: DynScalar>(
     model: &DynModel<T>,
     ws: &mut Data<T>,
@@ -62,43 +78,69 @@ pub fn composite_inertia_matrix<T: DynScalar>(
 ) {
     let n = model.nl;
     assert_eq!(a.shape(), (n, n), "A must be NL x NL");
-    composite_links(model, ws, q);
-    a.fill(T::zero());
-    for j in 1..=n {
-        let fr = model.frame(j);
-        let ms = &ws.msc[j];
-        let (mut f, mut m) = match fr.joint {
-            JointType::Revolute => (
-                Vector3::new(-ms.y.clone(), ms.x.clone(), T::zero()),
-                ws.jc[j].column(2).into_owned(),
-            ),
-            JointType::Prismatic => (
-                Vector3::new(T::zero(), T::zero(), ws.mc[j].clone()),
-                Vector3::new(ms.y.clone(), -ms.x.clone(), T::zero()),
-            ),
-            JointType::Fixed => continue,
-        };
-        a[(j - 1, j - 1)] = project(fr.joint, &f, &m) + model.link(j).ia.clone();
-        let mut k = j;
-        while model.frame(k).ant != 0 {
-            let fi = &ws.rot[k] * &f;
-            m = &ws.rot[k] * &m + ws.pos[k].cross(&fi);
-            f = fi;
-            k = model.frame(k).ant;
+    let idx = &model.index;
+    link_placements(model, ws, q);
+    if !idx.serial {
+        // entries of unrelated joints (and of fixed frames) are zero; a serial chain writes all
+        a.fill(T::zero());
+    }
+    let a = a.as_mut_slice();
+    for k in (1..=n).rev() {
+        let fr = model.frame(k);
+        let (s, e) = idx.subtree[k];
+        name_composite(model, ws, k);
+        if fr.joint.is_movable() {
+            // composite link k is complete: its successors were added to it
+            let ms = &ws.msc[k];
+            let (f, m) = if fr.joint == JointType::Revolute {
+                (
+                    Vector3::new(-ms.y.clone(), ms.x.clone(), T::zero()),
+                    ws.jc[k].column(2).into_owned(),
+                )
+            } else {
+                (
+                    Vector3::new(T::zero(), T::zero(), ws.mc[k].clone()),
+                    Vector3::new(ms.y.clone(), -ms.x.clone(), T::zero()),
+                )
+            };
+            // k is the first of its subtree in preorder
+            ws.col_f[s] = f;
+            ws.col_m[s] = m;
+            let r = k - 1;
+            let row = |p: usize| {
+                if fr.joint == JointType::Revolute {
+                    ws.col_m[p].z.clone()
+                } else {
+                    ws.col_f[p].z.clone()
+                }
+            };
+            a[r + r * n] = row(s) + model.link(k).ia.clone();
+            for p in s + 1..e {
+                let c = idx.preorder[p] - 1;
+                let v = row(p);
+                a[r + c * n] = v.clone();
+                a[c + r * n] = v;
+            }
+        }
+        add_to_antecedent(model, ws, k);
+        let i = fr.ant;
+        if i == 0 {
+            continue;
+        }
+        let (rot, pos) = (&ws.rot[k], &ws.pos[k]);
+        for p in s..e {
+            let fi = rot * &ws.col_f[p];
+            let mut mi = rot * &ws.col_m[p] + pos.cross(&fi);
+            let mut fi = fi;
             if T::NAMED {
-                // the wrench of column j carried to link k: named, or it would grow with the
-                // depth of the tree
-                // (by the description's link numbers)
-                let (lk, lj) = (model.wrench_link(k), model.wrench_link(j));
-                f = f.map_with_location(|c, _, x| x.named(|| format!("AF{}_{lk}_{lj}", c + 1)));
-                m = m.map_with_location(|c, _, x| x.named(|| format!("AN{}_{lk}_{lj}", c + 1)));
+                // the wrench of column j carried to link i: named, or it would grow with the
+                // depth of the tree (by the description's link numbers)
+                let (li, lj) = (model.wrench_link(i), model.wrench_link(idx.preorder[p]));
+                fi = fi.map_with_location(|c, _, x| x.named(|| format!("AF{}_{li}_{lj}", c + 1)));
+                mi = mi.map_with_location(|c, _, x| x.named(|| format!("AN{}_{li}_{lj}", c + 1)));
             }
-            let joint = model.frame(k).joint;
-            if joint.is_movable() {
-                let v = project(joint, &f, &m);
-                a[(k - 1, j - 1)] = v.clone();
-                a[(j - 1, k - 1)] = v;
-            }
+            ws.col_f[p] = fi;
+            ws.col_m[p] = mi;
         }
     }
 }
@@ -125,15 +167,6 @@ fn name_composite<T: DynScalar>(model: &DynModel<T>, ws: &mut Data<T>, k: usize)
     ws.mc[k] = ws.mc[k].clone().named(|| format!("MP{n}"));
 }
 
-#[inline]
-fn project<T: DynScalar>(joint: JointType, f: &Vector3<T>, m: &Vector3<T>) -> T {
-    match joint {
-        JointType::Revolute => m.z.clone(),
-        JointType::Prismatic => f.z.clone(),
-        JointType::Fixed => T::zero(),
-    }
-}
-
 /// Inertia matrix A(q) into `a` (N x N over the movable joints, frame order; kg m², kg, and
 /// kg m for the coupling of a revolute and a prismatic joint) by composite links, rotor inertias
 /// on the diagonal. `q` over the movable joints (rad, m). Allocation-free.
@@ -143,8 +176,9 @@ pub fn inertia_matrix_into(
     q: &[f64],
     a: &mut DMatrix<f64>,
 ) -> Result<()> {
-    check_state(robot, data, ["q", "q", "q"], [q, q, q])?;
+    data.check(robot)?;
     let c = robot.coordinates();
+    c.check("q", q, "movable joints")?;
     let n = c.len();
     if a.shape() != (n, n) {
         return Err(crate::Error::dimension(
@@ -161,10 +195,9 @@ pub fn inertia_matrix_into(
 
 /// A(q) (N x N over the movable joints); checks its input and allocates.
 pub fn inertia_matrix(robot: &Robot, q: &[f64]) -> Result<DMatrix<f64>> {
-    let mut data = Data::new(robot);
     let n = robot.dof();
     let mut a = DMatrix::zeros(n, n);
-    inertia_matrix_into(robot, &mut data, q, &mut a)?;
+    with_data(robot, |data| inertia_matrix_into(robot, data, q, &mut a))?;
     Ok(a)
 }
 
@@ -198,15 +231,9 @@ pub fn h_vector_into(
 
 /// H(q, qd) over the movable joints with the robot's environment; allocates.
 pub fn h_vector(robot: &Robot, q: &[f64], qd: &[f64]) -> Result<DVector<f64>> {
-    let mut data = Data::new(robot);
     let mut h = DVector::zeros(robot.dof());
-    h_vector_into(
-        robot,
-        &mut data,
-        robot.environment(),
-        q,
-        qd,
-        h.as_mut_slice(),
-    )?;
+    with_data(robot, |data| {
+        h_vector_into(robot, data, robot.environment(), q, qd, h.as_mut_slice())
+    })?;
     Ok(h)
 }

@@ -8,7 +8,7 @@
 //!   generic kernel over any [`DynScalar`] on tree arrays (NL entries, joint j at index j-1),
 //!   unchecked, for the customized symbolic models and automatic differentiation.
 
-use crate::data::Data;
+use crate::data::{with_data, Data};
 use crate::error::Result;
 use crate::model::{DynModel, Environment, FoldedLink, JointType, Robot};
 use crate::scalar::DynScalar;
@@ -223,7 +223,7 @@ pub(crate) fn forward_pass<T: DynScalar>(
         let n = if T::NAMED { model.wrench_link(j) } else { j };
         let fr = model.frame(j);
         let i = fr.ant;
-        let (rot, pos) = fr.transform(&q[j - 1]);
+        let (rot, pos) = fr.placement(&q[j - 1]);
         // jA_i = (iA_j)^T
         let jai = rot.transpose();
         // iU_i iP_j (10.6)
@@ -557,18 +557,20 @@ pub fn inverse_dynamics_into(
 
 /// Inverse dynamic model with the robot's own environment: Gamma (N m, N) of the movable joints
 /// (frame order) for q, qd, qdd over the movable joints. Allocates; use
-/// [`inverse_dynamics_into`] in loops.
+/// [`inverse_dynamics_into`] in loops (this form allocates only its result: its buffers are
+/// the thread's kept [`Data`]).
 pub fn inverse_dynamics(robot: &Robot, q: &[f64], qd: &[f64], qdd: &[f64]) -> Result<DVector<f64>> {
-    let mut data = Data::new(robot);
     let mut tau = DVector::zeros(robot.dof());
-    inverse_dynamics_into(
-        robot,
-        &mut data,
-        robot.environment(),
-        q,
-        qd,
-        qdd,
-        tau.as_mut_slice(),
-    )?;
+    with_data(robot, |data| {
+        inverse_dynamics_into(
+            robot,
+            data,
+            robot.environment(),
+            q,
+            qd,
+            qdd,
+            tau.as_mut_slice(),
+        )
+    })?;
     Ok(tau)
 }

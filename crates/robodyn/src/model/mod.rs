@@ -8,7 +8,9 @@ mod description;
 mod environment;
 mod structure;
 
-pub use constants::{inertia_to_antecedent, DynModel, FoldedLink, FrameConstants, LinkConstants};
+pub use constants::{
+    inertia_to_antecedent, DynModel, FoldedLink, FrameConstants, LinkConstants, TreeIndex,
+};
 pub use coordinates::Coordinates;
 pub use description::{
     param, FrameDesc, JointLimits, JointType, LinkDesc, RobotDescription, Transmission,
