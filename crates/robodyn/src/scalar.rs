@@ -22,7 +22,7 @@ pub trait DynScalar:
     fn sin(&self) -> Self;
     /// cos(x).
     fn cos(&self) -> Self;
-    /// (sin(x), cos(x)); cos is taken first (the symbolic model names C<j> before S<j>). `f64`
+    /// (sin(x), cos(x)); cos is taken first (the symbolic model names `C<j>` before `S<j>`). `f64`
     /// computes both with one argument reduction.
     #[inline]
     fn sin_cos(&self) -> (Self, Self) {
