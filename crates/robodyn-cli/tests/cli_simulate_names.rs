@@ -125,3 +125,43 @@ fn closed_chain_passive_columns_follow_the_names() {
         assert!(label.starts_with('_') && label.len() > 1, "{c} in {h:?}");
     }
 }
+
+#[test]
+fn closure_names_its_variables_by_joint_name() {
+    // `closure --names joint` names q_a, q_p, the cut joints and W's rows and columns by joint
+    // name (the file's names, `j<frame>` when it gives none); the values are those of the run
+    // named by frame number.
+    let robot = common::robot("fivebar.toml");
+    let json = |names: &str| -> serde_json::Value {
+        let out = run(&[
+            "closure",
+            &robot,
+            "--qa",
+            "0.3,2.0",
+            "--jacobian",
+            "--format",
+            "json",
+            "--names",
+            names,
+        ]);
+        serde_json::from_str(&out).unwrap()
+    };
+    let (by_frame, by_name) = (json("frame"), json("joint"));
+    let desc = robodyn::io::load(std::path::Path::new(&robot))
+        .unwrap()
+        .into_description();
+    for part in ["q_a", "q_p", "q_c"] {
+        let f = by_frame[part].as_object().unwrap();
+        let n = by_name[part].as_object().unwrap();
+        assert_eq!(f.len(), n.len());
+        assert!(!f.is_empty(), "{part}");
+        for (key, v) in f {
+            let j: usize = key[1..].parse().unwrap();
+            let named = format!("q_{}", desc.frame(j).name);
+            assert_eq!(n.get(&named), Some(v), "{part}: {key} -> {named} in {n:?}");
+        }
+    }
+    let cols = by_name["W"]["columns"].as_array().unwrap();
+    assert!(cols.iter().all(|c| c.as_str().unwrap().starts_with("q_")));
+    assert_eq!(by_name["W"]["values"], by_frame["W"]["values"]);
+}

@@ -4,7 +4,7 @@
 
 use crate::common::{
     conditioning_json, format_number, parse_list, print_out, start_branch, warn_conditioning,
-    CliResult, RobotArgs,
+    CliResult, Names, NamesArg, RobotArgs,
 };
 use robodyn::{loop_closure, ClosedChain};
 use serde_json::json;
@@ -26,6 +26,8 @@ pub struct Args {
     pub jacobian: bool,
     #[arg(long, value_enum, default_value = "text")]
     pub format: Format,
+    #[command(flatten)]
+    pub names: NamesArg,
 }
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
@@ -46,14 +48,17 @@ pub fn run(a: Args) -> CliResult {
     let pas = cc.passive_coordinates().frames();
     let cuts: Vec<usize> = cc.loops().iter().map(|l| l.topology.cut).collect();
     let (q_p, q_c) = (s.q_p.as_slice(), s.q_c.as_slice());
+    // the variable of tree frame j: `q<j>`, or `q_<joint name>` with --names joint
+    // (cut frames included: the joint name of frame j, as in the coordinate map)
+    let var = |j: &usize| match a.names.names {
+        Names::Joint => format!("q_{}", robot.description().frame(*j).name),
+        Names::Frame => format!("q{j}"),
+    };
     let mut out = String::new();
     match a.format {
         Format::Json => {
             let named = |js: &[usize], v: &[f64]| -> serde_json::Map<String, serde_json::Value> {
-                js.iter()
-                    .zip(v)
-                    .map(|(j, x)| (format!("q{j}"), json!(x)))
-                    .collect()
+                js.iter().zip(v).map(|(j, x)| (var(j), json!(x))).collect()
             };
             let mut o = json!({
                 "robot": robot.name(),
@@ -70,8 +75,8 @@ pub fn run(a: Args) -> CliResult {
                     .map(|r| w.row(r).iter().copied().collect())
                     .collect();
                 o["W"] = json!({
-                    "rows": pas.iter().map(|j| format!("q{j}")).collect::<Vec<_>>(),
-                    "columns": act.iter().map(|j| format!("q{j}")).collect::<Vec<_>>(),
+                    "rows": pas.iter().map(var).collect::<Vec<_>>(),
+                    "columns": act.iter().map(var).collect::<Vec<_>>(),
                     "values": rows,
                 });
             }
@@ -88,7 +93,7 @@ pub fn run(a: Args) -> CliResult {
             );
             let list = |out: &mut String, js: &[usize], v: &[f64]| {
                 for (j, x) in js.iter().zip(v) {
-                    outln!(out, "  q{j:<3} = {:>24}", format_number(*x));
+                    outln!(out, "  {:<4} = {:>24}", var(j), format_number(*x));
                 }
             };
             outln!(out, "actuated q_a:");
@@ -104,10 +109,7 @@ pub fn run(a: Args) -> CliResult {
                 s.conditioning.describe(cc.limits())
             );
             if let Some(w) = &w {
-                let cols: Vec<String> = act
-                    .iter()
-                    .map(|j| format!("{:>14}", format!("q{j}")))
-                    .collect();
+                let cols: Vec<String> = act.iter().map(|j| format!("{:>14}", var(j))).collect();
                 outln!(out, "W = d q_p / d q_a (10.30):");
                 outln!(out, "       {}", cols.join(" "));
                 for (r, j) in pas.iter().enumerate() {
@@ -117,7 +119,7 @@ pub fn run(a: Args) -> CliResult {
                         .iter()
                         .map(|x| format!("{:>14.6e}", x + 0.0))
                         .collect();
-                    outln!(out, "  {:<5}{}", format!("q{j}"), v.join(" "));
+                    outln!(out, "  {:<5}{}", var(j), v.join(" "));
                 }
             }
         }
