@@ -36,10 +36,10 @@ pub struct Data<T: DynScalar = f64> {
     pub(crate) jc: Vec<Matrix3<T>>,
     pub(crate) msc: Vec<Vector3<T>>,
     pub(crate) mc: Vec<T>,
-    /// Column wrenches of the inertia matrix (force, moment), indexed by preorder position
-    /// ([`crate::model::TreeIndex::preorder`]).
-    pub(crate) col_f: Vec<Vector3<T>>,
-    pub(crate) col_m: Vec<Vector3<T>>,
+    /// Column wrenches of the inertia matrix by component (fx, fy, fz, mx, my, mz), each
+    /// indexed by preorder position ([`crate::model::TreeIndex::preorder`]): a subtree's
+    /// columns are contiguous in each, so their transport is a vectorizable loop.
+    pub(crate) col: [Vec<T>; 6],
     /// A(q) (NL x NL), then its L'DL factors.
     pub(crate) a: DMatrix<T>,
     /// A(q) and its L'DL factors for the model of the dynamic recursions (N x N over the
@@ -148,8 +148,7 @@ impl<T: DynScalar> Data<T> {
             jc: vec![Matrix3::zeros(); nl + 1],
             msc: v(),
             mc: vec![T::zero(); nl + 1],
-            col_f: v(),
-            col_m: v(),
+            col: std::array::from_fn(|_| vec![T::zero(); nl + 1]),
             a: DMatrix::from_element(nl, nl, T::zero()),
             a_dyn: DMatrix::from_element(0, 0, T::zero()),
             gamma: v6(),

@@ -310,14 +310,23 @@ pub(crate) fn check_vector(
     if v.len() != n {
         return Err(Error::dimension(what, n, v.len(), context()));
     }
-    if let Some(index) = v.iter().position(|x| !x.is_finite()) {
-        return Err(Error::NotFinite {
-            what: what.into(),
-            index,
-            value: v[index],
-        });
+    // x * 0 is NaN exactly when x is not finite: a branch-free pass (an early-exit scan cost
+    // ~10 ns per vector, 10 % of a 6-joint Newton–Euler); the index is looked for on failure
+    if v.iter().fold(0.0, |acc, &x| acc + x * 0.0).is_nan() {
+        return Err(not_finite(what, v));
     }
     Ok(())
+}
+
+/// The error naming the first entry of `v` that is not finite.
+#[cold]
+fn not_finite(what: &str, v: &[f64]) -> Error {
+    let index = v.iter().position(|x| !x.is_finite()).unwrap_or(0);
+    Error::NotFinite {
+        what: what.into(),
+        index,
+        value: v[index],
+    }
 }
 
 /// The result type of the library.

@@ -177,7 +177,7 @@ pub(crate) fn rcond_cholesky(
     let n = col.len();
     let mut inv_norm: f64 = 0.0;
     for k in 0..n {
-        col.fill(0.0);
+        col.as_mut_slice().fill(0.0);
         col[k] = 1.0;
         chol.solve_mut(col);
         inv_norm = inv_norm.max(col.iter().map(|x| x.abs()).sum());

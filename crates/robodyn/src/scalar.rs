@@ -31,6 +31,15 @@ pub trait DynScalar:
     }
     /// sign(x) in {-1, 0, 1} (Coulomb friction).
     fn sign(&self) -> Self;
+    /// The sine or cosine of a constant angle with its rounding residue removed: `f64` returns
+    /// exactly 0 below 1e-15 in magnitude (cos(pi/2) is 6.1e-17 in floating point; an angle
+    /// error below 1e-15 rad), so that the constant rotations of alpha, gamma in {0, ±pi/2, pi}
+    /// have exact zeros the recursions can rely on ([`crate::model::RotationForm`]). The
+    /// identity for other scalars.
+    #[inline(always)]
+    fn snap_zero(self) -> Self {
+        self
+    }
     /// True for a scalar that records named intermediate values (the symbolic program builder):
     /// the recursions skip their naming hooks entirely when false.
     const NAMED: bool = false;
@@ -60,6 +69,14 @@ impl DynScalar for f64 {
     #[inline]
     fn sin_cos(&self) -> (Self, Self) {
         libm::sincos(*self)
+    }
+    #[inline]
+    fn snap_zero(self) -> Self {
+        if self.abs() < 1e-15 {
+            0.0
+        } else {
+            self
+        }
     }
     #[inline]
     fn sign(&self) -> Self {

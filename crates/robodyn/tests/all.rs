@@ -83,6 +83,8 @@ mod properties;
 mod regressor;
 #[path = "rnea_allocations.rs"]
 mod rnea_allocations;
+#[path = "rotation_forms.rs"]
+mod rotation_forms;
 #[path = "simulation.rs"]
 mod simulation;
 

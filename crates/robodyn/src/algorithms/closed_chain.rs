@@ -447,7 +447,7 @@ impl ClosedChain {
         let mut w = std::mem::replace(&mut d.w, DMatrix::zeros(0, 0));
         d.lu.solve_matrix(&mut w);
         d.w = w;
-        d.g.fill(0.0);
+        d.g.as_mut_slice().fill(0.0);
         for (c, &j) in lc.actuated_joints().iter().enumerate() {
             d.g[(j - 1, c)] = 1.0;
         }

@@ -151,6 +151,7 @@ pub fn convert_model<T: DynScalar>(m: &DynModel<f64>) -> DynModel<T> {
                 ant: c.ant,
                 joint: c.joint,
                 pre_rot: c.pre_rot.map(f),
+                form: c.form,
                 pre_pos: map3(&c.pre_pos),
                 theta0: f(c.theta0),
                 r0: f(c.r0),

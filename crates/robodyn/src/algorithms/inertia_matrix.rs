@@ -12,7 +12,7 @@
 use crate::algorithms::inverse_dynamics::{rnea_with_environment, tree_vector_map};
 use crate::data::{with_data, Data};
 use crate::error::Result;
-use crate::model::{inertia_to_antecedent, DynModel, Environment, JointType, Robot};
+use crate::model::{DynModel, Environment, JointType, Robot, RotationForm};
 use crate::scalar::DynScalar;
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 
@@ -50,7 +50,9 @@ fn add_to_antecedent<T: DynScalar>(model: &DynModel<T>, ws: &mut Data<T>, k: usi
     if i == 0 {
         return;
     }
-    let (jk, ms) = inertia_to_antecedent(&ws.rot[k], &ws.pos[k], &ws.jc[k], &ws.msc[k], &ws.mc[k]);
+    let (jk, ms) = model
+        .frame(k)
+        .inertia_to_antecedent(&ws.rot[k], &ws.pos[k], &ws.jc[k], &ws.msc[k], &ws.mc[k]);
     let mk = ws.mc[k].clone();
     ws.jc[i] += jk;
     ws.msc[i] += ms;
@@ -80,67 +82,151 @@ pub fn composite_inertia_matrix<T: DynScalar>(
     assert_eq!(a.shape(), (n, n), "A must be NL x NL");
     let idx = &model.index;
     link_placements(model, ws, q);
+    let a = a.as_mut_slice();
     if !idx.serial {
         // entries of unrelated joints (and of fixed frames) are zero; a serial chain writes all
+        // (on the contiguous slice: nalgebra's `fill` walks a strided iterator, 5x slower)
         a.fill(T::zero());
     }
-    let a = a.as_mut_slice();
     for k in (1..=n).rev() {
         let fr = model.frame(k);
         let (s, e) = idx.subtree[k];
         name_composite(model, ws, k);
         if fr.joint.is_movable() {
-            // composite link k is complete: its successors were added to it
+            // composite link k is complete: its successors were added to it; its column wrench
+            // (f, m), k first of its subtree in preorder
             let ms = &ws.msc[k];
-            let (f, m) = if fr.joint == JointType::Revolute {
-                (
-                    Vector3::new(-ms.y.clone(), ms.x.clone(), T::zero()),
-                    ws.jc[k].column(2).into_owned(),
-                )
-            } else {
-                (
-                    Vector3::new(T::zero(), T::zero(), ws.mc[k].clone()),
-                    Vector3::new(ms.y.clone(), -ms.x.clone(), T::zero()),
-                )
-            };
-            // k is the first of its subtree in preorder
-            ws.col_f[s] = f;
-            ws.col_m[s] = m;
-            let r = k - 1;
-            let row = |p: usize| {
-                if fr.joint == JointType::Revolute {
-                    ws.col_m[p].z.clone()
-                } else {
-                    ws.col_f[p].z.clone()
+            let c = &mut ws.col;
+            if fr.joint == JointType::Revolute {
+                let jz = ws.jc[k].column(2);
+                let f = [-ms.y.clone(), ms.x.clone(), T::zero()];
+                let m = [jz[0].clone(), jz[1].clone(), jz[2].clone()];
+                for (x, v) in c.iter_mut().zip(f.into_iter().chain(m)) {
+                    x[s] = v;
                 }
+            } else {
+                let f = [T::zero(), T::zero(), ws.mc[k].clone()];
+                let m = [ms.y.clone(), -ms.x.clone(), T::zero()];
+                for (x, v) in c.iter_mut().zip(f.into_iter().chain(m)) {
+                    x[s] = v;
+                }
+            }
+            // row k of A: the projections on joint k's axis (moment z, revolute; force z,
+            // prismatic) of its subtree's column wrenches
+            let proj = if fr.joint == JointType::Revolute {
+                &c[5]
+            } else {
+                &c[2]
             };
-            a[r + r * n] = row(s) + model.link(k).ia.clone();
+            let r = k - 1;
+            a[r + r * n] = proj[s].clone() + model.link(k).ia.clone();
             for p in s + 1..e {
-                let c = idx.preorder[p] - 1;
-                let v = row(p);
-                a[r + c * n] = v.clone();
-                a[c + r * n] = v;
+                let col = idx.preorder[p] - 1;
+                let v = proj[p].clone();
+                a[r + col * n] = v.clone();
+                a[col + r * n] = v;
             }
         }
         add_to_antecedent(model, ws, k);
         let i = fr.ant;
-        if i == 0 {
+        if i == 0 || s == e {
             continue;
         }
-        let (rot, pos) = (&ws.rot[k], &ws.pos[k]);
-        for p in s..e {
-            let fi = rot * &ws.col_f[p];
-            let mut mi = rot * &ws.col_m[p] + pos.cross(&fi);
-            let mut fi = fi;
-            if T::NAMED {
-                // the wrench of column j carried to link i: named, or it would grow with the
-                // depth of the tree (by the description's link numbers)
-                let (li, lj) = (model.wrench_link(i), model.wrench_link(idx.preorder[p]));
-                fi = fi.map_with_location(|c, _, x| x.named(|| format!("AF{}_{li}_{lj}", c + 1)));
-                mi = mi.map_with_location(|c, _, x| x.named(|| format!("AN{}_{li}_{lj}", c + 1)));
-            }
-            ws.col_f[p] = fi;
-            ws.col_m[p] = mi;
+        if T::NAMED {
+            transport_named(model, ws, k, i, s, e);
+        } else {
+            transport(fr.form, &ws.rot[k], &ws.pos[k], &mut ws.col, s, e);
+        }
+    }
+}
+
+/// Carry the column wrenches at preorder positions s..e from R_k to R_a(k) (rotation `rot` =
+/// a(k)A_k of rotation form `form`, origin `pos` = a(k)P_k): f' = R f, m' = R m + P x f'. One
+/// loop over the six component arrays with the transform's entries hoisted and the form's zeros
+/// skipped at compile time: independent iterations, vectorized for f64.
+#[inline]
+fn transport<T: DynScalar>(
+    form: RotationForm,
+    rot: &Matrix3<T>,
+    pos: &Vector3<T>,
+    col: &mut [Vec<T>; 6],
+    s: usize,
+    e: usize,
+) {
+    let r: [[T; 3]; 3] = std::array::from_fn(|i| std::array::from_fn(|j| rot[(i, j)].clone()));
+    let p = [pos.x.clone(), pos.y.clone(), pos.z.clone()];
+    match form {
+        RotationForm::General => transport_loop::<T, 3>(&r, &p, col, s, e),
+        RotationForm::Axis(0) => transport_loop::<T, 0>(&r, &p, col, s, e),
+        RotationForm::Axis(1) => transport_loop::<T, 1>(&r, &p, col, s, e),
+        RotationForm::Axis(_) => transport_loop::<T, 2>(&r, &p, col, s, e),
+    }
+}
+
+/// Row i of R v for a rotation whose row K is (0, 0, R_K2) (K < 3; K = 3: a full row).
+#[inline(always)]
+fn rot_row<T: DynScalar, const K: usize>(r: &[[T; 3]; 3], i: usize, v: [&T; 3]) -> T {
+    let ri = &r[i];
+    if K == 3 {
+        ri[0].clone() * v[0].clone() + ri[1].clone() * v[1].clone() + ri[2].clone() * v[2].clone()
+    } else if i == K {
+        ri[2].clone() * v[2].clone()
+    } else {
+        ri[0].clone() * v[0].clone() + ri[1].clone() * v[1].clone()
+    }
+}
+
+#[inline(always)]
+fn transport_loop<T: DynScalar, const K: usize>(
+    r: &[[T; 3]; 3],
+    p: &[T; 3],
+    col: &mut [Vec<T>; 6],
+    s: usize,
+    e: usize,
+) {
+    let [fx, fy, fz, mx, my, mz] = col;
+    let (fx, fy, fz) = (&mut fx[s..e], &mut fy[s..e], &mut fz[s..e]);
+    let (mx, my, mz) = (&mut mx[s..e], &mut my[s..e], &mut mz[s..e]);
+    let len = fx.len();
+    // equal lengths, stated once: no bounds check in the loop
+    assert!(fy.len() == len && fz.len() == len && mx.len() == len);
+    assert!(my.len() == len && mz.len() == len);
+    let [px, py, pz] = p;
+    for q in 0..len {
+        let g0 = rot_row::<T, K>(r, 0, [&fx[q], &fy[q], &fz[q]]);
+        let g1 = rot_row::<T, K>(r, 1, [&fx[q], &fy[q], &fz[q]]);
+        let g2 = rot_row::<T, K>(r, 2, [&fx[q], &fy[q], &fz[q]]);
+        let n0 = rot_row::<T, K>(r, 0, [&mx[q], &my[q], &mz[q]]);
+        let n1 = rot_row::<T, K>(r, 1, [&mx[q], &my[q], &mz[q]]);
+        let n2 = rot_row::<T, K>(r, 2, [&mx[q], &my[q], &mz[q]]);
+        mx[q] = n0 + py.clone() * g2.clone() - pz.clone() * g1.clone();
+        my[q] = n1 + pz.clone() * g0.clone() - px.clone() * g2.clone();
+        mz[q] = n2 + px.clone() * g1.clone() - py.clone() * g0.clone();
+        fx[q] = g0;
+        fy[q] = g1;
+        fz[q] = g2;
+    }
+}
+
+/// [`transport`] for the customized symbolic model: the wrench of column j carried to link i
+/// is named (`AF<c>_<i>_<j>`, `AN<c>_<i>_<j>`, by the description's link numbers), or it would
+/// grow with the depth of the tree.
+fn transport_named<T: DynScalar>(
+    model: &DynModel<T>,
+    ws: &mut Data<T>,
+    k: usize,
+    i: usize,
+    s: usize,
+    e: usize,
+) {
+    let form = model.frame(k).form;
+    transport(form, &ws.rot[k], &ws.pos[k], &mut ws.col, s, e);
+    let li = model.wrench_link(i);
+    for p in s..e {
+        let lj = model.wrench_link(model.index.preorder[p]);
+        for (c, x) in ws.col.iter_mut().enumerate() {
+            let (tag, comp) = if c < 3 { ("AF", c + 1) } else { ("AN", c - 2) };
+            x[p] = x[p].clone().named(|| format!("{tag}{comp}_{li}_{lj}"));
         }
     }
 }

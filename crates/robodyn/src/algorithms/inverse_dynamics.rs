@@ -224,18 +224,18 @@ pub(crate) fn forward_pass<T: DynScalar>(
         let fr = model.frame(j);
         let i = fr.ant;
         let (rot, pos) = fr.placement(&q[j - 1]);
-        // jA_i = (iA_j)^T
-        let jai = rot.transpose();
+        // products by jA_i = (iA_j)^T, zeros of the frame's rotation form skipped
+        let jai = |v: &Vector3<T>| fr.rot_tr_mul(&rot, v);
         // iU_i iP_j (10.6)
         let up = &ws.u[i] * &pos;
-        let wi = name3(&jai * &ws.w[i], "WI", n); // (10.3)
+        let wi = name3(jai(&ws.w[i]), "WI", n); // (10.3)
         let vsp = name3(&ws.vd[i] + up, "VSP", n);
-        let mut vd = &jai * vsp; // (10.6), first part
+        let mut vd = jai(&vsp); // (10.6), first part
         let share = shared.get(j - 1).and_then(Option::as_ref);
         let (w, wd) = match share {
             Some(s) => (s.rot.tr_mul(&ws.w[s.link]), s.rot.tr_mul(&ws.wd[s.link])),
             None => {
-                let mut wd = &jai * &ws.wd[i];
+                let mut wd = jai(&ws.wd[i]);
                 let mut w = wi.clone();
                 if fr.joint == JointType::Revolute {
                     // (10.4), (10.5)
@@ -369,8 +369,12 @@ pub fn backward_recursion_sharing<T: DynScalar>(
         let i = fr.ant;
         if i > 0 {
             // (10.10), (10.11)
-            let fi = name3(&ws.rot[j] * &ws.f[j], "FDI", n);
-            let mi = name3(&ws.rot[j] * &ws.m[j] + ws.pos[j].cross(&fi), "NDI", n);
+            let fi = name3(fr.rot_mul(&ws.rot[j], &ws.f[j]), "FDI", n);
+            let mi = name3(
+                fr.rot_mul(&ws.rot[j], &ws.m[j]) + ws.pos[j].cross(&fi),
+                "NDI",
+                n,
+            );
             ws.f[i] += fi;
             ws.m[i] += mi;
         }

@@ -203,7 +203,7 @@ pub fn tree_regressor(
     let nl = model.nl;
     assert_eq!(phi.shape(), (nl, PARAMS_PER_LINK * nl), "regressor size");
     forward_pass(model, env, ws, q, qd, qdd, &[]);
-    phi.fill(0.0);
+    phi.as_mut_slice().fill(0.0); // contiguous: nalgebra's `fill` walks a strided iterator
     for j in 1..=nl {
         let mut y = link_wrench_map(&ws.w[j], &ws.wd[j], &ws.vd[j]);
         let col = PARAMS_PER_LINK * (j - 1);

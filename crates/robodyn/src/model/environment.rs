@@ -155,6 +155,22 @@ impl Environment<f64> {
         ] {
             check_vector(what, v.as_slice(), 3, String::new)?;
         }
+        // x * 0 is NaN exactly when x is not finite: one branch-free pass over every
+        // component (an early-exit scan per link cost as much as a 6-joint NE); the offending
+        // link is looked for only when the sum is NaN
+        let sum = self.wrenches.iter().fold(0.0, |acc, w| {
+            let (f, m) = (&w.force, &w.moment);
+            acc + (f.x + f.y + f.z + m.x + m.y + m.z) * 0.0
+        });
+        if sum.is_nan() {
+            self.locate_non_finite_wrench()?;
+        }
+        Ok(())
+    }
+
+    /// The error naming the first link whose wrench is not finite.
+    #[cold]
+    fn locate_non_finite_wrench(&self) -> Result<()> {
         for (k, w) in self.wrenches.iter().enumerate() {
             if w.force
                 .iter()

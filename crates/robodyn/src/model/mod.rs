@@ -9,7 +9,8 @@ mod environment;
 mod structure;
 
 pub use constants::{
-    inertia_to_antecedent, DynModel, FoldedLink, FrameConstants, LinkConstants, TreeIndex,
+    inertia_to_antecedent, DynModel, FoldedLink, FrameConstants, LinkConstants, RotationForm,
+    TreeIndex,
 };
 pub use coordinates::Coordinates;
 pub use description::{
