@@ -17,7 +17,7 @@ use crate::algorithms::inertia_matrix::composite_inertia_matrix;
 use crate::algorithms::inverse_dynamics::{folded_wrench, rnea_with_environment, tree_vector_map};
 use crate::data::{with_data, Data};
 use crate::error::{Error, Result};
-use crate::model::{DynModel, Environment, FrameConstants, JointType, Robot, RotationForm};
+use crate::model::{DynModel, Environment, JointType, Robot};
 use crate::scalar::DynScalar;
 use nalgebra::{DMatrix, DVector, Matrix3, Matrix6, Vector3, Vector6};
 
@@ -212,29 +212,19 @@ fn skew(v: &Vector3<f64>) -> Matrix3<f64> {
 
 /// kT_i V: the motion V of frame i seen at O_k in R_k: [R' (v + w x p); R' w].
 #[inline]
-fn motion_to_child(
-    fr: &FrameConstants<f64>,
-    r: &Matrix3<f64>,
-    p: &Vector3<f64>,
-    v: &Vector6<f64>,
-) -> Vector6<f64> {
+fn motion_to_child(r: &Matrix3<f64>, p: &Vector3<f64>, v: &Vector6<f64>) -> Vector6<f64> {
     let lin = Vector3::new(v[0], v[1], v[2]);
     let ang = Vector3::new(v[3], v[4], v[5]);
-    let l = fr.rot_tr_mul(r, &(lin + ang.cross(p)));
-    let a = fr.rot_tr_mul(r, &ang);
+    let l = r.tr_mul(&(lin + ang.cross(p)));
+    let a = r.tr_mul(&ang);
     Vector6::new(l.x, l.y, l.z, a.x, a.y, a.z)
 }
 
 /// kT_i' F: the wrench F at O_k in R_k moved to O_i in R_i: [R f; p x R f + R m].
 #[inline]
-fn wrench_to_parent(
-    fr: &FrameConstants<f64>,
-    r: &Matrix3<f64>,
-    p: &Vector3<f64>,
-    f: &Vector6<f64>,
-) -> Vector6<f64> {
-    let fi = fr.rot_mul(r, &Vector3::new(f[0], f[1], f[2]));
-    let mi = fr.rot_mul(r, &Vector3::new(f[3], f[4], f[5])) + p.cross(&fi);
+fn wrench_to_parent(r: &Matrix3<f64>, p: &Vector3<f64>, f: &Vector6<f64>) -> Vector6<f64> {
+    let fi = r * Vector3::new(f[0], f[1], f[2]);
+    let mi = r * Vector3::new(f[3], f[4], f[5]) + p.cross(&fi);
     Vector6::new(fi.x, fi.y, fi.z, mi.x, mi.y, mi.z)
 }
 
@@ -242,16 +232,13 @@ fn wrench_to_parent(
 /// With B = R K R' blockwise and S = skew(p):
 /// [[B11, B12 - B11 S], [sym, S (B12 - B11 S) + B22 - B12' S]].
 #[inline]
-fn inertia_to_parent(
-    fr: &FrameConstants<f64>,
-    r: &Matrix3<f64>,
-    p: &Vector3<f64>,
-    k: &Matrix6<f64>,
-) -> Matrix6<f64> {
-    let block = |i: usize, j: usize| k.fixed_view::<3, 3>(i, j).into_owned();
-    let b11 = congruence(fr, r, &block(0, 0));
-    let b12 = congruence(fr, r, &block(0, 3));
-    let b22 = congruence(fr, r, &block(3, 3));
+fn inertia_to_parent(r: &Matrix3<f64>, p: &Vector3<f64>, k: &Matrix6<f64>) -> Matrix6<f64> {
+    let k11 = k.fixed_view::<3, 3>(0, 0);
+    let k12 = k.fixed_view::<3, 3>(0, 3);
+    let k22 = k.fixed_view::<3, 3>(3, 3);
+    let b11 = r * k11 * r.transpose();
+    let b12 = r * k12 * r.transpose();
+    let b22 = r * k22 * r.transpose();
     let s = skew(p);
     let c = b12 - b11 * s;
     let d = s * c + b22 - b12.transpose() * s;
@@ -261,26 +248,6 @@ fn inertia_to_parent(
     out.fixed_view_mut::<3, 3>(3, 0).copy_from(&c.transpose());
     out.fixed_view_mut::<3, 3>(3, 3).copy_from(&d);
     out
-}
-
-/// R K R^T for the rotation `r` of frame `fr`: R K column by column, then R (R K)^T = (R K R^T)^T,
-/// each a product by R with the zeros of the frame's rotation form skipped (30 products instead
-/// of 54 for an `Axis` form).
-#[inline]
-fn congruence(fr: &FrameConstants<f64>, r: &Matrix3<f64>, k: &Matrix3<f64>) -> Matrix3<f64> {
-    if fr.form == RotationForm::General {
-        return r * k * r.transpose();
-    }
-    let rk = Matrix3::from_columns(&[
-        fr.rot_mul(r, &k.column(0).into_owned()),
-        fr.rot_mul(r, &k.column(1).into_owned()),
-        fr.rot_mul(r, &k.column(2).into_owned()),
-    ]);
-    Matrix3::from_rows(&[
-        fr.rot_mul(r, &rk.row(0).transpose()).transpose(),
-        fr.rot_mul(r, &rk.row(1).transpose()).transpose(),
-        fr.rot_mul(r, &rk.row(2).transpose()).transpose(),
-    ])
 }
 
 /// Index of the joint axis a_j in a [linear; angular] spatial vector.
@@ -321,9 +288,10 @@ pub fn ddm_aba(
         let fr = model.frame(j);
         let i = fr.ant;
         let (rot, pos) = fr.placement(&q[j - 1]);
-        let wi = fr.rot_tr_mul(&rot, &b.w[i]);
+        let rt = rot.transpose();
+        let wi = rt * b.w[i];
         let wpos = b.w[i].cross(&b.w[i].cross(&pos));
-        let mut lin = fr.rot_tr_mul(&rot, &wpos);
+        let mut lin = rt * wpos;
         let mut ang = Vector3::zeros();
         let mut w = wi;
         let s = qd[j - 1];
@@ -397,8 +365,8 @@ pub fn ddm_aba(
         };
         let i = fr.ant;
         if i != 0 {
-            b.art_inertia[i] += inertia_to_parent(fr, &b.rot[k], &b.pos[k], &kk);
-            b.art_bias[i] += wrench_to_parent(fr, &b.rot[k], &b.pos[k], &alpha);
+            b.art_inertia[i] += inertia_to_parent(&b.rot[k], &b.pos[k], &kk);
+            b.art_bias[i] += wrench_to_parent(&b.rot[k], &b.pos[k], &alpha);
         }
     }
     // Forward: accelerations.
@@ -407,7 +375,7 @@ pub fn ddm_aba(
     b.acc[0] = Vector6::new(g.x, g.y, g.z, wp0.x, wp0.y, wp0.z);
     for j in 1..=n {
         let fr = model.frame(j);
-        let mut acc = motion_to_child(fr, &b.rot[j], &b.pos[j], &b.acc[fr.ant]) + b.gamma[j];
+        let mut acc = motion_to_child(&b.rot[j], &b.pos[j], &b.acc[fr.ant]) + b.gamma[j];
         match axis_index(fr.joint) {
             Some(ax) => {
                 let a = (b.art_tau[j] - b.art_u[j].dot(&acc) - b.art_bias[j][ax]) / b.art_d[j];
