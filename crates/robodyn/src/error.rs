@@ -310,9 +310,9 @@ pub(crate) fn check_vector(
     if v.len() != n {
         return Err(Error::dimension(what, n, v.len(), context()));
     }
-    // x * 0 is NaN exactly when x is not finite: a branch-free pass (an early-exit scan cost
-    // ~10 ns per vector, 10 % of a 6-joint Newton–Euler); the index is looked for on failure
-    if v.iter().fold(0.0, |acc, &x| acc + x * 0.0).is_nan() {
+    // a branch-free pass, vectorizable (an early-exit scan cost ~10 ns per vector, 10 % of a
+    // 6-joint Newton–Euler); the index is looked for on failure
+    if v.iter().fold(false, |bad, x| bad | !x.is_finite()) {
         return Err(not_finite(what, v));
     }
     Ok(())

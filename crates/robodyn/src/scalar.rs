@@ -40,6 +40,12 @@ pub trait DynScalar:
     fn snap_zero(self) -> Self {
         self
     }
+    /// False for an infinite or NaN number; true for a scalar that is not a number (an
+    /// expression).
+    #[inline(always)]
+    fn is_finite(&self) -> bool {
+        true
+    }
     /// True for a scalar that records named intermediate values (the symbolic program builder):
     /// the recursions skip their naming hooks entirely when false.
     const NAMED: bool = false;
@@ -69,6 +75,10 @@ impl DynScalar for f64 {
     #[inline]
     fn sin_cos(&self) -> (Self, Self) {
         libm::sincos(*self)
+    }
+    #[inline]
+    fn is_finite(&self) -> bool {
+        f64::is_finite(*self)
     }
     #[inline]
     fn snap_zero(self) -> Self {

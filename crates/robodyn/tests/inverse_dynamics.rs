@@ -383,3 +383,43 @@ fn bad_input_is_an_error() {
         Err(Error::NotFinite { .. })
     ));
 }
+
+/// A wrench that is not finite is refused at the call, naming its link, by every tree function
+/// that takes the environment; setting it back to a finite value (or clearing) makes the same
+/// environment usable again: the count of non-finite wrenches the setters keep follows them.
+#[test]
+fn non_finite_wrench_is_refused_until_replaced() {
+    let robot = sr400();
+    let n = robot.dof();
+    let mut data = Data::new(&robot);
+    let (q, mut tau) = (vec![0.3; n], vec![0.0; n]);
+    let mut env = robot.environment().clone();
+    let call = |env: &robodyn::Environment, data: &mut Data, tau: &mut [f64]| {
+        inverse_dynamics_into(&robot, data, env, &q, &q, &q, tau)
+    };
+    assert!(call(&env, &mut data, &mut tau).is_ok());
+    env.set_wrench_by_link(3, [f64::NAN, 0.0, 0.0].into(), [0.0; 3].into())
+        .unwrap();
+    env.set_wrench_by_link(4, [0.0; 3].into(), [0.0, f64::INFINITY, 0.0].into())
+        .unwrap();
+    let err = call(&env, &mut data, &mut tau).unwrap_err().to_string();
+    assert!(
+        err.contains("link 3") && err.contains("not finite"),
+        "{err}"
+    );
+    env.set_wrench_by_link(3, [1.0, 0.0, 0.0].into(), [0.0; 3].into())
+        .unwrap();
+    let err = call(&env, &mut data, &mut tau).unwrap_err().to_string();
+    assert!(err.contains("link 4"), "{err}");
+    env.set_wrench_on_link(4, [0.0; 3].into(), [0.0, 2.0, 0.0].into())
+        .unwrap();
+    assert!(call(&env, &mut data, &mut tau).is_ok());
+    env.set_wrench_by_link(2, [f64::NAN; 3].into(), [0.0; 3].into())
+        .unwrap();
+    assert!(call(&env, &mut data, &mut tau).is_err());
+    env.clear_wrenches();
+    assert!(call(&env, &mut data, &mut tau).is_ok());
+    env.gravity.z = f64::NAN;
+    let err = call(&env, &mut data, &mut tau).unwrap_err().to_string();
+    assert!(err.contains("gravity"), "{err}");
+}

@@ -20,7 +20,9 @@ What it does (build products in target/peers/):
 5. Interleaved rounds pinned to one core (`taskset -c 1`): in each round, per robot, Pinocchio then
    robodyn (order swapped every other round); each program prints the median over samples of ns
    per call (a sample loops over all states, repeated to last ~400 us). The table gives the median
-   over rounds and the spread (min-max over rounds) as a percentage.
+   over rounds and the spread (min-max over rounds) as a percentage; the ratio is the median over
+   rounds of each round's ratio (the two programs back to back), with its range: the VM's speed
+   changes by up to 2x within seconds, so a ratio of medians taken at different times can mislead.
 6. With --codegen, the generated-code comparison of codegen.py runs too.
 """
 
@@ -289,7 +291,7 @@ def main():
 
     print()
     extra = " robodyn merged ns | ratio merged |" if args.merged else ""
-    print(f"| robot (nv) | algorithm | robodyn ns | Pinocchio ns (variant) | ratio | spread rd / pin |{extra}")
+    print(f"| robot (nv) | algorithm | robodyn ns | Pinocchio ns (variant) | ratio (range) | spread rd / pin |{extra}")
     print("|---|---|---|---|---|---|" + ("---|---|" if args.merged else ""))
     for key in robots:
         nv = files[key][3]
@@ -305,9 +307,13 @@ def main():
             best = min(pnames, key=lambda n: stat(pn, n)[0])
             pm, ps = stat(pn, best)
             variant = best.rsplit("_", 1)[1] if best != "rnea" else "local"
+            # the ratio of each round (the two programs ran back to back): its median and range
+            # are robust to the VM's speed changing between rounds
+            ratios = [a[rname] / b[best] for a, b in zip(rd, pn)]
+            rmed = statistics.median(ratios)
             cols = f" {stat(rdm, rname)[0]:.0f} | {stat(rdm, rname)[0] / pm:.2f} |" if args.merged else ""
             print(f"| {ROBOTS[key][0]} ({nv}) | {label} | {rm:.0f} | {pm:.0f} ({variant}) | "
-                  f"{rm / pm:.2f} | {rs:.0f}% / {ps:.0f}% |{cols}")
+                  f"{rmed:.2f} ({min(ratios):.2f}-{max(ratios):.2f}) | {rs:.0f}% / {ps:.0f}% |{cols}")
     if args.codegen:
         run([sys.executable, os.path.join(HERE, "codegen.py")])
 

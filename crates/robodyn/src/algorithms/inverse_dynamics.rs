@@ -263,16 +263,23 @@ pub(crate) fn forward_pass<T: DynScalar>(
         // (10.8): M = J wd + w x (J w) + MS x vd
         let m = euler_moment(&l.inertia, &l.inertia_diff, &wd, &p, &sq, &u) + l.ms.cross(&vd);
         ws.u[j] = u;
-        let e = env.wrench(model.wrench_link(j));
-        ws.f[j] = name3(f + &e.force, "F", n);
-        ws.m[j] = name3(m + &e.moment, "No", n);
+        let (f, m) = if env.has_wrenches() {
+            let e = env.wrench(model.wrench_link(j));
+            (f + &e.force, m + &e.moment)
+        } else {
+            (f, m)
+        };
+        ws.f[j] = name3(f, "F", n);
+        ws.m[j] = name3(m, "No", n);
         ws.rot[j] = rot;
         ws.pos[j] = pos;
         ws.w[j] = w;
         ws.wd[j] = wd;
         ws.vd[j] = vd;
     }
-    add_folded_wrenches(model, env, &mut ws.f, &mut ws.m);
+    if env.has_wrenches() {
+        add_folded_wrenches(model, env, &mut ws.f, &mut ws.m);
+    }
 }
 
 /// Carry the external wrenches of the links folded into movable links ([`DynModel::folded`])

@@ -41,6 +41,19 @@ pub struct Wrench<T: DynScalar = f64> {
 }
 
 impl<T: DynScalar> Wrench<T> {
+    /// Every component finite ([`DynScalar::is_finite`]).
+    pub fn is_finite(&self) -> bool {
+        self.force
+            .iter()
+            .chain(self.moment.iter())
+            .all(T::is_finite)
+    }
+
+    /// Every component exactly zero.
+    pub fn is_zero(&self) -> bool {
+        self.force.iter().chain(self.moment.iter()).all(T::is_zero)
+    }
+
     /// No wrench.
     pub fn zero() -> Self {
         Wrench {
@@ -61,6 +74,12 @@ pub struct Environment<T: DynScalar = f64> {
     pub base: BaseMotion<T>,
     /// Wrench exerted by link j on the environment at index j-1 (NL entries).
     wrenches: Vec<Wrench<T>>,
+    /// How many of `wrenches` have a component that is not finite (kept by the setters, so
+    /// that the per-call check does not scan every link).
+    non_finite: usize,
+    /// How many of `wrenches` are not zero (kept by the setters: the recursions skip the
+    /// wrenches when there is none).
+    non_zero: usize,
 }
 
 impl<T: DynScalar> Environment<T> {
@@ -70,6 +89,8 @@ impl<T: DynScalar> Environment<T> {
             gravity,
             base,
             wrenches: vec![Wrench::zero(); nl],
+            non_finite: 0,
+            non_zero: 0,
         }
     }
 
@@ -87,6 +108,12 @@ impl<T: DynScalar> Environment<T> {
         &self.wrenches[j - 1]
     }
 
+    /// True when some link has a nonzero external wrench.
+    #[inline]
+    pub fn has_wrenches(&self) -> bool {
+        self.non_zero > 0
+    }
+
     /// All wrenches, link 1 first.
     pub fn wrenches(&self) -> &[Wrench<T>] {
         &self.wrenches
@@ -101,7 +128,12 @@ impl<T: DynScalar> Environment<T> {
         moment: Vector3<T>,
     ) -> Result<()> {
         self.check_link(j)?;
-        self.wrenches[j - 1] = Wrench { force, moment };
+        let w = Wrench { force, moment };
+        let old = &self.wrenches[j - 1];
+        self.non_finite = self.non_finite + usize::from(!w.is_finite())
+            - usize::from(!old.is_finite());
+        self.non_zero = self.non_zero + usize::from(!w.is_zero()) - usize::from(!old.is_zero());
+        self.wrenches[j - 1] = w;
         Ok(())
     }
 
@@ -121,6 +153,8 @@ impl<T: DynScalar> Environment<T> {
         for w in self.wrenches.iter_mut() {
             *w = Wrench::zero();
         }
+        self.non_finite = 0;
+        self.non_zero = 0;
     }
 
     fn check_link(&self, j: usize) -> Result<()> {
@@ -145,6 +179,22 @@ impl Environment<f64> {
                 "one per link",
             ));
         }
+        // one branch-free pass over gravity and base motion (early-exit scans per vector cost
+        // as much as a 6-joint NE), the wrenches' count kept by their setters; the offending
+        // vector is looked for only on failure
+        let b = &self.base;
+        let finite = |v: &Vector3<f64>| v.iter().fold(true, |ok, x| ok & x.is_finite());
+        let base_ok = finite(&self.gravity) & finite(&b.w0) & finite(&b.wp0);
+        if base_ok & finite(&b.v0) & finite(&b.vp0) & (self.non_finite == 0) {
+            Ok(())
+        } else {
+            self.locate_non_finite()
+        }
+    }
+
+    /// The error naming the first vector that is not finite.
+    #[cold]
+    fn locate_non_finite(&self) -> Result<()> {
         let b = &self.base;
         for (what, v) in [
             ("gravity", &self.gravity),
@@ -155,22 +205,6 @@ impl Environment<f64> {
         ] {
             check_vector(what, v.as_slice(), 3, String::new)?;
         }
-        // x * 0 is NaN exactly when x is not finite: one branch-free pass over every
-        // component (an early-exit scan per link cost as much as a 6-joint NE); the offending
-        // link is looked for only when the sum is NaN
-        let sum = self.wrenches.iter().fold(0.0, |acc, w| {
-            let (f, m) = (&w.force, &w.moment);
-            acc + (f.x + f.y + f.z + m.x + m.y + m.z) * 0.0
-        });
-        if sum.is_nan() {
-            self.locate_non_finite_wrench()?;
-        }
-        Ok(())
-    }
-
-    /// The error naming the first link whose wrench is not finite.
-    #[cold]
-    fn locate_non_finite_wrench(&self) -> Result<()> {
         for (k, w) in self.wrenches.iter().enumerate() {
             if w.force
                 .iter()
