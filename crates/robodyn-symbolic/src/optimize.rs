@@ -654,6 +654,46 @@ impl Program {
             *self = factored;
         }
         self.name_outputs();
+        self.hoist_function_calls();
+    }
+
+    /// Move the function calls (sin, cos, sign, sqrt) and the assignments they depend on to
+    /// the front, each group keeping its order (SYMORO's layout: the sines and cosines of the
+    /// joint angles first). Generated code then calls no function in the middle of its
+    /// arithmetic, where every live intermediate would be saved around the call (no
+    /// floating-point register survives a call in the C calling conventions). No operation
+    /// changes.
+    pub fn hoist_function_calls(&mut self) {
+        let index: HashMap<&str, usize> = self
+            .assignments
+            .iter()
+            .enumerate()
+            .map(|(i, a)| (a.name.as_str(), i))
+            .collect();
+        let mut hoist = vec![false; self.assignments.len()];
+        // backwards: an assignment is hoisted if it calls a function or a hoisted one uses it
+        for i in (0..self.assignments.len()).rev() {
+            let e = &self.assignments[i].expr;
+            if !hoist[i] && count_ops(e).func == 0 {
+                continue;
+            }
+            hoist[i] = true;
+            e.for_each_symbol(&mut |s| {
+                if let Some(&k) = index.get(s) {
+                    hoist[k] = true;
+                }
+            });
+        }
+        let (mut front, mut back) = (Vec::new(), Vec::new());
+        for (a, h) in self.assignments.drain(..).zip(hoist) {
+            if h {
+                front.push(a);
+            } else {
+                back.push(a);
+            }
+        }
+        front.append(&mut back);
+        self.assignments = front;
     }
 
     /// An output that is a copy of an intermediate (`W3_1 = X2_1`, `QDP2 = X2`) gives that

@@ -13,7 +13,7 @@
 //! samples is printed (the same protocol as `pinocchio_peer.cpp`).
 //!
 //! `peer_timing --batch URDF N` times `inverse_dynamics_batch` on N random states with a rayon
-//! pool of 1 and of 2 threads (median of 7 runs each) and prints their ratio.
+//! pool of 1 and of 2 threads, 15 pairs run back to back, and prints the median ratio.
 
 use nalgebra::DMatrix;
 use robodyn::model::param;
@@ -114,30 +114,41 @@ fn batch(path: &Path, rows: usize) -> Result<(), Error> {
     let (q, qd, qdd) = (v(3.0), v(2.0), v(5.0));
     let mut tau = vec![0.0; rows * n];
     let env = robot.environment();
-    let mut med = Vec::new();
-    for threads in [1, 2] {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()?;
-        let mut ms: Vec<f64> = (0..7)
-            .map(|_| {
-                let t = std::time::Instant::now();
-                pool.install(|| {
-                    robodyn::inverse_dynamics_batch(&robot, env, black_box(&q), &qd, &qdd, &mut tau)
-                })
-                .unwrap();
-                black_box(&tau);
-                t.elapsed().as_secs_f64() * 1e3
-            })
-            .collect();
-        ms.sort_by(f64::total_cmp);
-        println!(
-            "batch idm {rows} states, {threads} thread(s): median {:.2} ms",
-            ms[3]
-        );
-        med.push(ms[3]);
+    let pools = [1, 2].map(|t| rayon::ThreadPoolBuilder::new().num_threads(t).build());
+    let [one, two] = pools;
+    let (one, two) = (one?, two?);
+    let mut run = |pool: &rayon::ThreadPool| -> Result<f64, Error> {
+        let t = std::time::Instant::now();
+        pool.install(|| {
+            robodyn::inverse_dynamics_batch(&robot, env, black_box(&q), &qd, &qdd, &mut tau)
+        })?;
+        black_box(&tau);
+        Ok(t.elapsed().as_secs_f64() * 1e3)
+    };
+    // pairs run back to back (order swapped every other pair): the VM's speed changes within
+    // seconds, so each pair's ratio is compared, not medians taken at different times
+    let (mut t1, mut t2, mut ratio) = (Vec::new(), Vec::new(), Vec::new());
+    for k in 0..15 {
+        let (a, b) = if k % 2 == 0 {
+            let a = run(&one)?;
+            (a, run(&two)?)
+        } else {
+            let b = run(&two)?;
+            (run(&one)?, b)
+        };
+        t1.push(a);
+        t2.push(b);
+        ratio.push(a / b);
     }
-    println!("speedup 2 threads / 1 thread: {:.2}", med[0] / med[1]);
+    for v in [&mut t1, &mut t2, &mut ratio] {
+        v.sort_by(f64::total_cmp);
+    }
+    println!("batch idm {rows} states, 1 thread: median {:.2} ms", t1[7]);
+    println!("batch idm {rows} states, 2 threads: median {:.2} ms", t2[7]);
+    println!(
+        "speedup 2 threads / 1 thread: {:.2} (median of 15 back-to-back pairs; range {:.2}-{:.2})",
+        ratio[7], ratio[0], ratio[14]
+    );
     Ok(())
 }
 

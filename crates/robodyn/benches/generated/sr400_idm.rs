@@ -38,9 +38,21 @@ pub fn sr400_idm(q: &[f64], qd: &[f64], qdd: &[f64], p: &[f64], out: &mut [f64])
     let QDP6 = qdd[5];
     let QDP7 = qdd[6];
     let QDP8 = qdd[7];
-    let U111 = -QP1*QP1;
     let C2 = (q2).cos();
     let S2 = (q2).sin();
+    let C3 = (q3).cos();
+    let S3 = (q3).sin();
+    let C4 = (q4).cos();
+    let S4 = (q4).sin();
+    let C5 = (q5).cos();
+    let S5 = (q5).sin();
+    let C6 = (q6).cos();
+    let S6 = (q6).sin();
+    let C7 = (q7).cos();
+    let S7 = (q7).sin();
+    let C8 = (q8).cos();
+    let S8 = (q8).sin();
+    let U111 = -QP1*QP1;
     let WI12 = -QP1*S2;
     let WI22 = -C2*QP1;
     let VSP12 = (3.0/20.0)*U111;
@@ -61,8 +73,6 @@ pub fn sr400_idm(q: &[f64], qd: &[f64], qdd: &[f64], p: &[f64], out: &mut [f64])
     let F32 = (9.0/2.0)*U312 + (3.0/4.0)*U332 + 15.0*VSP22;
     let No12 = -(3.0/80.0)*T10 - (9.0/40.0)*U212 - (3.0/4.0)*VP22 + (7.0/80.0)*WP12;
     let No22 = -(149.0/80.0)*QP2*WI12 + (3.0/4.0)*VP12 - (9.0/2.0)*VSP22 + (159.0/80.0)*WP22 - (9.0/40.0)*(T1 - T4);
-    let C3 = (q3).cos();
-    let S3 = (q3).sin();
     let WI13 = C3*WI12 + S3*WI22;
     let WI23 = C3*WI22 - S3*WI12;
     let VSP13 = (3.0/5.0)*U112 + VP12;
@@ -90,8 +100,6 @@ pub fn sr400_idm(q: &[f64], qd: &[f64], qdd: &[f64], p: &[f64], out: &mut [f64])
     let No13 = (3.0/50.0)*U313 + (6.0/5.0)*VSP33 + (37.0/100.0)*W33*WI23 + (21.0/50.0)*WP13;
     let No23 = -(3.0/50.0)*U323 - (3.0/5.0)*VSP33 - (3.0/100.0)*W33*WI13 + (2.0/25.0)*WP23;
     let No33 = -(17.0/50.0)*T12 - (6.0/5.0)*VP13 + (3.0/5.0)*VP23 + (9.0/20.0)*WP33 - (3.0/50.0)*(T5 - T8);
-    let C4 = (q4).cos();
-    let S4 = (q4).sin();
     let WI14 = C4*WI13 - S4*W33;
     let WI24 = -C4*W33 - S4*WI13;
     let VSP14 = (11.0/100.0)*U113 + (16.0/25.0)*U123 + VP13;
@@ -119,8 +127,6 @@ pub fn sr400_idm(q: &[f64], qd: &[f64], qdd: &[f64], p: &[f64], out: &mut [f64])
     let No14 = -(131.0/200.0)*T11 + (9.0/5.0)*VP24 + (3.0/10.0)*VSP24 + (141.0/200.0)*WP14 + (9.0/100.0)*(-T3 + T9);
     let No24 = -(9.0/100.0)*U124 - (9.0/5.0)*VP14 + (67.0/100.0)*W34*WI14 + (69.0/100.0)*WP24;
     let No34 = (9.0/100.0)*U134 - (3.0/10.0)*VP14 - (3.0/200.0)*WI14*WI24 + (7.0/200.0)*WP34;
-    let C5 = (q5).cos();
-    let S5 = (q5).sin();
     let WI15 = C5*WI14 + S5*W34;
     let WI25 = C5*W34 - S5*WI14;
     let W35 = QP5 - WI24;
@@ -138,8 +144,6 @@ pub fn sr400_idm(q: &[f64], qd: &[f64], qdd: &[f64], p: &[f64], out: &mut [f64])
     let No15 = -(1.0/25.0)*VP25 - (9.0/5000.0)*W35*WI25 + (3.0/625.0)*WP15;
     let No25 = (1.0/25.0)*VP15 + (9.0/5000.0)*W35*WI15 + (3.0/625.0)*WP25;
     let No35 = (3.0/1000.0)*WP35;
-    let C6 = (q6).cos();
-    let S6 = (q6).sin();
     let WI16 = C6*WI15 - S6*W35;
     let WI26 = -C6*W35 - S6*WI15;
     let W36 = QP6 + WI25;
@@ -157,8 +161,6 @@ pub fn sr400_idm(q: &[f64], qd: &[f64], qdd: &[f64], p: &[f64], out: &mut [f64])
     let No16 = -(1.0/40.0)*VP26 - (29.0/20000.0)*W36*WI26 + (9.0/4000.0)*WP16;
     let No26 = (1.0/40.0)*VP16 + (29.0/20000.0)*W36*WI16 + (9.0/4000.0)*WP26;
     let No36 = (1.0/1250.0)*WP36;
-    let C7 = (q7).cos();
-    let S7 = (q7).sin();
     let WI17 = -QP1*S7;
     let WI27 = -C7*QP1;
     let WP17 = -QDP1*S7 + QP7*WI27;
@@ -171,8 +173,6 @@ pub fn sr400_idm(q: &[f64], qd: &[f64], qdd: &[f64], p: &[f64], out: &mut [f64])
     let F37 = (2.0/5.0)*U317 + 4.0*VSP22;
     let No17 = (1.0/100.0)*WP17;
     let No27 = -(2.0/25.0)*QP7*WI17 - (2.0/5.0)*VSP22 + (9.0/100.0)*WP27;
-    let C8 = (q8).cos();
-    let S8 = (q8).sin();
     let WI18 = C8*WI17 + S8*WI27;
     let WI28 = C8*WI27 - S8*WI17;
     let VSP18 = (1.0/5.0)*U117 + VP17;

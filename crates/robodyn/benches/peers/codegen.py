@@ -21,6 +21,7 @@ CppADCodeGen, on UR5 and Panda (fixed base). NOT run by CI.
 
 import json
 import os
+import statistics
 import subprocess
 import sys
 
@@ -184,7 +185,7 @@ def main():
     med = peers.round_stat
 
     print()
-    print("| robot | model | robodyn C ns | robodyn Rust ns | CppADCodeGen ns | ratio C | ratio Rust | spread C / Rust / cg |")
+    print("| robot | model | robodyn C ns | robodyn Rust ns | CppADCodeGen ns | ratio C (range) | ratio Rust (range) | spread C / Rust / cg |")
     print("|---|---|---|---|---|---|---|---|")
     for key in robots:
         c, rs = times[key]["c"], times[key]["rs"]
@@ -192,8 +193,13 @@ def main():
                                     ("inertia matrix (crba)", "inertia", "cg_crba"),
                                     ("direct dynamics (robodyn L D L' / cg ABA)", "ddm", "cg_aba")]:
             (mc, sc), (mr, sr), (mg, sg) = med(c, f"rd_{rname}_c"), med(rs, f"rd_{rname}_rust"), med(c, cname)
-            print(f"| {peers.ROBOTS[key][0]} | {label} | {mc:.0f} | {mr:.0f} | {mg:.0f} | {mc / mg:.2f} | "
-                  f"{mr / mg:.2f} | {sc:.0f}% / {sr:.0f}% / {sg:.0f}% |")
+            # ratios per round (C: the same program; Rust: the program run next to it), their
+            # median and range, as in run.py
+            rc = [a[f"rd_{rname}_c"] / a[cname] for a in c]
+            rr = [b[f"rd_{rname}_rust"] / a[cname] for a, b in zip(c, rs)]
+            fmt = lambda v: f"{statistics.median(v):.2f} ({min(v):.2f}-{max(v):.2f})"  # noqa: E731
+            print(f"| {peers.ROBOTS[key][0]} | {label} | {mc:.0f} | {mr:.0f} | {mg:.0f} | {fmt(rc)} | "
+                  f"{fmt(rr)} | {sc:.0f}% / {sr:.0f}% / {sg:.0f}% |")
 
 
 if __name__ == "__main__":

@@ -130,8 +130,8 @@ impl<T: DynScalar> Environment<T> {
         self.check_link(j)?;
         let w = Wrench { force, moment };
         let old = &self.wrenches[j - 1];
-        self.non_finite = self.non_finite + usize::from(!w.is_finite())
-            - usize::from(!old.is_finite());
+        self.non_finite =
+            self.non_finite + usize::from(!w.is_finite()) - usize::from(!old.is_finite());
         self.non_zero = self.non_zero + usize::from(!w.is_zero()) - usize::from(!old.is_zero());
         self.wrenches[j - 1] = w;
         Ok(())
