@@ -198,3 +198,57 @@ fn decimal_printing_reads_back_to_the_same_expression() {
     // the plain Display is unchanged (generated code and equations keep exact fractions)
     assert_eq!(Expr::parse("0.705").unwrap().to_string(), "141/200");
 }
+
+/// Hoisting the function calls moves every call and what it needs to the front, keeps both
+/// groups in order, and changes no value.
+#[test]
+fn function_calls_are_hoisted_with_their_dependencies() {
+    use crate::{Assignment, Program};
+    let a = |name: &str, e: &str| Assignment {
+        name: name.into(),
+        expr: p(e),
+    };
+    let mut prog = Program {
+        assignments: vec![
+            a("A", "x*y"),
+            a("T", "q + 1"),
+            a("B", "A + x"),
+            a("S", "sin(T)"),
+            a("C", "B*S"),
+            a("U", "q*q"),
+            a("D", "cos(U) + C"),
+        ],
+        outputs: vec![a("OUT1", "D*A"), a("OUT2", "C + B")],
+        ..Program::default()
+    };
+    let env = |s: &str| match s {
+        "x" => Some(0.7),
+        "y" => Some(-1.3),
+        "q" => Some(0.4),
+        _ => None,
+    };
+    let before = prog.evaluate(&env).unwrap();
+    prog.hoist_function_calls();
+    let order: Vec<&str> = prog.assignments.iter().map(|a| a.name.as_str()).collect();
+    // D calls cos but also needs C, B, A: the whole chain moves; nothing stays behind here
+    // but keeps its order
+    assert_eq!(order, ["A", "T", "B", "S", "C", "U", "D"]);
+    assert_eq!(prog.evaluate(&env).unwrap(), before);
+
+    let mut prog = Program {
+        assignments: vec![
+            a("A", "x*y"),
+            a("T", "q + 1"),
+            a("B", "A + x"),
+            a("S", "sin(T)"),
+            a("C", "B*S"),
+        ],
+        outputs: vec![a("OUT", "C + A")],
+        ..Program::default()
+    };
+    let before = prog.evaluate(&env).unwrap();
+    prog.hoist_function_calls();
+    let order: Vec<&str> = prog.assignments.iter().map(|a| a.name.as_str()).collect();
+    assert_eq!(order, ["T", "S", "A", "B", "C"]);
+    assert_eq!(prog.evaluate(&env).unwrap(), before);
+}
