@@ -102,30 +102,11 @@ impl<T: DynScalar> FrameConstants<T> {
     /// of its [`RotationForm`] skipped.
     #[inline(always)]
     pub fn rot_mul(&self, m: &Matrix3<T>, v: &Vector3<T>) -> Vector3<T> {
-        let e = |r: usize, c: usize| m[(r, c)].clone();
-        let (x, y, z) = (v.x.clone(), v.y.clone(), v.z.clone());
-        match self.form {
-            RotationForm::General => m * v,
-            RotationForm::Axis(2) => Vector3::new(
-                e(0, 0) * x.clone() + e(0, 1) * y.clone(),
-                e(1, 0) * x + e(1, 1) * y,
-                e(2, 2) * z,
-            ),
-            RotationForm::Axis(1) => Vector3::new(
-                e(0, 0) * x.clone() + e(0, 1) * y.clone(),
-                e(1, 2) * z,
-                e(2, 0) * x + e(2, 1) * y,
-            ),
-            RotationForm::Axis(_) => Vector3::new(
-                e(0, 2) * z,
-                e(1, 0) * x.clone() + e(1, 1) * y.clone(),
-                e(2, 0) * x + e(2, 1) * y,
-            ),
-        }
+        rot_mul(self.form, m, v)
     }
 
-    /// [`inertia_to_antecedent`] through this frame (`r` = iA_j): R J R^T as (R J) R^T with the
-    /// zeros of its [`RotationForm`] skipped (25 products instead of 45 for an `Axis` form).
+    /// [`inertia_to_antecedent`] through this frame (`r` = iA_j), the zeros of its
+    /// [`RotationForm`] skipped (R J R^T in 25 products instead of 45 for an `Axis` form).
     #[inline]
     pub fn inertia_to_antecedent(
         &self,
@@ -135,37 +116,7 @@ impl<T: DynScalar> FrameConstants<T> {
         ms: &Vector3<T>,
         mass: &T,
     ) -> (Matrix3<T>, Vector3<T>) {
-        let RotationForm::Axis(k) = self.form else {
-            return inertia_to_antecedent(r, p, j, ms, mass);
-        };
-        let k = k as usize;
-        let m = self.rot_mul(r, ms);
-        let u = &m + p * mass.clone();
-        let diag = p.dot(&(&u + &m));
-        let rj = Matrix3::from_columns(&[
-            self.rot_mul(r, &j.column(0).into_owned()),
-            self.rot_mul(r, &j.column(1).into_owned()),
-            self.rot_mul(r, &j.column(2).into_owned()),
-        ]);
-        let mut out = Matrix3::zeros();
-        for a in 0..3 {
-            for b in a..3 {
-                // row b of R: (0, 0, R_k2) for b = k, else (R_b0, R_b1, 0)
-                let rjr = if b == k {
-                    rj[(a, 2)].clone() * r[(b, 2)].clone()
-                } else {
-                    rj[(a, 0)].clone() * r[(b, 0)].clone() + rj[(a, 1)].clone() * r[(b, 1)].clone()
-                };
-                let mut v = rjr - p[a].clone() * u[b].clone() - m[a].clone() * p[b].clone();
-                if a == b {
-                    v += diag.clone();
-                } else {
-                    out[(b, a)] = v.clone();
-                }
-                out[(a, b)] = v;
-            }
-        }
-        (out, u)
+        inertia_transfer(self.form, r, p, j, ms, mass)
     }
 
     /// jA_i v = (iA_j)^T v for `m` = iA_j of this frame (a vector of R_i expressed in R_j), with
@@ -407,20 +358,68 @@ pub fn inertia_to_antecedent<T: DynScalar>(
     ms: &Vector3<T>,
     mass: &T,
 ) -> (Matrix3<T>, Vector3<T>) {
-    let m = r * ms;
+    inertia_transfer(RotationForm::General, r, p, j, ms, mass)
+}
+
+/// R v for a rotation `m` of form `form` (its zeros skipped).
+#[inline(always)]
+fn rot_mul<T: DynScalar>(form: RotationForm, m: &Matrix3<T>, v: &Vector3<T>) -> Vector3<T> {
+    let e = |r: usize, c: usize| m[(r, c)].clone();
+    let (x, y, z) = (v.x.clone(), v.y.clone(), v.z.clone());
+    match form {
+        RotationForm::General => m * v,
+        RotationForm::Axis(2) => Vector3::new(
+            e(0, 0) * x.clone() + e(0, 1) * y.clone(),
+            e(1, 0) * x + e(1, 1) * y,
+            e(2, 2) * z,
+        ),
+        RotationForm::Axis(1) => Vector3::new(
+            e(0, 0) * x.clone() + e(0, 1) * y.clone(),
+            e(1, 2) * z,
+            e(2, 0) * x + e(2, 1) * y,
+        ),
+        RotationForm::Axis(_) => Vector3::new(
+            e(0, 2) * z,
+            e(1, 0) * x.clone() + e(1, 1) * y.clone(),
+            e(2, 0) * x + e(2, 1) * y,
+        ),
+    }
+}
+
+/// [`inertia_to_antecedent`] for a rotation of form `form`: R J R^T as (R J) R^T, row b of R
+/// being (0, 0, R_k2) for b = k of an `Axis(k)` form, else (R_b0, R_b1, 0).
+#[inline]
+fn inertia_transfer<T: DynScalar>(
+    form: RotationForm,
+    r: &Matrix3<T>,
+    p: &Vector3<T>,
+    j: &Matrix3<T>,
+    ms: &Vector3<T>,
+    mass: &T,
+) -> (Matrix3<T>, Vector3<T>) {
+    let m = rot_mul(form, r, ms);
     // with u = m + M p (= MS'): M p p' + m p' + p m' = p u' + m p' and
     // M p'p + 2 p'm = p'(u + m)
     let u = &m + p * mass.clone();
     let diag = p.dot(&(&u + &m));
-    let rj = r * j;
+    let rj = match form {
+        RotationForm::General => r * j,
+        _ => Matrix3::from_columns(&[
+            rot_mul(form, r, &j.column(0).into_owned()),
+            rot_mul(form, r, &j.column(1).into_owned()),
+            rot_mul(form, r, &j.column(2).into_owned()),
+        ]),
+    };
+    let t = |a: usize, b: usize, c: usize| rj[(a, c)].clone() * r[(b, c)].clone();
     let mut out = Matrix3::zeros();
     for a in 0..3 {
         for b in a..3 {
-            let mut v = rj[(a, 0)].clone() * r[(b, 0)].clone()
-                + rj[(a, 1)].clone() * r[(b, 1)].clone()
-                + rj[(a, 2)].clone() * r[(b, 2)].clone()
-                - p[a].clone() * u[b].clone()
-                - m[a].clone() * p[b].clone();
+            let rjr = match form {
+                RotationForm::General => t(a, b, 0) + t(a, b, 1) + t(a, b, 2),
+                RotationForm::Axis(k) if b == k as usize => t(a, b, 2),
+                RotationForm::Axis(_) => t(a, b, 0) + t(a, b, 1),
+            };
+            let mut v = rjr - p[a].clone() * u[b].clone() - m[a].clone() * p[b].clone();
             if a == b {
                 v += diag.clone();
             } else {
