@@ -19,8 +19,8 @@ use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 /// Composite links (backward recursion j = NL..1): jJ^c, jMS^c, M^c of every link about its own
 /// origin, and iA_j, iP_j, in the buffers of `ws` (kernel, tree array q).
 ///
-/// Composite link k is moved to its antecedent by [`inertia_to_antecedent`] (parallel-axis
-/// theorem).
+/// Composite link k is moved to its antecedent by the parallel-axis theorem through frame k's
+/// rotation form ([`crate::model::FrameConstants::inertia_to_antecedent`]).
 pub fn composite_links<T: DynScalar>(model: &DynModel<T>, ws: &mut Data<T>, q: &[T]) {
     link_placements(model, ws, q);
     for k in (1..=model.nl).rev() {
