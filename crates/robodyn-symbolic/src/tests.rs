@@ -208,47 +208,41 @@ fn function_calls_are_hoisted_with_their_dependencies() {
         name: name.into(),
         expr: p(e),
     };
-    let mut prog = Program {
-        assignments: vec![
-            a("A", "x*y"),
-            a("T", "q + 1"),
-            a("B", "A + x"),
-            a("S", "sin(T)"),
-            a("C", "B*S"),
-            a("U", "q*q"),
-            a("D", "cos(U) + C"),
-        ],
-        outputs: vec![a("OUT1", "D*A"), a("OUT2", "C + B")],
-        ..Program::default()
-    };
     let env = |s: &str| match s {
         "x" => Some(0.7),
         "y" => Some(-1.3),
         "q" => Some(0.4),
         _ => None,
     };
-    let before = prog.evaluate(&env).unwrap();
-    prog.hoist_function_calls();
-    let order: Vec<&str> = prog.assignments.iter().map(|a| a.name.as_str()).collect();
+    // the order after hoisting; the outputs' values are checked unchanged
+    let hoisted = |assignments: Vec<Assignment>, outputs: Vec<Assignment>| -> Vec<String> {
+        let mut prog = Program {
+            assignments,
+            outputs,
+            ..Program::default()
+        };
+        let before = prog.evaluate(&env).unwrap();
+        prog.hoist_function_calls();
+        assert_eq!(prog.evaluate(&env).unwrap(), before);
+        prog.assignments.into_iter().map(|a| a.name).collect()
+    };
+    let chain = vec![
+        a("A", "x*y"),
+        a("T", "q + 1"),
+        a("B", "A + x"),
+        a("S", "sin(T)"),
+        a("C", "B*S"),
+    ];
     // D calls cos but also needs C, B, A: the whole chain moves; nothing stays behind here
     // but keeps its order
-    assert_eq!(order, ["A", "T", "B", "S", "C", "U", "D"]);
-    assert_eq!(prog.evaluate(&env).unwrap(), before);
-
-    let mut prog = Program {
-        assignments: vec![
-            a("A", "x*y"),
-            a("T", "q + 1"),
-            a("B", "A + x"),
-            a("S", "sin(T)"),
-            a("C", "B*S"),
-        ],
-        outputs: vec![a("OUT", "C + A")],
-        ..Program::default()
-    };
-    let before = prog.evaluate(&env).unwrap();
-    prog.hoist_function_calls();
-    let order: Vec<&str> = prog.assignments.iter().map(|a| a.name.as_str()).collect();
-    assert_eq!(order, ["T", "S", "A", "B", "C"]);
-    assert_eq!(prog.evaluate(&env).unwrap(), before);
+    let mut with_d = chain.clone();
+    with_d.extend([a("U", "q*q"), a("D", "cos(U) + C")]);
+    assert_eq!(
+        hoisted(with_d, vec![a("OUT1", "D*A"), a("OUT2", "C + B")]),
+        ["A", "T", "B", "S", "C", "U", "D"]
+    );
+    assert_eq!(
+        hoisted(chain, vec![a("OUT", "C + A")]),
+        ["T", "S", "A", "B", "C"]
+    );
 }

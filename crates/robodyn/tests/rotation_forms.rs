@@ -25,17 +25,17 @@ fn form_products_equal_the_full_products_on_random_frames() {
         for model in [robot.numeric(), robot.dynamic()] {
             for j in 1..=model.nl {
                 let fr = model.frame(j);
-                match fr.form {
+                match fr.form() {
                     RotationForm::General => seen[3] += 1,
                     RotationForm::Axis(k) => {
                         seen[k as usize] += 1;
                         // the form's zeros are exact
                         let k = k as usize;
-                        assert_eq!(fr.pre_rot[(k, 0)], 0.0, "case {case} frame {j}");
-                        assert_eq!(fr.pre_rot[(k, 1)], 0.0, "case {case} frame {j}");
-                        assert_eq!(fr.pre_rot[(k, 2)].abs(), 1.0, "case {case} frame {j}");
+                        assert_eq!(fr.pre_rot()[(k, 0)], 0.0, "case {case} frame {j}");
+                        assert_eq!(fr.pre_rot()[(k, 1)], 0.0, "case {case} frame {j}");
+                        assert_eq!(fr.pre_rot()[(k, 2)].abs(), 1.0, "case {case} frame {j}");
                         for i in (0..3).filter(|&i| i != k) {
-                            assert_eq!(fr.pre_rot[(i, 2)], 0.0, "case {case} frame {j}");
+                            assert_eq!(fr.pre_rot()[(i, 2)], 0.0, "case {case} frame {j}");
                         }
                     }
                 }
@@ -100,7 +100,7 @@ fn dh_robot_frames_have_the_forms_their_alpha_implies() {
         } else {
             RotationForm::General
         };
-        assert_eq!(robot.numeric().frame(j).form, expected, "frame {j}");
+        assert_eq!(robot.numeric().frame(j).form(), expected, "frame {j}");
         checked += 1;
     }
     assert!(checked >= 6, "{checked} frames checked");

@@ -12,9 +12,7 @@
 //!   `P = sum_j V_j'fe_j + w_j'me_j`, whose generalized force is dP/dqd.
 
 use crate::error::{Error, Result};
-use crate::model::{
-    BaseMotion, DynModel, Environment, FrameConstants, JointType, LinkConstants, Robot,
-};
+use crate::model::{BaseMotion, DynModel, Environment, JointType, LinkConstants, Robot};
 use crate::scalar::DynScalar;
 use nalgebra::{DVector, Matrix3, Vector3};
 use num_dual::{DualNum, HyperDual64};
@@ -144,19 +142,7 @@ pub fn convert_model<T: DynScalar>(m: &DynModel<f64>) -> DynModel<T> {
     let f = T::from_f64;
     DynModel {
         nl: m.nl,
-        frames: m
-            .frames
-            .iter()
-            .map(|c| FrameConstants {
-                ant: c.ant,
-                joint: c.joint,
-                pre_rot: c.pre_rot.map(f),
-                form: c.form,
-                pre_pos: map3(&c.pre_pos),
-                theta0: f(c.theta0),
-                r0: f(c.r0),
-            })
-            .collect(),
+        frames: m.frames.iter().map(|c| c.map(|&x| f(x))).collect(),
         links: m
             .links
             .iter()

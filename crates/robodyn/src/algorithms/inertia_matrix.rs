@@ -12,7 +12,7 @@
 use crate::algorithms::inverse_dynamics::{rnea_with_environment, tree_vector_map};
 use crate::data::{with_data, Data};
 use crate::error::Result;
-use crate::model::{DynModel, Environment, JointType, Robot, RotationForm};
+use crate::model::{form_row, DynModel, Environment, JointType, Robot, RotationForm};
 use crate::scalar::DynScalar;
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 
@@ -96,20 +96,17 @@ pub fn composite_inertia_matrix<T: DynScalar>(
             // composite link k is complete: its successors were added to it; its column wrench
             // (f, m), k first of its subtree in preorder
             let ms = &ws.msc[k];
-            let c = &mut ws.col;
-            if fr.joint == JointType::Revolute {
+            let (f, m) = if fr.joint == JointType::Revolute {
                 let jz = ws.jc[k].column(2);
-                let f = [-ms.y.clone(), ms.x.clone(), T::zero()];
                 let m = [jz[0].clone(), jz[1].clone(), jz[2].clone()];
-                for (x, v) in c.iter_mut().zip(f.into_iter().chain(m)) {
-                    x[s] = v;
-                }
+                ([-ms.y.clone(), ms.x.clone(), T::zero()], m)
             } else {
-                let f = [T::zero(), T::zero(), ws.mc[k].clone()];
                 let m = [ms.y.clone(), -ms.x.clone(), T::zero()];
-                for (x, v) in c.iter_mut().zip(f.into_iter().chain(m)) {
-                    x[s] = v;
-                }
+                ([T::zero(), T::zero(), ws.mc[k].clone()], m)
+            };
+            let c = &mut ws.col;
+            for (x, v) in c.iter_mut().zip(f.into_iter().chain(m)) {
+                x[s] = v;
             }
             // row k of A: the projections on joint k's axis (moment z, revolute; force z,
             // prismatic) of its subtree's column wrenches
@@ -135,15 +132,15 @@ pub fn composite_inertia_matrix<T: DynScalar>(
         if T::NAMED {
             transport_named(model, ws, k, i, s, e);
         } else {
-            transport(fr.form, &ws.rot[k], &ws.pos[k], &mut ws.col, s, e);
+            transport(fr.form(), &ws.rot[k], &ws.pos[k], &mut ws.col, s, e);
         }
     }
 }
 
 /// Carry the column wrenches at preorder positions s..e from R_k to R_a(k) (rotation `rot` =
 /// a(k)A_k of rotation form `form`, origin `pos` = a(k)P_k): f' = R f, m' = R m + P x f'. One
-/// loop over the six component arrays with the transform's entries hoisted and the form's zeros
-/// skipped at compile time: independent iterations, vectorized for f64.
+/// loop over the six component arrays, the form's zeros skipped at compile time
+/// ([`form_row`]): independent iterations, vectorized for f64.
 #[inline]
 fn transport<T: DynScalar>(
     form: RotationForm,
@@ -153,33 +150,18 @@ fn transport<T: DynScalar>(
     s: usize,
     e: usize,
 ) {
-    let r: [[T; 3]; 3] = std::array::from_fn(|i| std::array::from_fn(|j| rot[(i, j)].clone()));
-    let p = [pos.x.clone(), pos.y.clone(), pos.z.clone()];
     match form {
-        RotationForm::General => transport_loop::<T, 3>(&r, &p, col, s, e),
-        RotationForm::Axis(0) => transport_loop::<T, 0>(&r, &p, col, s, e),
-        RotationForm::Axis(1) => transport_loop::<T, 1>(&r, &p, col, s, e),
-        RotationForm::Axis(_) => transport_loop::<T, 2>(&r, &p, col, s, e),
-    }
-}
-
-/// Row i of R v for a rotation whose row K is (0, 0, R_K2) (K < 3; K = 3: a full row).
-#[inline(always)]
-fn rot_row<T: DynScalar, const K: usize>(r: &[[T; 3]; 3], i: usize, v: [&T; 3]) -> T {
-    let ri = &r[i];
-    if K == 3 {
-        ri[0].clone() * v[0].clone() + ri[1].clone() * v[1].clone() + ri[2].clone() * v[2].clone()
-    } else if i == K {
-        ri[2].clone() * v[2].clone()
-    } else {
-        ri[0].clone() * v[0].clone() + ri[1].clone() * v[1].clone()
+        RotationForm::General => transport_loop::<T, 3>(rot, pos, col, s, e),
+        RotationForm::Axis(0) => transport_loop::<T, 0>(rot, pos, col, s, e),
+        RotationForm::Axis(1) => transport_loop::<T, 1>(rot, pos, col, s, e),
+        RotationForm::Axis(_) => transport_loop::<T, 2>(rot, pos, col, s, e),
     }
 }
 
 #[inline(always)]
 fn transport_loop<T: DynScalar, const K: usize>(
-    r: &[[T; 3]; 3],
-    p: &[T; 3],
+    r: &Matrix3<T>,
+    p: &Vector3<T>,
     col: &mut [Vec<T>; 6],
     s: usize,
     e: usize,
@@ -191,14 +173,20 @@ fn transport_loop<T: DynScalar, const K: usize>(
     // equal lengths, stated once: no bounds check in the loop
     assert!(fy.len() == len && fz.len() == len && mx.len() == len);
     assert!(my.len() == len && mz.len() == len);
-    let [px, py, pz] = p;
+    let (px, py, pz) = (&p.x, &p.y, &p.z);
     for q in 0..len {
-        let g0 = rot_row::<T, K>(r, 0, [&fx[q], &fy[q], &fz[q]]);
-        let g1 = rot_row::<T, K>(r, 1, [&fx[q], &fy[q], &fz[q]]);
-        let g2 = rot_row::<T, K>(r, 2, [&fx[q], &fy[q], &fz[q]]);
-        let n0 = rot_row::<T, K>(r, 0, [&mx[q], &my[q], &mz[q]]);
-        let n1 = rot_row::<T, K>(r, 1, [&mx[q], &my[q], &mz[q]]);
-        let n2 = rot_row::<T, K>(r, 2, [&mx[q], &my[q], &mz[q]]);
+        let f = [&fx[q], &fy[q], &fz[q]];
+        let (g0, g1, g2) = (
+            form_row::<T, K>(r, 0, f),
+            form_row::<T, K>(r, 1, f),
+            form_row::<T, K>(r, 2, f),
+        );
+        let m = [&mx[q], &my[q], &mz[q]];
+        let (n0, n1, n2) = (
+            form_row::<T, K>(r, 0, m),
+            form_row::<T, K>(r, 1, m),
+            form_row::<T, K>(r, 2, m),
+        );
         mx[q] = n0 + py.clone() * g2.clone() - pz.clone() * g1.clone();
         my[q] = n1 + pz.clone() * g0.clone() - px.clone() * g2.clone();
         mz[q] = n2 + px.clone() * g1.clone() - py.clone() * g0.clone();
@@ -219,7 +207,7 @@ fn transport_named<T: DynScalar>(
     s: usize,
     e: usize,
 ) {
-    let form = model.frame(k).form;
+    let form = model.frame(k).form();
     transport(form, &ws.rot[k], &ws.pos[k], &mut ws.col, s, e);
     let li = model.wrench_link(i);
     for p in s..e {

@@ -277,9 +277,7 @@ pub(crate) fn forward_pass<T: DynScalar>(
         ws.wd[j] = wd;
         ws.vd[j] = vd;
     }
-    if env.has_wrenches() {
-        add_folded_wrenches(model, env, &mut ws.f, &mut ws.m);
-    }
+    add_folded_wrenches(model, env, &mut ws.f, &mut ws.m);
 }
 
 /// Carry the external wrenches of the links folded into movable links ([`DynModel::folded`])
@@ -307,7 +305,7 @@ pub(crate) fn folded_wrench<T: DynScalar>(
     env: &Environment<T>,
 ) -> Option<(Vector3<T>, Vector3<T>)> {
     let e = env.wrench(fl.link);
-    if e.force.iter().chain(e.moment.iter()).all(|x| x.is_zero()) {
+    if !env.has_wrenches() || e.is_zero() {
         return None;
     }
     let fh = &fl.rot * &e.force;

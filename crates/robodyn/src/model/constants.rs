@@ -15,17 +15,18 @@ pub struct FrameConstants<T: DynScalar> {
     pub ant: usize,
     /// sigma_j.
     pub joint: JointType,
-    /// Rz(gamma) Rx(alpha).
-    pub pre_rot: Matrix3<T>,
+    /// Rz(gamma) Rx(alpha) ([`Self::pre_rot`]); private so that `form`, derived from it, is
+    /// never stale ([`Self::set_pre_rot`]).
+    pre_rot: Matrix3<T>,
     /// Rz(gamma) ([0 0 b] + Rx(alpha) [d 0 0]).
     pub pre_pos: Vector3<T>,
     /// Constant part of theta (the revolute joint variable is added to it).
     pub theta0: T,
     /// Constant part of r (the prismatic joint variable is added to it).
     pub r0: T,
-    /// Sparsity of iA_j = pre_rot Rz(theta) read off `pre_rot` ([`RotationForm::of`]); set by
-    /// [`Self::new`] and whenever `pre_rot` changes ([`Self::set_pre_rot`]).
-    pub form: RotationForm,
+    /// Sparsity of iA_j = pre_rot Rz(theta) read off `pre_rot` ([`RotationForm::of`]), set
+    /// with it ([`Self::form`]).
+    form: RotationForm,
 }
 
 /// Sparsity of a frame's rotation iA_j = pre_rot Rz(theta), known from its constant part. When
@@ -92,10 +93,36 @@ impl<T: DynScalar> FrameConstants<T> {
         fc
     }
 
+    /// Rz(gamma) Rx(alpha): the constant rotation before the joint's Rz(theta) (for a fixed
+    /// frame, its whole constant rotation).
+    pub fn pre_rot(&self) -> &Matrix3<T> {
+        &self.pre_rot
+    }
+
     /// Replace pre_rot (and its [`RotationForm`]).
     pub fn set_pre_rot(&mut self, pre_rot: Matrix3<T>) {
         self.form = RotationForm::of(&pre_rot);
         self.pre_rot = pre_rot;
+    }
+
+    /// The sparsity of this frame's rotation iA_j, found from pre_rot.
+    pub fn form(&self) -> RotationForm {
+        self.form
+    }
+
+    /// These constants in another scalar, each entry mapped by `f` (the form found again from
+    /// the mapped pre_rot).
+    pub fn map<U: DynScalar>(&self, f: impl Fn(&T) -> U) -> FrameConstants<U> {
+        let pre_rot = self.pre_rot.map(|x| f(&x));
+        FrameConstants {
+            ant: self.ant,
+            joint: self.joint,
+            form: RotationForm::of(&pre_rot),
+            pre_rot,
+            pre_pos: self.pre_pos.map(|x| f(&x)),
+            theta0: f(&self.theta0),
+            r0: f(&self.r0),
+        }
     }
 
     /// iA_j v for `m` = iA_j of this frame (a vector of R_j expressed in R_i), with the zeros
@@ -123,25 +150,12 @@ impl<T: DynScalar> FrameConstants<T> {
     /// the zeros of its [`RotationForm`] skipped.
     #[inline(always)]
     pub fn rot_tr_mul(&self, m: &Matrix3<T>, v: &Vector3<T>) -> Vector3<T> {
-        let e = |r: usize, c: usize| m[(r, c)].clone();
-        let (x, y, z) = (v.x.clone(), v.y.clone(), v.z.clone());
+        let w = [&v.x, &v.y, &v.z];
         match self.form {
             RotationForm::General => m.tr_mul(v),
-            RotationForm::Axis(2) => Vector3::new(
-                e(0, 0) * x.clone() + e(1, 0) * y.clone(),
-                e(0, 1) * x + e(1, 1) * y,
-                e(2, 2) * z,
-            ),
-            RotationForm::Axis(1) => Vector3::new(
-                e(0, 0) * x.clone() + e(2, 0) * z.clone(),
-                e(0, 1) * x + e(2, 1) * z,
-                e(1, 2) * y,
-            ),
-            RotationForm::Axis(_) => Vector3::new(
-                e(1, 0) * y.clone() + e(2, 0) * z.clone(),
-                e(1, 1) * y + e(2, 1) * z,
-                e(0, 2) * x,
-            ),
+            RotationForm::Axis(0) => form_tr_mul::<T, 0>(m, w),
+            RotationForm::Axis(1) => form_tr_mul::<T, 1>(m, w),
+            RotationForm::Axis(_) => form_tr_mul::<T, 2>(m, w),
         }
     }
 
@@ -364,25 +378,66 @@ pub fn inertia_to_antecedent<T: DynScalar>(
 /// R v for a rotation `m` of form `form` (its zeros skipped).
 #[inline(always)]
 fn rot_mul<T: DynScalar>(form: RotationForm, m: &Matrix3<T>, v: &Vector3<T>) -> Vector3<T> {
-    let e = |r: usize, c: usize| m[(r, c)].clone();
-    let (x, y, z) = (v.x.clone(), v.y.clone(), v.z.clone());
+    let w = [&v.x, &v.y, &v.z];
     match form {
         RotationForm::General => m * v,
-        RotationForm::Axis(2) => Vector3::new(
-            e(0, 0) * x.clone() + e(0, 1) * y.clone(),
-            e(1, 0) * x + e(1, 1) * y,
-            e(2, 2) * z,
-        ),
-        RotationForm::Axis(1) => Vector3::new(
-            e(0, 0) * x.clone() + e(0, 1) * y.clone(),
-            e(1, 2) * z,
-            e(2, 0) * x + e(2, 1) * y,
-        ),
-        RotationForm::Axis(_) => Vector3::new(
-            e(0, 2) * z,
-            e(1, 0) * x.clone() + e(1, 1) * y.clone(),
-            e(2, 0) * x + e(2, 1) * y,
-        ),
+        RotationForm::Axis(0) => form_mul::<T, 0>(m, w),
+        RotationForm::Axis(1) => form_mul::<T, 1>(m, w),
+        RotationForm::Axis(_) => form_mul::<T, 2>(m, w),
+    }
+}
+
+/// R v for a rotation of form `Axis(K)`, entry by entry ([`form_row`]).
+#[inline(always)]
+fn form_mul<T: DynScalar, const K: usize>(m: &Matrix3<T>, v: [&T; 3]) -> Vector3<T> {
+    let row = |i: usize| form_row::<T, K>(m, i, v);
+    Vector3::new(row(0), row(1), row(2))
+}
+
+/// R^T v for a rotation of form `Axis(K)`, entry by entry ([`form_col`]).
+#[inline(always)]
+fn form_tr_mul<T: DynScalar, const K: usize>(m: &Matrix3<T>, v: [&T; 3]) -> Vector3<T> {
+    let col = |c: usize| form_col::<T, K>(m, c, v);
+    Vector3::new(col(0), col(1), col(2))
+}
+
+/// The two row indices other than K (K < 3).
+#[inline(always)]
+const fn others(k: usize) -> (usize, usize) {
+    match k {
+        0 => (1, 2),
+        1 => (0, 2),
+        _ => (0, 1),
+    }
+}
+
+/// Entry i of R v for a rotation `r` whose row K is (0, 0, r_K2) and whose third column is
+/// r_K2 e_K (`RotationForm::Axis(K)`); K = 3: a full rotation. K is a constant, so the zeros
+/// are skipped at compile time.
+#[inline(always)]
+pub(crate) fn form_row<T: DynScalar, const K: usize>(r: &Matrix3<T>, i: usize, v: [&T; 3]) -> T {
+    let e = |c: usize| r[(i, c)].clone() * v[c].clone();
+    if K == 3 {
+        e(0) + e(1) + e(2)
+    } else if i == K {
+        e(2)
+    } else {
+        e(0) + e(1)
+    }
+}
+
+/// Entry c of R^T v for a rotation `r` of form `Axis(K)` (K = 3: a full rotation), as
+/// [`form_row`].
+#[inline(always)]
+pub(crate) fn form_col<T: DynScalar, const K: usize>(r: &Matrix3<T>, c: usize, v: [&T; 3]) -> T {
+    let e = |i: usize| r[(i, c)].clone() * v[i].clone();
+    if K == 3 {
+        e(0) + e(1) + e(2)
+    } else if c == 2 {
+        e(K)
+    } else {
+        let (a, b) = others(K);
+        e(a) + e(b)
     }
 }
 
@@ -546,7 +601,8 @@ impl<T: DynScalar> DynModel<T> {
                 c.ant = red[h];
                 if let Some((r, p)) = pre {
                     c.pre_pos = p + r * &c.pre_pos;
-                    c.set_pre_rot(r * &c.pre_rot);
+                    let pre_rot = r * &c.pre_rot;
+                    c.set_pre_rot(pre_rot);
                 }
                 frames.push(c);
                 links.push(self.link(j).clone());

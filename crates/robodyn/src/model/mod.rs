@@ -8,6 +8,7 @@ mod description;
 mod environment;
 mod structure;
 
+pub(crate) use constants::form_row;
 pub use constants::{
     inertia_to_antecedent, DynModel, FoldedLink, FrameConstants, LinkConstants, RotationForm,
     TreeIndex,
