@@ -126,7 +126,7 @@ impl ClosedChain {
                 c.describe(chain.limits())
             );
             py.import("warnings")?
-                .call_method1("warn", (msg, py.get_type::<SingularityWarning>(), 2))?;
+                .call_method1("warn", (msg, py.get_type::<SingularityWarning>(), 1))?;
         }
         out.finish(py)
     }
@@ -254,8 +254,9 @@ impl ClosedChain {
         })
     }
 
-    /// Loop closure at one q_a with everything: q_p, cut-joint variables q_c, the tree's
-    /// movable-joint vector q_tree, W = d q_p / d q_a (10.30), residual and rcond of Wp.
+    /// Loop closure at one q_a (nq,): q_p, cut-joint variables q_c, the tree's movable-joint
+    /// vector q_tree (rad, m), W = d q_p / d q_a (eq 10.30, (p, nq)), residual, rcond_wp,
+    /// warning.
     fn closure<'py>(&self, py: Python<'py>, q_a: Vec<f64>) -> PyResult<Bound<'py, PyDict>> {
         let chain = &self.chain;
         let s = py
@@ -406,7 +407,7 @@ impl ClosedChain {
     /// evaluation. Returns a dict of arrays: t (M,) s, q, qd, qdd, tau (M, nq) over the actuated
     /// joints, energy (M,) J, closure_residual (M,) and the passive joints' q<j> (M,). torque,
     /// dt, rtol, atol, output_dt, max_steps as for Robot.simulate; Ctrl-C stops the run.
-    #[pyo3(signature = (duration, q0=None, qd0=None, torque=None, dt=None, rtol=1e-8, atol=1e-10, output_dt=0.01, coulomb_smoothing=None, max_steps=robodyn::simulation::DEFAULT_MAX_STEPS))]
+    #[pyo3(signature = (duration, q0=None, qd0=None, torque=None, dt=None, rtol=1e-8, atol=1e-10, output_dt=0.01, coulomb_smoothing=None, max_steps=5_000_000))]
     #[allow(clippy::too_many_arguments)]
     fn simulate<'py>(
         &self,

@@ -36,7 +36,7 @@ fn load(
             for w in warnings {
                 warn.call_method1(
                     "warn",
-                    (w.to_string(), py.get_type::<errors::RobotFileWarning>(), 2),
+                    (w.to_string(), py.get_type::<errors::RobotFileWarning>(), 1),
                 )?;
             }
             Ok(robot::Robot::wrap(r, Some(path)))

@@ -489,6 +489,10 @@ impl Dynamics for Interruptible<'_> {
     }
 }
 
+// the default of `max_steps` in the signatures of `simulate` (a literal, so that Python's
+// `inspect.signature` shows it) is the library's, the CLI's
+const _: () = assert!(robodyn::simulation::DEFAULT_MAX_STEPS == 5_000_000);
+
 /// Simulation settings shared by trees and closed chains.
 pub struct SimArgs<'py> {
     pub duration: f64,

@@ -793,7 +793,7 @@ impl Robot {
     /// output_dt (s). max_steps (the CLI's default, 5,000,000) bounds the integration steps: a
     /// run that needs more is an error, said before it starts when the step or the output step
     /// already needs more. Ctrl-C stops the run (KeyboardInterrupt).
-    #[pyo3(signature = (duration, q0=None, qd0=None, torque=None, dt=None, rtol=1e-8, atol=1e-10, output_dt=0.01, method="aba", coulomb_smoothing=None, max_steps=robodyn::simulation::DEFAULT_MAX_STEPS))]
+    #[pyo3(signature = (duration, q0=None, qd0=None, torque=None, dt=None, rtol=1e-8, atol=1e-10, output_dt=0.01, method="aba", coulomb_smoothing=None, max_steps=5_000_000))]
     #[allow(clippy::too_many_arguments)]
     fn simulate<'py>(
         &self,
