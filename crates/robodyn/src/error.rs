@@ -218,8 +218,9 @@ pub fn check_finite_matrix(what: &str, m: &nalgebra::DMatrix<f64>) -> Result<()>
 
 fn overflow(entry: &str, value: f64) -> Error {
     Error::Numerical(format!(
-        "{entry} = {value}: the result overflows the floating-point range for these finite \
-         inputs (velocities, accelerations, parameters, gravity or wrenches too large)"
+        "{entry} = {value} is not a finite number: the result overflows the floating-point \
+         range for these finite inputs (velocities, accelerations, parameters, gravity or \
+         wrenches too large)"
     ))
 }
 
