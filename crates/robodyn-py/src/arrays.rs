@@ -319,6 +319,16 @@ impl Shape {
         }
     }
 
+    /// The result of a call: `rows` as [`Shape::rows`], or with `stacked` the N results
+    /// stacked (the regressor: (N n, p) for one-state results (n, p)).
+    pub fn result(rows: Option<usize>, one: &[usize], stacked: bool) -> Shape {
+        match (rows, stacked) {
+            // an overflowing count is refused by `size` (MemoryError)
+            (Some(r), true) => Shape::of(&[r.saturating_mul(one[0]), one[1]]),
+            (rows, _) => Shape::rows(rows, one),
+        }
+    }
+
     /// The dimensions.
     pub fn dims(&self) -> &[usize] {
         &self.dims[..self.len]

@@ -80,13 +80,7 @@ impl ClosedChain {
                 chain.coordinates().names().join(", ")
             )
         })?;
-        let shape = match (inp.rows, call.stacked) {
-            (Some(r), true) => Shape::of(&[
-                r.checked_mul(call.one[0]).unwrap_or(usize::MAX),
-                call.one[1],
-            ]),
-            (rows, _) => Shape::rows(rows, call.one),
-        };
+        let shape = Shape::result(inp.rows, call.one, call.stacked);
         let mut out = Output::new(py, call.out, shape, inp.rows.is_some())?;
         let st = inp.states(out.span())?;
         let width: usize = call.one.iter().product();

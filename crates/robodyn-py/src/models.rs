@@ -478,7 +478,7 @@ impl Dynamics for Interruptible<'_> {
         qdd: &mut [f64],
     ) -> robodyn::Result<()> {
         self.calls = self.calls.wrapping_add(1);
-        if self.calls % 16 == 0 && self.last.elapsed() >= SIGNAL_INTERVAL {
+        if self.calls.is_multiple_of(16) && self.last.elapsed() >= SIGNAL_INTERVAL {
             self.last = Instant::now();
             if let Err(e) = Python::attach(|py| py.check_signals()) {
                 self.error = Some(e);

@@ -223,13 +223,7 @@ impl Robot {
     {
         let n = robot.dof();
         let inp = inputs(call.inputs, n, &|| Self::joint_text(robot))?;
-        let shape = match (inp.rows, call.stacked) {
-            (Some(r), true) => {
-                let rows = r.checked_mul(call.one[0]).unwrap_or(usize::MAX);
-                Shape::of(&[rows, call.one[1]])
-            }
-            (rows, _) => Shape::rows(rows, call.one),
-        };
+        let shape = Shape::result(inp.rows, call.one, call.stacked);
         let mut out = Output::new(py, call.out, shape, inp.rows.is_some())?;
         let st = inp.states(out.span())?;
         let width: usize = call.one.iter().product();
