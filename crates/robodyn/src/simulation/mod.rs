@@ -315,14 +315,22 @@ fn check_step_budget(opts: &SimOptions) -> Result<()> {
     };
     let steps = |h: f64| (opts.duration / h).ceil();
     let (least, why) = match opts.integrator {
-        Integrator::Rk4 { dt } if steps(dt) >= steps(opts.output_dt) => (steps(dt), "step"),
-        _ => (steps(opts.output_dt), "output step"),
+        Integrator::Rk4 { dt } if steps(dt) >= steps(opts.output_dt) => {
+            (steps(dt), format!("the step {dt} s"))
+        }
+        _ => (
+            steps(opts.output_dt),
+            format!(
+                "the output step {} s, one step at least per row",
+                opts.output_dt
+            ),
+        ),
     };
     if least > m as f64 {
         return Err(Error::Numerical(format!(
-            "the run needs at least {least:e} integration steps (duration {} s / {why} of the \
-             run), more than the step limit (max_steps = {m}): shorten the run, lengthen the \
-             step or raise the limit",
+            "the run needs at least {least:e} integration steps (duration {} s over {why}), more \
+             than the step limit (max_steps = {m}): shorten the run, lengthen the step or raise \
+             the limit",
             opts.duration
         )));
     }
