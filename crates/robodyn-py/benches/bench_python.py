@@ -54,7 +54,7 @@ def report(title, times, ref):
     print(title)
     for k, t in times.items():
         ratios = [a / b for a, b in zip(t, times[ref])]
-        line = f"  {k:<28} {statistics.median(t) * 1e6:6.3f} µs/call"
+        line = f"  {k:<32} {statistics.median(t) * 1e6:6.3f} µs/call"
         if k != ref:
             line += (f"   ratio to {ref}: {statistics.median(ratios):.2f} "
                      f"({min(ratios):.2f}-{max(ratios):.2f})")
