@@ -14,38 +14,16 @@ pub struct RobotArgs {
     /// Robot file (.toml, .par or .urdf; `-` reads standard input, format recognized from the
     /// text).
     pub robot: PathBuf,
-    /// Give or override a symbol value, e.g. `--set d3=0.6` or `--set D3=pi/8` (repeatable; the
-    /// symbol must be one the file uses, the value a constant expression as for `--q`).
+    /// Give or override a symbol value, e.g. `--set d3=0.6` or `--set D3=pi/8`, or a standard
+    /// parameter the file writes as a number, e.g. `--set M3=12` (mass of link 3 of a URDF robot)
+    /// or `--set FS2=0.5` (repeatable; the name must be a symbol or a standard parameter of the
+    /// robot, the value a constant expression as for `--q`).
     #[arg(long = "set", value_name = "NAME=VALUE")]
     pub set: Vec<String>,
 }
 
-/// The symbols a description uses or gives a value to.
-pub fn known_symbols(
-    desc: &robodyn::model::RobotDescription,
-) -> std::collections::BTreeSet<String> {
-    let mut known: std::collections::BTreeSet<String> = desc.symbols.keys().cloned().collect();
-    let mut add = |e: &robodyn::Expr| {
-        e.for_each_symbol(&mut |s| {
-            known.insert(s.to_string());
-        })
-    };
-    for f in &desc.frames {
-        for e in f.geometric() {
-            add(e);
-        }
-    }
-    for l in &desc.links {
-        l.params.iter().chain(&l.wrench).for_each(&mut add);
-    }
-    for v in [&desc.gravity, &desc.w0, &desc.wp0, &desc.v0, &desc.vp0] {
-        v.iter().for_each(&mut add);
-    }
-    known
-}
-
 impl RobotArgs {
-    /// The `--set` values (names not yet checked against a robot: see [`check_overrides`]).
+    /// The `--set` values (names not yet checked against a robot: see [`Self::description`]).
     pub fn overrides(&self) -> CliResult<BTreeMap<String, f64>> {
         let mut m = BTreeMap::new();
         for s in &self.set {
@@ -62,15 +40,14 @@ impl RobotArgs {
         Ok(m)
     }
 
-    /// Load the robot's description with the `--set` values (each must name a symbol the file
-    /// uses).
+    /// Load the robot's description with the `--set` values (the library's rule,
+    /// `robodyn::io::set_values`: each names a symbol or a standard parameter of the robot).
     pub fn description(
         &self,
     ) -> CliResult<(robodyn::model::RobotDescription, robodyn::io::SourceMap)> {
         let (mut desc, map) = robodyn::io::load_description_mapped(&self.robot)?;
         let o = self.overrides()?;
-        check_overrides(&desc, &o)?;
-        desc.symbols.extend(o);
+        robodyn::io::set_values(&mut desc, &o).map_err(|e| format!("--set: {e}"))?;
         Ok((desc, map))
     }
 
@@ -102,29 +79,6 @@ impl RobotArgs {
         }
         Ok(robot)
     }
-}
-
-/// `--set` names must be symbols of the robot (a misspelt `d3` for `D3` would be ignored).
-pub fn check_overrides(
-    desc: &robodyn::model::RobotDescription,
-    o: &BTreeMap<String, f64>,
-) -> CliResult {
-    let known = known_symbols(desc);
-    for k in o.keys() {
-        if !known.contains(k) {
-            let list: Vec<&str> = known.iter().map(String::as_str).collect();
-            return Err(format!(
-                "--set {k}=...: the robot has no symbol `{k}` (its symbols: {})",
-                if list.is_empty() {
-                    "none".to_string()
-                } else {
-                    list.join(", ")
-                }
-            )
-            .into());
-        }
-    }
-    Ok(())
 }
 
 /// One value of the command line: a number or a constant expression (`pi/8`, `-1e-3`), finite.

@@ -1,6 +1,6 @@
 //! The conventions of docs/cli.md, one test each: non-finite results refused, a closed pipe ends
 //! quietly, `-` for standard input and output, `--set` checked and parsed as `--q`, `--input`
-//! defaults and carried columns, shortest round-trip numbers, units in `--help`, `simulate`
+//! defaults and carried columns, `--set` of a standard parameter a file writes as a number, shortest round-trip numbers, units in `--help`, `simulate`
 //! options checked before the output file is touched, the step limit named, joint limits
 //! (URDF `<limit>`) shown and checked, the plot's content.
 
@@ -138,6 +138,35 @@ fn set_names_a_symbol_and_takes_expressions() {
     assert_eq!(a, b);
     let c = run(&["idm", &rx90, q[0], q[1]]);
     assert_ne!(a, c, "--set D3 changed nothing");
+}
+
+#[test]
+fn set_names_a_standard_parameter_a_file_writes_as_a_number() {
+    // a URDF has no symbols: `M3` is link 3's mass, `FS2` joint 2's Coulomb friction
+    let urdf = robot("rx90.urdf");
+    let q = ["--q", "0.1,0.2,0.3,0.4,0.5,0.6", "--qd", "0,1,0,0,0,0"];
+    let base = csv(&run(&["idm", &urdf, q[0], q[1], q[2], q[3]])).1[0].clone();
+    let fs = csv(&run(&[
+        "idm", &urdf, "--set", "FS2=0.5", q[0], q[1], q[2], q[3],
+    ]))
+    .1[0]
+        .clone();
+    for (k, (a, b)) in fs.iter().zip(&base).enumerate() {
+        let expected = if k == 1 { 0.5 } else { 0.0 };
+        assert!(
+            (a - b - expected).abs() < 1e-12,
+            "joint {}: {a} - {b}",
+            k + 1
+        );
+    }
+    let heavy = run(&["idm", &urdf, "--set", "M3=100", q[0], q[1]]);
+    assert_ne!(
+        heavy,
+        run(&["idm", &urdf, q[0], q[1]]),
+        "--set M3 changed nothing"
+    );
+    let e = fails(&["idm", &urdf, "--set", "M33=1", q[0], q[1]]);
+    assert!(e.contains("no symbol `M33`") && e.contains("1..6"), "{e}");
 }
 
 #[test]

@@ -2,10 +2,11 @@
 //! tracker held by the object. The rows of a batch are evaluated in order on one assembly
 //! branch (each row reached from the previous one), with the GIL released.
 
-use crate::arrays::{output, states};
+use crate::arrays::{in_blocks, inputs, Output, Shape};
 use crate::errors::{InputError, IntoPy};
-use crate::robot::{copy_rows, Robot};
+use crate::robot::{alias, copy_rows, Call, Robot};
 use nalgebra::DMatrix;
+use numpy::PyArrayMethods;
 use pyo3::create_exception;
 use pyo3::exceptions::PyUserWarning;
 use pyo3::prelude::*;
@@ -40,15 +41,26 @@ pub struct ClosedChain {
     source: Option<std::path::PathBuf>,
 }
 
-/// Results of the rows, and the worst-conditioned row that warned (0-based).
-type RowsAndWorst = (Vec<f64>, Option<(usize, Conditioning)>);
+/// The worst-conditioned row that warned (0-based) and its conditioning.
+type Worst = Option<(usize, Conditioning)>;
+
+/// Whether `c` is worse conditioned than the row kept in `worst`.
+fn worse(worst: &Worst, c: &Conditioning) -> bool {
+    match worst {
+        None => true,
+        Some((_, w)) => c.wp < w.wp || c.a_cl.unwrap_or(1.0) < w.a_cl.unwrap_or(1.0),
+    }
+}
 
 impl ClosedChain {
+    /// Evaluate `f` on one state or on the N rows in order (one branch, the tracker moving
+    /// from row to row), in blocks with the GIL released, the signals checked between blocks;
+    /// a SingularityWarning names the worst row near a singularity.
     fn eval<'py, F>(
         &self,
         py: Python<'py>,
-        inputs: &[(&str, Option<&Bound<'py, PyAny>>)],
-        shape_one: &[usize],
+        name: &str,
+        call: Call<'_, 'py>,
         f: F,
     ) -> PyResult<Bound<'py, PyAny>>
     where
@@ -62,45 +74,42 @@ impl ClosedChain {
             + Sync,
     {
         let chain = &self.chain;
-        let st = states(inputs, chain.dof(), &|| {
+        let inp = inputs(call.inputs, chain.dof(), &|| {
             format!(
                 "actuated joints [{}]",
                 chain.coordinates().names().join(", ")
             )
         })?;
-        let width: usize = shape_one.iter().product();
-        let k = st.data.len();
-        let rows = st.count();
-        let (v, warn) = py
-            .detach(|| -> robodyn::Result<RowsAndWorst> {
-                let mut t = self.tracker.lock().unwrap();
-                let mut out = vec![0.0; rows * width];
-                let mut warn: Option<(usize, Conditioning)> = None;
-                for r in 0..rows {
-                    let x: [&[f64]; 3] =
-                        std::array::from_fn(|i| if i < k { st.row(i, r) } else { &[][..] });
-                    let c =
-                        f(chain, &mut t, x, &mut out[r * width..(r + 1) * width]).map_err(|e| {
-                            if st.rows.is_some() {
-                                e.in_row(r + 1)
-                            } else {
-                                e
-                            }
-                        })?;
-                    let worse = match &warn {
-                        None => true,
-                        Some((_, w)) => {
-                            c.wp < w.wp || c.a_cl.unwrap_or(1.0) < w.a_cl.unwrap_or(1.0)
+        let shape = Shape::result(inp.rows, call.one, call.stacked);
+        let mut out = Output::new(py, call.out, shape, inp.rows.is_some())?;
+        let st = inp.states(out.span())?;
+        let width: usize = call.one.iter().product();
+        let mut worst: Worst = None;
+        in_blocks(py, st.count(), out.slice(), width, |first, o| {
+            let mut t = self.tracker.lock().unwrap();
+            for (i, row) in o.chunks_mut(width.max(1)).enumerate() {
+                let r = first + i;
+                let c = f(chain, &mut t, st.rows3(r), row)
+                    .and_then(|c| {
+                        // the library's rule for results (finite inputs can overflow), which
+                        // the closed-chain functions do not apply themselves yet
+                        robodyn::error::check_finite_result(name, row)?;
+                        Ok(c)
+                    })
+                    .map_err(|e| {
+                        if st.rows.is_some() {
+                            e.in_row(r + 1)
+                        } else {
+                            e
                         }
-                    };
-                    if c.warning && worse {
-                        warn = Some((r, c));
-                    }
+                    })?;
+                if c.warning && worse(&worst, &c) {
+                    worst = Some((r, c));
                 }
-                Ok((out, warn))
-            })
-            .py()?;
-        if let Some((r, c)) = warn {
+            }
+            Ok(())
+        })?;
+        if let Some((r, c)) = worst {
             let at = if st.rows.is_some() {
                 format!(" (worst at row {})", r + 1)
             } else {
@@ -111,9 +120,9 @@ impl ClosedChain {
                 c.describe(chain.limits())
             );
             py.import("warnings")?
-                .call_method1("warn", (msg, py.get_type::<SingularityWarning>(), 2))?;
+                .call_method1("warn", (msg, py.get_type::<SingularityWarning>(), 1))?;
         }
-        output(py, v, st.rows, shape_one)
+        out.finish(py)
     }
 }
 
@@ -218,20 +227,30 @@ impl ClosedChain {
         Ok(())
     }
 
-    /// Loop closure: the passive tree variables q_p for the actuated q_a, (p,) or (N, p).
+    /// Loop closure: the passive tree variables q_p (rad, m) for the actuated q_a (rad, m):
+    /// (p,) for q_a of shape (nq,), (N, p) for (N, nq), p = n_equations. out: as for idm.
+    #[pyo3(signature = (q_a, *, out=None))]
     fn solve_loops<'py>(
         &self,
         py: Python<'py>,
         q_a: &Bound<'py, PyAny>,
+        out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let p = self.chain.n_equations();
-        self.eval(py, &[("q_a", Some(q_a))], &[p], |c, t, x, o| {
+        let call = Call {
+            inputs: &[("q_a", Some(q_a))],
+            one: &[p],
+            stacked: false,
+            out,
+        };
+        self.eval(py, "q_p", call, |c, t, x, o| {
             loop_closure_into(c, &mut t.data, &mut t.branch, x[0], o)
         })
     }
 
-    /// Loop closure at one q_a with everything: q_p, cut-joint variables q_c, the tree's
-    /// movable-joint vector q_tree, W = d q_p / d q_a (10.30), residual and rcond of Wp.
+    /// Loop closure at one q_a (nq,): q_p, cut-joint variables q_c, the tree's movable-joint
+    /// vector q_tree (rad, m), W = d q_p / d q_a (eq 10.30, (p, nq)), residual, rcond_wp,
+    /// warning.
     fn closure<'py>(&self, py: Python<'py>, q_a: Vec<f64>) -> PyResult<Bound<'py, PyDict>> {
         let chain = &self.chain;
         let s = py
@@ -250,112 +269,139 @@ impl ClosedChain {
         let mut w = vec![0.0; r * c];
         let all: Vec<usize> = (0..c).collect();
         copy_rows(&s.w, &all, &mut w);
-        d.set_item("W", output(py, w, None, &[r, c])?)?;
+        d.set_item("W", numpy::PyArray1::from_vec(py, w).reshape([r, c])?)?;
         d.set_item("residual", s.residual)?;
         d.set_item("rcond_wp", s.conditioning.wp)?;
         d.set_item("warning", s.conditioning.warning)?;
         Ok(d)
     }
 
-    /// Closed-chain inverse dynamic model Γ_cl = G^T Γ_tr (10.40) on the actuated joints.
-    #[pyo3(signature = (q_a, qd_a=None, qdd_a=None))]
+    /// Closed-chain inverse dynamic model Γ_cl = G^T Γ_tr (eq 10.40): the torques (N m) /
+    /// forces (N) of the actuated joints for their positions q_a (rad, m), velocities qd_a and
+    /// accelerations qdd_a (v, a: Pinocchio's names), the passive joints solved by loop
+    /// closure. Shapes (nq,) or (N, nq) (rows followed in order on one branch). out: a float64
+    /// C-contiguous writeable array of the result's shape to write into (returned).
+    #[pyo3(signature = (q_a, qd_a=None, qdd_a=None, *, v=None, a=None, out=None))]
+    #[allow(clippy::too_many_arguments)]
     fn idm<'py>(
         &self,
         py: Python<'py>,
         q_a: &Bound<'py, PyAny>,
         qd_a: Option<&Bound<'py, PyAny>>,
         qdd_a: Option<&Bound<'py, PyAny>>,
+        v: Option<&Bound<'py, PyAny>>,
+        a: Option<&Bound<'py, PyAny>>,
+        out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
+        let qd_a = alias("qd_a", qd_a, "v", v)?;
+        let qdd_a = alias("qdd_a", qdd_a, "a", a)?;
         let n = self.chain.dof();
-        self.eval(
-            py,
-            &[("q_a", Some(q_a)), ("qd_a", qd_a), ("qdd_a", qdd_a)],
-            &[n],
-            |c, t, x, o| {
-                closed_inverse_dynamics_into(
-                    c,
-                    &mut t.data,
-                    &mut t.branch,
-                    c.robot().environment(),
-                    x[0],
-                    x[1],
-                    x[2],
-                    o,
-                )
-            },
-        )
+        let call = Call {
+            inputs: &[("q_a", Some(q_a)), ("qd_a", qd_a), ("qdd_a", qdd_a)],
+            one: &[n],
+            stacked: false,
+            out,
+        };
+        self.eval(py, "tau_a", call, |c, t, x, o| {
+            closed_inverse_dynamics_into(
+                c,
+                &mut t.data,
+                &mut t.branch,
+                c.robot().environment(),
+                x[0],
+                x[1],
+                x[2],
+                o,
+            )
+        })
     }
 
-    /// Closed-chain direct dynamic model qdd_a = A_cl^-1 (Γ_cl - H_cl) (10.46–10.48).
-    #[pyo3(signature = (q_a, qd_a=None, tau_a=None))]
+    /// Closed-chain direct dynamic model qdd_a = A_cl^-1 (Γ_cl - H_cl) (eqs 10.46–10.48): the
+    /// accelerations (rad/s², m/s²) of the actuated joints for q_a, qd_a (v: Pinocchio's name)
+    /// and their torques tau_a (N m, N). Shapes as idm. out: as for idm.
+    #[pyo3(signature = (q_a, qd_a=None, tau_a=None, *, v=None, out=None))]
     fn ddm<'py>(
         &self,
         py: Python<'py>,
         q_a: &Bound<'py, PyAny>,
         qd_a: Option<&Bound<'py, PyAny>>,
         tau_a: Option<&Bound<'py, PyAny>>,
+        v: Option<&Bound<'py, PyAny>>,
+        out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
+        let qd_a = alias("qd_a", qd_a, "v", v)?;
         let n = self.chain.dof();
-        self.eval(
-            py,
-            &[("q_a", Some(q_a)), ("qd_a", qd_a), ("tau_a", tau_a)],
-            &[n],
-            |c, t, x, o| {
-                closed_direct_dynamics_into(
-                    c,
-                    &mut t.data,
-                    &mut t.branch,
-                    c.robot().environment(),
-                    x[0],
-                    x[1],
-                    x[2],
-                    o,
-                )
-            },
-        )
+        let call = Call {
+            inputs: &[("q_a", Some(q_a)), ("qd_a", qd_a), ("tau_a", tau_a)],
+            one: &[n],
+            stacked: false,
+            out,
+        };
+        self.eval(py, "qdd_a", call, |c, t, x, o| {
+            closed_direct_dynamics_into(
+                c,
+                &mut t.data,
+                &mut t.branch,
+                c.robot().environment(),
+                x[0],
+                x[1],
+                x[2],
+                o,
+            )
+        })
     }
 
-    /// Regressor of the closed chain, G^T Φ over all 13 NL standard parameters (K order):
-    /// (n, 13 NL) for one state, stacked (N n, 13 NL) for N states.
-    #[pyo3(signature = (q_a, qd_a=None, qdd_a=None))]
+    /// Regressor of the closed chain, G^T Φ over all 13 NL standard parameters (K order,
+    /// `robot.parameter_names`): (nq, 13 NL) for one state, stacked (N nq, 13 NL) for N states,
+    /// for q_a, qd_a, qdd_a (v, a: Pinocchio's names). out: as for idm.
+    #[pyo3(signature = (q_a, qd_a=None, qdd_a=None, *, v=None, a=None, out=None))]
+    #[allow(clippy::too_many_arguments)]
     fn regressor<'py>(
         &self,
         py: Python<'py>,
         q_a: &Bound<'py, PyAny>,
         qd_a: Option<&Bound<'py, PyAny>>,
         qdd_a: Option<&Bound<'py, PyAny>>,
+        v: Option<&Bound<'py, PyAny>>,
+        a: Option<&Bound<'py, PyAny>>,
+        out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
+        let qd_a = alias("qd_a", qd_a, "v", v)?;
+        let qdd_a = alias("qdd_a", qdd_a, "a", a)?;
         let n = self.chain.dof();
         let nk = PARAMS_PER_LINK * self.chain.robot().nl();
-        let cols: Vec<usize> = (0..nk).collect();
-        let a = self.eval(
-            py,
-            &[("q_a", Some(q_a)), ("qd_a", qd_a), ("qdd_a", qdd_a)],
-            &[n, nk],
-            |c, t, x, o| {
-                if t.phi.shape() != (n, nk) {
-                    t.phi = DMatrix::zeros(n, nk);
-                }
-                let cond = closed_regressor_into(
-                    c,
-                    &mut t.data,
-                    &mut t.branch,
-                    c.robot().environment(),
-                    x,
-                    &mut t.phi,
-                    &mut t.tau_e,
-                )?;
-                copy_rows(&t.phi, &cols, o);
-                Ok(cond)
-            },
-        )?;
-        a.call_method1("reshape", ((-1i64, nk),))
+        let call = Call {
+            inputs: &[("q_a", Some(q_a)), ("qd_a", qd_a), ("qdd_a", qdd_a)],
+            one: &[n, nk],
+            stacked: true,
+            out,
+        };
+        self.eval(py, "Phi", call, |c, t, x, o| {
+            if t.phi.shape() != (n, nk) {
+                t.phi = DMatrix::zeros(n, nk);
+            }
+            let cond = closed_regressor_into(
+                c,
+                &mut t.data,
+                &mut t.branch,
+                c.robot().environment(),
+                x,
+                &mut t.phi,
+                &mut t.tau_e,
+            )?;
+            for (k, o) in o.iter_mut().enumerate() {
+                *o = t.phi[(k / nk, k % nk)];
+            }
+            Ok(cond)
+        })
     }
 
-    /// Simulate in the actuated coordinates from (q0, qd0) (default: the tracker's q_a, 0);
-    /// the passive joints are re-solved at every evaluation. Returns a dict of arrays (t, q,
-    /// qd, qdd, tau, energy, closure_residual, the passive joints' q<j>).
-    #[pyo3(signature = (duration, q0=None, qd0=None, torque=None, dt=None, rtol=1e-8, atol=1e-10, output_dt=0.01, coulomb_smoothing=None, max_steps=None))]
+    /// Simulate in the actuated coordinates from (q0, qd0) (rad, m; rad/s, m/s; default: the
+    /// tracker's q_a, zeros) over [0, duration] (s); the passive joints are re-solved at every
+    /// evaluation. Returns a dict of arrays: t (M,) s, q, qd, qdd, tau (M, nq) over the actuated
+    /// joints, energy (M,) J, closure_residual (M,) and the passive joints' q<j> (M,). torque,
+    /// dt, rtol, atol, output_dt, max_steps as for Robot.simulate; Ctrl-C stops the run.
+    #[pyo3(signature = (duration, q0=None, qd0=None, torque=None, dt=None, rtol=1e-8, atol=1e-10, output_dt=0.01, coulomb_smoothing=None, max_steps=5_000_000))]
     #[allow(clippy::too_many_arguments)]
     fn simulate<'py>(
         &self,
@@ -369,7 +415,7 @@ impl ClosedChain {
         atol: f64,
         output_dt: f64,
         coulomb_smoothing: Option<f64>,
-        max_steps: Option<usize>,
+        max_steps: usize,
     ) -> PyResult<Bound<'py, PyDict>> {
         let n = self.chain.dof();
         let branch = self.tracker.lock().unwrap().branch.clone();

@@ -68,6 +68,13 @@ create_exception!(
     "A numerical failure (no convergence, step-size underflow...)."
 );
 
+create_exception!(
+    robodyn,
+    RobotFileWarning,
+    pyo3::exceptions::PyUserWarning,
+    "What a robot file's reader noticed that is not an error (inertial parameters no rigid body has, a legged robot loaded with a fixed base, ...): the file loads, but may not mean what its author meant."
+);
+
 /// Register the classes in the module.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();

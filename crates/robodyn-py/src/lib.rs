@@ -13,16 +13,34 @@ use errors::IntoPy;
 use pyo3::prelude::*;
 use std::path::PathBuf;
 
-/// Read a robot file (TOML, SYMORO .par or URDF, by extension); `values` give or change symbol
-/// values (`robodyn.load("robots/sr400.toml", d3=0.6)`). A file whose symbols lack values (a
-/// SYMORO file of symbols only) is refused with the list of them and the two ways on: values as
-/// keyword arguments, or `robodyn.base_parameters(path)`, which needs none.
+/// Read a robot file (TOML, SYMORO .par or URDF, by extension). `values` give or change values
+/// by name: symbols (`robodyn.load("robots/sr400.toml", d3=0.6)`) or standard parameters the
+/// file writes as numbers (`load("ur5.urdf", M3=3.2, FV2=0.5)`: mass of link 3, viscous
+/// friction of joint 2; names as `Robot.parameter_names`); an unknown name raises InputError
+/// listing the known ones. What the reader notices (inertias no rigid body has, a legged robot
+/// loaded with a fixed base, ...) is issued as a `robodyn.RobotFileWarning`. A file whose symbols
+/// lack values (a SYMORO file of symbols only) is refused with the list of them and the two
+/// ways on: values as keyword arguments, or `robodyn.base_parameters(path)`, which needs none.
 #[pyfunction]
 #[pyo3(signature = (path, **values))]
-fn load(path: PathBuf, values: Option<&Bound<'_, pyo3::types::PyDict>>) -> PyResult<robot::Robot> {
+fn load(
+    py: Python<'_>,
+    path: PathBuf,
+    values: Option<&Bound<'_, pyo3::types::PyDict>>,
+) -> PyResult<robot::Robot> {
     let overrides = robot::kwargs_values(values)?;
-    match robodyn::io::load_with(&path, &overrides) {
-        Ok(r) => Ok(robot::Robot::wrap(r, Some(path))),
+    robot::check_finite(&overrides)?;
+    match robodyn::io::load_with_warnings(&path, &overrides) {
+        Ok((r, warnings)) => {
+            let warn = py.import("warnings")?;
+            for w in warnings {
+                warn.call_method1(
+                    "warn",
+                    (w.to_string(), py.get_type::<errors::RobotFileWarning>(), 1),
+                )?;
+            }
+            Ok(robot::Robot::wrap(r, Some(path)))
+        }
         Err(e) => {
             let missing = robodyn::io::load_description(&path)
                 .map(|mut d| {
@@ -67,21 +85,9 @@ fn load(path: PathBuf, values: Option<&Bound<'_, pyo3::types::PyDict>>) -> PyRes
 
 /// The symbols a description uses without giving them a value, in order.
 fn symbols_without_value(d: &robodyn::RobotDescription) -> Vec<String> {
-    let mut exprs: Vec<&robodyn::Expr> = Vec::new();
-    for f in &d.frames {
-        exprs.extend(f.geometric());
-    }
-    for l in &d.links {
-        exprs.extend(l.params.iter().chain(l.wrench.iter()));
-    }
-    for v in [&d.gravity, &d.w0, &d.wp0, &d.v0, &d.vp0] {
-        exprs.extend(v.iter());
-    }
-    let mut seen = std::collections::BTreeSet::new();
-    exprs
-        .iter()
-        .flat_map(|e| e.symbols())
-        .filter(|s| !d.symbols.contains_key(s) && seen.insert(s.clone()))
+    d.used_symbols()
+        .into_iter()
+        .filter(|s| !d.symbols.contains_key(s))
         .collect()
 }
 
@@ -91,6 +97,10 @@ fn _robodyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add(
         "SingularityWarning",
         m.py().get_type::<closed::SingularityWarning>(),
+    )?;
+    m.add(
+        "RobotFileWarning",
+        m.py().get_type::<errors::RobotFileWarning>(),
     )?;
     m.add_class::<robot::Robot>()?;
     m.add_class::<closed::ClosedChain>()?;

@@ -1,8 +1,9 @@
 //! Base parameters, code generation and simulation for Python.
 
+use crate::arrays::SIGNAL_INTERVAL;
 use crate::errors::{InputError, IntoPy};
 use crate::robot::{parse_method, parse_rotor, Robot};
-use numpy::{PyArray1, PyArray2, PyArrayMethods, PyUntypedArrayMethods};
+use numpy::{PyArray1, PyArray2, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 use robodyn::algorithms::base_parameters::symbolic::standard_index;
@@ -18,6 +19,7 @@ use robodyn::simulation::{
 };
 use robodyn_symbolic::{emit, Lang};
 use std::collections::HashMap;
+use std::time::Instant;
 
 /// Base inertial parameters of a robot by one method (§10.2.4, §10.3.4–10.3.6).
 #[pyclass(module = "robodyn", frozen, get_all)]
@@ -152,7 +154,9 @@ pub fn base_parameters_of_file(
     values: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<BaseParameters> {
     let mut desc = robodyn::io::load_description(&path).py()?;
-    desc.symbols.extend(crate::robot::kwargs_values(values)?);
+    let values = crate::robot::kwargs_values(values)?;
+    crate::robot::check_finite(&values)?;
+    robodyn::io::set_values(&mut desc, &values).py()?;
     let zeros = crate::robot::parse_zeros(zeros, Some(&path))?;
     base_parameters_of(py, &desc, None, zeros, method, friction, rotor, seed)
 }
@@ -402,12 +406,7 @@ fn call_torque(f: &Py<PyAny>, t: f64, q: &[f64], qd: &[f64], out: &mut [f64]) ->
             py,
             (t, PyArray1::from_slice(py, q), PyArray1::from_slice(py, qd)),
         )?;
-        let v: Vec<f64> = crate::arrays::float_array(r.bind(py))?
-            .readonly()
-            .as_array()
-            .iter()
-            .copied()
-            .collect();
+        let (v, _) = crate::arrays::values(r.bind(py))?;
         if v.len() != out.len() {
             return Err(crate::errors::DimensionError::new_err(format!(
                 "the torque callback returned {} values, {} expected",
@@ -420,13 +419,29 @@ fn call_torque(f: &Py<PyAny>, t: f64, q: &[f64], qd: &[f64], out: &mut [f64]) ->
     })
 }
 
+/// The calls of a system, delegated; `Callback` and `Interruptible` change `accel`.
+macro_rules! delegate_dynamics {
+    () => {
+        fn dof(&self) -> usize {
+            self.inner.dof()
+        }
+        fn labels(&self) -> Vec<String> {
+            self.inner.labels()
+        }
+        fn energy(&mut self, q: &[f64], qd: &[f64]) -> robodyn::Result<f64> {
+            self.inner.energy(q, qd)
+        }
+        fn extra_columns(&self) -> Vec<String> {
+            self.inner.extra_columns()
+        }
+        fn extra_values(&mut self, q: &[f64], qd: &[f64], out: &mut [f64]) -> robodyn::Result<()> {
+            self.inner.extra_values(q, qd, out)
+        }
+    };
+}
+
 impl Dynamics for Callback<'_> {
-    fn dof(&self) -> usize {
-        self.inner.dof()
-    }
-    fn labels(&self) -> Vec<String> {
-        self.inner.labels()
-    }
+    delegate_dynamics!();
     fn accel(
         &mut self,
         t: f64,
@@ -441,16 +456,42 @@ impl Dynamics for Callback<'_> {
         }
         self.inner.accel(t, q, qd, &self.tau, qdd)
     }
-    fn energy(&mut self, q: &[f64], qd: &[f64]) -> robodyn::Result<f64> {
-        self.inner.energy(q, qd)
-    }
-    fn extra_columns(&self) -> Vec<String> {
-        self.inner.extra_columns()
-    }
-    fn extra_values(&mut self, q: &[f64], qd: &[f64], out: &mut [f64]) -> robodyn::Result<()> {
-        self.inner.extra_values(q, qd, out)
+}
+
+/// Another system whose evaluations check the Python signals about every
+/// [`SIGNAL_INTERVAL`]: Ctrl-C stops a run (KeyboardInterrupt), however long.
+struct Interruptible<'a> {
+    inner: &'a mut (dyn Dynamics + Send),
+    last: Instant,
+    calls: u32,
+    error: Option<PyErr>,
+}
+
+impl Dynamics for Interruptible<'_> {
+    delegate_dynamics!();
+    fn accel(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        tau: &[f64],
+        qdd: &mut [f64],
+    ) -> robodyn::Result<()> {
+        self.calls = self.calls.wrapping_add(1);
+        if self.calls.is_multiple_of(16) && self.last.elapsed() >= SIGNAL_INTERVAL {
+            self.last = Instant::now();
+            if let Err(e) = Python::attach(|py| py.check_signals()) {
+                self.error = Some(e);
+                return Err(robodyn::Error::Input("interrupted".into()));
+            }
+        }
+        self.inner.accel(t, q, qd, tau, qdd)
     }
 }
+
+// the default of `max_steps` in the signatures of `simulate` (a literal, so that Python's
+// `inspect.signature` shows it) is the library's, the CLI's
+const _: () = assert!(robodyn::simulation::DEFAULT_MAX_STEPS == 5_000_000);
 
 /// Simulation settings shared by trees and closed chains.
 pub struct SimArgs<'py> {
@@ -462,7 +503,38 @@ pub struct SimArgs<'py> {
     pub rtol: f64,
     pub atol: f64,
     pub output_dt: f64,
-    pub max_steps: Option<usize>,
+    pub max_steps: usize,
+}
+
+/// The torque input of a simulation (a callable is returned apart: it is called from the run).
+fn torque_input(
+    torque: Option<&Bound<'_, PyAny>>,
+    n: usize,
+) -> PyResult<(TorqueInput, Option<Py<PyAny>>)> {
+    Ok(match torque {
+        None => (TorqueInput::Constant(vec![0.0; n]), None),
+        Some(t) if t.is_callable() => (
+            TorqueInput::Constant(vec![0.0; n]),
+            Some(t.clone().unbind()),
+        ),
+        Some(t) if t.is_instance_of::<PyTuple>() => {
+            let (times, values): (Bound<PyAny>, Bound<PyAny>) = t.extract()?;
+            let (times, _) = crate::arrays::values(&times)?;
+            let (flat, shape) = crate::arrays::values(&values)?;
+            if shape.len() != 2 || shape[1] != n || shape[0] != times.len() {
+                return Err(crate::errors::DimensionError::new_err(format!(
+                    "torque = (times, values): values has shape {shape:?}, expected ({}, {n})",
+                    times.len()
+                )));
+            }
+            let rows = flat.chunks(n.max(1)).map(|c| c.to_vec()).collect();
+            (
+                TorqueInput::Series(TimeSeries::new(times, rows).py()?),
+                None,
+            )
+        }
+        Some(t) => (TorqueInput::Constant(crate::arrays::values(t)?.0), None),
+    })
 }
 
 /// Run a simulation of `dynamics` and return the trajectory as a dict of arrays.
@@ -472,85 +544,63 @@ pub fn run_simulation<'py>(
     a: SimArgs<'py>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let n = dynamics.dof();
-    let mut callback = None;
-    let input = match &a.torque {
-        None => TorqueInput::Constant(vec![0.0; n]),
-        Some(t) if t.is_callable() => {
-            callback = Some(t.clone().unbind());
-            TorqueInput::Constant(vec![0.0; n])
-        }
-        Some(t) if t.is_instance_of::<PyTuple>() => {
-            let (times, values): (Bound<PyAny>, Bound<PyAny>) = t.extract()?;
-            let times: Vec<f64> = crate::arrays::float_array(&times)?
-                .readonly()
-                .as_array()
-                .iter()
-                .copied()
-                .collect();
-            let values = crate::arrays::float_array(&values)?;
-            let shape = values.shape().to_vec();
-            if shape.len() != 2 || shape[1] != n || shape[0] != times.len() {
-                return Err(crate::errors::DimensionError::new_err(format!(
-                    "torque = (times, values): values has shape {shape:?}, expected ({}, {n})",
-                    times.len()
-                )));
-            }
-            let flat: Vec<f64> = values.readonly().as_array().iter().copied().collect();
-            let rows = flat.chunks(n).map(|c| c.to_vec()).collect();
-            TorqueInput::Series(TimeSeries::new(times, rows).py()?)
-        }
-        Some(t) => {
-            let v: Vec<f64> = crate::arrays::float_array(t)?
-                .readonly()
-                .as_array()
-                .iter()
-                .copied()
-                .collect();
-            TorqueInput::Constant(v)
-        }
-    };
-    let integrator = Integrator::fixed_or_adaptive(a.dt, a.rtol, a.atol);
+    if a.max_steps == 0 {
+        return Err(InputError::new_err("max_steps = 0: must be at least 1"));
+    }
+    let (input, callback) = torque_input(a.torque.as_ref(), n)?;
     let opts = SimOptions {
         duration: a.duration,
-        integrator,
+        integrator: Integrator::fixed_or_adaptive(a.dt, a.rtol, a.atol),
         output_dt: a.output_dt,
-        max_steps: a.max_steps,
+        max_steps: Some(a.max_steps),
     };
     let mut rec = Recorder::default();
-    let result = match &callback {
-        None => py.detach(|| {
-            sim(
-                dynamics,
-                &input,
-                &a.q0,
-                &a.qd0,
-                &opts,
-                &mut rec,
-                &mut |_| {},
-            )
+    let mut cb = None;
+    let inner: &mut (dyn Dynamics + Send) = match &callback {
+        Some(f) => cb.insert(Callback {
+            inner: dynamics,
+            f: f.clone_ref(py),
+            tau: vec![0.0; n],
+            error: None,
         }),
-        Some(f) => {
-            let mut cb = Callback {
-                inner: dynamics,
-                f: f.clone_ref(py),
-                tau: vec![0.0; n],
-                error: None,
-            };
-            let r = py.detach(|| sim(&mut cb, &input, &a.q0, &a.qd0, &opts, &mut rec, &mut |_| {}));
-            if let Some(e) = cb.error.take() {
-                return Err(e);
-            }
-            // the recorded torques are the callback's at each output row
-            for row in rec.rows.iter_mut() {
-                let (t, rest) = row.split_at_mut(1);
-                let (q, rest) = rest.split_at_mut(n);
-                let (qd, rest) = rest.split_at_mut(n);
-                call_torque(f, t[0], q, qd, &mut rest[n..2 * n])?;
-            }
-            r
-        }
+        None => dynamics,
     };
+    let mut run = Interruptible {
+        inner,
+        last: Instant::now(),
+        calls: 0,
+        error: None,
+    };
+    let result = py.detach(|| {
+        sim(
+            &mut run,
+            &input,
+            &a.q0,
+            &a.qd0,
+            &opts,
+            &mut rec,
+            &mut |_| {},
+        )
+    });
+    let interrupted = run.error.take();
+    if let Some(e) = interrupted.or_else(|| cb.as_mut().and_then(|c| c.error.take())) {
+        return Err(e);
+    }
+    if let Some(f) = &callback {
+        // the recorded torques are the callback's at each output row
+        for row in rec.rows.iter_mut() {
+            let (t, rest) = row.split_at_mut(1);
+            let (q, rest) = rest.split_at_mut(n);
+            let (qd, rest) = rest.split_at_mut(n);
+            call_torque(f, t[0], q, qd, &mut rest[n..2 * n])?;
+        }
+    }
     result.py()?;
+    trajectory(py, &rec, n)
+}
+
+/// The recorded trajectory as a dict of arrays.
+fn trajectory<'py>(py: Python<'py>, rec: &Recorder, n: usize) -> PyResult<Bound<'py, PyDict>> {
     let out = PyDict::new(py);
     let rows = rec.rows.len();
     let col = |c: usize| -> Vec<f64> { rec.rows.iter().map(|r| r[c]).collect() };

@@ -2,7 +2,7 @@
 //! as methods on one state (1-D arrays) or N states (2-D arrays, evaluated over all cores with
 //! the GIL released).
 
-use crate::arrays::{output, states, States};
+use crate::arrays::{in_blocks, inputs, shift_row, Output, Shape, States};
 use crate::errors::{InputError, IntoPy};
 use nalgebra::DMatrix;
 use pyo3::prelude::*;
@@ -17,12 +17,14 @@ use robodyn::{
 };
 use std::collections::BTreeMap;
 use std::path::PathBuf;
-use std::sync::{Arc, Mutex, RwLock};
+use std::sync::{Arc, Mutex, OnceLock, RwLock};
 
-/// Per-thread buffers of a tree evaluation: the library's `Data` and a matrix output.
+/// Per-thread buffers of a tree evaluation: the library's `Data`, a matrix output and a tree
+/// vector (NL entries).
 pub struct Work {
     pub data: Data,
     pub m: DMatrix<f64>,
+    pub tree: Vec<f64>,
 }
 
 impl Work {
@@ -30,6 +32,7 @@ impl Work {
         Work {
             data: Data::new(robot),
             m: DMatrix::zeros(0, 0),
+            tree: vec![0.0; robot.nl()],
         }
     }
 
@@ -49,6 +52,56 @@ pub fn copy_rows(m: &DMatrix<f64>, cols: &[usize], out: &mut [f64]) {
         for (k, &c) in cols.iter().enumerate() {
             out[r * w + k] = m[(r, c)];
         }
+    }
+}
+
+/// `x` or its alias `y` (Pinocchio's spelling: `v` for `qd`, `a` for `qdd`), not both.
+pub fn alias<'a, 'py>(
+    name: &str,
+    x: Option<&'a Bound<'py, PyAny>>,
+    other: &str,
+    y: Option<&'a Bound<'py, PyAny>>,
+) -> PyResult<Option<&'a Bound<'py, PyAny>>> {
+    match (x, y) {
+        (Some(_), Some(_)) => Err(InputError::new_err(format!(
+            "{name} and {other} are the same argument ({other} is Pinocchio's name for {name}): \
+             give one of them"
+        ))),
+        (x, y) => Ok(x.or(y)),
+    }
+}
+
+/// The model of a `Robot` and, made on first use, the same robot without friction (FS = FV =
+/// 0 on every joint: what Pinocchio's `rnea` and `aba` compute).
+pub struct Models {
+    pub full: Arc<robodyn::Robot>,
+    frictionless: OnceLock<Result<robodyn::Robot, robodyn::Error>>,
+}
+
+impl Models {
+    fn new(robot: robodyn::Robot) -> Models {
+        Models {
+            full: Arc::new(robot),
+            frictionless: OnceLock::new(),
+        }
+    }
+
+    /// The robot, or (friction = false) the robot with FS = FV = 0.
+    pub fn select(&self, friction: bool) -> PyResult<&robodyn::Robot> {
+        if friction {
+            return Ok(&self.full);
+        }
+        self.frictionless
+            .get_or_init(|| {
+                let mut d = self.full.description().clone();
+                for l in &mut d.links {
+                    l.params[robodyn::model::param::FS] = robodyn::Expr::zero();
+                    l.params[robodyn::model::param::FV] = robodyn::Expr::zero();
+                }
+                robodyn::Robot::new(d)
+            })
+            .as_ref()
+            .map_err(|e| crate::errors::to_py(e.clone()))
     }
 }
 
@@ -95,38 +148,54 @@ pub fn parse_rotor(rotor: &str) -> PyResult<RotorMode> {
 /// for the closed-chain models).
 #[pyclass(module = "robodyn", frozen)]
 pub struct Robot {
-    inner: RwLock<Arc<robodyn::Robot>>,
-    /// Buffers of single-state calls (made for the model they hold).
-    cache: Mutex<Option<(Arc<robodyn::Robot>, Work)>>,
+    inner: RwLock<Arc<Models>>,
+    /// Buffers of single-state calls (made for the models they hold; the frictionless robot
+    /// has the same structure and shares them).
+    cache: Mutex<Option<(Arc<Models>, Work)>>,
     /// The file it was read from (decides what a literal 0 means for base parameters).
     pub source: Option<PathBuf>,
+}
+
+/// A call of a model function: the inputs (name, array), the result's shape for one state,
+/// whether N states stack their rows (the regressor: (N n, p)) or add a leading N, and the
+/// caller's `out`.
+pub struct Call<'a, 'py> {
+    pub inputs: &'a [(&'a str, Option<&'a Bound<'py, PyAny>>)],
+    pub one: &'a [usize],
+    pub stacked: bool,
+    pub out: Option<&'a Bound<'py, PyAny>>,
 }
 
 impl Robot {
     pub fn wrap(robot: robodyn::Robot, source: Option<PathBuf>) -> Robot {
         Robot {
-            inner: RwLock::new(Arc::new(robot)),
+            inner: RwLock::new(Arc::new(Models::new(robot))),
             cache: Mutex::new(None),
             source,
         }
     }
 
-    /// The current model (shared).
-    pub fn model(&self) -> Arc<robodyn::Robot> {
+    /// The current models (shared).
+    pub fn models(&self) -> Arc<Models> {
         self.inner.read().unwrap().clone()
     }
 
-    fn with_work<T>(&self, robot: &Arc<robodyn::Robot>, f: impl FnOnce(&mut Work) -> T) -> T {
+    /// The current model (shared).
+    pub fn model(&self) -> Arc<robodyn::Robot> {
+        self.models().full.clone()
+    }
+
+    fn with_work<T>(&self, models: &Arc<Models>, f: impl FnOnce(&mut Work) -> T) -> T {
         if let Ok(mut g) = self.cache.try_lock() {
             match g.as_mut() {
-                Some((r, w)) if Arc::ptr_eq(r, robot) => return f(w),
+                Some((m, w)) if Arc::ptr_eq(m, models) => return f(w),
                 _ => {
-                    *g = Some((robot.clone(), Work::new(robot)));
+                    *g = Some((models.clone(), Work::new(&models.full)));
                     return f(&mut g.as_mut().unwrap().1);
                 }
             }
         }
-        f(&mut Work::new(robot))
+        f(&mut Work::new(&models.full))
     }
 
     fn joint_text(robot: &robodyn::Robot) -> String {
@@ -136,12 +205,15 @@ impl Robot {
         )
     }
 
-    /// Evaluate `f(robot, work, row inputs, out)` on one state or on every row of N states.
+    /// Evaluate `f` (on `robot`, one of `models`) on one state or on every row of N states:
+    /// one state on this robot's kept buffers, N states over all cores in blocks with the GIL
+    /// released (signals checked between blocks).
     pub fn eval<'py, F>(
         &self,
         py: Python<'py>,
-        inputs: &[(&str, Option<&Bound<'py, PyAny>>)],
-        shape_one: &[usize],
+        models: &Arc<Models>,
+        robot: &robodyn::Robot,
+        call: Call<'_, 'py>,
         f: F,
     ) -> PyResult<Bound<'py, PyAny>>
     where
@@ -149,52 +221,46 @@ impl Robot {
             + Sync
             + Send,
     {
-        let robot = self.model();
         let n = robot.dof();
-        let st = states(inputs, n, &|| Self::joint_text(&robot))?;
-        let (v, rows) = self.run(py, &robot, &st, shape_one.iter().product(), f)?;
-        output(py, v, rows, shape_one)
+        let inp = inputs(call.inputs, n, &|| Self::joint_text(robot))?;
+        let shape = Shape::result(inp.rows, call.one, call.stacked);
+        let mut out = Output::new(py, call.out, shape, inp.rows.is_some())?;
+        let st = inp.states(out.span())?;
+        let width: usize = call.one.iter().product();
+        self.run(py, models, robot, &st, width, out.slice(), f)?;
+        out.finish(py)
     }
 
+    #[allow(clippy::too_many_arguments)]
     fn run<F>(
         &self,
         py: Python<'_>,
-        robot: &Arc<robodyn::Robot>,
-        st: &States,
+        models: &Arc<Models>,
+        robot: &robodyn::Robot,
+        st: &States<'_>,
         width: usize,
+        out: &mut [f64],
         f: F,
-    ) -> PyResult<(Vec<f64>, Option<usize>)>
+    ) -> PyResult<()>
     where
         F: Fn(&robodyn::Robot, &mut Work, [&[f64]; 3], &mut [f64]) -> robodyn::Result<()>
             + Sync
             + Send,
     {
-        let k = st.data.len();
-        let row = |r: usize| -> [&[f64]; 3] {
-            std::array::from_fn(|i| if i < k { st.row(i, r) } else { &[][..] })
-        };
         match st.rows {
-            None => {
-                let mut out = vec![0.0; width];
-                self.with_work(robot, |w| f(robot, w, row(0), &mut out))
-                    .py()?;
-                Ok((out, None))
-            }
-            Some(n) => {
-                let r: &robodyn::Robot = robot;
-                let mut v = vec![0.0; n * width];
-                py.detach(|| {
-                    for_each_row(
-                        n,
-                        &mut v,
-                        width,
-                        || Work::new(r),
-                        |w, i, o| f(r, w, row(i), o),
-                    )
-                })
-                .py()?;
-                Ok((v, Some(n)))
-            }
+            None => self
+                .with_work(models, |w| f(robot, w, st.rows3(0), out))
+                .py(),
+            Some(rows) => in_blocks(py, rows, out, width, |first, o| {
+                for_each_row(
+                    o.len() / width.max(1),
+                    o,
+                    width,
+                    || Work::new(robot),
+                    |w, i, row| f(robot, w, st.rows3(first + i), row),
+                )
+                .map_err(|e| shift_row(e, first))
+            }),
         }
     }
 
@@ -225,19 +291,26 @@ impl Robot {
         parse_zeros(zeros, self.source.as_deref())
     }
 
+    /// The robot with values given by name (the library's rule, `robodyn::io::set_values`:
+    /// symbols, and standard parameters written as numbers; an unknown name is an error).
     fn with_symbols(&self, values: BTreeMap<String, f64>) -> PyResult<robodyn::Robot> {
-        let robot = self.model();
-        let mut d = robot.description().clone();
-        for (k, v) in &values {
-            if !v.is_finite() {
-                return Err(crate::errors::NotFiniteError::new_err(format!(
-                    "{k} = {v} is not a finite number"
-                )));
-            }
-        }
-        d.symbols.extend(values);
+        let mut d = self.models().full.description().clone();
+        check_finite(&values)?;
+        robodyn::io::set_values(&mut d, &values).py()?;
         robodyn::Robot::new(d).py()
     }
+}
+
+/// Values must be finite numbers (NotFiniteError naming the first that is not).
+pub fn check_finite(values: &BTreeMap<String, f64>) -> PyResult<()> {
+    for (k, v) in values {
+        if !v.is_finite() {
+            return Err(crate::errors::NotFiniteError::new_err(format!(
+                "{k} = {v} is not a finite number"
+            )));
+        }
+    }
+    Ok(())
 }
 
 pub fn kwargs_values(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<BTreeMap<String, f64>> {
@@ -388,15 +461,19 @@ impl Robot {
             .collect()
     }
 
-    /// Give or change symbol values in place: `robot.set(d3=0.45, M2=10.0)`.
+    /// Give or change values by name, in place: symbols (`robot.set(d3=0.45)`) or standard
+    /// parameters the file writes as numbers (`robot.set(M3=12.0, FS2=0.5)`: mass of link 3 in
+    /// kg, Coulomb friction of joint 2 in N m; names as `parameter_names`). An unknown name
+    /// raises InputError listing the known ones; nothing changes then.
     #[pyo3(signature = (**values))]
     fn set(&self, values: Option<&Bound<'_, PyDict>>) -> PyResult<()> {
         let r = self.with_symbols(kwargs_values(values)?)?;
-        *self.inner.write().unwrap() = Arc::new(r);
+        *self.inner.write().unwrap() = Arc::new(Models::new(r));
         Ok(())
     }
 
-    /// A new robot with symbol values given or changed (this one unchanged).
+    /// A new robot with values given or changed by name as `set` does (this one unchanged):
+    /// `urdf_robot.with_values(M3=12.0)` changes the mass of link 3 (kg).
     #[pyo3(signature = (**values))]
     fn with_values(&self, values: Option<&Bound<'_, PyDict>>) -> PyResult<Robot> {
         let r = self.with_symbols(kwargs_values(values)?)?;
@@ -425,54 +502,106 @@ impl Robot {
         )
     }
 
-    /// Inverse dynamic model (Newton–Euler, 10.3–10.12): torques of the movable joints.
-    #[pyo3(signature = (q, qd=None, qdd=None))]
+    /// Inverse dynamic model (Newton–Euler, eqs 10.3–10.12): the torques (N m) / forces (N)
+    /// tau of the movable joints for positions q (rad, m), velocities qd (rad/s, m/s) and
+    /// accelerations qdd (rad/s², m/s²), under the robot's gravity and wrenches.
+    ///
+    /// Shapes: (nq,) for one state, (N, nq) for N states (the result likewise). Omitted qd,
+    /// qdd are zeros; v and a are Pinocchio's names for qd and qdd. Friction Fv qd + Fs sign(qd)
+    /// (URDF <dynamics damping friction>) and rotor inertias Ia qdd are included; friction=False
+    /// leaves out Fv and Fs (Pinocchio's rnea). out: a float64 C-contiguous writeable array of
+    /// the result's shape to write into (returned).
+    #[pyo3(signature = (q, qd=None, qdd=None, *, v=None, a=None, friction=true, out=None))]
+    #[allow(clippy::too_many_arguments)]
     fn idm<'py>(
         &self,
         py: Python<'py>,
         q: &Bound<'py, PyAny>,
         qd: Option<&Bound<'py, PyAny>>,
         qdd: Option<&Bound<'py, PyAny>>,
+        v: Option<&Bound<'py, PyAny>>,
+        a: Option<&Bound<'py, PyAny>>,
+        friction: bool,
+        out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let n = self.model().dof();
-        self.eval(
-            py,
-            &[("q", Some(q)), ("qd", qd), ("qdd", qdd)],
-            &[n],
-            |r, w, x, o| {
-                inverse_dynamics_into(r, &mut w.data, r.environment(), x[0], x[1], x[2], o)
-            },
-        )
+        let qd = alias("qd", qd, "v", v)?;
+        let qdd = alias("qdd", qdd, "a", a)?;
+        let models = self.models();
+        let robot = models.select(friction)?;
+        let n = robot.dof();
+        let call = Call {
+            inputs: &[("q", Some(q)), ("qd", qd), ("qdd", qdd)],
+            one: &[n],
+            stacked: false,
+            out,
+        };
+        self.eval(py, &models, robot, call, |r, w, x, o| {
+            inverse_dynamics_into(r, &mut w.data, r.environment(), x[0], x[1], x[2], o)
+        })
     }
 
-    /// Inertia matrix A(q) by composite links (n x n, or N x n x n).
-    fn inertia<'py>(&self, py: Python<'py>, q: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
-        let n = self.model().dof();
-        self.eval(py, &[("q", Some(q))], &[n, n], |r, w, x, o| {
+    /// Inertia matrix A(q) by composite links (kg m², kg, kg m): (nq, nq) for q of shape (nq,),
+    /// (N, nq, nq) for (N, nq); rotor inertias on the diagonal. out: as for idm.
+    #[pyo3(signature = (q, *, out=None))]
+    fn inertia<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        out: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let models = self.models();
+        let n = models.full.dof();
+        let call = Call {
+            inputs: &[("q", Some(q))],
+            one: &[n, n],
+            stacked: false,
+            out,
+        };
+        self.eval(py, &models, &models.full, call, |r, w, x, o| {
             let (data, a) = w.split(n, n);
             inertia_matrix_into(r, data, x[0], a)?;
-            let all: Vec<usize> = (0..n).collect();
-            copy_rows(&w.m, &all, o);
+            for (k, o) in o.iter_mut().enumerate() {
+                *o = a[(k / n, k % n)];
+            }
             Ok(())
         })
     }
 
-    /// H(q, qd): centrifugal, Coriolis, gravity, friction and external-wrench torques.
-    #[pyo3(signature = (q, qd=None))]
+    /// H(q, qd) (N m, N): centrifugal, Coriolis, gravity, friction and external-wrench torques,
+    /// so that tau = A(q) qdd + H(q, qd). Shapes as idm; v is Pinocchio's name for qd
+    /// (Pinocchio's nonLinearEffects, plus friction unless friction=False). out: as for idm.
+    #[pyo3(signature = (q, qd=None, *, v=None, friction=true, out=None))]
     fn h<'py>(
         &self,
         py: Python<'py>,
         q: &Bound<'py, PyAny>,
         qd: Option<&Bound<'py, PyAny>>,
+        v: Option<&Bound<'py, PyAny>>,
+        friction: bool,
+        out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let n = self.model().dof();
-        self.eval(py, &[("q", Some(q)), ("qd", qd)], &[n], |r, w, x, o| {
+        let qd = alias("qd", qd, "v", v)?;
+        let models = self.models();
+        let robot = models.select(friction)?;
+        let n = robot.dof();
+        let call = Call {
+            inputs: &[("q", Some(q)), ("qd", qd)],
+            one: &[n],
+            stacked: false,
+            out,
+        };
+        self.eval(py, &models, robot, call, |r, w, x, o| {
             h_vector_into(r, &mut w.data, r.environment(), x[0], x[1], o)
         })
     }
 
-    /// Direct dynamic model qdd = A^-1 (tau - H); method "composite" or "aba".
-    #[pyo3(signature = (q, qd=None, tau=None, method="composite"))]
+    /// Direct dynamic model: accelerations qdd (rad/s², m/s²) = A^-1 (tau - H) for positions q,
+    /// velocities qd and torques tau (N m, N); method "composite" (tree L'DL of A) or "aba"
+    /// (articulated bodies). Shapes as idm; v is Pinocchio's name for qd. friction=False
+    /// leaves out Fv and Fs (Pinocchio's aba). Raises SingularConfiguration for a singular A.
+    /// out: as for idm.
+    #[pyo3(signature = (q, qd=None, tau=None, method="composite", *, v=None, friction=true, out=None))]
+    #[allow(clippy::too_many_arguments)]
     fn ddm<'py>(
         &self,
         py: Python<'py>,
@@ -480,29 +609,47 @@ impl Robot {
         qd: Option<&Bound<'py, PyAny>>,
         tau: Option<&Bound<'py, PyAny>>,
         method: &str,
+        v: Option<&Bound<'py, PyAny>>,
+        friction: bool,
+        out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let m = parse_method(method)?;
-        let n = self.model().dof();
-        self.eval(
-            py,
-            &[("q", Some(q)), ("qd", qd), ("tau", tau)],
-            &[n],
-            move |r, w, x, o| {
-                direct_dynamics_into(r, &mut w.data, r.environment(), x[0], x[1], x[2], m, o)
-            },
-        )
+        let qd = alias("qd", qd, "v", v)?;
+        let models = self.models();
+        let robot = models.select(friction)?;
+        let n = robot.dof();
+        let call = Call {
+            inputs: &[("q", Some(q)), ("qd", qd), ("tau", tau)],
+            one: &[n],
+            stacked: false,
+            out,
+        };
+        self.eval(py, &models, robot, call, move |r, w, x, o| {
+            direct_dynamics_into(r, &mut w.data, r.environment(), x[0], x[1], x[2], m, o)
+        })
     }
 
-    /// Geometric model: 0T_j (4 x 4 homogeneous matrices) of the frames 1..NF for the movable
-    /// joints' values q (cut-joint variables taken as 0): shape (NF, 4, 4) or (N, NF, 4, 4).
+    /// Geometric model: 0T_j (4 x 4 homogeneous matrices, metres) of the frames 1..NF
+    /// (frame_names) for the movable joints' values q (rad, m; cut-joint variables taken as
+    /// 0): shape (NF, 4, 4) for q of shape (nq,), (N, NF, 4, 4) for (N, nq). out: as for idm.
+    #[pyo3(signature = (q, *, out=None))]
     fn forward_kinematics<'py>(
         &self,
         py: Python<'py>,
         q: &Bound<'py, PyAny>,
+        out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let nf = self.model().nf();
-        self.eval(py, &[("q", Some(q))], &[nf, 4, 4], |r, _w, x, o| {
-            let mut tree = vec![0.0; r.nl()];
+        let models = self.models();
+        let nf = models.full.nf();
+        let call = Call {
+            inputs: &[("q", Some(q))],
+            one: &[nf, 4, 4],
+            stacked: false,
+            out,
+        };
+        self.eval(py, &models, &models.full, call, |r, w, x, o| {
+            let tree = &mut w.tree;
+            tree.resize(r.nl(), 0.0);
             for (k, &j) in r.coordinates().frames().iter().enumerate() {
                 tree[j - 1] = x[0][k];
             }
@@ -513,7 +660,7 @@ impl Robot {
                     value: x[0][k],
                 });
             }
-            for (j, t) in robodyn::geometry::frame_transforms(r, &tree)
+            for (j, t) in robodyn::geometry::frame_transforms(r, tree)
                 .iter()
                 .enumerate()
             {
@@ -524,7 +671,7 @@ impl Robot {
                     }
                 }
             }
-            Ok(())
+            robodyn::error::check_finite_result("0T_j", o)
         })
     }
 
@@ -542,10 +689,12 @@ impl Robot {
             .1)
     }
 
-    /// Regressor Phi with Gamma = Phi K (+ external-wrench torques): (n, p) for one state,
-    /// stacked (N n, p) for N states (state after state), columns those of
-    /// `regressor_columns(columns, ...)`: the standard parameters or the base parameters.
-    #[pyo3(signature = (q, qd=None, qdd=None, columns="standard", friction=true, rotor="actuated", seed=1))]
+    /// Regressor Phi with tau = Phi K (+ external-wrench torques) for q (rad, m), qd, qdd
+    /// (v, a: Pinocchio's names): shape (nq, p) for one state, stacked (N nq, p) for N states
+    /// (state after state); its columns are `regressor_columns(columns, ...)`, the standard
+    /// parameters (K, 13 per link) or the base parameters; entries in N m (N) per unit of the
+    /// parameter. friction=False leaves out the FS, FV columns. out: as for idm.
+    #[pyo3(signature = (q, qd=None, qdd=None, columns="standard", friction=true, rotor="actuated", seed=1, *, v=None, a=None, out=None))]
     #[allow(clippy::too_many_arguments)]
     fn regressor<'py>(
         &self,
@@ -557,23 +706,29 @@ impl Robot {
         friction: bool,
         rotor: &str,
         seed: u64,
+        v: Option<&Bound<'py, PyAny>>,
+        a: Option<&Bound<'py, PyAny>>,
+        out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let robot = self.model();
-        let (cols, _) = self.columns(&robot, columns, friction, rotor, seed)?;
+        let qd = alias("qd", qd, "v", v)?;
+        let qdd = alias("qdd", qdd, "a", a)?;
+        let models = self.models();
+        let robot = &models.full;
+        let (cols, _) = self.columns(robot, columns, friction, rotor, seed)?;
         let n = robot.dof();
-        let p = cols.len();
         let nk = PARAMS_PER_LINK * robot.nl();
-        let st = states(&[("q", Some(q)), ("qd", qd), ("qdd", qdd)], n, &|| {
-            Self::joint_text(&robot)
-        })?;
-        let (v, rows) = self.run(py, &robot, &st, n * p, |r, w, x, o| {
+        let call = Call {
+            inputs: &[("q", Some(q)), ("qd", qd), ("qdd", qdd)],
+            one: &[n, cols.len()],
+            stacked: true,
+            out,
+        };
+        self.eval(py, &models, robot, call, |r, w, x, o| {
             let (data, phi) = w.split(n, nk);
             regressor_into(r, data, r.environment(), x[0], x[1], x[2], phi)?;
             copy_rows(&w.m, &cols, o);
             Ok(())
-        })?;
-        let stacked = rows.map(|k| k * n).unwrap_or(n);
-        output(py, v, None, &[stacked, p])
+        })
     }
 }
 
@@ -624,10 +779,15 @@ impl Robot {
         )
     }
 
-    /// Simulate from (q0, qd0) over [0, duration]; returns a dict of arrays (t, q, qd, qdd,
-    /// tau, energy). `torque`: None (zero), a constant vector, a (times, values) series or a
-    /// callable torque(t, q, qd) -> tau. RK4 with `dt`, else Dormand–Prince 5(4).
-    #[pyo3(signature = (duration, q0=None, qd0=None, torque=None, dt=None, rtol=1e-8, atol=1e-10, output_dt=0.01, method="aba", coulomb_smoothing=None, max_steps=None))]
+    /// Simulate from (q0, qd0) (rad, m; rad/s, m/s; default zeros) over [0, duration] (s);
+    /// returns a dict of arrays: t (M,) s, q, qd, qdd, tau (M, nq), energy (M,) J, and
+    /// joint_labels. torque: None (zero), a constant vector (nq,) N m / N, a (times, values)
+    /// series ((K,), (K, nq)) interpolated linearly, or a callable torque(t, q, qd) -> tau.
+    /// RK4 with a fixed step dt (s), else Dormand–Prince 5(4) with rtol, atol; a row every
+    /// output_dt (s). max_steps (the CLI's default, 5,000,000) bounds the integration steps: a
+    /// run that needs more is an error, said before it starts when the step or the output step
+    /// already needs more. Ctrl-C stops the run (KeyboardInterrupt).
+    #[pyo3(signature = (duration, q0=None, qd0=None, torque=None, dt=None, rtol=1e-8, atol=1e-10, output_dt=0.01, method="aba", coulomb_smoothing=None, max_steps=5_000_000))]
     #[allow(clippy::too_many_arguments)]
     fn simulate<'py>(
         &self,
@@ -642,7 +802,7 @@ impl Robot {
         output_dt: f64,
         method: &str,
         coulomb_smoothing: Option<f64>,
-        max_steps: Option<usize>,
+        max_steps: usize,
     ) -> PyResult<Bound<'py, PyDict>> {
         let robot = self.model();
         let n = robot.dof();

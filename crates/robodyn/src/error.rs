@@ -194,6 +194,36 @@ fn fmt_hint(h: &str) -> String {
     }
 }
 
+/// The rule for a result computed from finite inputs: every entry finite. Finite inputs can
+/// still overflow (a velocity of 1e200 squared, a gravity of 1e308 times a mass), and a model
+/// never returns such a number: the first non-finite entry `what[k]` is an
+/// [`Error::Numerical`] saying so. The checked functions (`*_into`) apply it to their outputs.
+pub fn check_finite_result(what: &str, values: &[f64]) -> Result<()> {
+    match values.iter().position(|x| !x.is_finite()) {
+        Some(k) => Err(overflow(&format!("{what}[{k}]"), values[k])),
+        None => Ok(()),
+    }
+}
+
+/// [`check_finite_result`] for a matrix: the entry is named `what[row, column]` (0-based).
+pub fn check_finite_matrix(what: &str, m: &nalgebra::DMatrix<f64>) -> Result<()> {
+    match m.as_slice().iter().position(|x| !x.is_finite()) {
+        Some(k) => {
+            let (r, c) = (k % m.nrows(), k / m.nrows());
+            Err(overflow(&format!("{what}[{r}, {c}]"), m[(r, c)]))
+        }
+        None => Ok(()),
+    }
+}
+
+fn overflow(entry: &str, value: f64) -> Error {
+    Error::Numerical(format!(
+        "{entry} = {value} is not a finite number: the result overflows the floating-point \
+         range for these finite inputs (velocities, accelerations, parameters, gravity or \
+         wrenches too large)"
+    ))
+}
+
 fn fmt_loc(l: &Location) -> String {
     let s = l.to_string();
     if s.is_empty() {

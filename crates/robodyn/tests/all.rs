@@ -45,6 +45,8 @@ mod codegen_latex;
 mod codegen_opcount;
 #[path = "direct_dynamics.rs"]
 mod direct_dynamics;
+#[path = "finite_results.rs"]
+mod finite_results;
 #[path = "fixed_frames.rs"]
 mod fixed_frames;
 #[path = "fuzz_regressions.rs"]
@@ -75,6 +77,8 @@ mod io_urdf;
 mod io_urdf_pinocchio;
 #[path = "loop_closure.rs"]
 mod loop_closure;
+#[path = "named_values.rs"]
+mod named_values;
 #[path = "parallel_links.rs"]
 mod parallel_links;
 #[path = "properties.rs"]

@@ -72,7 +72,7 @@ pub struct Args {
     #[arg(long, default_value_t = 0.01, value_name = "V")]
     pub coulomb_smoothing: f64,
     /// Stop after this many integration steps.
-    #[arg(long, default_value_t = 5_000_000)]
+    #[arg(long, default_value_t = robodyn::simulation::DEFAULT_MAX_STEPS)]
     pub max_steps: usize,
     /// Trajectory CSV (`-`: standard output): t [s], q<j> [rad or m], qd<j> [rad/s or m/s],
     /// qdd<j> [rad/s^2 or m/s^2], tau<j> [N m or N], energy [J] (closed chains: then

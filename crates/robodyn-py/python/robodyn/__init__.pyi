@@ -4,7 +4,9 @@ in the Khalil-Kleinfinger notation (Khalil & Dombre, chapter 10), on NumPy array
 Joint vectors hold the movable joints in frame order (``Robot.joint_names``); for a
 ``ClosedChain`` they hold the actuated joints. Units: rad and m, rad/s and m/s, rad/s^2 and m/s^2,
 N m and N. Every model function takes one state (1-D arrays) or N states (2-D arrays, one row per
-state); N states are evaluated in Rust over all cores with the GIL released.
+state); N states are evaluated in Rust over all cores with the GIL released (Ctrl-C interrupts).
+Arrays of any layout and dtype are read by their logical indices (float64 arrays with contiguous
+rows in place, others converted); ``out=`` writes into a float64 C-contiguous writeable array.
 """
 
 from os import PathLike
@@ -66,12 +68,19 @@ class NumericalError(Error):
 class SingularityWarning(UserWarning):
     """A result near a singular configuration (reciprocal condition number below the soft limit)."""
 
+class RobotFileWarning(UserWarning):
+    """What a robot file's reader noticed that is not an error (inertial parameters no rigid body
+    has, a legged robot loaded with a fixed base, ...)."""
+
 def load(path: Union[str, PathLike], **values: float) -> Robot:
-    """Read a robot file (TOML, SYMORO .par or URDF, by extension); ``values`` give or change
-    symbol values (``robodyn.load("robots/sr400.toml", d3=0.6)``). Raises RobotFileError with
-    the file and line of a bad entry; for a file whose symbols lack values (a SYMORO file of
-    symbols only) the message lists them: give them as keyword arguments, or use
-    ``base_parameters(path)``, which needs none."""
+    """Read a robot file (TOML, SYMORO .par or URDF, by extension). ``values`` give or change
+    values by name: symbols (``robodyn.load("robots/sr400.toml", d3=0.6)``) or standard
+    parameters the file writes as numbers (``load("ur5.urdf", M3=3.2, FV2=0.5)``: mass of link 3
+    in kg, viscous friction of joint 2 in N m s/rad; names as ``Robot.parameter_names``); an
+    unknown name raises InputError listing the known ones. What the reader notices is issued as
+    a RobotFileWarning. Raises RobotFileError with the file and line of a bad entry; for a file
+    whose symbols lack values (a SYMORO file of symbols only) the message lists them: give them
+    as keyword arguments, or use ``base_parameters(path)``, which needs none."""
 
 def base_parameters(path: Union[str, PathLike], method: str = "symbolic", friction: bool = True, rotor: str = "actuated", zeros: Optional[str] = None, seed: int = 1, **values: float) -> BaseParameters:
     """Base inertial parameters of a robot file, with or without numeric values (the CLI's
@@ -125,34 +134,53 @@ class Robot:
     """Names of the standard parameters (the robot file's own names), in K order."""
 
     def set(self, **values: float) -> None:
-        """Give or change symbol values in place: ``robot.set(d3=0.45, M2=10.0)``."""
+        """Give or change values by name, in place: symbols (``robot.set(d3=0.45)``) or standard
+        parameters the file writes as numbers (``robot.set(M3=12.0, FS2=0.5)``: mass of link 3 in
+        kg, Coulomb friction of joint 2 in N m; names as ``parameter_names``). An unknown name
+        raises InputError listing the known ones; nothing changes then."""
     def with_values(self, **values: float) -> Robot:
-        """A new robot with symbol values given or changed (this one unchanged)."""
+        """A new robot with values given or changed by name as ``set`` does (this one unchanged):
+        ``urdf_robot.with_values(M3=12.0)`` changes the mass of link 3 (kg)."""
     def save(self, path: Union[str, PathLike]) -> None:
         """Write the description (format by extension: .toml or .par)."""
     def to_toml(self) -> str:
         """The description as TOML text."""
 
-    def idm(self, q: ArrayLike, qd: Optional[ArrayLike] = None, qdd: Optional[ArrayLike] = None) -> Array:
-        """Inverse dynamic model (Newton-Euler, eqs 10.3-10.12): torques of the movable joints,
-        (nq,) or (N, nq). Friction (Fv qd + Fs sign(qd)) and rotor inertias included; missing
-        qd, qdd are zero."""
-    def inertia(self, q: ArrayLike) -> Array:
-        """Inertia matrix A(q) by composite links: (nq, nq) or (N, nq, nq)."""
-    def h(self, q: ArrayLike, qd: Optional[ArrayLike] = None) -> Array:
-        """H(q, qd): centrifugal, Coriolis, gravity, friction and external-wrench torques."""
-    def ddm(self, q: ArrayLike, qd: Optional[ArrayLike] = None, tau: Optional[ArrayLike] = None, method: str = "composite") -> Array:
-        """Direct dynamic model qdd = A^-1 (tau - H): method "composite" (tree L'DL of A) or
-        "aba" (O(n) articulated bodies). Raises SingularConfiguration for a singular A."""
-    def forward_kinematics(self, q: ArrayLike) -> Array:
-        """Geometric model: 0T_j (4 x 4 homogeneous matrices) of the frames 1..NF (``frame_names``)
-        for the movable joints' values q, cut-joint variables taken as 0: (NF, 4, 4) or
-        (N, NF, 4, 4)."""
+    def idm(self, q: ArrayLike, qd: Optional[ArrayLike] = None, qdd: Optional[ArrayLike] = None, *, v: Optional[ArrayLike] = None, a: Optional[ArrayLike] = None, friction: bool = True, out: Optional[Array] = None) -> Array:
+        """Inverse dynamic model (Newton-Euler, eqs 10.3-10.12): the torques (N m) / forces (N)
+        tau of the movable joints for positions q (rad, m), velocities qd (rad/s, m/s) and
+        accelerations qdd (rad/s^2, m/s^2), under the robot's gravity and wrenches.
+
+        Shapes: (nq,) for one state, (N, nq) for N states (the result likewise). Omitted qd,
+        qdd are zeros; v and a are Pinocchio's names for qd and qdd. Friction Fv qd + Fs sign(qd)
+        (URDF <dynamics damping friction>) and rotor inertias Ia qdd are included; friction=False
+        leaves out Fv and Fs (Pinocchio's rnea). out: a float64 C-contiguous writeable array of
+        the result's shape to write into (returned)."""
+    def inertia(self, q: ArrayLike, *, out: Optional[Array] = None) -> Array:
+        """Inertia matrix A(q) by composite links (kg m^2, kg, kg m): (nq, nq) for q of shape
+        (nq,), (N, nq, nq) for (N, nq); rotor inertias on the diagonal. out: as for idm."""
+    def h(self, q: ArrayLike, qd: Optional[ArrayLike] = None, *, v: Optional[ArrayLike] = None, friction: bool = True, out: Optional[Array] = None) -> Array:
+        """H(q, qd) (N m, N): centrifugal, Coriolis, gravity, friction and external-wrench
+        torques, so that tau = A(q) qdd + H(q, qd). Shapes as idm; v is Pinocchio's name for qd
+        (Pinocchio's nonLinearEffects, plus friction unless friction=False). out: as for idm."""
+    def ddm(self, q: ArrayLike, qd: Optional[ArrayLike] = None, tau: Optional[ArrayLike] = None, method: str = "composite", *, v: Optional[ArrayLike] = None, friction: bool = True, out: Optional[Array] = None) -> Array:
+        """Direct dynamic model: accelerations qdd (rad/s^2, m/s^2) = A^-1 (tau - H) for
+        positions q, velocities qd and torques tau (N m, N); method "composite" (tree L'DL of A)
+        or "aba" (articulated bodies). Shapes as idm; v is Pinocchio's name for qd.
+        friction=False leaves out Fv and Fs (Pinocchio's aba). Raises SingularConfiguration for
+        a singular A. out: as for idm."""
+    def forward_kinematics(self, q: ArrayLike, *, out: Optional[Array] = None) -> Array:
+        """Geometric model: 0T_j (4 x 4 homogeneous matrices, metres) of the frames 1..NF
+        (frame_names) for the movable joints' values q (rad, m; cut-joint variables taken as
+        0): shape (NF, 4, 4) for q of shape (nq,), (N, NF, 4, 4) for (N, nq). out: as for idm."""
     def regressor_columns(self, columns: str = "standard", friction: bool = True, rotor: str = "actuated", seed: int = 1) -> List[str]:
-        """Names of the regressor's columns: "standard" parameters or "base" parameters."""
-    def regressor(self, q: ArrayLike, qd: Optional[ArrayLike] = None, qdd: Optional[ArrayLike] = None, columns: str = "standard", friction: bool = True, rotor: str = "actuated", seed: int = 1) -> Array:
-        """Regressor Phi with Gamma = Phi K (+ external-wrench torques): (nq, p) for one state,
-        stacked (N nq, p) for N states (state after state); columns are ``regressor_columns``."""
+        """Names of the regressor's columns for ``columns`` ("standard" or "base")."""
+    def regressor(self, q: ArrayLike, qd: Optional[ArrayLike] = None, qdd: Optional[ArrayLike] = None, columns: str = "standard", friction: bool = True, rotor: str = "actuated", seed: int = 1, *, v: Optional[ArrayLike] = None, a: Optional[ArrayLike] = None, out: Optional[Array] = None) -> Array:
+        """Regressor Phi with tau = Phi K (+ external-wrench torques) for q (rad, m), qd, qdd
+        (v, a: Pinocchio's names): shape (nq, p) for one state, stacked (N nq, p) for N states
+        (state after state); its columns are ``regressor_columns(columns, ...)``, the standard
+        parameters (K, 13 per link) or the base parameters; entries in N m (N) per unit of the
+        parameter. friction=False leaves out the FS, FV columns. out: as for idm."""
     def base_parameters(self, method: str = "symbolic", friction: bool = True, rotor: str = "actuated", zeros: Optional[str] = None, seed: int = 1) -> BaseParameters:
         """Base inertial parameters: method "symbolic" (rules, equations in the robot's symbols),
         "numeric" (stacked regressor, rank-revealing QR) or "both" (symbolic, checked against the
@@ -161,11 +189,15 @@ class Robot:
     def generate(self, model: str = "idm", lang: str = "python", params: str = "standard", symmetric: bool = False, friction: bool = True, rotor: bool = True, numeric: bool = False, name: Optional[str] = None) -> Generated:
         """Customized symbolic model (idm, inertia, h, ddm, closed, w) as code (text, latex,
         rust, c, python, julia, matlab) with its operation counts; params "standard" or "base"."""
-    def simulate(self, duration: float, q0: Optional[Sequence[float]] = None, qd0: Optional[Sequence[float]] = None, torque: Torque = None, dt: Optional[float] = None, rtol: float = 1e-8, atol: float = 1e-10, output_dt: float = 0.01, method: str = "aba", coulomb_smoothing: Optional[float] = None, max_steps: Optional[int] = None) -> Dict[str, Any]:
-        """Simulate from (q0, qd0) over [0, duration]: dict of arrays t (M,), q, qd, qdd, tau
-        (M, nq), energy (M,). torque: None (zero), a constant vector, a (times, values) series
-        interpolated linearly, or a callable torque(t, q, qd) -> tau. RK4 with ``dt``, else
-        Dormand-Prince 5(4) with rtol, atol."""
+    def simulate(self, duration: float, q0: Optional[ArrayLike] = None, qd0: Optional[ArrayLike] = None, torque: Torque = None, dt: Optional[float] = None, rtol: float = 1e-8, atol: float = 1e-10, output_dt: float = 0.01, method: str = "aba", coulomb_smoothing: Optional[float] = None, max_steps: int = 5_000_000) -> Dict[str, Any]:
+        """Simulate from (q0, qd0) (rad, m; rad/s, m/s; default zeros) over [0, duration] (s);
+        returns a dict of arrays: t (M,) s, q, qd, qdd, tau (M, nq), energy (M,) J, and
+        joint_labels. torque: None (zero), a constant vector (nq,) N m / N, a (times, values)
+        series ((K,), (K, nq)) interpolated linearly, or a callable torque(t, q, qd) -> tau.
+        RK4 with a fixed step dt (s), else Dormand-Prince 5(4) with rtol, atol; a row every
+        output_dt (s). max_steps (the CLI's default, 5,000,000) bounds the integration steps: a
+        run that needs more is an error, said before it starts when the step or the output step
+        already needs more. Ctrl-C stops the run (KeyboardInterrupt)."""
 
 class ClosedChain:
     """A closed-chain robot: vectors over the actuated joints (``joint_names``); the passive ones
@@ -195,22 +227,34 @@ class ClosedChain:
 
     def reset(self, q_a: Optional[Sequence[float]] = None, q_p_guess: Optional[Sequence[float]] = None) -> None:
         """Put the tracker back on the assembly branch (or on the branch through (q_a, q_p_guess))."""
-    def solve_loops(self, q_a: ArrayLike) -> Array:
-        """Loop closure: the passive tree variables q_p for the actuated q_a, (p,) or (N, p)."""
-    def closure(self, q_a: Sequence[float]) -> Dict[str, Any]:
-        """Loop closure at one q_a: q_p, cut-joint variables q_c, the tree's movable-joint vector
-        q_tree, W = d q_p / d q_a (eq 10.30), residual, rcond_wp, warning."""
-    def idm(self, q_a: ArrayLike, qd_a: Optional[ArrayLike] = None, qdd_a: Optional[ArrayLike] = None) -> Array:
-        """Closed-chain inverse dynamic model Gamma_cl = G^T Gamma_tr (eq 10.40) on the actuated joints."""
-    def ddm(self, q_a: ArrayLike, qd_a: Optional[ArrayLike] = None, tau_a: Optional[ArrayLike] = None) -> Array:
-        """Closed-chain direct dynamic model qdd_a = A_cl^-1 (Gamma_cl - H_cl) (eqs 10.46-10.48)."""
-    def regressor(self, q_a: ArrayLike, qd_a: Optional[ArrayLike] = None, qdd_a: Optional[ArrayLike] = None) -> Array:
-        """Regressor G^T Phi over all 13 NL standard parameters (K order): (nq, 13 NL) for one
-        state, stacked (N nq, 13 NL) for N states."""
-    def simulate(self, duration: float, q0: Optional[Sequence[float]] = None, qd0: Optional[Sequence[float]] = None, torque: Torque = None, dt: Optional[float] = None, rtol: float = 1e-8, atol: float = 1e-10, output_dt: float = 0.01, coulomb_smoothing: Optional[float] = None, max_steps: Optional[int] = None) -> Dict[str, Any]:
-        """Simulate in the actuated coordinates from (q0, qd0) (default: the tracker's q_a, 0);
-        q_p is re-solved at every evaluation. Returns t, q, qd, qdd, tau, energy,
-        closure_residual and the passive joints' q<j>."""
+    def solve_loops(self, q_a: ArrayLike, *, out: Optional[Array] = None) -> Array:
+        """Loop closure: the passive tree variables q_p (rad, m) for the actuated q_a (rad, m):
+        (p,) for q_a of shape (nq,), (N, p) for (N, nq), p = n_equations. out: as for idm."""
+    def closure(self, q_a: ArrayLike) -> Dict[str, Any]:
+        """Loop closure at one q_a (nq,): q_p, cut-joint variables q_c, the tree's movable-joint
+        vector q_tree (rad, m), W = d q_p / d q_a (eq 10.30, (p, nq)), residual, rcond_wp,
+        warning."""
+    def idm(self, q_a: ArrayLike, qd_a: Optional[ArrayLike] = None, qdd_a: Optional[ArrayLike] = None, *, v: Optional[ArrayLike] = None, a: Optional[ArrayLike] = None, out: Optional[Array] = None) -> Array:
+        """Closed-chain inverse dynamic model Gamma_cl = G^T Gamma_tr (eq 10.40): the torques
+        (N m) / forces (N) of the actuated joints for their positions q_a (rad, m), velocities
+        qd_a and accelerations qdd_a (v, a: Pinocchio's names), the passive joints solved by
+        loop closure. Shapes (nq,) or (N, nq) (rows followed in order on one branch). out: a
+        float64 C-contiguous writeable array of the result's shape to write into (returned)."""
+    def ddm(self, q_a: ArrayLike, qd_a: Optional[ArrayLike] = None, tau_a: Optional[ArrayLike] = None, *, v: Optional[ArrayLike] = None, out: Optional[Array] = None) -> Array:
+        """Closed-chain direct dynamic model qdd_a = A_cl^-1 (Gamma_cl - H_cl) (eqs 10.46-10.48):
+        the accelerations (rad/s^2, m/s^2) of the actuated joints for q_a, qd_a (v: Pinocchio's
+        name) and their torques tau_a (N m, N). Shapes as idm. out: as for idm."""
+    def regressor(self, q_a: ArrayLike, qd_a: Optional[ArrayLike] = None, qdd_a: Optional[ArrayLike] = None, *, v: Optional[ArrayLike] = None, a: Optional[ArrayLike] = None, out: Optional[Array] = None) -> Array:
+        """Regressor of the closed chain, G^T Phi over all 13 NL standard parameters (K order,
+        ``robot.parameter_names``): (nq, 13 NL) for one state, stacked (N nq, 13 NL) for N
+        states, for q_a, qd_a, qdd_a (v, a: Pinocchio's names). out: as for idm."""
+    def simulate(self, duration: float, q0: Optional[ArrayLike] = None, qd0: Optional[ArrayLike] = None, torque: Torque = None, dt: Optional[float] = None, rtol: float = 1e-8, atol: float = 1e-10, output_dt: float = 0.01, coulomb_smoothing: Optional[float] = None, max_steps: int = 5_000_000) -> Dict[str, Any]:
+        """Simulate in the actuated coordinates from (q0, qd0) (rad, m; rad/s, m/s; default: the
+        tracker's q_a, zeros) over [0, duration] (s); the passive joints are re-solved at every
+        evaluation. Returns a dict of arrays: t (M,) s, q, qd, qdd, tau (M, nq) over the
+        actuated joints, energy (M,) J, closure_residual (M,) and the passive joints' q<j> (M,).
+        torque, dt, rtol, atol, output_dt, max_steps as for Robot.simulate; Ctrl-C stops the
+        run."""
 
 class BaseParameters:
     """Base inertial parameters by one method (section 10.2.4, 10.3.4-10.3.6)."""

@@ -434,7 +434,7 @@ pub fn direct_dynamics_into(
         "qdd",
         qdd,
         |m, d, q, qd, tau, a| ddm(m, d, env, method, q, qd, tau, a),
-    )?
+    )
 }
 
 /// Direct dynamic model with the robot's environment: qdd over the movable joints. Allocates;

@@ -264,7 +264,7 @@ pub fn inertia_matrix_into(
     }
     // the model of the dynamic recursions: its A is the matrix over the movable joints
     composite_inertia_matrix(robot.dynamic(), data, q, a);
-    Ok(())
+    crate::error::check_finite_matrix("A", a)
 }
 
 /// A(q) (N x N over the movable joints); checks its input and allocates.
@@ -299,6 +299,7 @@ pub fn h_vector_into(
             let z = std::mem::take(&mut d.zeros);
             rnea_with_environment(m, d, env, q, qd, &z, t);
             d.zeros = z;
+            Ok(())
         },
     )
 }

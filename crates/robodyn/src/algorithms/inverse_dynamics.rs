@@ -462,9 +462,10 @@ pub(crate) fn on_tree_arrays<R>(
 /// The frame of the checked tree functions that map joint vectors to a joint vector: check the
 /// inputs `x` (named `names`), the data, the environment and the output's length; run `kernel`
 /// on the model of the dynamic recursions ([`Robot::dynamic`], fixed frames folded out), whose
-/// tree arrays are the joint vectors themselves. Allocation-free.
+/// tree arrays are the joint vectors themselves; check that the output is finite (finite
+/// inputs can overflow: [`crate::error::check_finite_result`]). Allocation-free.
 #[allow(clippy::too_many_arguments)]
-pub(crate) fn tree_vector_map<R>(
+pub(crate) fn tree_vector_map(
     robot: &Robot,
     data: &mut Data,
     env: &Environment,
@@ -472,14 +473,15 @@ pub(crate) fn tree_vector_map<R>(
     x: [&[f64]; 3],
     out_name: &str,
     out: &mut [f64],
-    kernel: impl FnOnce(&DynModel<f64>, &mut Data, &[f64], &[f64], &[f64], &mut [f64]) -> R,
-) -> Result<R> {
+    kernel: impl FnOnce(&DynModel<f64>, &mut Data, &[f64], &[f64], &[f64], &mut [f64]) -> Result<()>,
+) -> Result<()> {
     check_state(robot, data, names, x)?;
     env.check(robot.nl())?;
     robot
         .coordinates()
         .check_output(out_name, out, "movable joints")?;
-    Ok(kernel(robot.dynamic(), data, x[0], x[1], x[2], out))
+    kernel(robot.dynamic(), data, x[0], x[1], x[2], out)?;
+    crate::error::check_finite_result(out_name, out)
 }
 
 /// Inverse dynamic model (eqs 10.3–10.12) into `tau`: the joint torques (N m) / forces (N) of the
@@ -560,7 +562,10 @@ pub fn inverse_dynamics_into(
         [q, qd, qdd],
         "tau",
         tau,
-        |m, d, q, qd, qdd, t| rnea_with_environment(m, d, env, q, qd, qdd, t),
+        |m, d, q, qd, qdd, t| {
+            rnea_with_environment(m, d, env, q, qd, qdd, t);
+            Ok(())
+        },
     )
 }
 

@@ -340,7 +340,7 @@ pub fn regressor_into(
         }
         data.phi = full;
     });
-    Ok(())
+    crate::error::check_finite_matrix("Phi", phi)
 }
 
 /// Gamma_e into `tau_e` (movable joints): the torques the external wrenches of `env` alone
@@ -361,7 +361,10 @@ pub fn wrench_torques_into(
         [q, q, q],
         "tau_e",
         tau_e,
-        |m, d, q, _, _, t| tree_wrench_torques(m, d, env, q, t),
+        |m, d, q, _, _, t| {
+            tree_wrench_torques(m, d, env, q, t);
+            Ok(())
+        },
     )
 }
 

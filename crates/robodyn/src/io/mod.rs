@@ -10,9 +10,11 @@ pub mod source;
 pub mod table;
 pub mod toml_format;
 pub mod urdf;
+mod values;
 
 pub use consistency::{body_inconsistency, physical_consistency};
 pub use source::{LineIndex, SourceMap};
+pub use values::{known_symbols, set_values};
 
 use crate::error::{Error, Item, Location, Result};
 use crate::model::RobotDescription;
@@ -155,14 +157,14 @@ pub fn load_description_mapped(path: &Path) -> Result<(RobotDescription, SourceM
     Ok((desc, map))
 }
 
-/// Read and validate a robot, with the warnings of [`load_description_mapped`].
+/// Read and validate a robot, with the warnings of [`load_description_mapped`]; `overrides`
+/// give values by name as [`set_values`] does.
 pub fn load_with_warnings(
     path: &Path,
     overrides: &BTreeMap<String, f64>,
 ) -> Result<(Robot, Vec<Warning>)> {
     let (mut desc, map) = load_description_mapped(path)?;
-    desc.symbols
-        .extend(overrides.iter().map(|(k, v)| (k.clone(), *v)));
+    set_values(&mut desc, overrides)?;
     let robot = Robot::new(desc).map_err(|e| map.locate(e))?;
     Ok((robot, map.warnings))
 }
@@ -172,12 +174,10 @@ pub fn load_description(path: &Path) -> Result<RobotDescription> {
     load_description_mapped(path).map(|(d, _)| d)
 }
 
-/// Read and validate a robot. `overrides` gives or replaces symbol values (the CLI's `--set`).
+/// Read and validate a robot. `overrides` give values by name as [`set_values`] does (symbols,
+/// and standard parameters written as numbers); an unknown name is an error.
 pub fn load_with(path: &Path, overrides: &BTreeMap<String, f64>) -> Result<Robot> {
-    let (mut desc, map) = load_description_mapped(path)?;
-    desc.symbols
-        .extend(overrides.iter().map(|(k, v)| (k.clone(), *v)));
-    Robot::new(desc).map_err(|e| map.locate(e))
+    load_with_warnings(path, overrides).map(|(r, _)| r)
 }
 
 /// Read and validate a robot.

@@ -267,7 +267,51 @@ pub fn parse_description(text: &str, file: Option<&str>) -> Result<(RobotDescrip
     let (links, link_index) = read_links(&ctx, robot)?;
     let joints = read_joints(&ctx, robot, &links, &link_index)?;
     let (root, order) = tree_order(&ctx, robot, &links, &joints)?;
-    build(&ctx, robot_name, &links, &joints, root, &order)
+    let (desc, mut map) = build(&ctx, robot_name, &links, &joints, root, &order)?;
+    if let Some(w) = legged_warning(&ctx, &links, root) {
+        map.warn(w);
+    }
+    Ok((desc, map))
+}
+
+/// A warning when the links look like the feet of a legged robot (two or more links named
+/// `*foot*`, `*feet*`, `*sole*` or `*ankle*` as a word: `lf_foot`, `LEFT_FOOT`, `l_sole`,
+/// `ankle1_1`; not `base_footprint`): such a robot has a floating base, which robodyn does not
+/// model yet, and the root link is taken as a fixed base.
+fn legged_warning(ctx: &Ctx, links: &[ULink], root: usize) -> Option<Warning> {
+    let feet: Vec<&str> = links
+        .iter()
+        .map(|l| l.name.as_str())
+        .filter(|n| {
+            n.split(|c: char| !c.is_ascii_alphabetic()).any(|w| {
+                ["foot", "feet", "sole", "ankle"]
+                    .iter()
+                    .any(|f| w.eq_ignore_ascii_case(f))
+            })
+        })
+        .collect();
+    if feet.len() < 2 {
+        return None;
+    }
+    let shown: Vec<String> = feet.iter().take(4).map(|n| format!("`{n}`")).collect();
+    let more = if feet.len() > shown.len() {
+        ", ..."
+    } else {
+        ""
+    };
+    let mut w = Warning::new(
+        Item::Robot,
+        format!(
+            "links {}{more} look like the feet of a legged robot, whose base floats: robodyn \
+             does not model floating bases yet and loads the root link `{}` as a fixed base \
+             (frame 0; its inertia plays no role), so the models are those of the robot with \
+             its base held fixed",
+            shown.join(", "),
+            links[root].name
+        ),
+    );
+    w.location.line = Some(ctx.line(links[root].node));
+    Some(w)
 }
 
 /// The `<link>`s, each defined once, with their inertials.

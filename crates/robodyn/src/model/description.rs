@@ -343,4 +343,29 @@ impl RobotDescription {
             .filter(|&j| !self.frame(j).actuated && self.frame(j).joint.is_movable())
             .collect()
     }
+
+    /// Every symbol the expressions use (geometry, inertial and drive parameters, wrenches,
+    /// gravity and base motion), each once, in order of first use; `symbols` may give values
+    /// of others too.
+    pub fn used_symbols(&self) -> Vec<String> {
+        let mut seen = std::collections::BTreeSet::new();
+        let mut out = Vec::new();
+        let mut add = |e: &Expr| {
+            e.for_each_symbol(&mut |s| {
+                if seen.insert(s.to_string()) {
+                    out.push(s.to_string());
+                }
+            })
+        };
+        for f in &self.frames {
+            f.geometric().into_iter().for_each(&mut add);
+        }
+        for l in &self.links {
+            l.params.iter().chain(&l.wrench).for_each(&mut add);
+        }
+        for v in [&self.gravity, &self.w0, &self.wp0, &self.v0, &self.vp0] {
+            v.iter().for_each(&mut add);
+        }
+        out
+    }
 }

@@ -201,6 +201,11 @@ impl Dynamics for TreeDynamics<'_> {
     }
 }
 
+/// The step limit of a simulation unless its caller gives another ([`SimOptions::max_steps`]):
+/// a run that needs more steps (a stiff motion, a duration far too long for the step) stops
+/// with an error instead of running for hours.
+pub const DEFAULT_MAX_STEPS: usize = 5_000_000;
+
 /// How to run a simulation.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SimOptions {
@@ -292,6 +297,7 @@ pub fn simulate(
         }
     }
     opts.integrator.validate()?;
+    check_step_budget(opts)?;
     input.validate(n)?;
     sink.begin(&trajectory_headers(dynamics))?;
     let result = run(dynamics, input, q0, qd0, opts, sink, progress);
@@ -299,6 +305,36 @@ pub fn simulate(
     let summary = result?;
     flushed?;
     Ok(summary)
+}
+
+/// A run that cannot end within its step limit is refused before it starts: every output
+/// interval takes at least one step, and fixed-step RK4 at least duration / dt.
+fn check_step_budget(opts: &SimOptions) -> Result<()> {
+    let Some(m) = opts.max_steps else {
+        return Ok(());
+    };
+    let steps = |h: f64| (opts.duration / h).ceil();
+    let (least, why) = match opts.integrator {
+        Integrator::Rk4 { dt } if steps(dt) >= steps(opts.output_dt) => {
+            (steps(dt), format!("the step {dt} s"))
+        }
+        _ => (
+            steps(opts.output_dt),
+            format!(
+                "the output step {} s, one step at least per row",
+                opts.output_dt
+            ),
+        ),
+    };
+    if least > m as f64 {
+        return Err(Error::Numerical(format!(
+            "the run needs at least {least:e} integration steps (duration {} s over {why}), more \
+             than the step limit (max_steps = {m}): shorten the run, lengthen the step or raise \
+             the limit",
+            opts.duration
+        )));
+    }
+    Ok(())
 }
 
 fn run(

@@ -61,17 +61,7 @@ impl ParameterNames {
     /// literal 0, an expression) takes its canonical name unless the file uses that name for
     /// something else.
     pub fn of(desc: &RobotDescription) -> ParameterNames {
-        let mut used: BTreeSet<String> = desc.symbols.keys().cloned().collect();
-        let mut add = |e: &Expr| used.extend(e.symbols());
-        for f in &desc.frames {
-            f.geometric().into_iter().for_each(&mut add);
-        }
-        for l in &desc.links {
-            l.params.iter().chain(&l.wrench).for_each(&mut add);
-        }
-        for v in [&desc.gravity, &desc.w0, &desc.wp0, &desc.v0, &desc.vp0] {
-            v.iter().for_each(&mut add);
-        }
+        let used = crate::io::known_symbols(desc);
         let n = PARAMS_PER_LINK * desc.nl;
         let own: Vec<Option<String>> = (0..n)
             .map(|k| {
