@@ -24,8 +24,9 @@ use super::model_access::{ModelAccess, FS, FV, IA, PER_LINK};
 use super::parameters::{Kind, ParameterModel};
 use super::Consistent;
 use crate::error::{Error, Result};
+use super::conic;
 use faer::Mat;
-use nalgebra::Matrix4;
+use nalgebra::{DMatrix, DVector, Matrix4};
 
 /// Weight of the pull toward the robot file's parameters (relative, per scaled parameter).
 const PRIOR_WEIGHT: f64 = 1e-6;
@@ -45,7 +46,6 @@ struct Variables {
     /// Index in K of each standard variable.
     standard: Vec<usize>,
     /// Positions (in `standard`) of the drive parameters (>= 0).
-    #[cfg_attr(not(feature = "sdp"), allow(dead_code))]
     drives: Vec<usize>,
     /// Parameter index (in x) of each offset variable.
     offsets: Vec<usize>,
@@ -180,23 +180,143 @@ pub fn min_pseudo_inertia_eigenvalue(k: &[f64]) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
+/// The solver of the semidefinite program.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Solver {
+    /// robodyn's interior-point method ([`super::conic`]), pure Rust: the default.
+    #[default]
+    InteriorPoint,
+    /// Clarabel's PSD cone (feature `sdp`, the system's LAPACK): a cross-check.
+    #[cfg(feature = "sdp")]
+    Clarabel,
+}
+
 /// Solve min 1/2 v^T P v + q^T v subject to the consistency cones; returns v and a description
 /// of the solver's end.
-fn solve(vars: &Variables, p_dense: &Mat<f64>, q: &[f64]) -> Result<(Vec<f64>, String)> {
-    #[cfg(feature = "sdp")]
-    {
-        solve_sdp(vars, p_dense, q)
+fn solve(
+    vars: &Variables,
+    p_dense: &Mat<f64>,
+    q: &[f64],
+    solver: Solver,
+) -> Result<(Vec<f64>, String)> {
+    match solver {
+        Solver::InteriorPoint => solve_interior_point(vars, p_dense, q),
+        #[cfg(feature = "sdp")]
+        Solver::Clarabel => solve_sdp(vars, p_dense, q),
     }
-    #[cfg(not(feature = "sdp"))]
-    {
-        let _ = (vars, p_dense, q);
-        Err(Error::Input(
-            "physically consistent parameters need the `sdp` feature (Clarabel's semidefinite \
-             programs with the system's LAPACK): install LAPACK (Debian/Ubuntu: apt-get install \
-             libopenblas-dev pkg-config gfortran) and build with `--features robodyn/sdp`"
-                .into(),
-        ))
+}
+
+/// Pseudo-inertia of the unit vector e_l of a link's 10 inertial parameters: J is linear in
+/// them, J = sum_l k_l pseudo_inertia(e_l).
+fn pseudo_inertia_basis() -> [Matrix4<f64>; 10] {
+    std::array::from_fn(|l| {
+        let mut e = [0.0; 10];
+        e[l] = 1.0;
+        pseudo_inertia(&e)
+    })
+}
+
+/// The semidefinite program as a conic QP: one 4x4 PSD block per link, drives >= 0.
+fn conic_problem(vars: &Variables, p_dense: &Mat<f64>, q: &[f64]) -> conic::ConicQp {
+    let nv = vars.count();
+    let basis = pseudo_inertia_basis();
+    conic::ConicQp {
+        p: DMatrix::from_fn(nv, nv, |r, c| p_dense[(r, c)]),
+        q: DVector::from_column_slice(q),
+        psd: (0..vars.nl)
+            .map(|j| conic::PsdBlock {
+                constant: Matrix4::zeros(),
+                terms: (0..10).map(|l| (10 * j + l, basis[l])).collect(),
+            })
+            .collect(),
+        lower: vars.drives.iter().map(|&d| (d, 0.0)).collect(),
+        upper: Vec::new(),
     }
+}
+
+fn solve_interior_point(
+    vars: &Variables,
+    p_dense: &Mat<f64>,
+    q: &[f64],
+) -> Result<(Vec<f64>, String)> {
+    let sol = conic::solve(&conic_problem(vars, p_dense, q), &conic::Settings::default())
+        .map_err(|e| {
+            Error::Numerical(format!(
+                "the SDP of the physically consistent parameters was not solved ({e}): no \
+                 consistent parameters are reported"
+            ))
+        })?;
+    let mut v = sol.x;
+    let moved = make_consistent(vars, &mut v);
+    let mut text = format!(
+        "interior point: solved in {} iterations (relative residuals {:.0e} primal, {:.0e} \
+         dual, gap {:.0e})",
+        sol.iterations, sol.primal_residual, sol.dual_residual, sol.gap
+    );
+    if moved > 0.0 {
+        text.push_str(&format!(
+            "; rounding-level violations projected onto the constraints (largest change {moved:.1e})"
+        ));
+    }
+    Ok((v, text))
+}
+
+/// Make the solver's point satisfy the constraints exactly: a pseudo-inertia with a negative
+/// eigenvalue (a rounding-level violation at the boundary) is replaced by its nearest PSD
+/// matrix (negative eigenvalues set to zero, then raised until the computed smallest
+/// eigenvalue is not negative), a negative drive parameter by 0. Returns the largest change.
+fn make_consistent(vars: &Variables, v: &mut [f64]) -> f64 {
+    let mut moved = 0.0f64;
+    for j in 0..vars.nl {
+        let k = &mut v[10 * j..10 * j + 10];
+        let mut jm = pseudo_inertia(k);
+        let mut shift = 0.0;
+        for _ in 0..4 {
+            let eig = jm.symmetric_eigen();
+            let lo = eig.eigenvalues.min();
+            if lo >= 0.0 {
+                break;
+            }
+            let clipped = eig.eigenvalues.map(|l| l.max(shift));
+            jm = eig.eigenvectors * Matrix4::from_diagonal(&clipped) * eig.eigenvectors.transpose();
+            jm = (jm + jm.transpose()) * 0.5;
+            shift = if shift == 0.0 {
+                4.0 * f64::EPSILON * jm.amax()
+            } else {
+                2.0 * shift
+            };
+        }
+        let new = from_pseudo_inertia(&jm);
+        for (a, b) in k.iter_mut().zip(new) {
+            moved = moved.max((*a - b).abs());
+            *a = b;
+        }
+    }
+    for &d in &vars.drives {
+        if v[d] < 0.0 {
+            moved = moved.max(-v[d]);
+            v[d] = 0.0;
+        }
+    }
+    moved
+}
+
+/// The 10 inertial parameters (XX XY XZ YY YZ ZZ MX MY MZ M) of a pseudo-inertia matrix: the
+/// inverse of [`pseudo_inertia`] (I = tr(Sigma) 1 - Sigma).
+pub fn from_pseudo_inertia(j: &Matrix4<f64>) -> [f64; 10] {
+    let t = j[(0, 0)] + j[(1, 1)] + j[(2, 2)];
+    [
+        t - j[(0, 0)],
+        -j[(0, 1)],
+        -j[(0, 2)],
+        t - j[(1, 1)],
+        -j[(1, 2)],
+        t - j[(2, 2)],
+        j[(0, 3)],
+        j[(1, 3)],
+        j[(2, 3)],
+        j[(3, 3)],
+    ]
 }
 
 #[cfg(feature = "sdp")]
@@ -364,6 +484,7 @@ pub fn consistent_parameters(
     model: &ParameterModel,
     tw: &Mat<f64>,
     estimate: &LsSolution,
+    solver: Solver,
 ) -> Result<ConsistentSolution> {
     let vars = Variables::new(model);
     let e = vars.x_map(model);
@@ -392,7 +513,7 @@ pub fn consistent_parameters(
         &mut pm,
         &mut q,
     );
-    let (v, text) = solve(&vars, &pm, &q)?;
+    let (v, text) = solve(&vars, &pm, &q, solver)?;
     let mut sol = finish(access, model, &vars, &v, estimate, text)?;
     // increase of the weighted residual, in units of sigma^2: the squared Mahalanobis distance
     let base = super::estimators::residual_sq(tw, &estimate.x);
