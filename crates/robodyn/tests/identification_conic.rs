@@ -42,7 +42,9 @@ fn random_psd(rng: &mut ChaCha8Rng, rank: usize) -> Matrix4<f64> {
 fn random_spd(rng: &mut ChaCha8Rng, n: usize, condition: f64) -> DMatrix<f64> {
     let a = DMatrix::from_fn(n, n, |_, _| rng.random_range(-1.0..1.0));
     let q = a.qr().q();
-    let d = DVector::from_fn(n, |i, _| condition.powf(-(i as f64) / (n - 1).max(1) as f64));
+    let d = DVector::from_fn(n, |i, _| {
+        condition.powf(-(i as f64) / (n - 1).max(1) as f64)
+    });
     &q * DMatrix::from_diagonal(&d) * q.transpose()
 }
 
@@ -76,12 +78,20 @@ fn assert_kkt(qp: &ConicQp, sol: &ConicSolution, tol: f64) {
         }
     }
     for (&(v, l), &y) in qp.lower.iter().zip(&sol.lower_dual) {
-        assert!(x[v] >= l - tol * l.abs().max(1.0) && y >= -tol, "x{v} {} >= {l}", x[v]);
+        assert!(
+            x[v] >= l - tol * l.abs().max(1.0) && y >= -tol,
+            "x{v} {} >= {l}",
+            x[v]
+        );
         assert!((y * (x[v] - l)).abs() <= tol * (1.0 + y.abs()), "lower {v}");
         grad[v] -= y;
     }
     for (&(v, u), &y) in qp.upper.iter().zip(&sol.upper_dual) {
-        assert!(x[v] <= u + tol * u.abs().max(1.0) && y >= -tol, "x{v} {} <= {u}", x[v]);
+        assert!(
+            x[v] <= u + tol * u.abs().max(1.0) && y >= -tol,
+            "x{v} {} <= {u}",
+            x[v]
+        );
         assert!((y * (u - x[v])).abs() <= tol * (1.0 + y.abs()), "upper {v}");
         grad[v] += y;
     }
@@ -151,11 +161,8 @@ fn the_projection_onto_the_psd_cone_is_the_eigenvalue_clipping() {
             })
             .collect();
         let j0 = Matrix4::from_fn(|r, c| (0..4).map(|i| u[(r, i)] * ev[i] * u[(c, i)]).sum());
-        let projected = Matrix4::from_fn(|r, c| {
-            (0..4)
-                .map(|i| u[(r, i)] * ev[i].max(0.0) * u[(c, i)])
-                .sum()
-        });
+        let projected =
+            Matrix4::from_fn(|r, c| (0..4).map(|i| u[(r, i)] * ev[i].max(0.0) * u[(c, i)]).sum());
         let q = DVector::from_fn(10, |k, _| -2.0 * block.terms[k].1.dot(&j0));
         let qp = ConicQp {
             p: &gram * 2.0,
@@ -182,7 +189,9 @@ fn the_projection_onto_the_psd_cone_is_the_eigenvalue_clipping() {
 fn bounds_clamp_a_separable_quadratic() {
     let mut rng = ChaCha8Rng::seed_from_u64(3);
     let n = 12;
-    let w: Vec<f64> = (0..n).map(|_| 10f64.powf(rng.random_range(-4.0..4.0))).collect();
+    let w: Vec<f64> = (0..n)
+        .map(|_| 10f64.powf(rng.random_range(-4.0..4.0)))
+        .collect();
     let a: Vec<f64> = (0..n).map(|_| rng.random_range(-3.0..3.0)).collect();
     let lo: Vec<f64> = (0..n).map(|_| rng.random_range(-2.0..0.0)).collect();
     let hi: Vec<f64> = (0..n).map(|_| rng.random_range(0.0..2.0)).collect();
@@ -196,7 +205,11 @@ fn bounds_clamp_a_separable_quadratic() {
     let sol = solve(&qp, &Settings::default()).unwrap();
     for i in 0..n {
         let want = a[i].clamp(lo[i], hi[i]);
-        assert!((sol.x[i] - want).abs() < 1e-8, "{i}: {} vs {want}", sol.x[i]);
+        assert!(
+            (sol.x[i] - want).abs() < 1e-8,
+            "{i}: {} vs {want}",
+            sol.x[i]
+        );
     }
     assert_kkt(&qp, &sol, 1e-8);
 }
@@ -249,7 +262,10 @@ fn random_problems_satisfy_the_kkt_conditions() {
                 .zip(&inner)
                 .map(|(a, b)| (1.0 - t) * a + t * b)
                 .collect();
-            assert!(objective(&qp, &y) >= f - 1e-9 * f.abs().max(1.0), "seed {seed}");
+            assert!(
+                objective(&qp, &y) >= f - 1e-9 * f.abs().max(1.0),
+                "seed {seed}"
+            );
         }
     }
 }
@@ -281,7 +297,10 @@ fn a_rank_deficient_optimum_is_found() {
             .map(|(a, b)| (a - b).abs())
             .fold(0.0, f64::max);
         let scale = truth.iter().map(|v| v.abs()).fold(0.0, f64::max);
-        eprintln!("rank {rank}: {} iterations, error {err:.1e}", sol.iterations);
+        eprintln!(
+            "rank {rank}: {} iterations, error {err:.1e}",
+            sol.iterations
+        );
         assert!(err < 1e-6 * scale, "rank {rank}: error {err:e}");
         let f = objective(&qp, &sol.x);
         let f0 = objective(&qp, &truth);

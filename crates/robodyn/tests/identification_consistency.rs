@@ -220,7 +220,11 @@ fn cross_check_problems() -> Vec<(String, ModelAccess, MemoryLog)> {
     }
     let mut desc = rx90();
     desc.links[5].params[5] = robodyn::Expr::num(-0.01);
-    noisy("RX-90 with ZZ6 < 0".into(), ModelAccess::new(desc).unwrap(), 7);
+    noisy(
+        "RX-90 with ZZ6 < 0".into(),
+        ModelAccess::new(desc).unwrap(),
+        7,
+    );
     out
 }
 
@@ -293,7 +297,13 @@ fn noisy_problems_give_exactly_consistent_parameters() {
             let ev = pseudo_inertia(&k[13 * j..13 * j + 10]).symmetric_eigenvalues();
             assert!(ev.min() >= 0.0, "{name}, link {}: {ev:?}", j + 1);
         }
-        let drives = id.model.map.iter().flatten().map(|(i, _)| *i).filter(|i| i % 13 >= 10);
+        let drives = id
+            .model
+            .map
+            .iter()
+            .flatten()
+            .map(|(i, _)| *i)
+            .filter(|i| i % 13 >= 10);
         for i in drives {
             assert!(k[i] >= 0.0, "{name}: drive parameter {i} = {}", k[i]);
         }

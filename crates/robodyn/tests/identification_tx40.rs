@@ -83,3 +83,47 @@ fn tx40_real_log() {
     let c = id.consistent.as_ref().unwrap();
     assert!(c.min_pseudo_inertia_eigenvalue > -1e-9 && c.min_inertia_eigenvalue > 0.0);
 }
+
+/// The consistent fit of the README's TX40 run by the interior-point solver equals Clarabel's
+/// (feature `sdp`): identified vectors to 1e-6 relative, squared Mahalanobis distances to 1e-6.
+#[cfg(feature = "sdp")]
+#[test]
+fn tx40_interior_point_and_clarabel_agree() {
+    use robodyn::identification::consistency::Solver;
+    let Some(path) = data() else { return };
+    let robot = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../robots/tx40.toml");
+    let mut acc = ModelAccess::new(load_description(&robot, &BTreeMap::new()).unwrap()).unwrap();
+    let labels = JointLabels {
+        numbers: acc.actuated_joints().to_vec(),
+        names: acc.joint_names(),
+    };
+    let log = CsvLog::open(&path, &labels).unwrap();
+    let mut run = |solver| {
+        let mut opt = Options {
+            consistent: true,
+            standard: true,
+            consistency_solver: solver,
+            ..Options::default()
+        };
+        opt.parameters.offsets = true;
+        identify(&mut acc, &log, &opt).unwrap()
+    };
+    let ipm = run(Solver::InteriorPoint);
+    let cl = run(Solver::Clarabel);
+    let (a, b) = (ipm.consistent.unwrap(), cl.consistent.unwrap());
+    let scale = cl.x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let dx = ipm
+        .x
+        .iter()
+        .zip(&cl.x)
+        .map(|(x, y)| (x - y).abs() / y.abs().max(1e-3 * scale))
+        .fold(0.0, f64::max);
+    let dd = (a.distance2 - b.distance2).abs() / b.distance2.max(1.0);
+    eprintln!(
+        "TX40 consistent: distance^2 {:.6e} vs {:.6e}, max relative difference of x {dx:.1e}; \
+         {} | {}",
+        a.distance2, b.distance2, a.solver, b.solver
+    );
+    assert!(dx < 1e-6, "x differs by {dx:e}");
+    assert!(dd < 1e-6, "objective differs by {dd:e}");
+}

@@ -19,12 +19,12 @@
 //! with the same base parameters (moving K by one scale unit costs as much as moving the
 //! estimate by 1e-3 standard deviations).
 
+use super::conic;
 use super::estimators::LsSolution;
 use super::model_access::{ModelAccess, FS, FV, IA, PER_LINK};
 use super::parameters::{Kind, ParameterModel};
 use super::Consistent;
 use crate::error::{Error, Result};
-use super::conic;
 use faer::Mat;
 use nalgebra::{DMatrix, DVector, Matrix4};
 
@@ -239,20 +239,34 @@ fn solve_interior_point(
     p_dense: &Mat<f64>,
     q: &[f64],
 ) -> Result<(Vec<f64>, String)> {
-    let sol = conic::solve(&conic_problem(vars, p_dense, q), &conic::Settings::default())
-        .map_err(|e| {
-            Error::Numerical(format!(
-                "the SDP of the physically consistent parameters was not solved ({e}): no \
+    let sol = conic::solve(
+        &conic_problem(vars, p_dense, q),
+        &conic::Settings::default(),
+    )
+    .map_err(|e| {
+        Error::Numerical(format!(
+            "the SDP of the physically consistent parameters was not solved ({e}): no \
                  consistent parameters are reported"
-            ))
-        })?;
+        ))
+    })?;
     let mut v = sol.x;
     let moved = make_consistent(vars, &mut v);
     let mut text = format!(
-        "interior point: solved in {} iterations (relative residuals {:.0e} primal, {:.0e} \
+        "interior point: solved in {} iterations{} (relative residuals {:.0e} primal, {:.0e} \
          dual, gap {:.0e})",
-        sol.iterations, sol.primal_residual, sol.dual_residual, sol.gap
+        sol.iterations,
+        if sol.polished {
+            ", polished on the active face"
+        } else {
+            ""
+        },
+        sol.primal_residual,
+        sol.dual_residual,
+        sol.gap
     );
+    if sol.dual_residual > conic::Settings::default().tolerance {
+        text.push_str(" (reduced accuracy: the dual residual did not reach 1e-10)");
+    }
     if moved > 0.0 {
         text.push_str(&format!(
             "; rounding-level violations projected onto the constraints (largest change {moved:.1e})"

@@ -637,7 +637,8 @@ pub fn identify(
     // consistent set nearest to the unconstrained estimate in the metric of its covariance
     let mut consistent = None;
     if opt.consistent || opt.standard {
-        let c = consistency::consistent_parameters(access, &model, &tw, &sol, opt.consistency_solver)?;
+        let c =
+            consistency::consistent_parameters(access, &model, &tw, &sol, opt.consistency_solver)?;
         let bound = p as f64 + 3.0 * (2.0 * p as f64).sqrt();
         // changes at rounding level (a noise-free fit whose true values lie on the boundary,
         // e.g. zero friction) are not reported
