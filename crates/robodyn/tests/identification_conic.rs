@@ -48,6 +48,16 @@ fn random_spd(rng: &mut ChaCha8Rng, n: usize, condition: f64) -> DMatrix<f64> {
     &q * DMatrix::from_diagonal(&d) * q.transpose()
 }
 
+/// The largest |a_i - b_i| and the largest |b_i|.
+fn max_error(a: &[f64], b: &[f64]) -> (f64, f64) {
+    let err = a
+        .iter()
+        .zip(b)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
+    (err, b.iter().map(|v| v.abs()).fold(0.0, f64::max))
+}
+
 fn objective(qp: &ConicQp, x: &[f64]) -> f64 {
     let x = DVector::from_column_slice(x);
     0.5 * x.dot(&(&qp.p * &x)) + qp.q.dot(&x)
@@ -127,13 +137,7 @@ fn an_interior_unconstrained_optimum_is_returned() {
             upper: vec![],
         };
         let sol = solve(&qp, &Settings::default()).unwrap();
-        let err = sol
-            .x
-            .iter()
-            .zip(&truth)
-            .map(|(a, b)| (a - b).abs())
-            .fold(0.0, f64::max);
-        let scale = truth.iter().map(|v| v.abs()).fold(0.0, f64::max);
+        let (err, scale) = max_error(&sol.x, &truth);
         assert!(err < 1e-8 * scale, "case {case}: error {err:e}");
         assert_kkt(&qp, &sol, 1e-8);
     }
@@ -290,13 +294,7 @@ fn a_rank_deficient_optimum_is_found() {
             upper: vec![],
         };
         let sol = solve(&qp, &Settings::default()).unwrap();
-        let err = sol
-            .x
-            .iter()
-            .zip(&truth)
-            .map(|(a, b)| (a - b).abs())
-            .fold(0.0, f64::max);
-        let scale = truth.iter().map(|v| v.abs()).fold(0.0, f64::max);
+        let (err, scale) = max_error(&sol.x, &truth);
         eprintln!(
             "rank {rank}: {} iterations, error {err:.1e}",
             sol.iterations

@@ -16,6 +16,19 @@ fn data() -> Option<PathBuf> {
     )
 }
 
+/// The bundled TX40 and its log (None, skipped visibly, without the shared data).
+fn tx40() -> Option<(ModelAccess, CsvLog)> {
+    let path = data()?;
+    let robot = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../robots/tx40.toml");
+    let acc = ModelAccess::new(load_description(&robot, &BTreeMap::new()).unwrap()).unwrap();
+    let labels = JointLabels {
+        numbers: acc.actuated_joints().to_vec(),
+        names: acc.joint_names(),
+    };
+    let log = CsvLog::open(&path, &labels).unwrap();
+    Some((acc, log))
+}
+
 /// The README's command: WLS, constant offsets, validation on 60..80 % of the log. The real
 /// robot's torques are explained to within the per-joint errors measured when this test was
 /// written (5.6, 7.5, 9.3, 12.0, 12.5, 14.5 %) with margin; the gravity parameter of link 2,
@@ -24,14 +37,7 @@ fn data() -> Option<PathBuf> {
 /// well identified; the consistent robot is found.
 #[test]
 fn tx40_real_log() {
-    let Some(path) = data() else { return };
-    let robot = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../robots/tx40.toml");
-    let mut acc = ModelAccess::new(load_description(&robot, &BTreeMap::new()).unwrap()).unwrap();
-    let labels = JointLabels {
-        numbers: acc.actuated_joints().to_vec(),
-        names: acc.joint_names(),
-    };
-    let log = CsvLog::open(&path, &labels).unwrap();
+    let Some((mut acc, log)) = tx40() else { return };
     let mut opt = Options {
         validation: Some((0.6, 0.8)),
         standard: true,
@@ -90,14 +96,7 @@ fn tx40_real_log() {
 #[test]
 fn tx40_interior_point_and_clarabel_agree() {
     use robodyn::identification::consistency::Solver;
-    let Some(path) = data() else { return };
-    let robot = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../robots/tx40.toml");
-    let mut acc = ModelAccess::new(load_description(&robot, &BTreeMap::new()).unwrap()).unwrap();
-    let labels = JointLabels {
-        numbers: acc.actuated_joints().to_vec(),
-        names: acc.joint_names(),
-    };
-    let log = CsvLog::open(&path, &labels).unwrap();
+    let Some((mut acc, log)) = tx40() else { return };
     let mut run = |solver| {
         let mut opt = Options {
             consistent: true,

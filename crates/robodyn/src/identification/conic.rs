@@ -12,7 +12,9 @@
 //! SVD of their product), Mehrotra's predictor–corrector, the Newton systems reduced to the
 //! n x n positive definite matrix P + L^T (W^T W)^-1 L, factored by Cholesky and refined
 //! iteratively, and the problem first equilibrated (Ruiz: columns of [P; L], one factor per
-//! cone block, and the objective) as Clarabel does.
+//! cone block, and the objective) as Clarabel does, its origin moved to the minimizer of the
+//! objective alone (so that the objective at the optimum is its increase over the
+//! unconstrained minimum and the relative gap measures that, not the size of the data).
 //!
 //! After convergence the answer is polished: the minimizer on the face of the cones that the
 //! last iterate identifies (active eigenvectors of each block, active bounds), kept only when
@@ -709,13 +711,39 @@ fn start(eq: &Equilibrated) -> Result<(DVector<f64>, ConeVec, ConeVec)> {
     Ok((x, s, ones))
 }
 
+/// The minimizer of the objective alone (regularized by 1e-12 of P's largest diagonal entry
+/// where P is singular), the origin of the centred problem; the start point where that is not
+/// finite or far from it (an objective unbounded without the constraints).
+fn unconstrained_minimizer(eq: &Equilibrated, start: &DVector<f64>) -> DVector<f64> {
+    let n = eq.n();
+    let scale = eq.p.diagonal().amax();
+    if !(scale > 0.0) {
+        return start.clone();
+    }
+    let mut h = eq.p.clone();
+    for i in 0..n {
+        h[(i, i)] += 1e-12 * scale;
+    }
+    let Ok(red) = Reduced::new(h) else {
+        return start.clone();
+    };
+    let x = red.solve(&-&eq.q);
+    let far = (&x - start).amax() > 1e6 * (1.0 + start.amax());
+    if x.iter().all(|v| v.is_finite()) && !far {
+        x
+    } else {
+        start.clone()
+    }
+}
+
 /// Solve the problem (see the module's documentation for the method and the stopping rules).
 pub fn solve(qp: &ConicQp, settings: &Settings) -> Result<ConicSolution> {
     let mut eq = Equilibrated::new(qp)?;
-    let (x0, mut s, mut z) = start(&eq)?;
+    let (xs, mut s, mut z) = start(&eq)?;
+    let x0 = unconstrained_minimizer(&eq, &xs);
     eq.center(&x0);
     eq.scale_objective();
-    let mut x = DVector::zeros(eq.n());
+    let mut x = xs - &x0;
     let degree = eq.degree().max(1) as f64;
     let tol = settings.tolerance;
     let mut st = status(&eq, &x, &s, &z);
