@@ -241,7 +241,9 @@ fn max_relative_difference(a: &[f64], b: &[f64]) -> f64 {
 
 /// The interior-point solver (default build) and Clarabel (feature `sdp`) find the same
 /// optimum: identified vectors to 1e-6 relative, objectives (squared Mahalanobis distances) to
-/// 1e-6 relative, on random trees and a deliberately inconsistent robot.
+/// 1e-6 relative, on random trees and a deliberately inconsistent robot, where Clarabel reports
+/// "Solved"; where it stops with reduced accuracy ("AlmostSolved"), the interior point's fit is
+/// at least as good and the vectors agree to 1e-2.
 #[cfg(feature = "sdp")]
 #[test]
 fn interior_point_and_clarabel_agree() {
@@ -271,8 +273,17 @@ fn interior_point_and_clarabel_agree() {
             a.solver,
             b.solver
         );
-        assert!(dx < 1e-6, "{name}: x differs by {dx:e}");
-        assert!(dd < 1e-6, "{name}: objective differs by {dd:e}");
+        if b.solver.contains("Solved in") && !b.solver.contains("AlmostSolved") {
+            assert!(dx < 1e-6, "{name}: x differs by {dx:e}");
+            assert!(dd < 1e-6, "{name}: objective differs by {dd:e}");
+        } else {
+            // Clarabel stopped with reduced accuracy: the interior point's fit is no worse
+            assert!(
+                a.distance2 <= b.distance2 * (1.0 + 1e-6) + 1e-9,
+                "{name}: worse fit"
+            );
+            assert!(dx < 1e-2, "{name}: x differs by {dx:e}");
+        }
         assert!(a.min_pseudo_inertia_eigenvalue >= 0.0, "{name}");
     }
 }

@@ -417,7 +417,25 @@ fn solve_sdp(vars: &Variables, p_dense: &Mat<f64>, q: &[f64]) -> Result<(Vec<f64
         colptr.push(rowval.len());
     }
     let a = CscMatrix::new(m, nv, colptr, rowval, nzval);
-    let b = vec![0.0; m];
+    // origin at the unconstrained minimizer v0 (as the interior-point solver): v = v0 + u,
+    // q + P v0, s = J(v0) + J(u) = b - A u with b = -A v0
+    let mut pr = DMatrix::from_fn(nv, nv, |r, c| 0.5 * (p_dense[(r, c)] + p_dense[(c, r)]));
+    let reg = 1e-12 * pr.diagonal().amax();
+    for i in 0..nv {
+        pr[(i, i)] += reg;
+    }
+    let v0 = pr
+        .cholesky()
+        .map(|c| c.solve(&-DVector::from_column_slice(q)))
+        .filter(|v| v.iter().all(|x| x.is_finite()))
+        .unwrap_or_else(|| DVector::zeros(nv));
+    let qc: Vec<f64> = (0..nv)
+        .map(|r| q[r] + (0..nv).map(|c| p_dense[(r, c)] * v0[c]).sum::<f64>())
+        .collect();
+    let b: Vec<f64> = rows
+        .iter()
+        .map(|t| -t.iter().map(|&(c, v)| v * v0[c]).sum::<f64>())
+        .collect();
     let settings = DefaultSettingsBuilder::default()
         .verbose(false)
         .max_iter(400)
@@ -427,15 +445,16 @@ fn solve_sdp(vars: &Variables, p_dense: &Mat<f64>, q: &[f64]) -> Result<(Vec<f64
         .tol_ktratio(1e-9)
         .build()
         .map_err(|e| Error::Numerical(format!("SDP settings: {e:?}")))?;
-    let mut solver = DefaultSolver::new(&p, q, &a, &b, &cones, settings)
+    let mut solver = DefaultSolver::new(&p, &qc, &a, &b, &cones, settings)
         .map_err(|e| Error::Numerical(format!("the SDP could not be set up: {e:?}")))?;
     solver.solve();
     let s = &solver.solution;
     let status = s.status;
     let text = format!("Clarabel: {status:?} in {} iterations", s.iterations);
+    let v: Vec<f64> = s.x.iter().zip(v0.iter()).map(|(u, v0)| u + v0).collect();
     match status {
-        SolverStatus::Solved => Ok((s.x.clone(), text)),
-        SolverStatus::AlmostSolved => Ok((s.x.clone(), format!("{text} (reduced accuracy)"))),
+        SolverStatus::Solved => Ok((v, text)),
+        SolverStatus::AlmostSolved => Ok((v, format!("{text} (reduced accuracy)"))),
         other => Err(Error::Numerical(format!(
             "the SDP of the physically consistent parameters did not converge ({other:?} after {} \
              iterations): no consistent parameters are reported",

@@ -8,7 +8,8 @@
 //! equality-constrained QP: one linear system), and keep the result only if it is optimal for
 //! the whole problem — primal feasible, its multipliers in the dual cones, and no worse than
 //! the interior point's answer. Several guesses are tried (the ratio slack / multiplier
-//! compared with 1, 1e-4 and 1e4); when none passes, the interior point's answer stands.
+//! compared with 1, then with every threshold that changes the face, nearest to 1 first);
+//! when none passes, the interior point's answer stands.
 
 use super::{ConeVec, Equilibrated};
 use nalgebra::{DMatrix, DVector, Matrix4, Vector4};
@@ -152,7 +153,7 @@ pub(super) fn polish(
     tol: f64,
 ) -> bool {
     let objective_ipm = 0.5 * u.dot(&(&eq.p * &*u)) + eq.q.dot(u);
-    for ratio in [1.0, 1e4, 1e8, 1e-4] {
+    for ratio in ratios(s, z) {
         let rows = face(eq, s, z, ratio);
         let Some((up, nu)) = solve_face(eq, &rows, u) else {
             continue;
@@ -168,3 +169,38 @@ pub(super) fn polish(
     }
     false
 }
+
+/// The thresholds to try: 1 first, then one between every two consecutive values of the
+/// directions' slack / multiplier ratios (every distinct face the ratio rule can give), nearest
+/// to 1 first, at most MAX_FACES in all.
+fn ratios(s: &ConeVec, z: &ConeVec) -> Vec<f64> {
+    let mut r: Vec<f64> = Vec::new();
+    for (sm, zm) in s.psd.iter().zip(&z.psd) {
+        let eig = sm.symmetric_eigen();
+        for k in 0..4 {
+            let v: Vector4<f64> = eig.eigenvectors.column(k).into();
+            r.push(eig.eigenvalues[k].max(0.0) / v.dot(&(zm * v)).max(f64::MIN_POSITIVE));
+        }
+    }
+    r.extend(
+        s.lin
+            .iter()
+            .zip(&z.lin)
+            .map(|(s, z)| s.max(0.0) / z.max(f64::MIN_POSITIVE)),
+    );
+    r.retain(|v| v.is_finite());
+    r.sort_by(f64::total_cmp);
+    let mut cuts: Vec<f64> = r
+        .windows(2)
+        .map(|w| (w[0] * w[1]).sqrt().max(w[0]))
+        .collect();
+    cuts.sort_by(|a, b| a.ln().abs().total_cmp(&b.ln().abs()));
+    let mut out = vec![1.0];
+    out.extend(cuts.into_iter().filter(|c| *c > 0.0));
+    out.dedup();
+    out.truncate(MAX_FACES);
+    out
+}
+
+/// Faces tried at most.
+const MAX_FACES: usize = 40;
