@@ -446,7 +446,7 @@ fn psd_scaling(s: &Matrix4<f64>, z: &Matrix4<f64>) -> Result<PsdScaling> {
     let svd = (lz.transpose() * ls).svd(false, true);
     let vt = svd.v_t.ok_or_else(fail)?;
     let lambda = svd.singular_values;
-    if lambda.iter().any(|l| !(*l > 0.0)) {
+    if lambda.iter().any(|l| l.is_nan() || *l <= 0.0) {
         return Err(fail());
     }
     let ls_inv = ls
@@ -717,7 +717,7 @@ fn start(eq: &Equilibrated) -> Result<(DVector<f64>, ConeVec, ConeVec)> {
 fn unconstrained_minimizer(eq: &Equilibrated, start: &DVector<f64>) -> DVector<f64> {
     let n = eq.n();
     let scale = eq.p.diagonal().amax();
-    if !(scale > 0.0) {
+    if scale.is_nan() || scale <= 0.0 {
         return start.clone();
     }
     let mut h = eq.p.clone();
@@ -768,7 +768,7 @@ fn solve_from(qp: &ConicQp, settings: &Settings, minimizer_origin: bool) -> Resu
             if polished {
                 st = status(&eq, &x, &s, &z);
             }
-            return Ok(unscale(qp, &eq, &x, &s, &z, it, &st, polished));
+            return Ok(unscale(qp, &eq, &x, &s, &z, (it, polished), &st));
         }
         if it >= settings.max_iterations || stalled >= 5 {
             // a stalled or exhausted run: its answer stands if polishing finds a point
@@ -780,11 +780,11 @@ fn solve_from(qp: &ConicQp, settings: &Settings, minimizer_origin: bool) -> Resu
                 let polished = polish::polish(&eq, &mut x, &mut s, &mut z, 10.0 * tol);
                 if polished {
                     st = status(&eq, &x, &s, &z);
-                    return Ok(unscale(qp, &eq, &x, &s, &z, it, &st, polished));
+                    return Ok(unscale(qp, &eq, &x, &s, &z, (it, polished), &st));
                 }
             }
             if st.primal <= tol && st.gap <= tol && st.dual <= REDUCED_DUAL {
-                return Ok(unscale(qp, &eq, &x, &s, &z, it, &st, false));
+                return Ok(unscale(qp, &eq, &x, &s, &z, (it, false), &st));
             }
             let why = if stalled >= 5 {
                 format!("no progress after {it} iterations")
@@ -819,7 +819,7 @@ fn solve_from(qp: &ConicQp, settings: &Settings, minimizer_origin: bool) -> Resu
         let d = direction(&eq, &w, &h, &st.r_d, &st.r_p, &corr);
         let a_max = w.max_step(&d.ds_t).min(w.max_step(&d.dz_t));
         let alpha = (STEP_FRACTION * a_max).min(1.0);
-        if !(alpha > 1e-10) || d.dx.iter().any(|v| !v.is_finite()) {
+        if alpha.is_nan() || alpha <= 1e-10 || d.dx.iter().any(|v| !v.is_finite()) {
             stalled = 5;
             continue;
         }
@@ -841,9 +841,8 @@ fn unscale(
     x: &DVector<f64>,
     s: &ConeVec,
     z: &ConeVec,
-    iterations: usize,
+    (iterations, polished): (usize, bool),
     st: &Status,
-    polished: bool,
 ) -> ConicSolution {
     let xo = (&eq.origin + x).component_mul(&eq.d);
     let nl = qp.lower.len();
