@@ -286,11 +286,11 @@ fn make_consistent(vars: &Variables, v: &mut [f64]) -> f64 {
         let mut jm = pseudo_inertia(k);
         let mut shift = 0.0;
         for _ in 0..4 {
-            let eig = jm.symmetric_eigen();
-            let lo = eig.eigenvalues.min();
-            if lo >= 0.0 {
+            // the eigenvalues as every check computes them (`min_pseudo_inertia_eigenvalue`)
+            if jm.symmetric_eigenvalues().min() >= 0.0 {
                 break;
             }
+            let eig = jm.symmetric_eigen();
             let clipped = eig.eigenvalues.map(|l| l.max(shift));
             jm = eig.eigenvectors * Matrix4::from_diagonal(&clipped) * eig.eigenvectors.transpose();
             jm = (jm + jm.transpose()) * 0.5;
