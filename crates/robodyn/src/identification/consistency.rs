@@ -283,27 +283,30 @@ fn make_consistent(vars: &Variables, v: &mut [f64]) -> f64 {
     let mut moved = 0.0f64;
     for j in 0..vars.nl {
         let k = &mut v[10 * j..10 * j + 10];
-        let mut jm = pseudo_inertia(k);
         let mut shift = 0.0;
-        for _ in 0..4 {
-            // the eigenvalues as every check computes them (`min_pseudo_inertia_eigenvalue`)
+        for _ in 0..8 {
+            // checked on the parameters themselves, with the eigenvalues every check computes
+            // (`min_pseudo_inertia_eigenvalue`): the round trip J -> K -> J rounds too
+            let jm = pseudo_inertia(k);
             if jm.symmetric_eigenvalues().min() >= 0.0 {
                 break;
             }
             let eig = jm.symmetric_eigen();
             let clipped = eig.eigenvalues.map(|l| l.max(shift));
-            jm = eig.eigenvectors * Matrix4::from_diagonal(&clipped) * eig.eigenvectors.transpose();
-            jm = (jm + jm.transpose()) * 0.5;
+            let jc =
+                eig.eigenvectors * Matrix4::from_diagonal(&clipped) * eig.eigenvectors.transpose();
+            for (a, b) in k
+                .iter_mut()
+                .zip(from_pseudo_inertia(&((jc + jc.transpose()) * 0.5)))
+            {
+                moved = moved.max((*a - b).abs());
+                *a = b;
+            }
             shift = if shift == 0.0 {
                 4.0 * f64::EPSILON * jm.amax()
             } else {
                 2.0 * shift
             };
-        }
-        let new = from_pseudo_inertia(&jm);
-        for (a, b) in k.iter_mut().zip(new) {
-            moved = moved.max((*a - b).abs());
-            *a = b;
         }
     }
     for &d in &vars.drives {
