@@ -53,6 +53,8 @@ mod fixed_frames;
 mod fuzz_regressions;
 #[path = "geometry.rs"]
 mod geometry;
+#[path = "identification_conic.rs"]
+mod identification_conic;
 #[path = "identification_consistency.rs"]
 mod identification_consistency;
 #[path = "identification_synthetic.rs"]

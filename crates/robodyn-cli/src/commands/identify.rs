@@ -161,6 +161,7 @@ pub fn run(a: Args) -> CliResult {
         },
         consistent: a.consistent,
         standard: a.write_robot.is_some(),
+        consistency_solver: Default::default(),
         essential: a.essential.then_some(EssentialOptions {
             max_relative_std: a.essential_max_std,
             tolerance: a.essential_tolerance,

@@ -19,13 +19,14 @@
 //! with the same base parameters (moving K by one scale unit costs as much as moving the
 //! estimate by 1e-3 standard deviations).
 
+use super::conic;
 use super::estimators::LsSolution;
 use super::model_access::{ModelAccess, FS, FV, IA, PER_LINK};
 use super::parameters::{Kind, ParameterModel};
 use super::Consistent;
 use crate::error::{Error, Result};
 use faer::Mat;
-use nalgebra::Matrix4;
+use nalgebra::{DMatrix, DVector, Matrix4};
 
 /// Weight of the pull toward the robot file's parameters (relative, per scaled parameter).
 const PRIOR_WEIGHT: f64 = 1e-6;
@@ -45,7 +46,6 @@ struct Variables {
     /// Index in K of each standard variable.
     standard: Vec<usize>,
     /// Positions (in `standard`) of the drive parameters (>= 0).
-    #[cfg_attr(not(feature = "sdp"), allow(dead_code))]
     drives: Vec<usize>,
     /// Parameter index (in x) of each offset variable.
     offsets: Vec<usize>,
@@ -180,23 +180,160 @@ pub fn min_pseudo_inertia_eigenvalue(k: &[f64]) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
+/// The solver of the semidefinite program.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Solver {
+    /// robodyn's interior-point method ([`super::conic`]), pure Rust: the default.
+    #[default]
+    InteriorPoint,
+    /// Clarabel's PSD cone (feature `sdp`, the system's LAPACK): a cross-check.
+    #[cfg(feature = "sdp")]
+    Clarabel,
+}
+
 /// Solve min 1/2 v^T P v + q^T v subject to the consistency cones; returns v and a description
 /// of the solver's end.
-fn solve(vars: &Variables, p_dense: &Mat<f64>, q: &[f64]) -> Result<(Vec<f64>, String)> {
-    #[cfg(feature = "sdp")]
-    {
-        solve_sdp(vars, p_dense, q)
+fn solve(
+    vars: &Variables,
+    p_dense: &Mat<f64>,
+    q: &[f64],
+    solver: Solver,
+) -> Result<(Vec<f64>, String)> {
+    match solver {
+        Solver::InteriorPoint => solve_interior_point(vars, p_dense, q),
+        #[cfg(feature = "sdp")]
+        Solver::Clarabel => solve_sdp(vars, p_dense, q),
     }
-    #[cfg(not(feature = "sdp"))]
-    {
-        let _ = (vars, p_dense, q);
-        Err(Error::Input(
-            "physically consistent parameters need the `sdp` feature (Clarabel's semidefinite \
-             programs with the system's LAPACK): install LAPACK (Debian/Ubuntu: apt-get install \
-             libopenblas-dev pkg-config gfortran) and build with `--features robodyn/sdp`"
-                .into(),
+}
+
+/// Pseudo-inertia of the unit vector e_l of a link's 10 inertial parameters: J is linear in
+/// them, J = sum_l k_l pseudo_inertia(e_l).
+fn pseudo_inertia_basis() -> [Matrix4<f64>; 10] {
+    std::array::from_fn(|l| {
+        let mut e = [0.0; 10];
+        e[l] = 1.0;
+        pseudo_inertia(&e)
+    })
+}
+
+/// The semidefinite program as a conic QP: one 4x4 PSD block per link, drives >= 0.
+fn conic_problem(vars: &Variables, p_dense: &Mat<f64>, q: &[f64]) -> conic::ConicQp {
+    let nv = vars.count();
+    let basis = pseudo_inertia_basis();
+    conic::ConicQp {
+        p: DMatrix::from_fn(nv, nv, |r, c| p_dense[(r, c)]),
+        q: DVector::from_column_slice(q),
+        psd: (0..vars.nl)
+            .map(|j| conic::PsdBlock {
+                constant: Matrix4::zeros(),
+                terms: (0..10).map(|l| (10 * j + l, basis[l])).collect(),
+            })
+            .collect(),
+        lower: vars.drives.iter().map(|&d| (d, 0.0)).collect(),
+        upper: Vec::new(),
+    }
+}
+
+fn solve_interior_point(
+    vars: &Variables,
+    p_dense: &Mat<f64>,
+    q: &[f64],
+) -> Result<(Vec<f64>, String)> {
+    let sol = conic::solve(
+        &conic_problem(vars, p_dense, q),
+        &conic::Settings::default(),
+    )
+    .map_err(|e| {
+        Error::Numerical(format!(
+            "the SDP of the physically consistent parameters was not solved ({e}): no \
+                 consistent parameters are reported"
         ))
+    })?;
+    let mut v = sol.x;
+    let moved = make_consistent(vars, &mut v);
+    let mut text = format!(
+        "interior point: solved in {} iterations{} (relative residuals {:.0e} primal, {:.0e} \
+         dual, gap {:.0e})",
+        sol.iterations,
+        if sol.polished {
+            ", polished on the active face"
+        } else {
+            ""
+        },
+        sol.primal_residual,
+        sol.dual_residual,
+        sol.gap
+    );
+    if sol.dual_residual > conic::Settings::default().tolerance {
+        text.push_str(" (reduced accuracy: the dual residual did not reach 1e-10)");
     }
+    if moved > 0.0 {
+        text.push_str(&format!(
+            "; rounding-level violations projected onto the constraints (largest change {moved:.1e})"
+        ));
+    }
+    Ok((v, text))
+}
+
+/// Make the solver's point satisfy the constraints exactly: a pseudo-inertia with a negative
+/// eigenvalue (a rounding-level violation at the boundary) is replaced by its nearest PSD
+/// matrix (negative eigenvalues set to zero, then raised until the computed smallest
+/// eigenvalue is not negative), a negative drive parameter by 0. Returns the largest change.
+fn make_consistent(vars: &Variables, v: &mut [f64]) -> f64 {
+    let mut moved = 0.0f64;
+    for j in 0..vars.nl {
+        let k = &mut v[10 * j..10 * j + 10];
+        let mut shift = 0.0;
+        for _ in 0..8 {
+            // checked on the parameters themselves, with the eigenvalues every check computes
+            // (`min_pseudo_inertia_eigenvalue`): the round trip J -> K -> J rounds too
+            let jm = pseudo_inertia(k);
+            if jm.symmetric_eigenvalues().min() >= 0.0 {
+                break;
+            }
+            let eig = jm.symmetric_eigen();
+            let clipped = eig.eigenvalues.map(|l| l.max(shift));
+            let jc =
+                eig.eigenvectors * Matrix4::from_diagonal(&clipped) * eig.eigenvectors.transpose();
+            for (a, b) in k
+                .iter_mut()
+                .zip(from_pseudo_inertia(&((jc + jc.transpose()) * 0.5)))
+            {
+                moved = moved.max((*a - b).abs());
+                *a = b;
+            }
+            shift = if shift == 0.0 {
+                4.0 * f64::EPSILON * jm.amax()
+            } else {
+                2.0 * shift
+            };
+        }
+    }
+    for &d in &vars.drives {
+        if v[d] < 0.0 {
+            moved = moved.max(-v[d]);
+            v[d] = 0.0;
+        }
+    }
+    moved
+}
+
+/// The 10 inertial parameters (XX XY XZ YY YZ ZZ MX MY MZ M) of a pseudo-inertia matrix: the
+/// inverse of [`pseudo_inertia`] (I = tr(Sigma) 1 - Sigma).
+pub fn from_pseudo_inertia(j: &Matrix4<f64>) -> [f64; 10] {
+    let t = j[(0, 0)] + j[(1, 1)] + j[(2, 2)];
+    [
+        t - j[(0, 0)],
+        -j[(0, 1)],
+        -j[(0, 2)],
+        t - j[(1, 1)],
+        -j[(1, 2)],
+        t - j[(2, 2)],
+        j[(0, 3)],
+        j[(1, 3)],
+        j[(2, 3)],
+        j[(3, 3)],
+    ]
 }
 
 #[cfg(feature = "sdp")]
@@ -283,7 +420,25 @@ fn solve_sdp(vars: &Variables, p_dense: &Mat<f64>, q: &[f64]) -> Result<(Vec<f64
         colptr.push(rowval.len());
     }
     let a = CscMatrix::new(m, nv, colptr, rowval, nzval);
-    let b = vec![0.0; m];
+    // origin at the unconstrained minimizer v0 (as the interior-point solver): v = v0 + u,
+    // q + P v0, s = J(v0) + J(u) = b - A u with b = -A v0
+    let mut pr = DMatrix::from_fn(nv, nv, |r, c| 0.5 * (p_dense[(r, c)] + p_dense[(c, r)]));
+    let reg = 1e-12 * pr.diagonal().amax();
+    for i in 0..nv {
+        pr[(i, i)] += reg;
+    }
+    let v0 = pr
+        .cholesky()
+        .map(|c| c.solve(&-DVector::from_column_slice(q)))
+        .filter(|v| v.iter().all(|x| x.is_finite()))
+        .unwrap_or_else(|| DVector::zeros(nv));
+    let qc: Vec<f64> = (0..nv)
+        .map(|r| q[r] + (0..nv).map(|c| p_dense[(r, c)] * v0[c]).sum::<f64>())
+        .collect();
+    let b: Vec<f64> = rows
+        .iter()
+        .map(|t| -t.iter().map(|&(c, v)| v * v0[c]).sum::<f64>())
+        .collect();
     let settings = DefaultSettingsBuilder::default()
         .verbose(false)
         .max_iter(400)
@@ -293,15 +448,16 @@ fn solve_sdp(vars: &Variables, p_dense: &Mat<f64>, q: &[f64]) -> Result<(Vec<f64
         .tol_ktratio(1e-9)
         .build()
         .map_err(|e| Error::Numerical(format!("SDP settings: {e:?}")))?;
-    let mut solver = DefaultSolver::new(&p, q, &a, &b, &cones, settings)
+    let mut solver = DefaultSolver::new(&p, &qc, &a, &b, &cones, settings)
         .map_err(|e| Error::Numerical(format!("the SDP could not be set up: {e:?}")))?;
     solver.solve();
     let s = &solver.solution;
     let status = s.status;
     let text = format!("Clarabel: {status:?} in {} iterations", s.iterations);
+    let v: Vec<f64> = s.x.iter().zip(v0.iter()).map(|(u, v0)| u + v0).collect();
     match status {
-        SolverStatus::Solved => Ok((s.x.clone(), text)),
-        SolverStatus::AlmostSolved => Ok((s.x.clone(), format!("{text} (reduced accuracy)"))),
+        SolverStatus::Solved => Ok((v, text)),
+        SolverStatus::AlmostSolved => Ok((v, format!("{text} (reduced accuracy)"))),
         other => Err(Error::Numerical(format!(
             "the SDP of the physically consistent parameters did not converge ({other:?} after {} \
              iterations): no consistent parameters are reported",
@@ -364,6 +520,7 @@ pub fn consistent_parameters(
     model: &ParameterModel,
     tw: &Mat<f64>,
     estimate: &LsSolution,
+    solver: Solver,
 ) -> Result<ConsistentSolution> {
     let vars = Variables::new(model);
     let e = vars.x_map(model);
@@ -392,7 +549,7 @@ pub fn consistent_parameters(
         &mut pm,
         &mut q,
     );
-    let (v, text) = solve(&vars, &pm, &q)?;
+    let (v, text) = solve(&vars, &pm, &q, solver)?;
     let mut sol = finish(access, model, &vars, &v, estimate, text)?;
     // increase of the weighted residual, in units of sigma^2: the squared Mahalanobis distance
     let base = super::estimators::residual_sq(tw, &estimate.x);

@@ -9,11 +9,13 @@
 //! - [`observation`]: one streaming pass building the triangular factors of [W Y];
 //! - [`estimators`]: OLS, Gautier's WLS, relative standard deviations, condition number,
 //!   IDIM-IV;
-//! - [`consistency`]: physically consistent standard parameters (SDP, pseudo-inertia PSD);
+//! - [`consistency`]: physically consistent standard parameters (SDP, pseudo-inertia PSD),
+//!   solved by [`conic`], a small interior-point method for 4x4 PSD blocks and bounds;
 //! - [`excitation`]: finite Fourier series minimizing the condition number;
 //! - [`report`]: table (text, JSON, CSV) and SVG plots;
 //! - [`model_access`]: the only calls into the rest of the library.
 
+pub mod conic;
 pub mod consistency;
 pub mod data;
 pub mod estimators;
@@ -80,6 +82,9 @@ pub struct Options {
     pub consistent: bool,
     /// Compute standard parameters consistent with the estimate (needed by `--write-robot`).
     pub standard: bool,
+    /// The solver of the consistency SDP (default robodyn's interior-point method; Clarabel
+    /// with the `sdp` feature, as a cross-check).
+    pub consistency_solver: consistency::Solver,
     /// Reduce to the essential parameters (None: keep every base parameter).
     pub essential: Option<EssentialOptions>,
     /// Joint-space bandwidth of the robot's dynamics (Hz); defaults follow from it.
@@ -115,6 +120,7 @@ impl Default for Options {
             estimator: Estimator::Wls,
             consistent: false,
             standard: false,
+            consistency_solver: consistency::Solver::default(),
             essential: None,
             bandwidth: 10.0,
             cutoff: None,
@@ -631,7 +637,8 @@ pub fn identify(
     // consistent set nearest to the unconstrained estimate in the metric of its covariance
     let mut consistent = None;
     if opt.consistent || opt.standard {
-        let c = consistency::consistent_parameters(access, &model, &tw, &sol)?;
+        let c =
+            consistency::consistent_parameters(access, &model, &tw, &sol, opt.consistency_solver)?;
         let bound = p as f64 + 3.0 * (2.0 * p as f64).sqrt();
         // changes at rounding level (a noise-free fit whose true values lie on the boundary,
         // e.g. zero friction) are not reported

@@ -465,12 +465,13 @@ impl ModelAccess {
         let mut lo = f64::INFINITY;
         for _ in 0..count {
             let s = sampler.sample(&robot, &mut rng)?;
-            let a = inertia_matrix(&robot, &s.q)?;
             let a = match &s.g {
-                Some(g) => g.transpose() * a * g,
-                None => a
-                    .select_rows(movable.iter().map(|j| j - 1).collect::<Vec<_>>().iter())
-                    .select_columns(movable.iter().map(|j| j - 1).collect::<Vec<_>>().iter()),
+                Some(g) => g.transpose() * inertia_matrix(&robot, &s.q)? * g,
+                // a tree's sample has a value per frame: A(q) takes the movable joints'
+                None => {
+                    let q: Vec<f64> = movable.iter().map(|j| s.q[j - 1]).collect();
+                    inertia_matrix(&robot, &q)?
+                }
             };
             lo = lo.min(a.symmetric_eigenvalues().min());
         }
