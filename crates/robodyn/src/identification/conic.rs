@@ -38,7 +38,7 @@ use nalgebra::{DMatrix, DVector, Matrix4, Vector4};
 
 mod polish;
 
-/// One 4x4 positive semidefinite constraint S(x) = constant + sum_k x[var_k] A_k (symmetric).
+/// One 4x4 positive semidefinite constraint S(x) = constant + sum_k x\[var_k\] A_k (symmetric).
 #[derive(Clone, Debug, PartialEq)]
 pub struct PsdBlock {
     /// The constant C (symmetric).
