@@ -185,9 +185,9 @@ pub fn load(path: &Path) -> Result<Robot> {
     load_with(path, &BTreeMap::new())
 }
 
-/// Write a description in the format given by the file's extension.
-pub fn save_description(desc: &RobotDescription, path: &Path) -> Result<()> {
-    let text = match Format::from_path(path)? {
+/// The text of a description in a format (TOML or `.par`; URDF is not written).
+pub fn description_text(desc: &RobotDescription, format: Format) -> Result<String> {
+    Ok(match format {
         Format::Toml => toml_format::write_description(desc),
         Format::Par => par::write_description(desc),
         Format::Urdf => {
@@ -195,6 +195,11 @@ pub fn save_description(desc: &RobotDescription, path: &Path) -> Result<()> {
                 "writing URDF is not supported: convert to .toml or .par".into(),
             ))
         }
-    };
+    })
+}
+
+/// Write a description in the format given by the file's extension.
+pub fn save_description(desc: &RobotDescription, path: &Path) -> Result<()> {
+    let text = description_text(desc, Format::from_path(path)?)?;
     std::fs::write(path, text).map_err(|e| Error::io(path.display().to_string(), e))
 }
