@@ -148,7 +148,7 @@ fn non_finite_joint_values_are_refused() {
         ("--qa=nan,0.2,0.3,0.4,0.5,1.6", "`nan` is not a constant number"),
         ("--qa=1e309,0.2,0.3,0.4,0.5,1.6", "`1e309` is not a finite number"),
         ("--qa=0.1,0.2,0.3,0.4,0.5,1/0", "division by zero"),
-        ("--qa=0.1,0.2,0.3,0.4,0.5,1e300*1e300", "is not finite"),
+        ("--qa=0.1,0.2,0.3,0.4,0.5,1e300*1e300", "infinite"),
     ] {
         let r = robodyn_within(&["closure", &sr400, q], LIMIT);
         r.assert_no_crash("closure");

@@ -131,13 +131,16 @@ pub fn run(a: Args) -> CliResult {
             let mut phi = nalgebra::DMatrix::zeros(n, rows.cols);
             let mut tau_e = vec![0.0; n];
             while input.next_chunk(chunk_states(3 * n + nc), &mut chunk)? {
+                t.lap("read");
                 for s in 0..chunk.count {
                     let number = chunk.first + s;
                     let x = chunk.state(s, n);
                     let cond = closed_regressor_into(c, &mut d, &mut b, env, x, &mut phi, &mut tau_e)
                         .map_err(|e| e.in_row(number))?;
                     warn_conditioning(c, Some(number), &cond);
+                    t.lap("model");
                     rows.state(number, chunk.carried(s, nc), &tau_e, |k, c| phi[(k, c)])?;
+                    t.lap("write");
                 }
             }
         }

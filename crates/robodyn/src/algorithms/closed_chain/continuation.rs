@@ -214,17 +214,18 @@ impl ClosedChain {
             };
             dq.abs() <= SAME_CONFIGURATION
         });
-        let after = fmt_vec(&b.q_p);
-        copy_branch(b, &d.probe);
-        if same {
+        let result = if same {
             Ok(used)
         } else {
             Err(format!(
                 "a full turn of it on this branch does not come back to the same configuration \
-                 (q_p = {} before, {after} after: another assembly)",
-                fmt_vec(&d.probe.q_p)
+                 (q_p = {} before, {} after: another assembly)",
+                fmt_vec(&d.probe.q_p),
+                fmt_vec(&b.q_p)
             ))
-        }
+        };
+        copy_branch(b, &d.probe);
+        result
     }
 
     /// Follow the straight path from the tracker's point to `q_a` with at most `budget` steps
