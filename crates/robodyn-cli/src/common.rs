@@ -1,9 +1,9 @@
 //! Options and helpers shared by the commands: loading a robot, reading and writing state tables.
 
+use crate::output::Output;
+pub use crate::output::{check_finite, write_table, write_text, TableFormat, TableWriter};
 use clap::Args;
 use robodyn::Robot;
-pub use crate::output::{check_finite, write_table, write_text, TableFormat, TableWriter};
-use crate::output::Output;
 use std::collections::BTreeMap;
 use std::io::Write;
 use std::path::PathBuf;
@@ -160,7 +160,10 @@ pub fn parse_list(name: &str, s: &str) -> CliResult<Vec<f64>> {
                     k if k + 1 == count => format!("a trailing comma after value {k}"),
                     k => format!("no value between commas {k} and {}", k + 1),
                 };
-                return Err(format!("--{name} {s}: {place} (give one number per joint, separated by commas)").into());
+                return Err(format!(
+                    "--{name} {s}: {place} (give one number per joint, separated by commas)"
+                )
+                .into());
             }
             parse_value(t).map_err(|e| format!("--{name}: {e}").into())
         })
@@ -182,7 +185,11 @@ pub struct TableOutput {
 impl TableOutput {
     /// A table writer on `--output` with these columns.
     pub fn writer(&self, headers: Vec<String>) -> CliResult<TableWriter> {
-        TableWriter::new(Output::create(self.output.as_deref())?, self.format, headers)
+        TableWriter::new(
+            Output::create(self.output.as_deref())?,
+            self.format,
+            headers,
+        )
     }
 }
 
@@ -267,7 +274,11 @@ pub fn start_branch(
 
 /// Say on stderr that a closed-chain state (`row` of a table, none for the command line's) is
 /// near a singularity.
-pub fn warn_conditioning(chain: &robodyn::ClosedChain, row: Option<usize>, c: &robodyn::Conditioning) {
+pub fn warn_conditioning(
+    chain: &robodyn::ClosedChain,
+    row: Option<usize>,
+    c: &robodyn::Conditioning,
+) {
     if c.warning {
         let which = row.map_or_else(String::new, |r| format!("row {r}: "));
         eprintln!(

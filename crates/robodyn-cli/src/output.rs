@@ -115,6 +115,12 @@ impl Output {
         }
     }
 
+    /// Write bytes (an error names the file).
+    pub fn write_all(&mut self, bytes: &[u8]) -> CliResult {
+        let r = self.writer().write_all(bytes);
+        r.map_err(|e| self.io(e))
+    }
+
     /// Write the content through a library function that writes a file by its path (the SVG
     /// plots): it writes the temporary file. Standard output gets the file's bytes.
     pub fn write_by_path<E: Into<Box<dyn std::error::Error>>>(
@@ -203,9 +209,7 @@ pub fn commit_all(outputs: Vec<Output>) -> CliResult {
 /// Write `text` to `path` (standard output for `None` or `-`), all or nothing.
 pub fn write_text(path: Option<&Path>, text: &str) -> CliResult {
     let mut o = Output::create(path)?;
-    o.writer()
-        .write_all(text.as_bytes())
-        .map_err(|e| o.io(e))?;
+    o.write_all(text.as_bytes())?;
     o.commit()
 }
 

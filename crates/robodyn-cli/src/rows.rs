@@ -20,7 +20,7 @@ pub fn tree_rows(
 ) -> CliResult {
     let nc = input.carried_headers().len();
     let (mut chunk, mut results, mut row) = (Chunk::default(), Vec::new(), Vec::new());
-    let numbered = !input.from_command_line();
+    let numbered = !input.is_command_line();
     t.lap("read");
     while input.next_chunk(chunk_states(3 * n + nc), &mut chunk)? {
         t.lap("read");
@@ -58,7 +58,7 @@ pub fn closed_rows(
     let nc = input.carried_headers().len();
     let (mut chunk, mut row) = (Chunk::default(), Vec::new());
     let mut tracker: Option<(Branch, ClosedData)> = None;
-    let numbered = !input.from_command_line();
+    let numbered = !input.is_command_line();
     t.lap("read");
     while input.next_chunk(chunk_states(3 * n + nc), &mut chunk)? {
         t.lap("read");

@@ -24,7 +24,12 @@ pub struct CarryArg {
     /// Columns of the --input table that are not inputs, copied to the output in front of the
     /// results (comma separated; `t` always is). Another column that is not an input is copied
     /// with a warning; one that looks like a misspelt input (`qdd_1` for `qdd1`) is an error.
-    #[arg(long, value_delimiter = ',', value_name = "COLUMNS", requires = "input")]
+    #[arg(
+        long,
+        value_delimiter = ',',
+        value_name = "COLUMNS",
+        requires = "input"
+    )]
     pub carry: Vec<String>,
 }
 
@@ -65,7 +70,10 @@ pub struct Columns {
 fn normalized(s: &str) -> String {
     let mut out = String::new();
     let mut prev_digit = false;
-    for c in s.chars().filter(|c| !matches!(c, '_' | '-' | ' ' | '.' | '(' | ')' | '[' | ']')) {
+    for c in s
+        .chars()
+        .filter(|c| !matches!(c, '_' | '-' | ' ' | '.' | '(' | ')' | '[' | ']'))
+    {
         let c = c.to_ascii_lowercase();
         if c == '0' && !prev_digit {
             // a leading zero of a number (`qdd01`), but `0` itself stays
@@ -100,8 +108,16 @@ fn expected(spec: &ColumnSpec) -> String {
     });
     match spec.groups.first() {
         Some(g) if numbered => {
-            let prefixes: Vec<String> = spec.groups.iter().map(|g| format!("{}<j>", g.prefix)).collect();
-            format!("{} for j in [{}]", prefixes.join(", "), labels(g).join(", "))
+            let prefixes: Vec<String> = spec
+                .groups
+                .iter()
+                .map(|g| format!("{}<j>", g.prefix))
+                .collect();
+            format!(
+                "{} for j in [{}]",
+                prefixes.join(", "),
+                labels(g).join(", ")
+            )
         }
         _ => {
             let all: Vec<&str> = spec
@@ -116,12 +132,9 @@ fn expected(spec: &ColumnSpec) -> String {
 
 /// Classify the header's columns (the rule of the module documentation). Warnings and notes go
 /// to standard error; errors name `file`.
-pub fn classify(
-    headers: &[String],
-    spec: &ColumnSpec,
-    file: &str,
-) -> CliResult<Columns> {
+pub fn classify(headers: &[String], spec: &ColumnSpec, file: &str) -> CliResult<Columns> {
     let find = |n: &str| headers.iter().position(|h| h == n);
+    // the inputs: found, absent as a whole (an optional group), or missing
     let mut groups = Vec::new();
     let mut missing: Vec<&str> = Vec::new();
     let mut absent: Vec<&Group> = Vec::new();
@@ -141,62 +154,17 @@ pub fn classify(
         );
         groups.push(Some(found.into_iter().map(|c| c.unwrap_or(0)).collect()));
     }
-    let inputs: std::collections::BTreeSet<&str> = spec
-        .groups
+    let not_read: Vec<&str> = absent
         .iter()
         .flat_map(|g| g.names.iter().map(String::as_str))
-        .collect();
-    let not_read: Vec<&str> = spec
-        .groups
-        .iter()
-        .zip(&groups)
-        .filter(|(_, c)| c.is_none())
-        .flat_map(|(g, _)| g.names.iter().map(String::as_str))
         .chain(missing.iter().copied())
         .collect();
-    let mut others = Vec::new();
-    let mut misspelt = Vec::new();
-    let mut unknown = Vec::new();
-    for (c, h) in headers.iter().enumerate() {
-        if inputs.contains(h.as_str()) {
-            continue;
-        }
-        others.push(c);
-        if spec.declared.contains(h) || spec.known.contains(h) {
-            continue;
-        }
-        let exact = not_read.iter().find(|n| normalized(h) == normalized(n));
-        match exact.or_else(|| not_read.iter().find(|n| resembles(h, n))) {
-            Some(n) => misspelt.push(format!("`{h}` (did you mean `{n}`?)")),
-            None => unknown.push(format!("`{h}`")),
-        }
-    }
+    let (others, misspelt, unknown) = others(headers, spec, &not_read);
     if !misspelt.is_empty() {
-        return Err(format!(
-            "{file}: column{} {} look{} like misspelt input{} and would be {} instead of read; \
-             the inputs are {} (rename the column{})",
-            plural(misspelt.len()),
-            misspelt.join(", "),
-            if misspelt.len() == 1 { "s" } else { "" },
-            plural(misspelt.len()),
-            spec.fate,
-            expected(spec),
-            plural(misspelt.len()),
-        )
-        .into());
+        return Err(misspelt_error(&misspelt, spec, file).into());
     }
     if !missing.is_empty() {
-        let optional: Vec<&str> = spec.groups[1..].iter().map(|g| g.prefix.as_str()).collect();
-        let names: Vec<String> = missing.iter().map(|m| format!("`{m}`")).collect();
-        return Err(format!(
-            "{file}: missing column{} {} (the inputs are {}; the {} columns may be absent all \
-             together, then they are zeros, not in part)",
-            plural(missing.len()),
-            names.join(", "),
-            expected(spec),
-            optional.join("/")
-        )
-        .into());
+        return Err(missing_error(&missing, spec, file).into());
     }
     if let Some(d) = spec.declared.iter().find(|d| find(d).is_none()) {
         return Err(format!("--carry {d}: {file} has no column `{d}`").into());
@@ -211,22 +179,94 @@ pub fn classify(
     }
     if !unknown.is_empty() {
         eprintln!(
-            "robodyn: warning: {file}: column{} {} {} not input{} of this command (the inputs \
-             are {}): {}{}",
-            plural(unknown.len()),
-            unknown.join(", "),
-            if unknown.len() == 1 { "is" } else { "are" },
-            plural(unknown.len()),
-            expected(spec),
-            spec.fate,
-            if spec.carry_option {
-                " (--carry with the column names says they are meant so, and silences this)"
-            } else {
-                ""
-            }
+            "robodyn: warning: {}",
+            unknown_warning(&unknown, spec, file)
         );
     }
     Ok(Columns { groups, others })
+}
+
+/// The columns that are not inputs (indices), and among those not declared nor known, the
+/// misspelt ones (`` `qdd_1` (did you mean `qdd1`?) ``, resembling an input in `not_read`) and
+/// the unknown ones.
+fn others(
+    headers: &[String],
+    spec: &ColumnSpec,
+    not_read: &[&str],
+) -> (Vec<usize>, Vec<String>, Vec<String>) {
+    let inputs: std::collections::BTreeSet<&str> = spec
+        .groups
+        .iter()
+        .flat_map(|g| g.names.iter().map(String::as_str))
+        .collect();
+    let (mut others, mut misspelt, mut unknown) = (Vec::new(), Vec::new(), Vec::new());
+    for (c, h) in headers.iter().enumerate() {
+        if inputs.contains(h.as_str()) {
+            continue;
+        }
+        others.push(c);
+        if spec.declared.contains(h) || spec.known.contains(h) {
+            continue;
+        }
+        let exact = not_read.iter().find(|n| normalized(h) == normalized(n));
+        match exact.or_else(|| not_read.iter().find(|n| resembles(h, n))) {
+            Some(n) => misspelt.push(format!("`{h}` (did you mean `{n}`?)")),
+            None => unknown.push(format!("`{h}`")),
+        }
+    }
+    (others, misspelt, unknown)
+}
+
+fn misspelt_error(misspelt: &[String], spec: &ColumnSpec, file: &str) -> String {
+    let s = plural(misspelt.len());
+    format!(
+        "{file}: column{s} {} look{} like misspelt input{s} and would be {} instead of read; \
+         the inputs are {} (rename the column{s})",
+        misspelt.join(", "),
+        if misspelt.len() == 1 { "s" } else { "" },
+        spec.fate,
+        expected(spec),
+    )
+}
+
+fn missing_error(missing: &[&str], spec: &ColumnSpec, file: &str) -> String {
+    let optional: Vec<&str> = spec
+        .groups
+        .iter()
+        .filter(|g| !g.required)
+        .map(|g| g.prefix.as_str())
+        .collect();
+    let names: Vec<String> = missing.iter().map(|m| format!("`{m}`")).collect();
+    let rule = if optional.is_empty() {
+        String::new()
+    } else {
+        format!(
+            "; the {} columns may be absent all together, not in part",
+            optional.join("/")
+        )
+    };
+    format!(
+        "{file}: missing column{} {} (the inputs are {}{rule})",
+        plural(missing.len()),
+        names.join(", "),
+        expected(spec),
+    )
+}
+
+fn unknown_warning(unknown: &[String], spec: &ColumnSpec, file: &str) -> String {
+    let s = plural(unknown.len());
+    format!(
+        "{file}: column{s} {} {} not input{s} of this command (the inputs are {}): {}{}",
+        unknown.join(", "),
+        if unknown.len() == 1 { "is" } else { "are" },
+        expected(spec),
+        spec.fate,
+        if spec.carry_option {
+            " (--carry with the column names says they are meant so, and silences this)"
+        } else {
+            ""
+        }
+    )
 }
 
 fn plural(n: usize) -> &'static str {
@@ -246,7 +286,6 @@ pub fn known_columns(labels: &[String]) -> Vec<String> {
     }
     known
 }
-
 
 /// A chunk of states: the quantities of `count` states, row-major (`count` x n each), and their
 /// carried columns (`count` x carried).
@@ -274,7 +313,7 @@ impl Chunk {
 /// Where the states come from.
 enum Source {
     Table {
-        reader: TableReader<Box<dyn Read>>,
+        reader: Box<TableReader<Box<dyn Read>>>,
         cols: Vec<Option<Vec<usize>>>,
         others: Vec<usize>,
         row: Vec<f64>,
@@ -360,7 +399,7 @@ impl StateInput {
             .collect();
         Ok(StateInput {
             source: Source::Table {
-                reader,
+                reader: Box::new(reader),
                 cols: c.groups,
                 others: c.others,
                 row: Vec::new(),
@@ -393,7 +432,7 @@ impl StateInput {
     }
 
     /// Whether the states come from the command line (one state: messages without a row).
-    pub fn from_command_line(&self) -> bool {
+    pub fn is_command_line(&self) -> bool {
         self.command_line
     }
 
@@ -481,10 +520,20 @@ mod tests {
         assert_eq!(normalized("QDD_01"), "qdd1");
         assert_eq!(normalized("q10"), "q10");
         assert_eq!(normalized("q_0"), "q0");
-        for (c, n) in [("qdd_1", "qdd1"), ("QDD1", "qdd1"), ("qdd01", "qdd1"), ("dqd1", "qdd1")] {
+        for (c, n) in [
+            ("qdd_1", "qdd1"),
+            ("QDD1", "qdd1"),
+            ("qdd01", "qdd1"),
+            ("dqd1", "qdd1"),
+        ] {
             assert!(resembles(c, n), "{c} {n}");
         }
-        for (c, n) in [("tau1", "qdd1"), ("t", "q1"), ("label", "qd1"), ("q12", "q3")] {
+        for (c, n) in [
+            ("tau1", "qdd1"),
+            ("t", "q1"),
+            ("label", "qd1"),
+            ("q12", "q3"),
+        ] {
             assert!(!resembles(c, n), "{c} {n}");
         }
     }

@@ -45,7 +45,12 @@ fn less_turns(x: f64) -> f64 {
 #[test]
 fn sr400_joints_off_the_loop_take_any_value() {
     let sr400 = robot("sr400.toml");
-    for (q1, q5) in [(1e300_f64, 0.5_f64), (1e5, 0.5), (1e6, -1.7e308), (-3.7e9, 1e17)] {
+    for (q1, q5) in [
+        (1e300_f64, 0.5_f64),
+        (1e5, 0.5),
+        (1e6, -1.7e308),
+        (-3.7e9, 1e17),
+    ] {
         let q = format!("--q={q1:e},0.2,0.3,0.4,{q5:e},1.6");
         for cmd in ["idm", "ddm"] {
             let r = ok(&[cmd, &sr400, &q, "--qd=1,2,3,4,5,6"]);
@@ -57,7 +62,11 @@ fn sr400_joints_off_the_loop_take_any_value() {
                 assert!(close(&got, &want, 1e-7), "{cmd} {q}: {got:?} vs {want:?}");
             }
         }
-        let r = ok(&["closure", &sr400, &format!("--qa={q1:e},0.2,0.3,0.4,{q5:e},1.6")]);
+        let r = ok(&[
+            "closure",
+            &sr400,
+            &format!("--qa={q1:e},0.2,0.3,0.4,{q5:e},1.6"),
+        ]);
         assert!(r.stdout.contains("closure residual"), "{}", r.stdout);
     }
 }
@@ -77,7 +86,10 @@ fn fourbar_crank_at_huge_angles_equals_the_reduced_angle() {
         let near = closure(format!("--qa={}", less_turns(q1)));
         assert!(far["residual"].as_f64().unwrap() < 1e-9, "{far}");
         for j in ["q2", "q3"] {
-            let (a, b) = (far["q_p"][j].as_f64().unwrap(), near["q_p"][j].as_f64().unwrap());
+            let (a, b) = (
+                far["q_p"][j].as_f64().unwrap(),
+                near["q_p"][j].as_f64().unwrap(),
+            );
             assert!(less_turns(a - b).abs() < 1e-7, "q1 = {q1}: {j} {a} vs {b}");
         }
     }
@@ -88,7 +100,10 @@ fn fourbar_crank_at_huge_angles_equals_the_reduced_angle() {
     }
     // the torques too
     let idm = |q: String| row(&ok(&["idm", &fourbar, &q, "--qd=2", "--qdd=-1"]).stdout);
-    let (a, b) = (idm("--q=1e6".into()), idm(format!("--q={}", less_turns(1e6))));
+    let (a, b) = (
+        idm("--q=1e6".into()),
+        idm(format!("--q={}", less_turns(1e6))),
+    );
     assert!(close(&a, &b, 1e-7), "{a:?} vs {b:?}");
 }
 
@@ -111,7 +126,11 @@ fn a_loop_joint_that_cannot_turn_is_refused_at_once() {
             "{cmd} {q}: {}",
             r.stderr
         );
-        assert!(!r.stderr.contains("0000000000000000"), "300 digits: {}", r.stderr);
+        assert!(
+            !r.stderr.contains("0000000000000000"),
+            "300 digits: {}",
+            r.stderr
+        );
     }
 }
 
@@ -145,8 +164,14 @@ fn simulate_closed_from_a_huge_angle_ends() {
 fn non_finite_joint_values_are_refused() {
     let sr400 = robot("sr400.toml");
     for (q, why) in [
-        ("--qa=nan,0.2,0.3,0.4,0.5,1.6", "`nan` is not a constant number"),
-        ("--qa=1e309,0.2,0.3,0.4,0.5,1.6", "`1e309` is not a finite number"),
+        (
+            "--qa=nan,0.2,0.3,0.4,0.5,1.6",
+            "`nan` is not a constant number",
+        ),
+        (
+            "--qa=1e309,0.2,0.3,0.4,0.5,1.6",
+            "`1e309` is not a finite number",
+        ),
         ("--qa=0.1,0.2,0.3,0.4,0.5,1/0", "division by zero"),
         ("--qa=0.1,0.2,0.3,0.4,0.5,1e300*1e300", "infinite"),
     ] {

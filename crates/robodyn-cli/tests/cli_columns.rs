@@ -32,9 +32,12 @@ fn run(args: &[&str]) -> Run {
 fn misspelt_input_columns_are_errors() {
     let rx90 = robot("rx90.toml");
     let sr400 = robot("sr400.toml");
-    let six = |p: &str, sep: &str| -> Vec<String> { (1..=6).map(|j| format!("{p}{sep}{j}")).collect() };
+    let six =
+        |p: &str, sep: &str| -> Vec<String> { (1..=6).map(|j| format!("{p}{sep}{j}")).collect() };
     let rx90_table = |third: &str, sep: &str| {
-        let h = [six("q", ""), six("qd", ""), six(third, sep)].concat().join(",");
+        let h = [six("q", ""), six("qd", ""), six(third, sep)]
+            .concat()
+            .join(",");
         format!("{h}\n0.1,0.2,0.3,0.4,0.5,0.6,1,1,1,1,1,1,2,2,2,2,2,2\n")
     };
     let qdd_ = table("qdd_.csv", &rx90_table("qdd", "_"));
@@ -64,10 +67,19 @@ fn misspelt_input_columns_are_errors() {
         assert!(out.stderr.contains(&want), "{cmd}: {}", out.stderr);
     }
     // simulate's time series
-    let track = table("track.csv", "t,q_1,q2,q3,q4,q5,q6\n0,0,0,0,0,0,0\n1,0.1,0,0,0,0,0\n");
-    let torque = table("torque.csv", "t,tau1,tau2,tau3,tau4,tau5,Tau6\n0,0,0,0,0,0,0\n");
+    let track = table(
+        "track.csv",
+        "t,q_1,q2,q3,q4,q5,q6\n0,0,0,0,0,0,0\n1,0.1,0,0,0,0,0\n",
+    );
+    let torque = table(
+        "torque.csv",
+        "t,tau1,tau2,tau3,tau4,tau5,Tau6\n0,0,0,0,0,0,0\n",
+    );
     let out_file = table("sim.csv", "");
-    for (source, t, bad) in [("--track", &track, "q_1"), ("--torque-csv", &torque, "Tau6")] {
+    for (source, t, bad) in [
+        ("--track", &track, "q_1"),
+        ("--torque-csv", &torque, "Tau6"),
+    ] {
         let mut args = vec![
             "simulate",
             &rx90,
@@ -100,15 +112,25 @@ fn unknown_columns_are_carried_with_a_warning() {
     let t = t.to_str().unwrap();
     let out = run(&["regressor", &rx90, "--input", t]);
     assert_eq!(out.code, Some(0), "{}", out.stderr);
-    assert!(out.stdout.starts_with("t,label,tau1,state,joint,tau_e,"), "{}", out.stdout);
+    assert!(
+        out.stdout.starts_with("t,label,tau1,state,joint,tau_e,"),
+        "{}",
+        out.stdout
+    );
     assert!(
         out.stderr.contains("warning")
             && out.stderr.contains("`label`")
-            && out.stderr.contains("q<j>, qd<j>, qdd<j> for j in [1, 2, 3, 4, 5, 6]"),
+            && out
+                .stderr
+                .contains("q<j>, qd<j>, qdd<j> for j in [1, 2, 3, 4, 5, 6]"),
         "{}",
         out.stderr
     );
-    assert!(!out.stderr.contains("`t`") && !out.stderr.contains("`tau1`"), "{}", out.stderr);
+    assert!(
+        !out.stderr.contains("`t`") && !out.stderr.contains("`tau1`"),
+        "{}",
+        out.stderr
+    );
     let out = run(&["regressor", &rx90, "--input", t, "--carry", "label"]);
     assert_eq!(out.code, Some(0));
     assert!(!out.stderr.contains("warning"), "{}", out.stderr);
@@ -128,15 +150,36 @@ fn absent_velocities_and_accelerations_are_said() {
     let t = table("q_only.csv", "q1,q2,q3,q4,q5,q6\n0.1,0.2,0.3,0.4,0.5,0.6\n");
     let out = run(&["idm", &rx90, "--input", t.to_str().unwrap()]);
     assert_eq!(out.code, Some(0));
-    assert!(out.stderr.contains("no qd columns") && out.stderr.contains("no qdd columns"), "{}", out.stderr);
-    let track = table("track_q.csv", "t,q1,q2,q3,q4,q5,q6\n0,0,0,0,0,0,0\n1,0.1,0,0,0,0,0\n");
+    assert!(
+        out.stderr.contains("no qd columns") && out.stderr.contains("no qdd columns"),
+        "{}",
+        out.stderr
+    );
+    let track = table(
+        "track_q.csv",
+        "t,q1,q2,q3,q4,q5,q6\n0,0,0,0,0,0,0\n1,0.1,0,0,0,0,0\n",
+    );
     let o = table("track_out.csv", "");
     let out = run(&[
-        "simulate", &rx90, "--duration", "0.01", "--output", o.to_str().unwrap(), "--track",
-        track.to_str().unwrap(), "--kp", "100", "--kd", "10",
+        "simulate",
+        &rx90,
+        "--duration",
+        "0.01",
+        "--output",
+        o.to_str().unwrap(),
+        "--track",
+        track.to_str().unwrap(),
+        "--kp",
+        "100",
+        "--kd",
+        "10",
     ]);
     assert_eq!(out.code, Some(0), "{}", out.stderr);
-    assert!(out.stderr.contains("no qd columns") && out.stderr.contains("slope"), "{}", out.stderr);
+    assert!(
+        out.stderr.contains("no qd columns") && out.stderr.contains("slope"),
+        "{}",
+        out.stderr
+    );
 }
 
 /// `--q 1,2,` names the trailing comma (it said "`` is not a number"); `--kp`/`--kd` without
@@ -151,12 +194,23 @@ fn command_line_slips_are_named() {
     ] {
         let out = run(&["idm", &rx90, q]);
         assert_eq!(out.code, Some(1));
-        assert!(out.stderr.contains(what) && !out.stderr.contains("``"), "{}", out.stderr);
+        assert!(
+            out.stderr.contains(what) && !out.stderr.contains("``"),
+            "{}",
+            out.stderr
+        );
     }
     let o = table("kp_out.csv", "");
     for gain in ["--kp", "--kd"] {
         let out = run(&[
-            "simulate", &rx90, "--duration", "0.01", "--output", o.to_str().unwrap(), gain, "100",
+            "simulate",
+            &rx90,
+            "--duration",
+            "0.01",
+            "--output",
+            o.to_str().unwrap(),
+            gain,
+            "100",
         ]);
         assert_ne!(out.code, Some(0), "{gain} without --track was accepted");
         assert!(out.stderr.contains("--track"), "{}", out.stderr);

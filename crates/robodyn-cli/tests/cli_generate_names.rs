@@ -16,7 +16,16 @@ fn bad_function_names_are_refused_per_language() {
     std::fs::create_dir_all(&d).unwrap();
     let file = d.join("model.out");
     // refused in every language: not identifiers
-    let everywhere = ["my func", "1abc", "f(void){}int x", "", "a-b", "é", "x\ny", "_"];
+    let everywhere = [
+        "my func",
+        "1abc",
+        "f(void){}int x",
+        "",
+        "a-b",
+        "é",
+        "x\ny",
+        "_",
+    ];
     // reserved in some languages only
     let some = [
         ("lambda", "python"),
@@ -41,25 +50,48 @@ fn bad_function_names_are_refused_per_language() {
         .collect();
     for (name, lang) in cases {
         let r = robodyn_within(
-            &["generate", &rx90, "--lang", lang, "--name", name, "--output", file.to_str().unwrap()],
+            &[
+                "generate",
+                &rx90,
+                "--lang",
+                lang,
+                "--name",
+                name,
+                "--output",
+                file.to_str().unwrap(),
+            ],
             60.0,
         );
         r.assert_no_crash("generate");
         assert_eq!(r.code, Some(1), "--name {name:?} --lang {lang}: accepted");
         assert!(r.stderr.contains("--name"), "{}", r.stderr);
-        assert!(!file.exists(), "--name {name:?} --lang {lang}: a file was written");
+        assert!(
+            !file.exists(),
+            "--name {name:?} --lang {lang}: a file was written"
+        );
     }
     // a reserved word of one language is a fine name in another
-    for (name, lang) in [("lambda", "c"), ("end", "python"), ("fn", "julia"), ("exp", "rust")] {
+    for (name, lang) in [
+        ("lambda", "c"),
+        ("end", "python"),
+        ("fn", "julia"),
+        ("exp", "rust"),
+    ] {
         let r = robodyn_within(&["generate", &rx90, "--lang", lang, "--name", name], 60.0);
         assert_eq!(r.code, Some(0), "--name {name} --lang {lang}: {}", r.stderr);
         assert!(r.stdout.contains(name), "{lang}");
     }
     // a name that is fine everywhere
     for lang in LANGS {
-        let r = robodyn_within(&["generate", &rx90, "--lang", lang, "--name", "rx90_tau"], 60.0);
+        let r = robodyn_within(
+            &["generate", &rx90, "--lang", lang, "--name", "rx90_tau"],
+            60.0,
+        );
         assert_eq!(r.code, Some(0), "{lang}: {}", r.stderr);
         // text and LaTeX name the function on standard error only (the operation counts)
-        assert!(r.stdout.contains("rx90_tau") || r.stderr.contains("rx90_tau"), "{lang}");
+        assert!(
+            r.stdout.contains("rx90_tau") || r.stderr.contains("rx90_tau"),
+            "{lang}"
+        );
     }
 }

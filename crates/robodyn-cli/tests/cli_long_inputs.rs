@@ -20,7 +20,11 @@ fn dir() -> PathBuf {
 fn refused(r: &Run, line: &str) {
     r.assert_no_crash("robodyn");
     assert_eq!(r.code, Some(1), "{}", r.stderr);
-    assert!(r.stderr.contains(line) && r.stderr.contains("longer than"), "{}", r.stderr);
+    assert!(
+        r.stderr.contains(line) && r.stderr.contains("longer than"),
+        "{}",
+        r.stderr
+    );
 }
 
 /// A header, then a line of 2 GB (a sparse file: zeros) in every reader of a table; `/dev/zero`
@@ -100,10 +104,17 @@ fn regressor_streams_a_long_table() {
         let one = d.join("one.csv");
         std::fs::write(
             &one,
-            format!("q1,q2,q3,q4,qd1,qd2,qd3,qd4\n{x},{},0.1,{},1,-1,0.5,{x}\n", -x, 2.0 * x),
+            format!(
+                "q1,q2,q3,q4,qd1,qd2,qd3,qd4\n{x},{},0.1,{},1,-1,0.5,{x}\n",
+                -x,
+                2.0 * x
+            ),
         )
         .unwrap();
-        let alone = robodyn_within(&["regressor", &scara, "--input", one.to_str().unwrap()], LIMIT);
+        let alone = robodyn_within(
+            &["regressor", &scara, "--input", one.to_str().unwrap()],
+            LIMIT,
+        );
         for (j, line) in alone.stdout.lines().skip(1).enumerate() {
             // the state number differs: 1 alone, k + 1 in the long table
             let (want, got) = (line.split_once(',').unwrap().1, lines[1 + 4 * k + j]);

@@ -54,7 +54,16 @@ fn plot_in_a_missing_directory_keeps_the_output() {
     std::fs::write(&o, PREVIOUS).unwrap();
     let plot = d.join("missing").join("p.svg");
     let rx90 = robot("rx90.toml");
-    let args = ["simulate", &rx90, "--duration", "0.05", "--output", s(&o), "--plot", s(&plot)];
+    let args = [
+        "simulate",
+        &rx90,
+        "--duration",
+        "0.05",
+        "--output",
+        s(&o),
+        "--plot",
+        s(&plot),
+    ];
     failed(&robodyn_within(&args, LIMIT), &[s(&plot)]);
     assert_eq!(std::fs::read_to_string(&o).unwrap(), PREVIOUS);
     only(&d, &["o.csv"]);
@@ -68,7 +77,16 @@ fn a_failing_run_leaves_the_previous_file() {
     let o = d.join("o.csv");
     let rx90 = robot("rx90.toml");
     std::fs::write(&o, PREVIOUS).unwrap();
-    let args = ["simulate", &rx90, "--set", "G3=1e308", "--duration", "0.05", "--output", s(&o)];
+    let args = [
+        "simulate",
+        &rx90,
+        "--set",
+        "G3=1e308",
+        "--duration",
+        "0.05",
+        "--output",
+        s(&o),
+    ];
     failed(&robodyn_within(&args, LIMIT), &[]);
     assert_eq!(std::fs::read_to_string(&o).unwrap(), PREVIOUS);
     // idm, ddm, regressor on a table whose second row overflows
@@ -78,7 +96,10 @@ fn a_failing_run_leaves_the_previous_file() {
     table += "0.1,0.2,0.3,0.4,0.5,0.6,1e200,1,1,1,1,1\n";
     std::fs::write(&input, table).unwrap();
     for cmd in ["idm", "ddm", "regressor"] {
-        let r = robodyn_within(&[cmd, &rx90, "--input", s(&input), "--output", s(&o)], LIMIT);
+        let r = robodyn_within(
+            &[cmd, &rx90, "--input", s(&input), "--output", s(&o)],
+            LIMIT,
+        );
         failed(&r, &["row 2"]);
         assert_eq!(std::fs::read_to_string(&o).unwrap(), PREVIOUS, "{cmd}");
     }
@@ -97,7 +118,16 @@ fn a_full_disk_leaves_the_previous_file() {
     // 64 kB at most (ulimit -f counts 512-byte blocks); the signal ignored, so write() fails
     let r = robodyn_in_shell(
         "trap '' XFSZ; ulimit -f 128",
-        &["simulate", &rx90, "--duration", "5", "--dt", "0.001", "--output", s(&o)],
+        &[
+            "simulate",
+            &rx90,
+            "--duration",
+            "5",
+            "--dt",
+            "0.001",
+            "--output",
+            s(&o),
+        ],
         LIMIT,
     );
     failed(&r, &[s(&o)]);
@@ -119,15 +149,46 @@ fn two_outputs_on_one_file_are_refused() {
     let new = d.join("new.csv");
     let new_again = d.join("sub").join("..").join("new.csv");
     for (output, plot) in [(&x, &x), (&x, &other), (&x, &link), (&new, &new_again)] {
-        let args = ["simulate", &rx90, "--duration", "0.05", "--output", s(output), "--plot", s(plot)];
-        failed(&robodyn_within(&args, LIMIT), &["same file", "nothing was written"]);
+        let args = [
+            "simulate",
+            &rx90,
+            "--duration",
+            "0.05",
+            "--output",
+            s(output),
+            "--plot",
+            s(plot),
+        ];
+        failed(
+            &robodyn_within(&args, LIMIT),
+            &["same file", "nothing was written"],
+        );
         assert_eq!(std::fs::read_to_string(&x).unwrap(), PREVIOUS);
         assert!(!new.exists());
     }
-    let args = ["excite", &robot("tx40.toml"), "--period", "2", "--harmonics", "2"];
-    let r = robodyn_within(&[&args[..], &["--output", s(&x), "--plot", s(&other)]].concat(), LIMIT);
+    let args = [
+        "excite",
+        &robot("tx40.toml"),
+        "--period",
+        "2",
+        "--harmonics",
+        "2",
+    ];
+    let r = robodyn_within(
+        &[&args[..], &["--output", s(&x), "--plot", s(&other)]].concat(),
+        LIMIT,
+    );
     failed(&r, &["same file"]);
-    let args = ["identify", &robot("rx90.toml"), "--data", s(&x), "--output", s(&new), "--plot", s(&new_again)];
+    let args = [
+        "identify",
+        &robot("rx90.toml"),
+        "--data",
+        s(&x),
+        "--output",
+        s(&new),
+        "--plot",
+        s(&new_again),
+    ];
     failed(&robodyn_within(&args, LIMIT), &["same file"]);
     assert_eq!(std::fs::read_to_string(&x).unwrap(), PREVIOUS);
     only(&d, &["x.csv", "link.svg", "sub"]);
@@ -155,11 +216,15 @@ fn two_writers_leave_one_whole_file() {
     let cases: Vec<[Vec<String>; 2]> = vec![
         [1, 2].map(|k| {
             let input = if k == 1 { &s1 } else { &s2 };
-            ["regressor", &rx90, "--input", s(input)].map(String::from).to_vec()
+            ["regressor", &rx90, "--input", s(input)]
+                .map(String::from)
+                .to_vec()
         }),
         [1, 2].map(|k| {
             let duration = if k == 1 { "0.8" } else { "0.9" };
-            ["simulate", &rx90, "--duration", duration, "--dt", "0.001"].map(String::from).to_vec()
+            ["simulate", &rx90, "--duration", duration, "--dt", "0.001"]
+                .map(String::from)
+                .to_vec()
         }),
     ];
     for runs in cases {
@@ -204,7 +269,13 @@ fn two_writers_leave_one_whole_file() {
     }
     only(
         &d,
-        &["states1.csv", "states2.csv", "out.csv", "alone0.csv", "alone1.csv"],
+        &[
+            "states1.csv",
+            "states2.csv",
+            "out.csv",
+            "alone0.csv",
+            "alone1.csv",
+        ],
     );
 }
 
@@ -217,25 +288,44 @@ fn outputs_keep_permissions_links_and_devices() {
     let d = dir("modes");
     let rx90 = robot("rx90.toml");
     let new = d.join("new.csv");
-    let r = robodyn_in_shell("umask 022", &["idm", &rx90, "--q=0,0,0,0,0,0", "--output", s(&new)], LIMIT);
+    let r = robodyn_in_shell(
+        "umask 022",
+        &["idm", &rx90, "--q=0,0,0,0,0,0", "--output", s(&new)],
+        LIMIT,
+    );
     assert_eq!(r.code, Some(0), "{}", r.stderr);
     let mode = |p: &Path| std::fs::metadata(p).unwrap().permissions().mode() & 0o777;
     assert_eq!(mode(&new), 0o644);
     std::fs::set_permissions(&new, std::fs::Permissions::from_mode(0o640)).unwrap();
-    let r = robodyn_within(&["idm", &rx90, "--q=1,0,0,0,0,0", "--output", s(&new)], LIMIT);
+    let r = robodyn_within(
+        &["idm", &rx90, "--q=1,0,0,0,0,0", "--output", s(&new)],
+        LIMIT,
+    );
     assert_eq!(r.code, Some(0));
     assert_eq!(mode(&new), 0o640);
     let link = d.join("link.csv");
     std::os::unix::fs::symlink(&new, &link).unwrap();
-    let r = robodyn_within(&["idm", &rx90, "--q=2,0,0,0,0,0", "--output", s(&link)], LIMIT);
+    let r = robodyn_within(
+        &["idm", &rx90, "--q=2,0,0,0,0,0", "--output", s(&link)],
+        LIMIT,
+    );
     assert_eq!(r.code, Some(0));
-    assert!(std::fs::symlink_metadata(&link).unwrap().file_type().is_symlink());
+    assert!(std::fs::symlink_metadata(&link)
+        .unwrap()
+        .file_type()
+        .is_symlink());
     let direct = robodyn_within(&["idm", &rx90, "--q=2,0,0,0,0,0"], LIMIT).stdout;
     assert_eq!(std::fs::read_to_string(&new).unwrap(), direct);
-    let r = robodyn_within(&["idm", &rx90, "--q=2,0,0,0,0,0", "--output", "/dev/null"], LIMIT);
+    let r = robodyn_within(
+        &["idm", &rx90, "--q=2,0,0,0,0,0", "--output", "/dev/null"],
+        LIMIT,
+    );
     assert_eq!(r.code, Some(0), "{}", r.stderr);
     use std::os::unix::fs::FileTypeExt;
-    assert!(std::fs::metadata("/dev/null").unwrap().file_type().is_char_device());
+    assert!(std::fs::metadata("/dev/null")
+        .unwrap()
+        .file_type()
+        .is_char_device());
     only(&d, &["new.csv", "link.csv"]);
 }
 
@@ -248,17 +338,26 @@ fn every_file_output_appears_whole_or_not_at_all() {
     let rx90 = robot("rx90.toml");
     let f = |n: &str| d.join(n);
     let runs: Vec<(Vec<String>, PathBuf)> = vec![
-        (vec!["convert".into(), rx90.clone(), s(&f("a.par")).into()], f("a.par")),
         (
-            ["generate", &rx90, "--lang", "c", "--output", s(&f("g.c"))].map(String::from).to_vec(),
+            vec!["convert".into(), rx90.clone(), s(&f("a.par")).into()],
+            f("a.par"),
+        ),
+        (
+            ["generate", &rx90, "--lang", "c", "--output", s(&f("g.c"))]
+                .map(String::from)
+                .to_vec(),
             f("g.c"),
         ),
         (
-            ["base-params", &rx90, "--write-robot", s(&f("b.toml"))].map(String::from).to_vec(),
+            ["base-params", &rx90, "--write-robot", s(&f("b.toml"))]
+                .map(String::from)
+                .to_vec(),
             f("b.toml"),
         ),
         (
-            ["inertia", &rx90, "--output", s(&f("i.csv"))].map(String::from).to_vec(),
+            ["inertia", &rx90, "--output", s(&f("i.csv"))]
+                .map(String::from)
+                .to_vec(),
             f("i.csv"),
         ),
     ];
@@ -270,12 +369,18 @@ fn every_file_output_appears_whole_or_not_at_all() {
     }
     // base-params --write-robot to a format it cannot write: an error before the report, no
     // file
-    let r = robodyn_within(&["base-params", &rx90, "--write-robot", s(&f("c.urdf"))], LIMIT);
+    let r = robodyn_within(
+        &["base-params", &rx90, "--write-robot", s(&f("c.urdf"))],
+        LIMIT,
+    );
     failed(&r, &["URDF"]);
     assert!(r.stdout.is_empty(), "{}", r.stdout);
     assert!(!f("c.urdf").exists());
     // generate with a model the robot does not have: no file
-    let r = robodyn_within(&["generate", &rx90, "--model", "w", "--output", s(&f("w.c"))], LIMIT);
+    let r = robodyn_within(
+        &["generate", &rx90, "--model", "w", "--output", s(&f("w.c"))],
+        LIMIT,
+    );
     failed(&r, &[]);
     only(&d, &["a.par", "g.c", "b.toml", "i.csv"]);
 }

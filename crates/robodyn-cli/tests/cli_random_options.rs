@@ -38,13 +38,44 @@ impl Rng {
 
 /// Numbers a user (or an attacker) may type.
 const HOSTILE: [&str; 24] = [
-    "0", "-0", "1", "-1", "0.5", "pi/3", "nan", "NaN", "inf", "-inf", "1e308", "-1e308", "1e300",
-    "1e-320", "1e309", "", "abc", "1e6", "-7.5e5", "1e17", "2*pi", "1/0", "0x10", "99999999999",
+    "0",
+    "-0",
+    "1",
+    "-1",
+    "0.5",
+    "pi/3",
+    "nan",
+    "NaN",
+    "inf",
+    "-inf",
+    "1e308",
+    "-1e308",
+    "1e300",
+    "1e-320",
+    "1e309",
+    "",
+    "abc",
+    "1e6",
+    "-7.5e5",
+    "1e17",
+    "2*pi",
+    "1/0",
+    "0x10",
+    "99999999999",
 ];
 
 /// Counts and positive options.
 const COUNTS: [&str; 10] = [
-    "0", "1", "3", "-1", "1e3", "", "nan", "18446744073709551615", "18446744073709551616", "2.5",
+    "0",
+    "1",
+    "3",
+    "-1",
+    "1e3",
+    "",
+    "nan",
+    "18446744073709551615",
+    "18446744073709551616",
+    "2.5",
 ];
 
 /// (robot file, joints of its state vectors, closed)
@@ -71,7 +102,10 @@ fn list(rng: &mut Rng, n: usize) -> String {
             if rng.chance(8) {
                 rng.pick(&HOSTILE).to_string()
             } else {
-                format!("{}", 0.1 * (k as f64 + 1.0) * if rng.chance(50) { 1.0 } else { -1.0 })
+                format!(
+                    "{}",
+                    0.1 * (k as f64 + 1.0) * if rng.chance(50) { 1.0 } else { -1.0 }
+                )
             }
         })
         .collect();
@@ -134,7 +168,10 @@ fn command(rng: &mut Rng, dir: &Path, k: usize, out: &Path) -> Vec<String> {
                 let t = state_table(rng, dir, n, third, k);
                 push(&["--input", t.to_str().unwrap()]);
             } else {
-                push(&[&format!("--q={}", list(rng, n)), &format!("--qd={}", list(rng, n))]);
+                push(&[
+                    &format!("--q={}", list(rng, n)),
+                    &format!("--qd={}", list(rng, n)),
+                ]);
             }
             if rng.chance(30) {
                 push(&["--format", rng.pick(&["csv", "json", "xml"])]);
@@ -151,7 +188,11 @@ fn command(rng: &mut Rng, dir: &Path, k: usize, out: &Path) -> Vec<String> {
             }
         }
         3 => {
-            let qa = if closed { list(rng, frames(file, n).len()) } else { list(rng, 1) };
+            let qa = if closed {
+                list(rng, frames(file, n).len())
+            } else {
+                list(rng, 1)
+            };
             push(&["closure", &r, &format!("--qa={qa}")]);
             if rng.chance(30) {
                 push(&["--guess", &list(rng, 3)]);
@@ -168,7 +209,9 @@ fn command(rng: &mut Rng, dir: &Path, k: usize, out: &Path) -> Vec<String> {
                 rng.pick(&["0", "-1", "nan", "inf", "1e-9", "1e308", ""])
             };
             push(&["simulate", &r, "--duration", duration, "--output", &o]);
-            let dt = rng.chance(50).then(|| rng.pick(&["1e-300", "0.001", "0.01", "nan", "-0", "1e308"]));
+            let dt = rng
+                .chance(50)
+                .then(|| rng.pick(&["1e-300", "0.001", "0.01", "nan", "-0", "1e308"]));
             if let Some(dt) = dt {
                 push(&["--dt", dt]);
             } else if rng.chance(30) {
@@ -224,7 +267,10 @@ fn command(rng: &mut Rng, dir: &Path, k: usize, out: &Path) -> Vec<String> {
                 push(&["--numeric"]);
             }
             if rng.chance(30) {
-                push(&["--name", rng.pick(&["f", "my func", "1x", "end", "lambda", "", "ok_name"])]);
+                push(&[
+                    "--name",
+                    rng.pick(&["f", "my func", "1x", "end", "lambda", "", "ok_name"]),
+                ]);
             }
             if rng.chance(30) {
                 push(&["--output", &o]);
@@ -240,7 +286,11 @@ fn command(rng: &mut Rng, dir: &Path, k: usize, out: &Path) -> Vec<String> {
     }
     if rng.chance(15) {
         a.push("--set".into());
-        a.push(format!("{}={}", rng.pick(&["G3", "D3", "M2", "XX"]), rng.pick(&HOSTILE)));
+        a.push(format!(
+            "{}={}",
+            rng.pick(&["G3", "D3", "M2", "XX"]),
+            rng.pick(&HOSTILE)
+        ));
     }
     a
 }
@@ -277,7 +327,12 @@ fn random_command_lines_never_crash_hang_or_print_non_finite_numbers() {
         let what = format!("seed {seed:#x}, run {k}: robodyn {}", shell_words(&a));
         let r = robodyn_within(&a, LIMIT);
         if std::env::var("ROBODYN_HARNESS_VERBOSE").is_ok() {
-            eprintln!("{what}\n  -> {:?} {:.3} s {}", r.code, r.seconds, r.stderr.lines().next().unwrap_or(""));
+            eprintln!(
+                "{what}\n  -> {:?} {:.3} s {}",
+                r.code,
+                r.seconds,
+                r.stderr.lines().next().unwrap_or("")
+            );
         }
         r.assert_no_crash(&what);
         exits[r.code.unwrap() as usize] += 1;
@@ -291,12 +346,19 @@ fn random_command_lines_never_crash_hang_or_print_non_finite_numbers() {
             let bad = non_finite_words(&written);
             assert!(bad.is_empty(), "{what}: exit 0 with {bad:?} in its output");
         } else {
-            assert!(r.stderr.contains("error"), "{what}: failed without saying why: {}", r.stderr);
+            assert!(
+                r.stderr.contains("error"),
+                "{what}: failed without saying why: {}",
+                r.stderr
+            );
         }
     }
     eprintln!("random command lines: {runs} runs, exit codes 0/1/2: {exits:?}");
     // the harness reaches both outcomes
-    assert!(exits[0] > runs / 10 && exits[1] > runs / 10, "exit codes 0/1/2: {exits:?}");
+    assert!(
+        exits[0] > runs / 10 && exits[1] > runs / 10,
+        "exit codes 0/1/2: {exits:?}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -304,7 +366,10 @@ fn random_command_lines_never_crash_hang_or_print_non_finite_numbers() {
 fn shell_words(a: &[&str]) -> String {
     a.iter()
         .map(|w| {
-            if !w.is_empty() && w.chars().all(|c| c.is_ascii_alphanumeric() || "-_./=,:+".contains(c)) {
+            if !w.is_empty()
+                && w.chars()
+                    .all(|c| c.is_ascii_alphanumeric() || "-_./=,:+".contains(c))
+            {
                 w.to_string()
             } else {
                 format!("'{}'", w.replace('\'', "'\\''"))

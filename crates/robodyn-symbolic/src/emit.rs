@@ -586,7 +586,10 @@ pub fn check_function_name(name: &str, lang: Lang) -> Result<(), String> {
             name.len()
         ));
     }
-    if lang == Lang::C && (name.starts_with("__") || name.starts_with("_") && name[1..].starts_with(|c: char| c.is_ascii_uppercase())) {
+    if lang == Lang::C
+        && (name.starts_with("__")
+            || name.starts_with("_") && name[1..].starts_with(|c: char| c.is_ascii_uppercase()))
+    {
         return Err(format!(
             "`{name}` is reserved in C (names beginning with `__` or `_` and a capital letter)"
         ));
@@ -594,7 +597,8 @@ pub fn check_function_name(name: &str, lang: Lang) -> Result<(), String> {
     if keywords(lang).split_whitespace().any(|k| k == name) {
         return Err(format!("`{name}` is a reserved word of {language}"));
     }
-    if lang != Lang::Text && lang != Lang::Latex && CODE_NAMES.split_whitespace().any(|k| k == name) {
+    if lang != Lang::Text && lang != Lang::Latex && CODE_NAMES.split_whitespace().any(|k| k == name)
+    {
         return Err(format!(
             "`{name}` is a name the generated {language} code uses itself (its arguments, \
              helpers and math functions: {CODE_NAMES})"

@@ -27,8 +27,6 @@ mod batch;
 mod branch_tracker;
 #[path = "closed_chain.rs"]
 mod closed_chain;
-#[path = "continuation.rs"]
-mod continuation;
 #[path = "closed_simulation.rs"]
 mod closed_simulation;
 #[path = "codegen_base.rs"]
@@ -45,6 +43,8 @@ mod codegen_errors;
 mod codegen_latex;
 #[path = "codegen_opcount.rs"]
 mod codegen_opcount;
+#[path = "continuation.rs"]
+mod continuation;
 #[path = "direct_dynamics.rs"]
 mod direct_dynamics;
 #[path = "fixed_frames.rs"]

@@ -43,7 +43,10 @@ fn less_turns(x: f64) -> f64 {
 /// exactly), whether the move is followed step by step (within the budget) or shortened.
 #[test]
 fn whole_turns_of_a_crank_are_dropped_exactly() {
-    for (label, r) in [("four-bar", robot("fourbar.toml")), ("slider-crank", slider_crank())] {
+    for (label, r) in [
+        ("four-bar", robot("fourbar.toml")),
+        ("slider-crank", slider_crank()),
+    ] {
         let cc = ClosedChain::new(&r).unwrap();
         let revolute: Vec<bool> = cc
             .passive_coordinates()
@@ -57,12 +60,17 @@ fn whole_turns_of_a_crank_are_dropped_exactly() {
             if q1.abs() > 1e7 {
                 continue;
             }
-            let near = loop_closure(&cc, &mut cc.assembly_branch().unwrap(), &[less_turns(q1)])
-                .unwrap();
+            let near =
+                loop_closure(&cc, &mut cc.assembly_branch().unwrap(), &[less_turns(q1)]).unwrap();
             for (k, rev) in revolute.iter().enumerate() {
                 let d = far.q_p[k] - near.q_p[k];
                 let d = if *rev { less_turns(d) } else { d };
-                assert!(d.abs() < 1e-7, "{label} at {q1:e}: q_p[{k}] {} vs {}", far.q_p[k], near.q_p[k]);
+                assert!(
+                    d.abs() < 1e-7,
+                    "{label} at {q1:e}: q_p[{k}] {} vs {}",
+                    far.q_p[k],
+                    near.q_p[k]
+                );
             }
         }
     }
@@ -75,8 +83,12 @@ fn joints_off_the_loops_are_set_at_once() {
     let r = robot("sr400.toml");
     let cc = ClosedChain::new(&r).unwrap();
     let at = |q1: f64| {
-        let s = loop_closure(&cc, &mut cc.assembly_branch().unwrap(), &[q1, 0.2, 0.3, 0.4, 0.5, 1.6])
-            .unwrap();
+        let s = loop_closure(
+            &cc,
+            &mut cc.assembly_branch().unwrap(),
+            &[q1, 0.2, 0.3, 0.4, 0.5, 1.6],
+        )
+        .unwrap();
         assert!(closure_gap(&r, &cc, &s) < 1e-9, "q1 = {q1:e}");
         s.q_p
     };
@@ -126,10 +138,26 @@ fn long_moves_keep_the_results_finite() {
     let mut d = ClosedData::new(&cc);
     let (mut tau, mut qp) = ([0.0], [0.0, 0.0]);
     for q1 in [1e300, -2.5, 7e12, 0.3, -1e9] {
-        closed_inverse_dynamics_into(&cc, &mut d, &mut b, r.environment(), &[q1], &[1.0], &[0.5], &mut tau)
-            .unwrap();
+        closed_inverse_dynamics_into(
+            &cc,
+            &mut d,
+            &mut b,
+            r.environment(),
+            &[q1],
+            &[1.0],
+            &[0.5],
+            &mut tau,
+        )
+        .unwrap();
         loop_closure_into(&cc, &mut d, &mut b, &[q1], &mut qp).unwrap();
-        assert!(tau[0].is_finite() && qp.iter().all(|x| x.is_finite()), "{q1:e}");
-        assert!(b.q_a()[0].abs() <= 2.0 * PI + 3.0, "held as an equivalent angle: {:?}", b.q_a());
+        assert!(
+            tau[0].is_finite() && qp.iter().all(|x| x.is_finite()),
+            "{q1:e}"
+        );
+        assert!(
+            b.q_a()[0].abs() <= 2.0 * PI + 3.0,
+            "held as an equivalent angle: {:?}",
+            b.q_a()
+        );
     }
 }

@@ -242,13 +242,31 @@ fn closed_chain_long_moves_allocate_nothing() {
     let mut data = ClosedData::new(&chain);
     let mut tau = [0.0];
     let env = robot.environment();
-    closed_inverse_dynamics_into(&chain, &mut data, &mut branch, env, &[1e6], &[1.0], &[0.0], &mut tau)
-        .unwrap();
+    closed_inverse_dynamics_into(
+        &chain,
+        &mut data,
+        &mut branch,
+        env,
+        &[1e6],
+        &[1.0],
+        &[0.0],
+        &mut tau,
+    )
+    .unwrap();
     counter_counts();
     let before = allocations();
     for q1 in [-3e7, 1e300, 0.5, 4e9, -1e12] {
-        closed_inverse_dynamics_into(&chain, &mut data, &mut branch, env, &[q1], &[1.0], &[0.0], &mut tau)
-            .unwrap();
+        closed_inverse_dynamics_into(
+            &chain,
+            &mut data,
+            &mut branch,
+            env,
+            &[q1],
+            &[1.0],
+            &[0.0],
+            &mut tau,
+        )
+        .unwrap();
     }
     assert_eq!(allocations() - before, 0, "long moves allocated");
     assert!(tau[0].is_finite());

@@ -191,8 +191,6 @@ fn base_robot_file(
     let out = base_robot(desc, &base, &values)?;
     let format = robodyn::io::Format::from_path(path)?;
     let mut file = crate::output::Output::create(Some(path))?;
-    file.writer()
-        .write_all(robodyn::io::description_text(&out, format)?.as_bytes())
-        .map_err(|e| format!("{}: {e}", path.display()))?;
+    file.write_all(robodyn::io::description_text(&out, format)?.as_bytes())?;
     Ok(file)
 }

@@ -94,7 +94,9 @@ pub fn run(a: Args) -> CliResult {
     if robot.is_tree() {
         let coords = robot.coordinates();
         input = StateInput::open(&a.states(&robot, coords, "movable joints"))?;
-        out = a.out.writer(input.headers_with(&a.names.columns("qdd", coords))?)?;
+        out = a
+            .out
+            .writer(input.headers_with(&a.names.columns("qdd", coords))?)?;
         // chunks of the table at once over the cores (the library's batch; errors name their
         // row)
         let method = a.method.into();
@@ -107,11 +109,18 @@ pub fn run(a: Args) -> CliResult {
         let chain = ClosedChain::new(&robot)?;
         let coords = chain.coordinates();
         input = StateInput::open(&a.states(&robot, coords, "actuated joints (closed chain)"))?;
-        out = a.out.writer(input.headers_with(&a.names.columns("qdd", coords))?)?;
+        out = a
+            .out
+            .writer(input.headers_with(&a.names.columns("qdd", coords))?)?;
         let guess = a.guess.as_deref();
-        closed_rows(&mut input, &mut out, &chain, guess, &mut t, |b, d, x, qdd| {
-            closed_direct_dynamics_into(&chain, d, b, env, x[0], x[1], x[2], qdd)
-        })?;
+        closed_rows(
+            &mut input,
+            &mut out,
+            &chain,
+            guess,
+            &mut t,
+            |b, d, x, qdd| closed_direct_dynamics_into(&chain, d, b, env, x[0], x[1], x[2], qdd),
+        )?;
     }
     out.finish()?;
     t.lap("write");

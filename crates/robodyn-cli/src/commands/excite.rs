@@ -96,7 +96,10 @@ fn per_joint(name: &str, s: Option<&str>, n: usize) -> CliResult<Option<Vec<f64>
 }
 
 pub fn run(a: Args) -> CliResult {
-    let files = [("--output", Some(a.output.as_path())), ("--plot", a.plot.as_deref())];
+    let files = [
+        ("--output", Some(a.output.as_path())),
+        ("--plot", a.plot.as_deref()),
+    ];
     crate::output::check_distinct(&files)?;
     let desc = a.robot.description()?.0;
     let mut access = ModelAccess::new(desc)?;
@@ -165,7 +168,11 @@ pub fn run(a: Args) -> CliResult {
     let rows = (a.period * a.periods as f64 * a.rate).round() as usize;
     // all or nothing: both files put in place once both are written
     let mut file = crate::output::Output::create(Some(&a.output))?;
-    let mut plot_file = a.plot.as_deref().map(|p| crate::output::Output::create(Some(p))).transpose()?;
+    let mut plot_file = a
+        .plot
+        .as_deref()
+        .map(|p| crate::output::Output::create(Some(p)))
+        .transpose()?;
     let out = file.writer();
     let mut header = vec!["t".to_string()];
     for p in ["q", "qd", "qdd"] {
@@ -205,20 +212,22 @@ pub fn run(a: Args) -> CliResult {
                 )
             })
             .collect();
-        plot_file.write_by_path(|p| plot_panels(
-            p,
-            &format!(
-                "{}: excitation, {} harmonics, period {} s, condition number {:.1}",
-                access.name(),
-                a.harmonics,
-                a.period,
-                d.condition
-            ),
-            &times,
-            &panels,
-            "rad, rad/s, rad/s^2",
-            false,
-        ))?;
+        plot_file.write_by_path(|p| {
+            plot_panels(
+                p,
+                &format!(
+                    "{}: excitation, {} harmonics, period {} s, condition number {:.1}",
+                    access.name(),
+                    a.harmonics,
+                    a.period,
+                    d.condition
+                ),
+                &times,
+                &panels,
+                "rad, rad/s, rad/s^2",
+                false,
+            )
+        })?;
     }
     crate::output::commit_all([Some(file), plot_file].into_iter().flatten().collect())?;
     eprintln!("wrote {}", a.output.display());

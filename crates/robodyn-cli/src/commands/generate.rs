@@ -213,7 +213,10 @@ fn function_name(a: &Args) -> Result<Option<String>, String> {
         return Ok(a.name.clone());
     };
     let stem = stem.to_string_lossy();
-    let output = a.output.as_ref().map_or(String::new(), |p| p.display().to_string());
+    let output = a
+        .output
+        .as_ref()
+        .map_or(String::new(), |p| p.display().to_string());
     checked(
         &stem,
         &format!("--output {output}: a MATLAB function file is named after its function"),

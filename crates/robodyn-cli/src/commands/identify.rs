@@ -195,7 +195,7 @@ pub fn run(a: Args) -> CliResult {
     };
     // all or nothing: the files are put in place once all are written
     let mut files = vec![crate::output::Output::create(a.output.as_deref())?];
-    files[0].writer().write_all(text.as_bytes())?;
+    files[0].write_all(text.as_bytes())?;
     if let Some(p) = &a.plot {
         let mut plot = crate::output::Output::create(Some(p))?;
         plot.write_by_path(|tmp| report::plot_fit(tmp, &id))?;
@@ -216,7 +216,7 @@ pub fn run(a: Args) -> CliResult {
         let mut robot = crate::output::Output::create(Some(p))?;
         let format = robodyn::io::Format::from_path(p)?;
         let text = robodyn::io::description_text(&desc, format)?;
-        robot.writer().write_all(text.as_bytes())?;
+        robot.write_all(text.as_bytes())?;
         files.push(robot);
     }
     crate::output::commit_all(files)?;

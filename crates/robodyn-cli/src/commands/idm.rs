@@ -74,7 +74,9 @@ pub fn run(a: Args) -> CliResult {
     if robot.is_tree() {
         let coords = robot.coordinates();
         input = StateInput::open(&a.states(&robot, coords, "movable joints"))?;
-        out = a.out.writer(input.headers_with(&a.names.columns("tau", coords))?)?;
+        out = a
+            .out
+            .writer(input.headers_with(&a.names.columns("tau", coords))?)?;
         // chunks of the table at once over the cores (the library's batch; errors name their
         // row)
         tree_rows(&mut input, &mut out, coords.len(), &mut t, |c, tau| {
@@ -86,11 +88,18 @@ pub fn run(a: Args) -> CliResult {
         let chain = ClosedChain::new(&robot)?;
         let coords = chain.coordinates();
         input = StateInput::open(&a.states(&robot, coords, "actuated joints (closed chain)"))?;
-        out = a.out.writer(input.headers_with(&a.names.columns("tau", coords))?)?;
+        out = a
+            .out
+            .writer(input.headers_with(&a.names.columns("tau", coords))?)?;
         let guess = a.guess.as_deref();
-        closed_rows(&mut input, &mut out, &chain, guess, &mut t, |b, d, x, tau| {
-            closed_inverse_dynamics_into(&chain, d, b, env, x[0], x[1], x[2], tau)
-        })?;
+        closed_rows(
+            &mut input,
+            &mut out,
+            &chain,
+            guess,
+            &mut t,
+            |b, d, x, tau| closed_inverse_dynamics_into(&chain, d, b, env, x[0], x[1], x[2], tau),
+        )?;
     }
     out.finish()?;
     t.lap("write");

@@ -8,8 +8,8 @@
 //! every loop (the numerical method is then the arbiter).
 
 use crate::common::{
-    chunk_states, in_table, warn_conditioning, CliResult, NamesArg, Phases, RobotArgs,
-    TableOutput, TableWriter, TimingsArg,
+    chunk_states, in_table, warn_conditioning, CliResult, NamesArg, Phases, RobotArgs, TableOutput,
+    TableWriter, TimingsArg,
 };
 use crate::states::{CarryArg, Chunk, StateInput, StateRequest};
 use robodyn::algorithms::regressor::{
@@ -96,58 +96,86 @@ pub fn run(a: Args) -> CliResult {
         cols: PARAMS_PER_LINK * robot.nl(),
         row: Vec::new(),
     };
-    let nc = input.carried_headers().len();
-    let mut chunk = Chunk::default();
-    let env = robot.environment();
     t.lap("read");
     match &chain {
-        // trees: chunks of states at once over the cores (the library's batch; errors name
-        // their row), row-major Phi of every state of the chunk, written before the next
-        None => {
-            let (mut phi, mut tau_e) = (Vec::new(), Vec::new());
-            let per_state = coords.len() * (rows.cols + 1) + 3 * coords.len() + nc;
-            while input.next_chunk(chunk_states(per_state), &mut chunk)? {
-                t.lap("read");
-                let n = coords.len();
-                phi.resize(chunk.count * n * rows.cols, 0.0);
-                tau_e.resize(chunk.count * n, 0.0);
-                let x = &chunk.x;
-                regressor_batch(&robot, env, &x[0], &x[1], &x[2], &mut phi, &mut tau_e)
-                    .map_err(|e| in_table(e, chunk.first))?;
-                t.lap("model");
-                let cols = rows.cols;
-                for s in 0..chunk.count {
-                    let (phi, tau_e) = (&phi[s * n * cols..], &tau_e[s * n..]);
-                    let number = chunk.first + s;
-                    rows.state(number, chunk.carried(s, nc), tau_e, |k, c| phi[k * cols + c])?;
-                }
-                t.lap("write");
-            }
-        }
-        // closed chains: one state at a time on the branch tracker (from the robot's assembly):
-        // G^T Phi and G^T Gamma_e, actuated-joint order (10.40)
-        Some(c) => {
-            let (n, mut d, mut b) = (coords.len(), ClosedData::new(c), c.assembly_branch()?);
-            let mut phi = nalgebra::DMatrix::zeros(n, rows.cols);
-            let mut tau_e = vec![0.0; n];
-            while input.next_chunk(chunk_states(3 * n + nc), &mut chunk)? {
-                t.lap("read");
-                for s in 0..chunk.count {
-                    let number = chunk.first + s;
-                    let x = chunk.state(s, n);
-                    let cond = closed_regressor_into(c, &mut d, &mut b, env, x, &mut phi, &mut tau_e)
-                        .map_err(|e| e.in_row(number))?;
-                    warn_conditioning(c, Some(number), &cond);
-                    t.lap("model");
-                    rows.state(number, chunk.carried(s, nc), &tau_e, |k, c| phi[(k, c)])?;
-                    t.lap("write");
-                }
-            }
-        }
+        None => tree_rows(&robot, &mut input, &mut rows, &mut t)?,
+        Some(c) => closed_rows(c, &mut input, &mut rows, &mut t)?,
     }
     rows.out.finish()?;
     t.lap("write");
     t.report(input.count());
+    Ok(())
+}
+
+/// Trees: chunks of states at once over the cores (the library's batch; errors name their row),
+/// row-major Phi of every state of the chunk, written before the next chunk is read.
+fn tree_rows(
+    robot: &robodyn::Robot,
+    input: &mut StateInput,
+    rows: &mut Rows,
+    t: &mut Phases,
+) -> CliResult {
+    let (n, cols) = (rows.coords.len(), rows.cols);
+    let nc = input.carried_headers().len();
+    let (mut chunk, mut phi, mut tau_e) = (Chunk::default(), Vec::new(), Vec::new());
+    let per_state = n * (cols + 1) + 3 * n + nc;
+    while input.next_chunk(chunk_states(per_state), &mut chunk)? {
+        t.lap("read");
+        phi.resize(chunk.count * n * cols, 0.0);
+        tau_e.resize(chunk.count * n, 0.0);
+        let x = &chunk.x;
+        regressor_batch(
+            robot,
+            robot.environment(),
+            &x[0],
+            &x[1],
+            &x[2],
+            &mut phi,
+            &mut tau_e,
+        )
+        .map_err(|e| in_table(e, chunk.first))?;
+        t.lap("model");
+        for s in 0..chunk.count {
+            let (phi, tau_e) = (&phi[s * n * cols..], &tau_e[s * n..]);
+            let number = chunk.first + s;
+            rows.state(number, chunk.carried(s, nc), tau_e, |k, c| {
+                phi[k * cols + c]
+            })?;
+        }
+        t.lap("write");
+    }
+    Ok(())
+}
+
+/// Closed chains: one state at a time on the branch tracker (from the robot's assembly):
+/// G^T Phi and G^T Gamma_e, actuated-joint order (10.40).
+fn closed_rows(
+    c: &ClosedChain,
+    input: &mut StateInput,
+    rows: &mut Rows,
+    t: &mut Phases,
+) -> CliResult {
+    let (n, nc, env) = (
+        c.dof(),
+        input.carried_headers().len(),
+        c.robot().environment(),
+    );
+    let (mut d, mut b, mut chunk) = (ClosedData::new(c), c.assembly_branch()?, Chunk::default());
+    let mut phi = nalgebra::DMatrix::zeros(n, rows.cols);
+    let mut tau_e = vec![0.0; n];
+    while input.next_chunk(chunk_states(3 * n + nc), &mut chunk)? {
+        t.lap("read");
+        for s in 0..chunk.count {
+            let number = chunk.first + s;
+            let x = chunk.state(s, n);
+            let cond = closed_regressor_into(c, &mut d, &mut b, env, x, &mut phi, &mut tau_e)
+                .map_err(|e| e.in_row(number))?;
+            warn_conditioning(c, Some(number), &cond);
+            t.lap("model");
+            rows.state(number, chunk.carried(s, nc), &tau_e, |k, c| phi[(k, c)])?;
+            t.lap("write");
+        }
+    }
     Ok(())
 }
 
@@ -172,11 +200,11 @@ impl Rows<'_> {
         tau_e: &[f64],
         phi: impl Fn(usize, usize) -> f64,
     ) -> CliResult {
-        for k in 0..self.coords.len() {
+        for (k, &tau_e) in tau_e.iter().take(self.coords.len()).enumerate() {
             self.row.clear();
             self.row.extend_from_slice(carried);
             self.row
-                .extend([number as f64, self.coords.frame(k) as f64, tau_e[k]]);
+                .extend([number as f64, self.coords.frame(k) as f64, tau_e]);
             self.row.extend(self.indices.iter().map(|&c| phi(k, c)));
             self.out.row(Some(number), &self.row, None)?;
         }

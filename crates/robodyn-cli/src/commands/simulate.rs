@@ -154,6 +154,21 @@ struct LimitWatch<'a> {
     rows: usize,
 }
 
+impl LimitWatch<'_> {
+    /// The crossings, on standard error.
+    fn warn(&self) {
+        for m in &self.crossed {
+            eprintln!("robodyn: warning: {m}");
+        }
+        if !self.crossed.is_empty() {
+            eprintln!(
+                "robodyn: warning: the simulation does not enforce joint limits \
+                 (--stop-at-limits stops the run at the first crossing)"
+            );
+        }
+    }
+}
+
 impl TrajectorySink for LimitWatch<'_> {
     fn begin(&mut self, headers: &[String]) -> robodyn::Result<()> {
         for (c, h) in headers.iter().enumerate() {
@@ -334,7 +349,12 @@ fn check_options(a: &Args) -> CliResult {
 
 /// The dynamics of the run: a tree's, or a closed chain's on the branch of its assembly; its
 /// joints (frame numbers), what they are in messages, and the default q0.
-type Model<'r> = (Box<dyn Dynamics + 'r>, Vec<usize>, &'static str, Option<Vec<f64>>);
+type Model<'r> = (
+    Box<dyn Dynamics + 'r>,
+    Vec<usize>,
+    &'static str,
+    Option<Vec<f64>>,
+);
 
 fn model<'r>(robot: &'r robodyn::Robot, a: &Args) -> CliResult<Model<'r>> {
     let smoothing = Some(a.coulomb_smoothing);
@@ -362,12 +382,22 @@ fn model<'r>(robot: &'r robodyn::Robot, a: &Args) -> CliResult<Model<'r>> {
 }
 
 /// The torque input: constant, a series (`--torque-csv`) or PD tracking (`--track`).
-fn torque_input(a: &Args, joints: &[usize], what: &str, labels: &[String], all: &[String]) -> CliResult<TorqueInput> {
+fn torque_input(
+    a: &Args,
+    joints: &[usize],
+    what: &str,
+    labels: &[String],
+    all: &[String],
+) -> CliResult<TorqueInput> {
     let n = joints.len();
     Ok(if let Some(p) = &a.torque_csv {
         TorqueInput::Series(read_series(p, &[("tau", true, "")], labels, all)?.0)
     } else if let Some(p) = &a.track {
-        let velocity = ("qd", false, "the reference velocity is the slope of the interpolated q");
+        let velocity = (
+            "qd",
+            false,
+            "the reference velocity is the slope of the interpolated q",
+        );
         let (reference, with_velocity) = read_series(p, &[("q", true, ""), velocity], labels, all)?;
         TorqueInput::Pd {
             reference,
@@ -376,7 +406,13 @@ fn torque_input(a: &Args, joints: &[usize], what: &str, labels: &[String], all: 
             kd: gains("kd", a.kd.as_deref().unwrap_or_default(), n)?,
         }
     } else {
-        TorqueInput::Constant(joint_values("torque", a.torque.as_deref(), joints, what, None)?)
+        TorqueInput::Constant(joint_values(
+            "torque",
+            a.torque.as_deref(),
+            joints,
+            what,
+            None,
+        )?)
     })
 }
 
@@ -423,6 +459,7 @@ pub fn run(a: Args) -> CliResult {
         labels: labels.clone(),
         extra,
     };
+    // the initial state and the input (the columns of its files checked)
     let q0 = joint_values("q0", a.q0.as_deref(), &joints, what, q0_default.as_deref())?;
     let qd0 = joint_values("qd0", a.qd0.as_deref(), &joints, what, None)?;
     let all_labels: Vec<String> = label.values().cloned().collect();
@@ -439,7 +476,11 @@ pub fn run(a: Args) -> CliResult {
     // the files are made now (a missing directory is an error before the run) and put in
     // place at the end
     let mut csv_out = Output::create(Some(&a.output))?;
-    let plot_out = a.plot.as_deref().map(|p| Output::create(Some(p))).transpose()?;
+    let plot_out = a
+        .plot
+        .as_deref()
+        .map(|p| Output::create(Some(p)))
+        .transpose()?;
     let out_name = csv_out.name().to_string();
     let mut csv = CsvSink::new(csv_out.writer(), out_name.clone());
     let mut rec = Recorder::default();
@@ -485,15 +526,7 @@ pub fn run(a: Args) -> CliResult {
             return Ok(());
         }
     }
-    for m in &watch.crossed {
-        eprintln!("robodyn: warning: {m}");
-    }
-    if !watch.crossed.is_empty() {
-        eprintln!(
-            "robodyn: warning: the simulation does not enforce joint limits (--stop-at-limits \
-             stops the run at the first crossing)"
-        );
-    }
+    watch.warn();
     let rows = watch.rows;
     drop(watch);
     drop(csv);

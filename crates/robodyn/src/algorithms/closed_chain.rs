@@ -12,8 +12,9 @@
 //! closed point reached on it. Every evaluation at q_a first moves the tracker to q_a by
 //! continuation along the straight path in q_a (predictor q_p + W dq_a, Newton corrector, steps
 //! halved on failure), checking at every step that det Wp keeps its sign, that Wp stays above the
-//! hard conditioning limit and that the corrector lands within the predictor's reach. A result
-//! therefore depends on (model, branch, inputs) only, never on a hidden history.
+//! hard conditioning limit and that the corrector lands within the predictor's reach, within a
+//! step budget (long moves are shortened where the model allows it: [`ClosedChain::step_budget`]). A
+//! result therefore depends on (model, branch, inputs) only, never on a hidden history.
 //!
 //! Public vectors: q_a, qd_a, qdd_a, Γ_cl over the actuated joints
 //! ([`ClosedChain::coordinates`]); q_p over the passive joints
@@ -259,7 +260,6 @@ impl ClosedData {
         }
     }
 }
-
 
 impl ClosedChain {
     /// The closed-chain model of `robot`: chooses the independent closure equations of each

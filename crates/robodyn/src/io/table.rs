@@ -254,8 +254,7 @@ mod tests {
     fn long_line_is_an_error_with_its_line() {
         let e = Table::parse(b"q1,q2\n1,2\n3,4444444444\n", "t.csv").unwrap();
         assert_eq!(e.rows.len(), 2);
-        let err = match TableReader::with_max_line(&b"q1,q2\n1,2\n3,4444444444\n"[..], "t.csv", 8)
-        {
+        let err = match TableReader::with_max_line(&b"q1,q2\n1,2\n3,4444444444\n"[..], "t.csv", 8) {
             Ok(mut t) => {
                 let mut row = Vec::new();
                 assert!(t.next_row(&mut row).unwrap());
@@ -264,13 +263,21 @@ mod tests {
             Err(e) => e,
         };
         let m = err.to_string();
-        assert!(m.starts_with("t.csv:3: the line is longer than 8 bytes"), "{m}");
+        assert!(
+            m.starts_with("t.csv:3: the line is longer than 8 bytes"),
+            "{m}"
+        );
         // an endless line of zeros: an error, after reading about the limit
         let err = Table::from_reader(std::io::repeat(0), "zeros").unwrap_err();
-        assert!(err.to_string().starts_with("zeros:1: the line is longer"), "{err}");
-        let err = Table::from_reader(&b"t,q1\n"[..].chain(std::io::repeat(b'1')), "ones");
         assert!(
-            err.unwrap_err().to_string().starts_with("ones:2: the line is longer"),
+            err.to_string().starts_with("zeros:1: the line is longer"),
+            "{err}"
+        );
+        let err = Table::from_reader((&b"t,q1\n"[..]).chain(std::io::repeat(b'1')), "ones");
+        assert!(
+            err.unwrap_err()
+                .to_string()
+                .starts_with("ones:2: the line is longer"),
             "line 2"
         );
     }
