@@ -5,9 +5,10 @@
 //! target only when the command succeeds ([`Output::commit`]); a reader sees the previous file or
 //! the new one, never a mixture, two processes writing one file leave one of their files whole,
 //! and a run that fails (an error, a full disk) leaves the previous file as it was and removes
-//! its temporary file. Standard output (`-`, or no file where it is optional) and targets that
-//! are not regular files (`/dev/null`, a pipe) are written directly. Two outputs of one command
-//! that name the same file are refused before anything is written ([`check_distinct`]).
+//! its temporary file. Standard output (`-`, or no file where it is optional), targets that are
+//! not regular files (`/dev/null`, a pipe) and files under `/dev` and `/proc` (`/dev/stdout`)
+//! are written directly. Two outputs of one command that name the same file are refused before
+//! anything is written ([`check_distinct`]).
 
 use crate::common::CliResult;
 use robodyn::simulation::output::Number;
@@ -50,7 +51,10 @@ impl Output {
         // a symbolic link is followed: the file it points to is replaced, the link kept
         let target = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf());
         let meta = std::fs::metadata(&target).ok();
-        if let Some(m) = meta.as_ref().filter(|m| !m.is_file()) {
+        // `/dev/stdout` may resolve to the regular file a shell redirected to: written in place,
+        // as every file under /dev and /proc and every file that is not a regular file
+        let special = path.starts_with("/dev") || path.starts_with("/proc");
+        if let Some(m) = meta.as_ref().filter(|m| !m.is_file() || special) {
             if m.is_dir() {
                 return Err(format!("{name}: is a directory").into());
             }

@@ -13,7 +13,7 @@
 //!   declared with `--carry` are carried to the output (or, for `simulate`, ignored) silently;
 //! - any other column is carried (or ignored) with a warning naming it and the inputs.
 
-use crate::common::{parse_list, CliResult, NamesArg};
+use crate::common::{parse_list, CliResult, Names, NamesArg};
 use robodyn::io::table::TableReader;
 use std::io::Read;
 use std::path::Path;
@@ -56,6 +56,8 @@ pub struct ColumnSpec<'a> {
     pub fate: &'static str,
     /// How `--carry` is spelt for this command, if it has it.
     pub carry_option: bool,
+    /// Said after a missing-column error (the table follows the other `--names`).
+    pub hint: Option<String>,
 }
 
 /// The columns of a header against a [`ColumnSpec`].
@@ -245,8 +247,12 @@ fn missing_error(missing: &[&str], spec: &ColumnSpec, file: &str) -> String {
             optional.join("/")
         )
     };
+    let hint = spec
+        .hint
+        .as_ref()
+        .map_or_else(String::new, |h| format!("; {h}"));
     format!(
-        "{file}: missing column{} {} (the inputs are {}{rule})",
+        "{file}: missing column{} {} (the inputs are {}{rule}){hint}",
         plural(missing.len()),
         names.join(", "),
         expected(spec),
@@ -390,6 +396,7 @@ impl StateInput {
             declared: r.carry,
             fate: "carried to the output",
             carry_option: true,
+            hint: other_naming(reader.headers(), r),
         };
         let c = classify(reader.headers(), &spec, &file)?;
         let carried_headers = c
@@ -478,6 +485,27 @@ impl StateInput {
         self.read += chunk.count;
         Ok(chunk.count > 0)
     }
+}
+
+/// "the table names its columns after the joints: give --names joint" when every `q` column of
+/// the other naming is in the header.
+fn other_naming(headers: &[String], r: &StateRequest) -> Option<String> {
+    let other = match r.names.names {
+        Names::Frame => Names::Joint,
+        Names::Joint => Names::Frame,
+    };
+    let names = NamesArg { names: other };
+    let all = names
+        .columns(r.prefixes[0], r.coords)
+        .iter()
+        .all(|c| headers.contains(c));
+    all.then(|| {
+        let (how, option) = match other {
+            Names::Joint => ("after the joints", "--names joint"),
+            Names::Frame => ("by frame number", "--names frame"),
+        };
+        format!("the table names its columns {how}: give {option}")
+    })
 }
 
 /// The one state of the command-line lists: the first required, the others zeros by default.

@@ -182,6 +182,34 @@ fn absent_velocities_and_accelerations_are_said() {
     );
 }
 
+/// A table named after the joints, read without `--names joint`: the missing columns and the hint.
+#[test]
+fn the_other_naming_is_pointed_out() {
+    let urdf = robot("rx90.urdf");
+    let out = run(&["idm", &urdf, "--q=0,0,0,0,0,0", "--names", "joint"]);
+    let header = out.stdout.lines().next().unwrap().replace("tau_", "q_");
+    let t = table(
+        "joint_named.csv",
+        &format!("{header}\n0.1,0.2,0.3,0.4,0.5,0.6\n"),
+    );
+    let out = run(&["idm", &urdf, "--input", t.to_str().unwrap()]);
+    assert_eq!(out.code, Some(1));
+    assert!(
+        out.stderr.contains("missing columns `q1`") && out.stderr.contains("give --names joint"),
+        "{}",
+        out.stderr
+    );
+    let out = run(&[
+        "idm",
+        &urdf,
+        "--input",
+        t.to_str().unwrap(),
+        "--names",
+        "joint",
+    ]);
+    assert_eq!(out.code, Some(0), "{}", out.stderr);
+}
+
 /// `--q 1,2,` names the trailing comma (it said "`` is not a number"); `--kp`/`--kd` without
 /// `--track` are refused (they were ignored).
 #[test]

@@ -294,6 +294,7 @@ fn read_series(
         declared: &[],
         fate: "ignored",
         carry_option: false,
+        hint: None,
     };
     let c = classify(&t.headers, &spec, &file)?;
     let cols: Vec<usize> = c.groups.iter().flatten().flatten().copied().collect();
