@@ -8,30 +8,12 @@
 
 mod common;
 
-use common::{robot, slider_crank};
-use robodyn::algorithms::closed_chain::{ClosureSolution, DEFAULT_STEP_BUDGET};
-use robodyn::geometry::frame_transforms;
+use common::{closure_gap, robot, slider_crank};
+use robodyn::algorithms::closed_chain::DEFAULT_STEP_BUDGET;
 use robodyn::{
     closed_inverse_dynamics_into, loop_closure, loop_closure_into, ClosedChain, ClosedData, Error,
-    Robot,
 };
 use std::f64::consts::PI;
-
-/// Largest gap between each cut frame and its twin at a solution (geometric model).
-fn closure_gap(r: &Robot, cc: &ClosedChain, s: &ClosureSolution) -> f64 {
-    let mut q: Vec<f64> = s.q_tree.iter().copied().collect();
-    q.extend(s.q_c.iter());
-    let t = frame_transforms(r, &q);
-    cc.loops()
-        .iter()
-        .map(|l| {
-            let (k, tw) = (l.topology.cut, l.topology.twin);
-            (t[k - 1].rot - t[tw - 1].rot)
-                .amax()
-                .max((t[k - 1].pos - t[tw - 1].pos).amax())
-        })
-        .fold(0.0, f64::max)
-}
 
 /// `x` less the whole turns nearest to it (rounding ~1e-9 at |x| = 1e7).
 fn less_turns(x: f64) -> f64 {

@@ -7,9 +7,9 @@
 //! or `--guess`); rows near a singularity are flagged on stderr and in JSON.
 
 use crate::common::{CliResult, NamesArg, Phases, RobotArgs, TableOutput, TimingsArg};
-use crate::rows::{closed_rows, tree_rows};
-use crate::states::{CarryArg, StateInput, StateRequest};
-use robodyn::{closed_direct_dynamics_into, direct_dynamics_batch, ClosedChain, Method};
+use crate::rows::Evaluation;
+use crate::states::CarryArg;
+use robodyn::{closed_direct_dynamics_into, direct_dynamics_batch, Method};
 use std::path::PathBuf;
 
 /// Direct-dynamics algorithm.
@@ -64,66 +64,31 @@ pub struct Args {
     pub timings: TimingsArg,
 }
 
-impl Args {
-    /// The states asked for, over `coords` (`what` names the joints in messages).
-    fn states<'a>(
-        &'a self,
-        robot: &'a robodyn::Robot,
-        coords: &'a robodyn::Coordinates,
-        what: &'a str,
-    ) -> StateRequest<'a> {
-        StateRequest {
-            tree: robot.coordinates(),
-            input: self.input.as_deref(),
-            prefixes: ["q", "qd", "tau"],
-            lists: [self.q.as_deref(), self.qd.as_deref(), self.tau.as_deref()],
-            coords,
-            names: self.names,
-            what,
-            carry: &self.carry.carry,
-        }
-    }
-}
-
 pub fn run(a: Args) -> CliResult {
     let mut t = Phases::start(a.timings);
     let robot = a.robot.load()?;
     t.lap("robot");
     let env = robot.environment();
-    let (mut input, mut out);
-    if robot.is_tree() {
-        let coords = robot.coordinates();
-        input = StateInput::open(&a.states(&robot, coords, "movable joints"))?;
-        out = a
-            .out
-            .writer(input.headers_with(&a.names.columns("qdd", coords))?)?;
-        // chunks of the table at once over the cores (the library's batch; errors name their
-        // row)
-        let method = a.method.into();
-        tree_rows(&mut input, &mut out, coords.len(), &mut t, |c, qdd| {
-            direct_dynamics_batch(&robot, env, &c.x[0], &c.x[1], &c.x[2], method, qdd)
-        })?;
-    } else {
-        // closed chains: the actuated joints' columns in and out (the `--method` is the
-        // closed-chain model's A_cl, H_cl), every row on the branch tracker
-        let chain = ClosedChain::new(&robot)?;
-        let coords = chain.coordinates();
-        input = StateInput::open(&a.states(&robot, coords, "actuated joints (closed chain)"))?;
-        out = a
-            .out
-            .writer(input.headers_with(&a.names.columns("qdd", coords))?)?;
-        let guess = a.guess.as_deref();
-        closed_rows(
-            &mut input,
-            &mut out,
-            &chain,
-            guess,
-            &mut t,
-            |b, d, x, qdd| closed_direct_dynamics_into(&chain, d, b, env, x[0], x[1], x[2], qdd),
-        )?;
-    }
-    out.finish()?;
-    t.lap("write");
-    t.report(input.count());
-    Ok(())
+    let method: Method = a.method.into();
+    let evaluation = Evaluation {
+        input: a.input.as_deref(),
+        prefixes: ["q", "qd", "tau"],
+        lists: [a.q.as_deref(), a.qd.as_deref(), a.tau.as_deref()],
+        names: a.names,
+        carry: &a.carry.carry,
+        guess: a.guess.as_deref(),
+        output: &a.out,
+        result: "qdd",
+    };
+    evaluation.run(
+        &robot,
+        &mut t,
+        // chunks of the table at once over the cores (the library's batch; errors name their row)
+        &mut |c, qdd| direct_dynamics_batch(&robot, env, &c.x[0], &c.x[1], &c.x[2], method, qdd),
+        // closed chains: A_cl, H_cl of 10.46-10.48 (not --method), every row on the branch
+        // tracker
+        &mut |chain, b, d, x, qdd| {
+            closed_direct_dynamics_into(chain, d, b, env, x[0], x[1], x[2], qdd)
+        },
+    )
 }

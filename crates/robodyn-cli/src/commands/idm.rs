@@ -7,9 +7,9 @@
 //! robot's `assembly` or `--guess`); rows near a singularity are flagged on stderr and in JSON.
 
 use crate::common::{CliResult, NamesArg, Phases, RobotArgs, TableOutput, TimingsArg};
-use crate::rows::{closed_rows, tree_rows};
-use crate::states::{CarryArg, StateInput, StateRequest};
-use robodyn::{closed_inverse_dynamics_into, inverse_dynamics_batch, ClosedChain};
+use crate::rows::Evaluation;
+use crate::states::CarryArg;
+use robodyn::{closed_inverse_dynamics_into, inverse_dynamics_batch};
 use std::path::PathBuf;
 
 #[derive(clap::Args, Debug)]
@@ -44,65 +44,29 @@ pub struct Args {
     pub timings: TimingsArg,
 }
 
-impl Args {
-    /// The states asked for, over `coords` (`what` names the joints in messages).
-    fn states<'a>(
-        &'a self,
-        robot: &'a robodyn::Robot,
-        coords: &'a robodyn::Coordinates,
-        what: &'a str,
-    ) -> StateRequest<'a> {
-        StateRequest {
-            tree: robot.coordinates(),
-            input: self.input.as_deref(),
-            prefixes: ["q", "qd", "qdd"],
-            lists: [self.q.as_deref(), self.qd.as_deref(), self.qdd.as_deref()],
-            coords,
-            names: self.names,
-            what,
-            carry: &self.carry.carry,
-        }
-    }
-}
-
 pub fn run(a: Args) -> CliResult {
     let mut t = Phases::start(a.timings);
     let robot = a.robot.load()?;
     t.lap("robot");
     let env = robot.environment();
-    let (mut input, mut out);
-    if robot.is_tree() {
-        let coords = robot.coordinates();
-        input = StateInput::open(&a.states(&robot, coords, "movable joints"))?;
-        out = a
-            .out
-            .writer(input.headers_with(&a.names.columns("tau", coords))?)?;
-        // chunks of the table at once over the cores (the library's batch; errors name their
-        // row)
-        tree_rows(&mut input, &mut out, coords.len(), &mut t, |c, tau| {
-            inverse_dynamics_batch(&robot, env, &c.x[0], &c.x[1], &c.x[2], tau)
-        })?;
-    } else {
-        // closed chains: the actuated joints' columns in and out, every row on the branch
-        // tracker (library: continuation from the previous row)
-        let chain = ClosedChain::new(&robot)?;
-        let coords = chain.coordinates();
-        input = StateInput::open(&a.states(&robot, coords, "actuated joints (closed chain)"))?;
-        out = a
-            .out
-            .writer(input.headers_with(&a.names.columns("tau", coords))?)?;
-        let guess = a.guess.as_deref();
-        closed_rows(
-            &mut input,
-            &mut out,
-            &chain,
-            guess,
-            &mut t,
-            |b, d, x, tau| closed_inverse_dynamics_into(&chain, d, b, env, x[0], x[1], x[2], tau),
-        )?;
-    }
-    out.finish()?;
-    t.lap("write");
-    t.report(input.count());
-    Ok(())
+    let evaluation = Evaluation {
+        input: a.input.as_deref(),
+        prefixes: ["q", "qd", "qdd"],
+        lists: [a.q.as_deref(), a.qd.as_deref(), a.qdd.as_deref()],
+        names: a.names,
+        carry: &a.carry.carry,
+        guess: a.guess.as_deref(),
+        output: &a.out,
+        result: "tau",
+    };
+    evaluation.run(
+        &robot,
+        &mut t,
+        // chunks of the table at once over the cores (the library's batch; errors name their row)
+        &mut |c, tau| inverse_dynamics_batch(&robot, env, &c.x[0], &c.x[1], &c.x[2], tau),
+        // closed chains: every row on the branch tracker (continued from the previous row)
+        &mut |chain, b, d, x, tau| {
+            closed_inverse_dynamics_into(chain, d, b, env, x[0], x[1], x[2], tau)
+        },
+    )
 }
