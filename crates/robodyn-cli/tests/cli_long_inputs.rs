@@ -68,6 +68,33 @@ fn endless_lines_are_errors_with_their_line() {
     std::fs::remove_file(&torques).unwrap();
 }
 
+/// An endless robot file or grouping list is refused after a bounded read (64 and 16 MiB),
+/// naming the file, where it was read until memory ran out (here, under a 1 GB limit so the
+/// machine stays safe: "out of memory").
+#[test]
+fn endless_robot_files_are_refused() {
+    let rx90 = robot("rx90.toml");
+    for (args, file) in [
+        (vec!["info", "/dev/zero"], "/dev/zero"),
+        (
+            vec![
+                "generate",
+                &rx90,
+                "--params",
+                "base",
+                "--base-file",
+                "/dev/zero",
+            ],
+            "/dev/zero",
+        ),
+    ] {
+        let r = robodyn_in_shell("ulimit -v 1000000", &args, LIMIT);
+        refused(&r, &format!("{file}: longer than"));
+    }
+    let r = robodyn_in_shell("ulimit -v 1000000; exec < /dev/zero", &["info", "-"], LIMIT);
+    refused(&r, "<stdin>: longer than");
+}
+
 /// `regressor --input` of 150,000 states under a 400 MB address-space limit: it streams (24 MB;
 /// the rows of Phi of every state in memory at once needed about 570 MB, and the allocation
 /// failure aborted). Its rows equal those of the same states one at a time.

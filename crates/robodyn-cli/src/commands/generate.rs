@@ -91,8 +91,19 @@ pub fn run(a: Args) -> CliResult {
         Params::Standard => None,
         Params::Base => match &a.base_file {
             Some(path) => {
-                let text = std::fs::read_to_string(path)
+                let mut text = String::new();
+                let file =
+                    std::fs::File::open(path).map_err(|e| format!("{}: {e}", path.display()))?;
+                // a grouping list is a few kB: an endless file (`/dev/zero`) is refused
+                std::io::Read::read_to_string(&mut std::io::Read::take(file, 1 << 24), &mut text)
                     .map_err(|e| format!("{}: {e}", path.display()))?;
+                if text.len() >= 1 << 24 {
+                    return Err(format!(
+                        "{}: longer than 16 MiB: not a grouping list",
+                        path.display()
+                    )
+                    .into());
+                }
                 Some(BaseParameters::parse(&text, &path.display().to_string())?)
             }
             // the grouping of the symbolic method (Table 10.2 for the SR400)

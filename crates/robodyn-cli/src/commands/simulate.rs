@@ -332,13 +332,18 @@ fn check_options(a: &Args) -> CliResult {
         return Err("--max-steps 0: must be at least 1".into());
     }
     let step = a.output_step.or(a.dt).unwrap_or(0.01);
-    if a.duration / step > MAX_ROWS {
+    let rows = a.duration / step;
+    if rows > MAX_ROWS {
         return Err(format!(
-            "--duration {} with an output step of {} s gives {:.1e} rows, more than {MAX_ROWS:.0e} \
+            "--duration {} with an output step of {} s gives {} rows, more than {MAX_ROWS:.0e} \
              (give a larger --output-step)",
             format_number(a.duration),
             format_number(step),
-            a.duration / step
+            if rows.is_finite() {
+                format!("{rows:.1e}")
+            } else {
+                "more than 1e308".into()
+            }
         )
         .into());
     }
