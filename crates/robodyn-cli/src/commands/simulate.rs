@@ -578,7 +578,11 @@ fn finish(
             eprintln!(
                 "simulated {} s: {} rows in {csv_name}, {} steps ({} rejected), {} model \
                  evaluations",
-                s.t_end, s.rows, s.stats.accepted, s.stats.rejected, s.stats.evaluations
+                format_number(s.t_end),
+                s.rows,
+                s.stats.accepted,
+                s.stats.rejected,
+                s.stats.evaluations
             );
             Ok(())
         }
