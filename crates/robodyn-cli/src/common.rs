@@ -1,10 +1,12 @@
 //! Options and helpers shared by the commands: loading a robot, reading and writing state tables.
 
+use crate::output::Output;
+pub use crate::output::{check_finite, write_table, write_text, TableFormat, TableWriter};
 use clap::Args;
 use robodyn::Robot;
 use std::collections::BTreeMap;
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 pub type CliResult<T = ()> = Result<T, Box<dyn std::error::Error>>;
 
@@ -96,196 +98,56 @@ pub fn parse_value(t: &str) -> Result<f64, String> {
     }
 }
 
-/// Parse a comma-separated list of numbers (`--q 0.1,0.2,...`), each by [`parse_value`].
+/// Parse a comma-separated list of numbers (`--q 0.1,0.2,...`), each by [`parse_value`]. An
+/// empty entry (`1,,2`, a trailing or leading comma) is an error saying where.
 pub fn parse_list(name: &str, s: &str) -> CliResult<Vec<f64>> {
-    s.split(',')
-        .map(|t| parse_value(t).map_err(|e| format!("--{name}: {e}").into()))
+    let parts: Vec<&str> = s.split(',').collect();
+    let count = parts.len();
+    parts
+        .iter()
+        .enumerate()
+        .map(|(k, t)| {
+            if t.trim().is_empty() {
+                let place = match k {
+                    0 if count == 1 => "no value given".to_string(),
+                    0 => "a comma before the first value".to_string(),
+                    k if k + 1 == count => format!("a trailing comma after value {k}"),
+                    k => format!("no value between commas {k} and {}", k + 1),
+                };
+                return Err(format!(
+                    "--{name} {s}: {place} (give one number per joint, separated by commas)"
+                )
+                .into());
+            }
+            parse_value(t).map_err(|e| format!("--{name}: {e}").into())
+        })
         .collect()
 }
 
-/// A table of named columns read from CSV.
-pub struct Table {
-    pub headers: Vec<String>,
-    pub rows: Vec<Vec<f64>>,
-    pub file: String,
-}
-
-impl Table {
-    /// Read a state table (the library's reader: a repeated column, a short row or a field
-    /// that is not a finite number is an error with its line); `-` is standard input.
-    pub fn read(path: &Path) -> CliResult<Table> {
-        let t = if robodyn::io::is_stdio(path) {
-            let mut b = Vec::new();
-            std::io::Read::read_to_end(&mut std::io::stdin().lock(), &mut b)
-                .map_err(|e| format!("<stdin>: {e}"))?;
-            robodyn::io::table::Table::parse(&b, "<stdin>")?
-        } else {
-            robodyn::io::table::Table::read(path)?
-        };
-        Ok(Table {
-            headers: t.headers,
-            rows: t.rows,
-            file: t.file,
-        })
-    }
-
-    /// Index of a column, or an error naming the file and the column.
-    pub fn column(&self, name: &str) -> CliResult<usize> {
-        self.headers
-            .iter()
-            .position(|h| h == name)
-            .ok_or_else(|| format!("{}: missing column `{name}`", self.file).into())
-    }
-
-    /// Index of a column if present.
-    pub fn find(&self, name: &str) -> Option<usize> {
-        self.headers.iter().position(|h| h == name)
-    }
-}
-
-/// Output format of tables.
-#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum TableFormat {
-    #[default]
-    Csv,
-    Json,
-}
-
-/// Where and how a command writes its table (`--output`, `--format`).
+/// `--output` and `--format` of the commands that write a table.
 #[derive(Args, Debug, Clone)]
 pub struct TableOutput {
-    /// Output file (default or `-`: standard output).
+    /// Output file (default or `-`: standard output), written all or nothing.
     #[arg(long)]
     pub output: Option<PathBuf>,
+    /// Table format: csv (a header of column names, one row per line) or json (a list of
+    /// objects keyed by column name).
     #[arg(long, value_enum, default_value = "csv")]
     pub format: TableFormat,
 }
 
 impl TableOutput {
-    /// Write rows of named columns.
-    pub fn write(&self, headers: &[String], rows: &[Vec<f64>]) -> CliResult {
-        write_table(self.output.as_deref(), self.format, headers, rows)
-    }
-
-    /// Write rows with extra JSON fields per row.
-    pub fn write_with(
-        &self,
-        headers: &[String],
-        rows: &[Vec<f64>],
-        json_extra: &[serde_json::Map<String, serde_json::Value>],
-    ) -> CliResult {
-        write_table_with(
-            self.output.as_deref(),
+    /// A table writer on `--output` with these columns.
+    pub fn writer(&self, headers: Vec<String>) -> CliResult<TableWriter> {
+        TableWriter::new(
+            Output::create(self.output.as_deref())?,
             self.format,
             headers,
-            rows,
-            json_extra,
         )
     }
 }
 
-/// Write rows of named columns as CSV or JSON (a list of objects) to a file or stdout.
-pub fn write_table(
-    path: Option<&Path>,
-    format: TableFormat,
-    headers: &[String],
-    rows: &[Vec<f64>],
-) -> CliResult {
-    write_table_with(path, format, headers, rows, &[])
-}
-
-/// [`write_table`] with extra fields per row in JSON output (e.g. a closed chain's
-/// conditioning); CSV output leaves them out.
-pub fn write_table_with(
-    path: Option<&Path>,
-    format: TableFormat,
-    headers: &[String],
-    rows: &[Vec<f64>],
-    json_extra: &[serde_json::Map<String, serde_json::Value>],
-) -> CliResult {
-    check_finite(headers, rows)?;
-    let mut out = create_output(path)?;
-    match format {
-        TableFormat::Csv => {
-            writeln!(out, "{}", headers.join(","))?;
-            // each number written in place (no string per number or per line)
-            for r in rows {
-                for (k, &x) in r.iter().enumerate() {
-                    if k > 0 {
-                        out.write_all(b",")?;
-                    }
-                    write!(out, "{}", Number(x))?;
-                }
-                out.write_all(b"\n")?;
-            }
-        }
-        TableFormat::Json => {
-            let v: Vec<serde_json::Map<String, serde_json::Value>> = rows
-                .iter()
-                .enumerate()
-                .map(|(k, r)| {
-                    let mut o: serde_json::Map<String, serde_json::Value> = headers
-                        .iter()
-                        .zip(r)
-                        .map(|(h, x)| (h.clone(), serde_json::json!(x)))
-                        .collect();
-                    if let Some(e) = json_extra.get(k) {
-                        o.extend(e.clone());
-                    }
-                    o
-                })
-                .collect();
-            serde_json::to_writer_pretty(&mut out, &v)?;
-            writeln!(out)?;
-        }
-    }
-    out.flush()?;
-    Ok(())
-}
-
 pub use robodyn::simulation::format_number;
-use robodyn::simulation::output::Number;
-
-/// A result that is not a finite number is an error, never printed (a velocity of 1e200 or a
-/// gravity of 1e308 overflows the model).
-pub fn check_finite(headers: &[String], rows: &[Vec<f64>]) -> CliResult {
-    for (k, r) in rows.iter().enumerate() {
-        if let Some((c, x)) = r.iter().enumerate().find(|(_, x)| !x.is_finite()) {
-            return Err(format!(
-                "{}{} = {x}: the result is not a finite number (an input, a symbol value or the \
-                 gravity is too large for the model's arithmetic); nothing was written",
-                if rows.len() > 1 {
-                    format!("row {}: ", k + 1)
-                } else {
-                    String::new()
-                },
-                headers.get(c).map_or("a value", String::as_str)
-            )
-            .into());
-        }
-    }
-    Ok(())
-}
-
-/// An output file, or standard output for `None` or `-`.
-pub fn create_output(path: Option<&Path>) -> CliResult<Box<dyn Write>> {
-    Ok(match path {
-        Some(p) if !robodyn::io::is_stdio(p) => Box::new(std::io::BufWriter::new(
-            std::fs::File::create(p).map_err(|e| format!("{}: {e}", p.display()))?,
-        )),
-        _ => Box::new(std::io::BufWriter::new(std::io::stdout().lock())),
-    })
-}
-
-/// Write text to a file, or to standard output for `None` or `-`.
-pub fn write_text(path: Option<&Path>, text: &str) -> CliResult {
-    match path {
-        Some(p) if !robodyn::io::is_stdio(p) => {
-            std::fs::write(p, text).map_err(|e| format!("{}: {e}", p.display()).into())
-        }
-        _ => print_out(text),
-    }
-}
 
 /// Write text to standard output (a closed pipe is an error [`is_broken_pipe`] recognizes).
 pub fn print_out(text: &str) -> CliResult {
@@ -351,123 +213,6 @@ impl NamesArg {
     }
 }
 
-/// One state per row: three per-joint columns (e.g. `q qd qdd` or `q qd tau`) over `coords`.
-pub type States = Vec<[Vec<f64>; 3]>;
-
-/// The columns of an `--input` table that are not inputs (`t`, labels...), carried through to
-/// the output in front of the results.
-#[derive(Default)]
-pub struct Carried {
-    pub headers: Vec<String>,
-    pub rows: Vec<Vec<f64>>,
-}
-
-impl Carried {
-    /// The output's headers and rows: the carried columns, then `headers`/`rows`.
-    pub fn prepend(&self, headers: &[String], rows: Vec<Vec<f64>>) -> (Vec<String>, Vec<Vec<f64>>) {
-        if self.headers.is_empty() {
-            return (headers.to_vec(), rows);
-        }
-        let h = self.headers.iter().chain(headers).cloned().collect();
-        let r = rows
-            .into_iter()
-            .zip(&self.rows)
-            .map(|(r, c)| c.iter().copied().chain(r).collect())
-            .collect();
-        (h, r)
-    }
-}
-
-/// Read states over `coords` from a CSV file (`input`, `-` for standard input, columns named by
-/// `names`) or from the comma lists of the command line (`lists`). In both, the first quantity
-/// (`q`) is required and the others default to zeros when absent (all their columns absent); the
-/// missing columns are reported together. `what` names the joints in messages ("movable
-/// joints", "actuated joints").
-pub fn read_joint_states(
-    input: Option<&Path>,
-    prefixes: [&str; 3],
-    lists: [Option<&str>; 3],
-    coords: &robodyn::Coordinates,
-    names: NamesArg,
-    what: &str,
-) -> CliResult<(States, Carried)> {
-    let n = coords.len();
-    if let Some(path) = input {
-        let t = Table::read(path)?;
-        let mut cols: [Vec<Option<usize>>; 3] = Default::default();
-        let mut missing = Vec::new();
-        for (i, prefix) in prefixes.iter().enumerate() {
-            let wanted: Vec<String> = (0..n).map(|k| names.column(prefix, coords, k)).collect();
-            cols[i] = wanted.iter().map(|w| t.find(w)).collect();
-            // q is required; qd, qdd (tau) may be absent altogether (zeros), not in part
-            if i == 0 || cols[i].iter().any(Option::is_some) {
-                missing.extend(
-                    wanted
-                        .iter()
-                        .zip(&cols[i])
-                        .filter(|(_, c)| c.is_none())
-                        .map(|(w, _)| format!("`{w}`")),
-                );
-            }
-        }
-        if !missing.is_empty() {
-            return Err(format!(
-                "{}: missing column{} {} (the {what} are {:?}; {} columns default to zero only \
-                 when all of them are absent)",
-                t.file,
-                if missing.len() > 1 { "s" } else { "" },
-                missing.join(", "),
-                coords.frames(),
-                prefixes[1..].join("/")
-            )
-            .into());
-        }
-        let used: std::collections::BTreeSet<usize> =
-            cols.iter().flatten().flatten().copied().collect();
-        let kept: Vec<usize> = (0..t.headers.len()).filter(|c| !used.contains(c)).collect();
-        let carried = Carried {
-            headers: kept.iter().map(|&c| t.headers[c].clone()).collect(),
-            rows: t
-                .rows
-                .iter()
-                .map(|r| kept.iter().map(|&c| r[c]).collect())
-                .collect(),
-        };
-        let states = t
-            .rows
-            .iter()
-            .map(|r| {
-                std::array::from_fn(|i| cols[i].iter().map(|c| c.map_or(0.0, |c| r[c])).collect())
-            })
-            .collect();
-        return Ok((states, carried));
-    }
-    if lists[0].is_none() {
-        return Err(format!(
-            "give --input states.csv or --{} (with --{}, --{})",
-            prefixes[0], prefixes[1], prefixes[2]
-        )
-        .into());
-    }
-    let mut s = [vec![0.0; n], vec![0.0; n], vec![0.0; n]];
-    for k in 0..3 {
-        if let Some(v) = lists[k] {
-            let vals = parse_list(prefixes[k], v)?;
-            if vals.len() != n {
-                return Err(format!(
-                    "--{} has {} values, the robot has {n} {what} ({:?})",
-                    prefixes[k],
-                    vals.len(),
-                    coords.frames()
-                )
-                .into());
-            }
-            s[k] = vals;
-        }
-    }
-    Ok((vec![s], Carried::default()))
-}
-
 /// The branch tracker of a closed chain: from `--guess` (q_p at the first q_a) when given, else
 /// the robot's assembly.
 pub fn start_branch(
@@ -481,19 +226,15 @@ pub fn start_branch(
     })
 }
 
-/// Say on stderr that a closed-chain row is near a singularity.
+/// Say on stderr that a closed-chain state (`row` of a table, none for the command line's) is
+/// near a singularity.
 pub fn warn_conditioning(
     chain: &robodyn::ClosedChain,
-    row: usize,
-    rows: usize,
+    row: Option<usize>,
     c: &robodyn::Conditioning,
 ) {
     if c.warning {
-        let which = if rows > 1 {
-            format!("row {row}: ")
-        } else {
-            String::new()
-        };
+        let which = row.map_or_else(String::new, |r| format!("row {r}: "));
         eprintln!(
             "robodyn: warning: {which}near a singular configuration: {}; the result is \
              sensitive to its inputs",
@@ -513,18 +254,25 @@ pub fn conditioning_json(c: &robodyn::Conditioning) -> serde_json::Map<String, s
     o
 }
 
-/// Column `i` (q, qd, qdd or tau) of the states as one row-major N x n slice: the layout of the
-/// library's batch functions (`robodyn::batch`).
-pub fn state_column(states: &[[Vec<f64>; 3]], i: usize) -> Vec<f64> {
-    states.iter().flat_map(|s| s[i].iter().copied()).collect()
+/// A library error of row `row` of a chunk of states as the error of the table's row: the
+/// chunk starts at state `first` (1-based).
+pub fn in_table(e: robodyn::Error, first: usize) -> robodyn::Error {
+    match e {
+        robodyn::Error::Row { row, source } => robodyn::Error::Row {
+            row: row + first - 1,
+            source,
+        },
+        e => e,
+    }
 }
 
-/// The `count` rows of n entries of a row-major result.
-pub fn result_rows(flat: &[f64], n: usize, count: usize) -> Vec<Vec<f64>> {
-    (0..count)
-        .map(|s| flat[s * n..(s + 1) * n].to_vec())
-        .collect()
+/// How many states a chunk of a table holds when each state gives `values` numbers: about 2
+/// million numbers (16 MB) per chunk, whatever the table's length.
+pub fn chunk_states(values: usize) -> usize {
+    (CHUNK_VALUES / values.max(1)).max(1)
 }
+
+const CHUNK_VALUES: usize = 1 << 21;
 
 /// `--timings` of the commands that evaluate a model on a state table.
 #[derive(Args, Debug, Clone, Copy)]
@@ -556,11 +304,15 @@ impl Phases {
         }
     }
 
-    /// The time since the previous phase ended was `phase`.
+    /// The time since the previous phase ended was `phase` (added to its total: a table read,
+    /// evaluated and written in chunks goes through the phases once per chunk).
     pub fn lap(&mut self, phase: &'static str) {
         if self.on {
             let now = std::time::Instant::now();
-            self.done.push((phase, now - self.last));
+            match self.done.iter_mut().find(|(p, _)| *p == phase) {
+                Some((_, d)) => *d += now - self.last,
+                None => self.done.push((phase, now - self.last)),
+            }
             self.last = now;
         }
     }

@@ -15,6 +15,9 @@ macro_rules! outln {
 
 mod commands;
 mod common;
+mod output;
+mod rows;
+mod states;
 
 use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 

@@ -15,18 +15,30 @@ mod cli_bad_input;
 mod cli_base_params_closed;
 #[path = "cli_closed.rs"]
 mod cli_closed;
+#[path = "cli_closed_budget.rs"]
+mod cli_closed_budget;
 #[path = "cli_closed_rows.rs"]
 mod cli_closed_rows;
+#[path = "cli_columns.rs"]
+mod cli_columns;
 #[path = "cli_conventions.rs"]
 mod cli_conventions;
 #[path = "cli_generate.rs"]
 mod cli_generate;
+#[path = "cli_generate_names.rs"]
+mod cli_generate_names;
 #[path = "cli_identify.rs"]
 mod cli_identify;
 #[path = "cli_info.rs"]
 mod cli_info;
 #[path = "cli_info_assembly.rs"]
 mod cli_info_assembly;
+#[path = "cli_long_inputs.rs"]
+mod cli_long_inputs;
+#[path = "cli_outputs.rs"]
+mod cli_outputs;
+#[path = "cli_random_options.rs"]
+mod cli_random_options;
 #[path = "cli_simulate_names.rs"]
 mod cli_simulate_names;
 

@@ -503,6 +503,110 @@ fn is_reserved(name: &str) -> bool {
     RESERVED.split_whitespace().any(|r| r == name)
 }
 
+/// The names the generated code itself uses in the function's scope: its arguments, helpers
+/// and the math functions it calls (a function of that name would hide or clash with them).
+const CODE_NAMES: &str = "q qd qdd p gam out sgn rd_sign np math sin cos tan sqrt abs fabs \
+    sign atan atan2 pow zeros pi Inf NaN inf nan";
+
+/// The reserved words of each language a function may not be named (keywords, and for C the
+/// functions `math.h` declares).
+fn keywords(lang: Lang) -> &'static str {
+    match lang {
+        Lang::Text | Lang::Latex => "",
+        Lang::Rust => {
+            "as async await break const continue crate dyn else enum extern false fn for gen if \
+             impl in let loop match mod move mut pub ref return self Self static struct super \
+             trait true type unsafe use where while abstract become box do final macro override \
+             priv try typeof unsized virtual yield f64 std"
+        }
+        Lang::C => {
+            "auto break case char const continue default do double else enum extern float for \
+             goto if inline int long register restrict return short signed sizeof static struct \
+             switch typedef union unsigned void volatile while _Bool _Complex _Imaginary \
+             bool true false acos asin atan atan2 ceil cos cosh exp fabs floor fmod frexp ldexp \
+             log log10 modf pow sin sinh sqrt tan tanh cbrt exp2 expm1 fma fmax fmin hypot \
+             log1p log2 lround round trunc nan remainder"
+        }
+        Lang::Python => {
+            "False None True and as assert async await break class continue def del elif else \
+             except finally for from global if import in is lambda nonlocal not or pass raise \
+             return try while with yield"
+        }
+        Lang::Julia => {
+            "baremodule begin break catch const continue do else elseif end export false \
+             finally for function global if import let local macro module quote return struct \
+             true try using while abstract mutable primitive type where in isa outer public"
+        }
+        Lang::Matlab => {
+            "break case catch classdef continue else elseif end for function global if \
+             otherwise parfor persistent return spmd switch try while arguments enumeration \
+             events methods properties"
+        }
+    }
+}
+
+/// Check a function name for generated code in `lang`: an ASCII identifier (a letter or `_`,
+/// then letters, digits, `_`; MATLAB: a letter first and at most 63 characters), not a reserved
+/// word of the language, and not a name the generated code uses itself (`q`, `out`, `sin`...).
+/// The same rule holds for text and LaTeX, whose headers name the function. The error says
+/// which rule the name breaks.
+pub fn check_function_name(name: &str, lang: Lang) -> Result<(), String> {
+    let language = match lang {
+        Lang::Text => "text",
+        Lang::Latex => "LaTeX",
+        Lang::Rust => "Rust",
+        Lang::C => "C",
+        Lang::Python => "Python",
+        Lang::Julia => "Julia",
+        Lang::Matlab => "MATLAB",
+    };
+    let first_ok = match lang {
+        Lang::Matlab => name.starts_with(|c: char| c.is_ascii_alphabetic()),
+        _ => name.starts_with(|c: char| c.is_ascii_alphabetic() || c == '_'),
+    };
+    if name.is_empty()
+        || !first_ok
+        || !name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_')
+        || name.chars().all(|c| c == '_')
+    {
+        let first = if lang == Lang::Matlab {
+            "a letter"
+        } else {
+            "a letter or `_`"
+        };
+        return Err(format!(
+            "`{name}` is not a {language} identifier, as a function name must be: it starts \
+             with {first} and has only ASCII letters, digits and `_` (no spaces, punctuation or \
+             other characters)"
+        ));
+    }
+    if lang == Lang::Matlab && name.len() > 63 {
+        return Err(format!(
+            "`{name}` has {} characters: MATLAB names have at most 63",
+            name.len()
+        ));
+    }
+    if lang == Lang::C
+        && (name.starts_with("__")
+            || name.starts_with("_") && name[1..].starts_with(|c: char| c.is_ascii_uppercase()))
+    {
+        return Err(format!(
+            "`{name}` is reserved in C (names beginning with `__` or `_` and a capital letter)"
+        ));
+    }
+    if keywords(lang).split_whitespace().any(|k| k == name) {
+        return Err(format!("`{name}` is a reserved word of {language}"));
+    }
+    if lang != Lang::Text && lang != Lang::Latex && CODE_NAMES.split_whitespace().any(|k| k == name)
+    {
+        return Err(format!(
+            "`{name}` is a name the generated {language} code uses itself (its arguments, \
+             helpers and math functions: {CODE_NAMES})"
+        ));
+    }
+    Ok(())
+}
+
 /// Names of a program's symbols in generated code. A symbol whose name is reserved (a robot
 /// symbol `p`, `end` or `in`) is written with underscores appended until the name is free; the
 /// caller never sees it, since inputs are passed by position.

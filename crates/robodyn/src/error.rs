@@ -154,6 +154,17 @@ pub enum Error {
         /// Why (a singularity or fold on the path, no convergence).
         reason: String,
     },
+    /// A closed-chain configuration the branch tracker cannot reach within its step budget
+    /// (`ClosedChain::step_budget`): the move is too long to follow and cannot be shortened.
+    #[error("q_a = {at} cannot be reached on the assembly branch within the continuation's budget of {budget} steps: {reason}")]
+    ContinuationBudget {
+        /// The target actuated values.
+        at: String,
+        /// The step budget.
+        budget: usize,
+        /// Why the move could not be followed or shortened.
+        reason: String,
+    },
     /// A closed robot without an assembly whose default start (q = 0) is singular.
     #[error("{robot}: the loops close at q = 0 but Wp is singular there (reciprocal condition number {rcond:.1e}): the start of loop closure does not define an assembly branch; give the joint values of an assembled, regular configuration (the robot's `assembly`, or an explicit start q_a, q_p)")]
     SingularStart {

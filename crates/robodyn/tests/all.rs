@@ -43,6 +43,8 @@ mod codegen_errors;
 mod codegen_latex;
 #[path = "codegen_opcount.rs"]
 mod codegen_opcount;
+#[path = "continuation.rs"]
+mod continuation;
 #[path = "direct_dynamics.rs"]
 mod direct_dynamics;
 #[path = "finite_results.rs"]

@@ -7,33 +7,14 @@
 
 mod common;
 
-use common::{cases, robot};
+use common::{cases, closure_gap, robot};
 use rand::Rng;
-use robodyn::algorithms::closed_chain::ClosureSolution;
-use robodyn::geometry::frame_transforms;
 use robodyn::{
     closed_inverse_dynamics_into, closed_state, loop_closure, Branch, ClosedChain, ClosedData,
     Error, Expr, Robot,
 };
 use std::f64::consts::{FRAC_PI_2, PI};
 use std::path::{Path, PathBuf};
-
-/// Largest gap between each cut frame and its twin (rotation and position) at a solution, from
-/// the geometric model 0T_j (frames 1..NJ with the cut-joint variables).
-fn closure_gap(r: &Robot, cc: &ClosedChain, s: &ClosureSolution) -> f64 {
-    let mut q: Vec<f64> = s.q_tree.iter().copied().collect();
-    q.extend(s.q_c.iter());
-    let t = frame_transforms(r, &q);
-    cc.loops()
-        .iter()
-        .map(|l| {
-            let (k, tw) = (l.topology.cut, l.topology.twin);
-            (t[k - 1].rot - t[tw - 1].rot)
-                .amax()
-                .max((t[k - 1].pos - t[tw - 1].pos).amax())
-        })
-        .fold(0.0, f64::max)
-}
 
 /// det Wp's sign at the tracker's point (nalgebra's determinant of the returned Wp).
 fn det_sign(cc: &ClosedChain, b: &mut Branch) -> f64 {

@@ -229,6 +229,49 @@ fn closed_chain_steady_state_allocates_nothing() {
     }
 }
 
+/// Long moves of the branch tracker (whole turns of the four-bar's crank dropped after a
+/// checked turn) allocate nothing either: their buffers are in `ClosedData`.
+#[test]
+fn closed_chain_long_moves_allocate_nothing() {
+    let robot = robodyn::io::load(
+        &PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../robots/fourbar.toml"),
+    )
+    .unwrap();
+    let chain = ClosedChain::new(&robot).unwrap();
+    let mut branch = chain.assembly_branch().unwrap();
+    let mut data = ClosedData::new(&chain);
+    let mut tau = [0.0];
+    let env = robot.environment();
+    closed_inverse_dynamics_into(
+        &chain,
+        &mut data,
+        &mut branch,
+        env,
+        &[1e6],
+        &[1.0],
+        &[0.0],
+        &mut tau,
+    )
+    .unwrap();
+    counter_counts();
+    let before = allocations();
+    for q1 in [-3e7, 1e300, 0.5, 4e9, -1e12] {
+        closed_inverse_dynamics_into(
+            &chain,
+            &mut data,
+            &mut branch,
+            env,
+            &[q1],
+            &[1.0],
+            &[0.0],
+            &mut tau,
+        )
+        .unwrap();
+    }
+    assert_eq!(allocations() - before, 0, "long moves allocated");
+    assert!(tau[0].is_finite());
+}
+
 /// The batch row runner allocates nothing per row: on every thread, between the end of one row
 /// and the start of the next, the only allocations are a new task's scratch (one `Data` per
 /// task of `ROWS_PER_TASK` rows), so at most one row in a task's worth sees any.

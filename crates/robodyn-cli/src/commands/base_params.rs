@@ -151,28 +151,46 @@ pub fn run(a: Args) -> CliResult {
             ));
         }
     }
+    // the base robot first: an error (a value missing, a missing directory) before any output
+    let robot_file = match &a.write_robot {
+        Some(path) => Some((path, base_robot_file(&desc, &report, path)?)),
+        None => None,
+    };
     crate::common::print_out(&match a.format {
         Format::Text => write::text(&report),
         Format::Latex => write::latex(&report),
         Format::Json => format!("{}\n", serde_json::to_string_pretty(&write::json(&report))?),
     })?;
-    if let Some(path) = &a.write_robot {
-        let values: Vec<f64> = report
-            .base
-            .iter()
-            .map(|b| {
-                b.value.ok_or_else(|| {
-                    format!(
-                        "--write-robot: {} has no numeric value (give every symbol a value)",
-                        b.name
-                    )
-                })
-            })
-            .collect::<Result<_, _>>()?;
-        let base: Vec<usize> = report.base.iter().map(|b| b.index).collect();
-        let out = base_robot(&desc, &base, &values)?;
-        robodyn::io::save_description(&out, path)?;
+    if let Some((path, file)) = robot_file {
+        file.commit()?;
         eprintln!("wrote {}", path.display());
     }
     Ok(())
+}
+
+/// `--write-robot`: the base robot (its parameters the grouped values), written into an
+/// [`Output`](crate::output::Output) to be committed after the report.
+fn base_robot_file(
+    desc: &robodyn::model::RobotDescription,
+    report: &robodyn::algorithms::base_parameters::summary::Summary,
+    path: &std::path::Path,
+) -> CliResult<crate::output::Output> {
+    let values: Vec<f64> = report
+        .base
+        .iter()
+        .map(|b| {
+            b.value.ok_or_else(|| {
+                format!(
+                    "--write-robot: {} has no numeric value (give every symbol a value)",
+                    b.name
+                )
+            })
+        })
+        .collect::<Result<_, _>>()?;
+    let base: Vec<usize> = report.base.iter().map(|b| b.index).collect();
+    let out = base_robot(desc, &base, &values)?;
+    let format = robodyn::io::Format::from_path(path)?;
+    let mut file = crate::output::Output::create(Some(path))?;
+    file.write_all(robodyn::io::description_text(&out, format)?.as_bytes())?;
+    Ok(file)
 }

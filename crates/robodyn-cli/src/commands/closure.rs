@@ -42,7 +42,7 @@ pub fn run(a: Args) -> CliResult {
     let qa = parse_list("qa", &a.qa)?;
     let mut branch = start_branch(&cc, &qa, a.guess.as_deref())?;
     let s = loop_closure(&cc, &mut branch, &qa)?;
-    warn_conditioning(&cc, 1, 1, &s.conditioning);
+    warn_conditioning(&cc, None, &s.conditioning);
     let w = a.jacobian.then(|| s.w.clone());
     let act = cc.coordinates().frames();
     let pas = cc.passive_coordinates().frames();

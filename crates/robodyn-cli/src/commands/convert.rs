@@ -8,12 +8,11 @@ use std::path::PathBuf;
 pub struct Args {
     /// Input robot file (.toml, .par or .urdf).
     pub input: PathBuf,
-    /// Output robot file (.toml or .par).
+    /// Output robot file (.toml or .par), written all or nothing.
     pub output: PathBuf,
 }
 
 pub fn run(a: Args) -> CliResult {
     let desc = robodyn::io::load_description(&a.input)?;
-    robodyn::io::save_description(&desc, &a.output)?;
-    Ok(())
+    crate::output::save_robot(&desc, &a.output)
 }

@@ -6,13 +6,10 @@
 //! row on the assembly branch (the library's branch tracker, started at the robot's `assembly`
 //! or `--guess`); rows near a singularity are flagged on stderr and in JSON.
 
-use crate::common::{
-    conditioning_json, read_joint_states, result_rows, start_branch, state_column,
-    warn_conditioning, CliResult, NamesArg, Phases, RobotArgs, TableOutput, TimingsArg,
-};
-use robodyn::{
-    closed_direct_dynamics_into, direct_dynamics_batch, ClosedChain, ClosedData, Method,
-};
+use crate::common::{CliResult, NamesArg, Phases, RobotArgs, TableOutput, TimingsArg};
+use crate::rows::Evaluation;
+use crate::states::CarryArg;
+use robodyn::{closed_direct_dynamics_into, direct_dynamics_batch, Method};
 use std::path::PathBuf;
 
 /// Direct-dynamics algorithm.
@@ -62,6 +59,8 @@ pub struct Args {
     #[arg(long, allow_hyphen_values = true)]
     pub guess: Option<String>,
     #[command(flatten)]
+    pub carry: CarryArg,
+    #[command(flatten)]
     pub timings: TimingsArg,
 }
 
@@ -69,69 +68,27 @@ pub fn run(a: Args) -> CliResult {
     let mut t = Phases::start(a.timings);
     let robot = a.robot.load()?;
     t.lap("robot");
-    if !robot.is_tree() {
-        return run_closed(a, robot, t);
-    }
-    let coords = robot.coordinates();
-    let (states, carried) = read_joint_states(
-        a.input.as_deref(),
-        ["q", "qd", "tau"],
-        [a.q.as_deref(), a.qd.as_deref(), a.tau.as_deref()],
-        coords,
-        a.names,
-        "movable joints",
-    )?;
-    t.lap("read");
-    // every row at once over the cores (the library's batch; errors name their row)
-    let (n, col) = (coords.len(), |i| state_column(&states, i));
-    let mut qdd = vec![0.0; states.len() * n];
     let env = robot.environment();
-    let method = a.method.into();
-    direct_dynamics_batch(&robot, env, &col(0), &col(1), &col(2), method, &mut qdd)?;
-    t.lap("model");
-    let rows = result_rows(&qdd, n, states.len());
-    let (headers, rows) = carried.prepend(&a.names.columns("qdd", coords), rows);
-    a.out.write(&headers, &rows)?;
-    t.lap("write");
-    t.report(states.len());
-    Ok(())
-}
-
-/// Closed chains: columns q<j>, qd<j>, tau<j> of the actuated joints in, qdd<j> of the actuated
-/// joints out (the `--method` is the closed-chain model's A_cl, H_cl), every row on the branch.
-fn run_closed(a: Args, robot: robodyn::Robot, mut t: Phases) -> CliResult {
-    let chain = ClosedChain::new(&robot)?;
-    let coords = chain.coordinates();
-    let (states, carried) = read_joint_states(
-        a.input.as_deref(),
-        ["q", "qd", "tau"],
-        [a.q.as_deref(), a.qd.as_deref(), a.tau.as_deref()],
-        coords,
-        a.names,
-        "actuated joints (closed chain)",
-    )?;
-    t.lap("read");
-    let Some(first) = states.first() else {
-        let (headers, _) = carried.prepend(&a.names.columns("qdd", coords), vec![]);
-        return a.out.write(&headers, &[]);
+    let method: Method = a.method.into();
+    let evaluation = Evaluation {
+        input: a.input.as_deref(),
+        prefixes: ["q", "qd", "tau"],
+        lists: [a.q.as_deref(), a.qd.as_deref(), a.tau.as_deref()],
+        names: a.names,
+        carry: &a.carry.carry,
+        guess: a.guess.as_deref(),
+        output: &a.out,
+        result: "qdd",
     };
-    let mut branch = start_branch(&chain, &first[0], a.guess.as_deref())?;
-    let mut data = ClosedData::new(&chain);
-    let env = robot.environment();
-    let (mut rows, mut extra) = (Vec::new(), Vec::new());
-    for (k, [q, qd, tau]) in states.iter().enumerate() {
-        let mut qdd = vec![0.0; coords.len()];
-        let c =
-            closed_direct_dynamics_into(&chain, &mut data, &mut branch, env, q, qd, tau, &mut qdd)
-                .map_err(|e| e.in_row(k + 1))?;
-        warn_conditioning(&chain, k + 1, states.len(), &c);
-        rows.push(qdd);
-        extra.push(conditioning_json(&c));
-    }
-    t.lap("model");
-    let (headers, rows) = carried.prepend(&a.names.columns("qdd", coords), rows);
-    a.out.write_with(&headers, &rows, &extra)?;
-    t.lap("write");
-    t.report(states.len());
-    Ok(())
+    evaluation.run(
+        &robot,
+        &mut t,
+        // chunks of the table at once over the cores (the library's batch; errors name their row)
+        &mut |c, qdd| direct_dynamics_batch(&robot, env, &c.x[0], &c.x[1], &c.x[2], method, qdd),
+        // closed chains: A_cl, H_cl of 10.46-10.48 (not --method), every row on the branch
+        // tracker
+        &mut |chain, b, d, x, qdd| {
+            closed_direct_dynamics_into(chain, d, b, env, x[0], x[1], x[2], qdd)
+        },
+    )
 }

@@ -11,7 +11,6 @@ use robodyn::identification::parameters::{ParameterModel, ParameterOptions};
 use robodyn::identification::report::plot_panels;
 use robodyn::identification::Rotors;
 use serde_json::json;
-use std::io::Write;
 use std::path::PathBuf;
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
@@ -97,6 +96,11 @@ fn per_joint(name: &str, s: Option<&str>, n: usize) -> CliResult<Option<Vec<f64>
 }
 
 pub fn run(a: Args) -> CliResult {
+    let files = [
+        ("--output", Some(a.output.as_path())),
+        ("--plot", a.plot.as_deref()),
+    ];
+    crate::output::check_distinct(&files)?;
     let desc = a.robot.description()?.0;
     let mut access = ModelAccess::new(desc)?;
     let joints = access.actuated_joints().to_vec();
@@ -162,7 +166,14 @@ pub fn run(a: Args) -> CliResult {
     }
     // CSV
     let rows = (a.period * a.periods as f64 * a.rate).round() as usize;
-    let mut out = crate::common::create_output(Some(&a.output))?;
+    // all or nothing: both files put in place once both are written
+    let mut file = crate::output::Output::create(Some(&a.output))?;
+    let mut plot_file = a
+        .plot
+        .as_deref()
+        .map(|p| crate::output::Output::create(Some(p)))
+        .transpose()?;
+    let out = file.writer();
     let mut header = vec!["t".to_string()];
     for p in ["q", "qd", "qdd"] {
         header.extend(joints.iter().map(|j| format!("{p}{j}")));
@@ -184,8 +195,7 @@ pub fn run(a: Args) -> CliResult {
         writeln!(out, "{}", line.join(","))?;
     }
     out.flush()?;
-    eprintln!("wrote {}", a.output.display());
-    if let Some(p) = &a.plot {
+    if let Some(plot_file) = &mut plot_file {
         let names = ["q", "qd", "qdd"];
         let panels: Vec<robodyn::identification::report::Panel> = (0..3)
             .map(|k| {
@@ -202,20 +212,26 @@ pub fn run(a: Args) -> CliResult {
                 )
             })
             .collect();
-        plot_panels(
-            p,
-            &format!(
-                "{}: excitation, {} harmonics, period {} s, condition number {:.1}",
-                access.name(),
-                a.harmonics,
-                a.period,
-                d.condition
-            ),
-            &times,
-            &panels,
-            "rad, rad/s, rad/s^2",
-            false,
-        )?;
+        plot_file.write_by_path(|p| {
+            plot_panels(
+                p,
+                &format!(
+                    "{}: excitation, {} harmonics, period {} s, condition number {:.1}",
+                    access.name(),
+                    a.harmonics,
+                    a.period,
+                    d.condition
+                ),
+                &times,
+                &panels,
+                "rad, rad/s, rad/s^2",
+                false,
+            )
+        })?;
+    }
+    crate::output::commit_all([Some(file), plot_file].into_iter().flatten().collect())?;
+    eprintln!("wrote {}", a.output.display());
+    if let Some(p) = &a.plot {
         eprintln!("wrote {}", p.display());
     }
     let mut out = String::new();

@@ -4,7 +4,7 @@
 use crate::common::CliResult;
 use robodyn::algorithms::regressor::ZeroParameters;
 use robodyn::codegen::{generate_with_progress, BaseParameters, GenOptions, ModelKind};
-use robodyn_symbolic::{emit, Lang};
+use robodyn_symbolic::{check_function_name, emit, Lang};
 use std::path::PathBuf;
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug)]
@@ -70,7 +70,8 @@ pub struct Args {
     pub numeric: bool,
     #[arg(long, value_enum, default_value = "text")]
     pub lang: Language,
-    /// Function name in the generated code.
+    /// Function name in the generated code (an identifier of the language that is not one of its
+    /// reserved words; default `<robot>_<model>`).
     #[arg(long)]
     pub name: Option<String>,
     /// Output file (default or `-`: standard output).
@@ -90,8 +91,19 @@ pub fn run(a: Args) -> CliResult {
         Params::Standard => None,
         Params::Base => match &a.base_file {
             Some(path) => {
-                let text = std::fs::read_to_string(path)
+                let mut text = String::new();
+                let file =
+                    std::fs::File::open(path).map_err(|e| format!("{}: {e}", path.display()))?;
+                // a grouping list is a few kB: an endless file (`/dev/zero`) is refused
+                std::io::Read::read_to_string(&mut std::io::Read::take(file, 1 << 24), &mut text)
                     .map_err(|e| format!("{}: {e}", path.display()))?;
+                if text.len() >= 1 << 24 {
+                    return Err(format!(
+                        "{}: longer than 16 MiB: not a grouping list",
+                        path.display()
+                    )
+                    .into());
+                }
                 Some(BaseParameters::parse(&text, &path.display().to_string())?)
             }
             // the grouping of the symbolic method (Table 10.2 for the SR400)
@@ -151,16 +163,7 @@ pub fn run(a: Args) -> CliResult {
     });
     spinner.finish_and_clear();
     let prog = prog?;
-    let lang = match a.lang {
-        Language::Text => Lang::Text,
-        Language::Latex => Lang::Latex,
-        Language::Rust => Lang::Rust,
-        Language::C => Lang::C,
-        Language::Python => Lang::Python,
-        Language::Julia => Lang::Julia,
-        Language::Matlab => Lang::Matlab,
-    };
-    let text = emit(&prog, lang);
+    let text = emit(&prog, lang(a.lang));
     crate::common::write_text(a.output.as_deref(), &text)?;
     let c = prog.count();
     eprintln!(
@@ -190,9 +193,30 @@ fn working(what: String) -> indicatif::ProgressBar {
     bar
 }
 
+/// The language of the generated code.
+fn lang(l: Language) -> Lang {
+    match l {
+        Language::Text => Lang::Text,
+        Language::Latex => Lang::Latex,
+        Language::Rust => Lang::Rust,
+        Language::C => Lang::C,
+        Language::Python => Lang::Python,
+        Language::Julia => Lang::Julia,
+        Language::Matlab => Lang::Matlab,
+    }
+}
+
 /// The function name: `--name`, or for MATLAB, which calls a function file by its file name, the
-/// stem of `--output` (`sr400_idm.m` -> `sr400_idm`).
+/// stem of `--output` (`sr400_idm.m` -> `sr400_idm`). Checked for the language: an identifier
+/// that is no reserved word and no name the generated code uses itself.
 fn function_name(a: &Args) -> Result<Option<String>, String> {
+    let language = lang(a.lang);
+    let checked = |name: &str, what: &str| {
+        check_function_name(name, language).map_err(|e| format!("{what}: {e}"))
+    };
+    if let Some(n) = &a.name {
+        checked(n, &format!("--name {n}"))?;
+    }
     if !matches!(a.lang, Language::Matlab) {
         return Ok(a.name.clone());
     }
@@ -200,15 +224,14 @@ fn function_name(a: &Args) -> Result<Option<String>, String> {
         return Ok(a.name.clone());
     };
     let stem = stem.to_string_lossy();
-    let valid = stem.starts_with(|c: char| c.is_ascii_alphabetic())
-        && stem.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
-    if !valid {
-        return Err(format!(
-            "--output {}: a MATLAB function file needs a name that is a MATLAB identifier \
-             (a letter, then letters, digits or underscores)",
-            a.output.as_ref().unwrap().display()
-        ));
-    }
+    let output = a
+        .output
+        .as_ref()
+        .map_or(String::new(), |p| p.display().to_string());
+    checked(
+        &stem,
+        &format!("--output {output}: a MATLAB function file is named after its function"),
+    )?;
     match &a.name {
         Some(n) if n != stem.as_ref() => Err(format!(
             "--name {n} differs from the file name {stem}.m: MATLAB calls a function file by its \

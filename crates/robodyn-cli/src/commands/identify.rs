@@ -5,7 +5,7 @@
 
 use crate::common::{parse_list, CliResult, RobotArgs};
 use robodyn::identification::data::{CsvLog, JointLabels};
-use robodyn::identification::model_access::{save_description, ModelAccess};
+use robodyn::identification::model_access::ModelAccess;
 use robodyn::identification::parameters::ParameterOptions;
 use robodyn::identification::{identify, report, EssentialOptions, Estimator, Options, Rotors};
 use std::path::PathBuf;
@@ -136,6 +136,11 @@ fn parse_validation(s: &str) -> CliResult<Option<(f64, f64)>> {
 }
 
 pub fn run(a: Args) -> CliResult {
+    crate::output::check_distinct(&[
+        ("--output", a.output.as_deref()),
+        ("--plot", a.plot.as_deref()),
+        ("--write-robot", a.write_robot.as_deref()),
+    ])?;
     let desc = a.robot.description()?.0;
     let mut access = ModelAccess::new(desc)?;
     let labels = JointLabels {
@@ -189,10 +194,13 @@ pub fn run(a: Args) -> CliResult {
         Format::Json => format!("{}\n", serde_json::to_string_pretty(&report::to_json(&id))?),
         Format::Csv => report::to_csv(&id),
     };
-    crate::common::write_text(a.output.as_deref(), &text)?;
+    // all or nothing: the files are put in place once all are written
+    let mut files = vec![crate::output::Output::create(a.output.as_deref())?];
+    files[0].write_all(text.as_bytes())?;
     if let Some(p) = &a.plot {
-        report::plot_fit(p, &id)?;
-        eprintln!("wrote {}", p.display());
+        let mut plot = crate::output::Output::create(Some(p))?;
+        plot.write_by_path(|tmp| report::plot_fit(tmp, &id))?;
+        files.push(plot);
     }
     if let Some(p) = &a.write_robot {
         let mut desc = access.description_with(&id.standard_parameters())?;
@@ -206,7 +214,14 @@ pub fn run(a: Args) -> CliResult {
             id.estimator,
             id.consistent.as_ref().map_or(0.0, |c| c.distance2)
         ));
-        save_description(&desc, p)?;
+        let mut robot = crate::output::Output::create(Some(p))?;
+        let format = robodyn::io::Format::from_path(p)?;
+        let text = robodyn::io::description_text(&desc, format)?;
+        robot.write_all(text.as_bytes())?;
+        files.push(robot);
+    }
+    crate::output::commit_all(files)?;
+    for p in [&a.plot, &a.write_robot].into_iter().flatten() {
         eprintln!("wrote {}", p.display());
     }
     for w in &id.warnings {

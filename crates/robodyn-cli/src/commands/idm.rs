@@ -6,11 +6,10 @@
 //! (the library's branch tracker: each row continued from the previous one, the first from the
 //! robot's `assembly` or `--guess`); rows near a singularity are flagged on stderr and in JSON.
 
-use crate::common::{
-    conditioning_json, read_joint_states, result_rows, start_branch, state_column,
-    warn_conditioning, CliResult, NamesArg, Phases, RobotArgs, TableOutput, TimingsArg,
-};
-use robodyn::{closed_inverse_dynamics_into, inverse_dynamics_batch, ClosedChain, ClosedData};
+use crate::common::{CliResult, NamesArg, Phases, RobotArgs, TableOutput, TimingsArg};
+use crate::rows::Evaluation;
+use crate::states::CarryArg;
+use robodyn::{closed_inverse_dynamics_into, inverse_dynamics_batch};
 use std::path::PathBuf;
 
 #[derive(clap::Args, Debug)]
@@ -40,6 +39,8 @@ pub struct Args {
     #[arg(long, allow_hyphen_values = true)]
     pub guess: Option<String>,
     #[command(flatten)]
+    pub carry: CarryArg,
+    #[command(flatten)]
     pub timings: TimingsArg,
 }
 
@@ -47,68 +48,25 @@ pub fn run(a: Args) -> CliResult {
     let mut t = Phases::start(a.timings);
     let robot = a.robot.load()?;
     t.lap("robot");
-    if !robot.is_tree() {
-        return run_closed(a, robot, t);
-    }
-    let coords = robot.coordinates();
-    let (states, carried) = read_joint_states(
-        a.input.as_deref(),
-        ["q", "qd", "qdd"],
-        [a.q.as_deref(), a.qd.as_deref(), a.qdd.as_deref()],
-        coords,
-        a.names,
-        "movable joints",
-    )?;
-    t.lap("read");
-    // every row at once over the cores (the library's batch; errors name their row)
-    let (n, col) = (coords.len(), |i| state_column(&states, i));
-    let mut tau = vec![0.0; states.len() * n];
     let env = robot.environment();
-    inverse_dynamics_batch(&robot, env, &col(0), &col(1), &col(2), &mut tau)?;
-    t.lap("model");
-    let rows = result_rows(&tau, n, states.len());
-    let (headers, rows) = carried.prepend(&a.names.columns("tau", coords), rows);
-    a.out.write(&headers, &rows)?;
-    t.lap("write");
-    t.report(states.len());
-    Ok(())
-}
-
-/// Closed chains: columns of the actuated joints in, tau<j> of the actuated joints out, every
-/// row on the branch tracker (library: continuation from the previous row).
-fn run_closed(a: Args, robot: robodyn::Robot, mut t: Phases) -> CliResult {
-    let chain = ClosedChain::new(&robot)?;
-    let coords = chain.coordinates();
-    let (states, carried) = read_joint_states(
-        a.input.as_deref(),
-        ["q", "qd", "qdd"],
-        [a.q.as_deref(), a.qd.as_deref(), a.qdd.as_deref()],
-        coords,
-        a.names,
-        "actuated joints (closed chain)",
-    )?;
-    t.lap("read");
-    let Some(first) = states.first() else {
-        let (headers, _) = carried.prepend(&a.names.columns("tau", coords), vec![]);
-        return a.out.write(&headers, &[]);
+    let evaluation = Evaluation {
+        input: a.input.as_deref(),
+        prefixes: ["q", "qd", "qdd"],
+        lists: [a.q.as_deref(), a.qd.as_deref(), a.qdd.as_deref()],
+        names: a.names,
+        carry: &a.carry.carry,
+        guess: a.guess.as_deref(),
+        output: &a.out,
+        result: "tau",
     };
-    let mut branch = start_branch(&chain, &first[0], a.guess.as_deref())?;
-    let mut data = ClosedData::new(&chain);
-    let env = robot.environment();
-    let (mut rows, mut extra) = (Vec::new(), Vec::new());
-    for (k, [q, qd, qdd]) in states.iter().enumerate() {
-        let mut tau = vec![0.0; coords.len()];
-        let c =
-            closed_inverse_dynamics_into(&chain, &mut data, &mut branch, env, q, qd, qdd, &mut tau)
-                .map_err(|e| e.in_row(k + 1))?;
-        warn_conditioning(&chain, k + 1, states.len(), &c);
-        rows.push(tau);
-        extra.push(conditioning_json(&c));
-    }
-    t.lap("model");
-    let (headers, rows) = carried.prepend(&a.names.columns("tau", coords), rows);
-    a.out.write_with(&headers, &rows, &extra)?;
-    t.lap("write");
-    t.report(states.len());
-    Ok(())
+    evaluation.run(
+        &robot,
+        &mut t,
+        // chunks of the table at once over the cores (the library's batch; errors name their row)
+        &mut |c, tau| inverse_dynamics_batch(&robot, env, &c.x[0], &c.x[1], &c.x[2], tau),
+        // closed chains: every row on the branch tracker (continued from the previous row)
+        &mut |chain, b, d, x, tau| {
+            closed_inverse_dynamics_into(chain, d, b, env, x[0], x[1], x[2], tau)
+        },
+    )
 }

@@ -38,7 +38,7 @@ pub fn run(a: Args) -> CliResult {
         }
         TableFormat::Json => {
             let v = serde_json::json!({ "joints": joints, "q": q, "A": rows });
-            crate::common::check_finite(&["A".to_string()], &rows)?;
+            crate::common::check_finite("A", &rows.concat())?;
             let text = serde_json::to_string_pretty(&v)?;
             crate::common::write_text(a.output.as_deref(), &(text + "\n"))
         }

@@ -8,13 +8,14 @@
 //! every loop (the numerical method is then the arbiter).
 
 use crate::common::{
-    read_joint_states, state_column, warn_conditioning, CliResult, NamesArg, Phases, RobotArgs,
-    TableOutput, TimingsArg,
+    chunk_states, in_table, warn_conditioning, CliResult, NamesArg, Phases, RobotArgs, TableOutput,
+    TableWriter, TimingsArg,
 };
+use crate::states::{CarryArg, Chunk, StateInput, StateRequest};
 use robodyn::algorithms::regressor::{
     base_columns, standard_columns, ParameterSelection, RotorMode, ZeroParameters, PARAMS_PER_LINK,
 };
-use robodyn::{closed_regressor_into, regressor_batch, ClosedChain, ClosedData};
+use robodyn::{closed_regressor_into, regressor_batch, ClosedChain, ClosedData, Coordinates};
 use std::path::PathBuf;
 
 #[derive(clap::Args, Debug)]
@@ -39,13 +40,14 @@ pub struct Args {
     #[command(flatten)]
     pub names: NamesArg,
     #[command(flatten)]
+    pub carry: CarryArg,
+    #[command(flatten)]
     pub timings: TimingsArg,
 }
 
 pub fn run(a: Args) -> CliResult {
     let mut t = Phases::start(a.timings);
     let robot = a.robot.load()?;
-    let nl = robot.nl();
     // a literal 0 in a SYMORO file means the parameter does not exist (docs/robot-format.md)
     let sel = ParameterSelection::new(&robot, RotorMode::Actuated, !a.no_friction)
         .with_zero_parameters(
@@ -70,77 +72,142 @@ pub fn run(a: Args) -> CliResult {
         None => robot.coordinates(),
     };
     t.lap("robot");
-    let (states, carried) = read_joint_states(
-        Some(&a.input),
-        ["q", "qd", "qdd"],
-        [None; 3],
+    let mut input = StateInput::open(&StateRequest {
+        input: Some(&a.input),
+        prefixes: ["q", "qd", "qdd"],
+        lists: [None; 3],
         coords,
-        a.names,
-        "joints",
+        tree: robot.coordinates(),
+        names: a.names,
+        what: "joints",
+        carry: &a.carry.carry,
+    })?;
+    let headers = input.headers_with(
+        &["state", "joint", "tau_e"]
+            .iter()
+            .map(|s| s.to_string())
+            .chain(columns.names.iter().cloned())
+            .collect::<Vec<_>>(),
     )?;
-    t.lap("read");
-    let n = coords.len();
-    let cols = PARAMS_PER_LINK * nl;
-    let mut phi = nalgebra::DMatrix::zeros(n, cols);
-    let mut tau_e = vec![0.0; n];
-    let env = robot.environment();
-    let mut rows = Vec::new();
-    let mut closed = match &chain {
-        Some(c) => Some((c, ClosedData::new(c), c.assembly_branch()?)),
-        None => None,
+    let mut rows = Rows {
+        out: a.out.writer(headers)?,
+        coords,
+        indices: &columns.indices,
+        cols: PARAMS_PER_LINK * robot.nl(),
+        row: Vec::new(),
     };
-    // trees: every row at once over the cores (the library's batch; errors name their row),
-    // row-major Phi of every state; closed chains: one state at a time into the first slot
-    let count = if closed.is_none() { states.len() } else { 1 };
-    let mut phi_all = vec![0.0; count * n * cols];
-    let mut tau_e_all = vec![0.0; count * n];
-    if closed.is_none() {
-        let col = |i| state_column(&states, i);
-        regressor_batch(
-            &robot,
-            env,
-            &col(0),
-            &col(1),
-            &col(2),
-            &mut phi_all,
-            &mut tau_e_all,
-        )?;
+    t.lap("read");
+    match &chain {
+        None => tree_rows(&robot, &mut input, &mut rows, &mut t)?,
+        Some(c) => closed_rows(c, &mut input, &mut rows, &mut t)?,
     }
-    for (s, [q, qd, qdd]) in states.iter().enumerate() {
-        let slot = match &mut closed {
-            // Gamma_cl rows (10.40): G^T Phi and G^T Gamma_e, actuated-joint order
-            Some((c, d, b)) => {
-                let cond = closed_regressor_into(c, d, b, env, [q, qd, qdd], &mut phi, &mut tau_e)
-                    .map_err(|e| e.in_row(s + 1))?;
-                warn_conditioning(c, s + 1, states.len(), &cond);
-                for k in 0..n {
-                    for c in 0..cols {
-                        phi_all[k * cols + c] = phi[(k, c)];
-                    }
-                }
-                tau_e_all.copy_from_slice(&tau_e);
-                0
-            }
-            None => s,
-        };
-        for k in 0..n {
-            let r = slot * n + k;
-            let mut row = carried.rows.get(s).cloned().unwrap_or_default();
-            row.extend([(s + 1) as f64, coords.frame(k) as f64, tau_e_all[r]]);
-            row.extend(columns.indices.iter().map(|&c| phi_all[r * cols + c]));
-            rows.push(row);
+    rows.out.finish()?;
+    t.lap("write");
+    t.report(input.count());
+    Ok(())
+}
+
+/// Trees: chunks of states at once over the cores (the library's batch; errors name their row),
+/// row-major Phi of every state of the chunk, written before the next chunk is read.
+fn tree_rows(
+    robot: &robodyn::Robot,
+    input: &mut StateInput,
+    rows: &mut Rows,
+    t: &mut Phases,
+) -> CliResult {
+    let (n, cols) = (rows.coords.len(), rows.cols);
+    let nc = input.carried_headers().len();
+    let (mut chunk, mut phi, mut tau_e) = (Chunk::default(), Vec::new(), Vec::new());
+    let per_state = n * (cols + 1) + 3 * n + nc;
+    while input.next_chunk(chunk_states(per_state), &mut chunk)? {
+        t.lap("read");
+        phi.resize(chunk.count * n * cols, 0.0);
+        tau_e.resize(chunk.count * n, 0.0);
+        let x = &chunk.x;
+        regressor_batch(
+            robot,
+            robot.environment(),
+            &x[0],
+            &x[1],
+            &x[2],
+            &mut phi,
+            &mut tau_e,
+        )
+        .map_err(|e| in_table(e, chunk.first))?;
+        t.lap("model");
+        for s in 0..chunk.count {
+            let (phi, tau_e) = (&phi[s * n * cols..], &tau_e[s * n..]);
+            let number = chunk.first + s;
+            rows.state(number, chunk.carried(s, nc), tau_e, |k, c| {
+                phi[k * cols + c]
+            })?;
+        }
+        t.lap("write");
+    }
+    Ok(())
+}
+
+/// Closed chains: one state at a time on the branch tracker (from the robot's assembly):
+/// G^T Phi and G^T Gamma_e, actuated-joint order (10.40).
+fn closed_rows(
+    c: &ClosedChain,
+    input: &mut StateInput,
+    rows: &mut Rows,
+    t: &mut Phases,
+) -> CliResult {
+    let (n, nc, env) = (
+        c.dof(),
+        input.carried_headers().len(),
+        c.robot().environment(),
+    );
+    let (mut d, mut b, mut chunk) = (ClosedData::new(c), c.assembly_branch()?, Chunk::default());
+    let mut phi = nalgebra::DMatrix::zeros(n, rows.cols);
+    let mut tau_e = vec![0.0; n];
+    while input.next_chunk(chunk_states(3 * n + nc), &mut chunk)? {
+        t.lap("read");
+        for s in 0..chunk.count {
+            let number = chunk.first + s;
+            let x = chunk.state(s, n);
+            let cond = closed_regressor_into(c, &mut d, &mut b, env, x, &mut phi, &mut tau_e)
+                .map_err(|e| e.in_row(number))?;
+            warn_conditioning(c, Some(number), &cond);
+            t.lap("model");
+            rows.state(number, chunk.carried(s, nc), &tau_e, |k, c| phi[(k, c)])?;
+            t.lap("write");
         }
     }
-    let headers: Vec<String> = carried
-        .headers
-        .iter()
-        .cloned()
-        .chain(["state", "joint", "tau_e"].iter().map(|s| s.to_string()))
-        .chain(columns.names)
-        .collect();
-    t.lap("model");
-    a.out.write(&headers, &rows)?;
-    t.lap("write");
-    t.report(states.len());
     Ok(())
+}
+
+/// The regressor's output rows: one per state and joint.
+struct Rows<'a> {
+    out: TableWriter,
+    coords: &'a Coordinates,
+    /// The columns of Phi written (standard or base parameters).
+    indices: &'a [usize],
+    /// Columns of Phi (13 per link).
+    cols: usize,
+    row: Vec<f64>,
+}
+
+impl Rows<'_> {
+    /// The rows of state `number`: carried values, state, joint, tau_e, the selected columns of
+    /// Phi (`phi(joint, column)`).
+    fn state(
+        &mut self,
+        number: usize,
+        carried: &[f64],
+        tau_e: &[f64],
+        phi: impl Fn(usize, usize) -> f64,
+    ) -> CliResult {
+        for (k, &tau_e) in tau_e.iter().take(self.coords.len()).enumerate() {
+            self.row.clear();
+            self.row.extend_from_slice(carried);
+            self.row
+                .extend([number as f64, self.coords.frame(k) as f64, tau_e]);
+            self.row.extend(self.indices.iter().map(|&c| phi(k, c)));
+            self.out.row(Some(number), &self.row, None)?;
+        }
+        Ok(())
+    }
 }

@@ -10,9 +10,9 @@
 //! `q_shoulder` (joint name), in the CSV, the `--torque-csv` / `--track` input and the plot.
 
 use crate::commands::ddm::MethodArg;
-use crate::common::{
-    create_output, format_number, parse_list, CliResult, NamesArg, RobotArgs, Table,
-};
+use crate::common::{format_number, parse_list, CliResult, NamesArg, RobotArgs};
+use crate::output::{check_distinct, commit_all, Output};
+use crate::states::{classify, known_columns, ColumnSpec, Group};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use robodyn::simulation::{
     plot_svg, simulate, ClosedChainDynamics, CsvSink, Dynamics, Integrator, PlotInfo, Recorder,
@@ -58,11 +58,11 @@ pub struct Args {
     /// the slope of the interpolated q<j>). tau = Kp (q_ref - q) + Kd (qd_ref - qd).
     #[arg(long, requires_all = ["kp", "kd"])]
     pub track: Option<PathBuf>,
-    /// Proportional gains: one value for all joints or one per joint.
-    #[arg(long, allow_hyphen_values = true)]
+    /// Proportional gains of --track: one value for all joints or one per joint.
+    #[arg(long, allow_hyphen_values = true, requires = "track")]
     pub kp: Option<String>,
-    /// Derivative gains: one value for all joints or one per joint.
-    #[arg(long, allow_hyphen_values = true)]
+    /// Derivative gains of --track: one value for all joints or one per joint.
+    #[arg(long, allow_hyphen_values = true, requires = "track")]
     pub kd: Option<String>,
     /// Direct model of a tree robot (closed chains always use A_cl, H_cl of 10.46–10.48).
     #[arg(long, value_enum, default_value = "aba")]
@@ -74,7 +74,7 @@ pub struct Args {
     /// Stop after this many integration steps.
     #[arg(long, default_value_t = robodyn::simulation::DEFAULT_MAX_STEPS)]
     pub max_steps: usize,
-    /// Trajectory CSV (`-`: standard output): t [s], q<j> [rad or m], qd<j> [rad/s or m/s],
+    /// Trajectory CSV (`-`: standard output; written all or nothing: see docs/cli.md): t [s], q<j> [rad or m], qd<j> [rad/s or m/s],
     /// qdd<j> [rad/s^2 or m/s^2], tau<j> [N m or N], energy [J] (closed chains: then
     /// closure_residual and the passive q<j>).
     #[arg(long)]
@@ -150,6 +150,23 @@ struct LimitWatch<'a> {
     crossed: Vec<String>,
     seen: std::collections::BTreeSet<(usize, &'static str)>,
     stop: bool,
+    /// Rows written.
+    rows: usize,
+}
+
+impl LimitWatch<'_> {
+    /// The crossings, on standard error.
+    fn warn(&self) {
+        for m in &self.crossed {
+            eprintln!("robodyn: warning: {m}");
+        }
+        if !self.crossed.is_empty() {
+            eprintln!(
+                "robodyn: warning: the simulation does not enforce joint limits \
+                 (--stop-at-limits stops the run at the first crossing)"
+            );
+        }
+    }
 }
 
 impl TrajectorySink for LimitWatch<'_> {
@@ -191,6 +208,7 @@ impl TrajectorySink for LimitWatch<'_> {
     }
     fn row(&mut self, values: &[f64]) -> robodyn::Result<()> {
         self.sink.row(values)?;
+        self.rows += 1;
         for (c, named, j, what, lo, hi, unit) in &self.checks {
             let (c, j, what, lo, hi, unit) = (*c, *j, *what, *lo, *hi, *unit);
             let x = values[c];
@@ -246,48 +264,52 @@ fn gains(name: &str, s: &str, n: usize) -> CliResult<Vec<f64>> {
     }
 }
 
-/// Column indices of `<prefix><l>` for every joint label and prefix, in order; an optional prefix
-/// whose columns are all absent is skipped (the flag says whether all optional ones were found).
-fn series_columns(
-    t: &Table,
-    prefixes: &[(&str, bool)],
-    joints: &[String],
-) -> CliResult<(Vec<usize>, bool)> {
-    let mut cols = Vec::new();
-    let mut all_optional_present = true;
-    for (prefix, optional) in prefixes {
-        let present: Vec<Option<usize>> = joints
-            .iter()
-            .map(|j| t.find(&format!("{prefix}{j}")))
-            .collect();
-        if *optional && present.iter().all(Option::is_none) {
-            all_optional_present = false;
-            continue;
-        }
-        for j in joints {
-            cols.push(t.column(&format!("{prefix}{j}"))?);
-        }
-    }
-    Ok((cols, all_optional_present))
-}
-
+/// Read a time series (`--torque-csv`, `--track`): column `t` and, per group of `prefixes`
+/// (prefix, required, what its absence means), the columns `<prefix><l>` of every joint label;
+/// the columns are checked by the rule of `idm`'s tables (a misspelt one is an error, an unknown
+/// one a warning: it is ignored). Whether every optional group is present.
 fn read_series(
     path: &std::path::Path,
-    prefixes: &[(&str, bool)],
+    prefixes: &[(&str, bool, &'static str)],
     joints: &[String],
+    all_labels: &[String],
 ) -> CliResult<(TimeSeries, bool)> {
-    let t = Table::read(path)?;
-    let tc = t.column("t")?;
-    let (cols, with_optional) = series_columns(&t, prefixes, joints)?;
+    let file = path.display().to_string();
+    let f = std::fs::File::open(path).map_err(|e| format!("{file}: {e}"))?;
+    let t = robodyn::io::table::Table::from_reader(std::io::BufReader::new(f), &file)?;
+    let tc = t
+        .find("t")
+        .ok_or_else(|| format!("{file}: missing column `t` (the time, s)"))?;
+    let spec = ColumnSpec {
+        groups: prefixes
+            .iter()
+            .map(|&(prefix, required, absent)| Group {
+                prefix: prefix.into(),
+                names: joints.iter().map(|j| format!("{prefix}{j}")).collect(),
+                required,
+                absent,
+            })
+            .collect(),
+        known: known_columns(all_labels),
+        declared: &[],
+        fate: "ignored",
+        carry_option: false,
+        hint: None,
+    };
+    let c = classify(&t.headers, &spec, &file)?;
+    let cols: Vec<usize> = c.groups.iter().flatten().flatten().copied().collect();
     let times = t.rows.iter().map(|r| r[tc]).collect();
     let values = t
         .rows
         .iter()
         .map(|r| cols.iter().map(|&c| r[c]).collect())
         .collect();
-    let s = TimeSeries::new(times, values).map_err(|e| format!("{}: {e}", t.file))?;
-    Ok((s, with_optional))
+    let s = TimeSeries::new(times, values).map_err(|e| format!("{file}: {e}"))?;
+    Ok((s, c.groups.iter().all(Option::is_some)))
 }
+
+/// More output rows than this (a CSV of about 100 GB) is refused: an output step far too small.
+const MAX_ROWS: f64 = 1e9;
 
 /// The numeric options, checked before any file is touched.
 fn check_options(a: &Args) -> CliResult {
@@ -309,39 +331,118 @@ fn check_options(a: &Args) -> CliResult {
     if a.max_steps == 0 {
         return Err("--max-steps 0: must be at least 1".into());
     }
+    let step = a.output_step.or(a.dt).unwrap_or(0.01);
+    let rows = a.duration / step;
+    if rows > MAX_ROWS {
+        return Err(format!(
+            "--duration {} with an output step of {} s gives {} rows, more than {MAX_ROWS:.0e} \
+             (give a larger --output-step)",
+            format_number(a.duration),
+            format_number(step),
+            if rows.is_finite() {
+                format!("{rows:.1e}")
+            } else {
+                "more than 1e308".into()
+            }
+        )
+        .into());
+    }
     if !(a.coulomb_smoothing.is_finite() && a.coulomb_smoothing >= 0.0) {
         return Err("--coulomb-smoothing must be a finite number >= 0".into());
     }
     Ok(())
 }
 
+/// The dynamics of the run: a tree's, or a closed chain's on the branch of its assembly; its
+/// joints (frame numbers), what they are in messages, and the default q0.
+type Model<'r> = (
+    Box<dyn Dynamics + 'r>,
+    Vec<usize>,
+    &'static str,
+    Option<Vec<f64>>,
+);
+
+fn model<'r>(robot: &'r robodyn::Robot, a: &Args) -> CliResult<Model<'r>> {
+    let smoothing = Some(a.coulomb_smoothing);
+    if robot.is_tree() {
+        let d = TreeDynamics::new(robot, a.method.into()).with_coulomb_smoothing(smoothing);
+        let joints = d.joints().to_vec();
+        return Ok((Box::new(d), joints, "movable tree joints", None));
+    }
+    let chain = robodyn::ClosedChain::new(robot)?;
+    let branch = chain.assembly_branch().map_err(|e| {
+        format!(
+            "the simulation starts on the branch of the assembly configuration, which cannot \
+             be used: {e}"
+        )
+    })?;
+    let q0 = branch.q_a().to_vec();
+    let d = ClosedChainDynamics::new(chain, branch).with_coulomb_smoothing(smoothing);
+    let joints = d.chain().coordinates().frames().to_vec();
+    Ok((
+        Box::new(d),
+        joints,
+        "actuated joints (closed chain)",
+        Some(q0),
+    ))
+}
+
+/// The torque input: constant, a series (`--torque-csv`) or PD tracking (`--track`).
+fn torque_input(
+    a: &Args,
+    joints: &[usize],
+    what: &str,
+    labels: &[String],
+    all: &[String],
+) -> CliResult<TorqueInput> {
+    let n = joints.len();
+    Ok(if let Some(p) = &a.torque_csv {
+        TorqueInput::Series(read_series(p, &[("tau", true, "")], labels, all)?.0)
+    } else if let Some(p) = &a.track {
+        let velocity = (
+            "qd",
+            false,
+            "the reference velocity is the slope of the interpolated q",
+        );
+        let (reference, with_velocity) = read_series(p, &[("q", true, ""), velocity], labels, all)?;
+        TorqueInput::Pd {
+            reference,
+            with_velocity,
+            kp: gains("kp", a.kp.as_deref().unwrap_or_default(), n)?,
+            kd: gains("kd", a.kd.as_deref().unwrap_or_default(), n)?,
+        }
+    } else {
+        TorqueInput::Constant(joint_values(
+            "torque",
+            a.torque.as_deref(),
+            joints,
+            what,
+            None,
+        )?)
+    })
+}
+
+/// A progress bar on a terminal's standard error (hidden otherwise).
+fn progress_bar() -> CliResult<ProgressBar> {
+    let bar = if std::io::stderr().is_terminal() {
+        ProgressBar::with_draw_target(Some(1000), ProgressDrawTarget::stderr())
+    } else {
+        ProgressBar::hidden()
+    };
+    bar.set_style(
+        ProgressStyle::with_template(
+            "{bar:40} {percent:>3}% t = {msg} s, elapsed {elapsed}, eta {eta}",
+        )
+        .map_err(|e| e.to_string())?,
+    );
+    Ok(bar)
+}
+
 pub fn run(a: Args) -> CliResult {
     check_options(&a)?;
+    check_distinct(&[("--output", Some(&a.output)), ("--plot", a.plot.as_deref())])?;
     let robot = a.robot.load()?;
-    let smoothing = Some(a.coulomb_smoothing);
-    let (dynamics, joints, what, q0_default): (Box<dyn Dynamics + '_>, _, _, _) = if robot.is_tree()
-    {
-        let d = TreeDynamics::new(&robot, a.method.into()).with_coulomb_smoothing(smoothing);
-        let joints = d.joints().to_vec();
-        (Box::new(d), joints, "movable tree joints", None)
-    } else {
-        let chain = robodyn::ClosedChain::new(&robot)?;
-        let branch = chain.assembly_branch().map_err(|e| {
-            format!(
-                "the simulation starts on the branch of the assembly configuration, which \
-                     cannot be used: {e}"
-            )
-        })?;
-        let q0 = branch.q_a().to_vec();
-        let d = ClosedChainDynamics::new(chain, branch).with_coulomb_smoothing(smoothing);
-        let joints = d.chain().coordinates().frames().to_vec();
-        (
-            Box::new(d),
-            joints,
-            "actuated joints (closed chain)",
-            Some(q0),
-        )
-    };
+    let (dynamics, joints, what, q0_default) = model(&robot, &a)?;
     let n = joints.len();
     if n == 0 {
         return Err("the robot has no movable joint: nothing to simulate".into());
@@ -364,27 +465,11 @@ pub fn run(a: Args) -> CliResult {
         labels: labels.clone(),
         extra,
     };
+    // the initial state and the input (the columns of its files checked)
     let q0 = joint_values("q0", a.q0.as_deref(), &joints, what, q0_default.as_deref())?;
     let qd0 = joint_values("qd0", a.qd0.as_deref(), &joints, what, None)?;
-    let input = if let Some(p) = &a.torque_csv {
-        TorqueInput::Series(read_series(p, &[("tau", false)], &labels)?.0)
-    } else if let Some(p) = &a.track {
-        let (reference, with_velocity) = read_series(p, &[("q", false), ("qd", true)], &labels)?;
-        TorqueInput::Pd {
-            reference,
-            with_velocity,
-            kp: gains("kp", a.kp.as_deref().unwrap_or_default(), n)?,
-            kd: gains("kd", a.kd.as_deref().unwrap_or_default(), n)?,
-        }
-    } else {
-        TorqueInput::Constant(joint_values(
-            "torque",
-            a.torque.as_deref(),
-            &joints,
-            what,
-            None,
-        )?)
-    };
+    let all_labels: Vec<String> = label.values().cloned().collect();
+    let input = torque_input(&a, &joints, what, &labels, &all_labels)?;
     let integrator = Integrator::fixed_or_adaptive(a.dt, a.rtol, a.atol);
     let opts = SimOptions {
         duration: a.duration,
@@ -394,25 +479,18 @@ pub fn run(a: Args) -> CliResult {
     };
     integrator.validate()?;
     input.validate(n)?;
-    let to_stdout = robodyn::io::is_stdio(&a.output);
-    let out_name = if to_stdout {
-        "standard output".to_string()
-    } else {
-        a.output.display().to_string()
-    };
-    let mut csv = CsvSink::new(create_output(Some(&a.output))?, out_name.clone());
+    // the files are made now (a missing directory is an error before the run) and put in
+    // place at the end
+    let mut csv_out = Output::create(Some(&a.output))?;
+    let plot_out = a
+        .plot
+        .as_deref()
+        .map(|p| Output::create(Some(p)))
+        .transpose()?;
+    let out_name = csv_out.name().to_string();
+    let mut csv = CsvSink::new(csv_out.writer(), out_name.clone());
     let mut rec = Recorder::default();
-    let bar = if std::io::stderr().is_terminal() {
-        ProgressBar::with_draw_target(Some(1000), ProgressDrawTarget::stderr())
-    } else {
-        ProgressBar::hidden()
-    };
-    bar.set_style(
-        ProgressStyle::with_template(
-            "{bar:40} {percent:>3}% t = {msg} s, elapsed {elapsed}, eta {eta}",
-        )
-        .map_err(|e| e.to_string())?,
-    );
+    let bar = progress_bar()?;
     let duration = a.duration;
     let mut progress = |t: f64| {
         bar.set_position(((t / duration) * 1000.0).round() as u64);
@@ -436,6 +514,7 @@ pub fn run(a: Args) -> CliResult {
         crossed: Vec::new(),
         seen: Default::default(),
         stop: a.stop_at_limits,
+        rows: 0,
     };
     let result = simulate(
         &mut dynamics,
@@ -453,48 +532,62 @@ pub fn run(a: Args) -> CliResult {
             return Ok(());
         }
     }
-    for m in &watch.crossed {
-        eprintln!("robodyn: warning: {m}");
-    }
-    if !watch.crossed.is_empty() {
-        eprintln!(
-            "robodyn: warning: the simulation does not enforce joint limits (--stop-at-limits \
-             stops the run at the first crossing)"
-        );
-    }
+    watch.warn();
+    let rows = watch.rows;
     drop(watch);
     drop(csv);
-    let stopped = result.as_ref().err().map(|e| e.to_string());
-    let plotted = match (&a.plot, &result) {
-        (Some(p), _) if !rec.rows.is_empty() => Some(plot_svg(
-            p,
-            &rec,
-            &PlotInfo {
-                title: plot_title(&robot, &a),
-                stopped,
-                prismatic: prismatic_labels(&robot, &label),
-            },
-        )),
-        _ => None,
+    let info = PlotInfo {
+        title: plot_title(&robot, &a),
+        stopped: result.as_ref().err().map(|e| e.to_string()),
+        prismatic: prismatic_labels(&robot, &label),
     };
+    finish(result, rows, &rec, csv_out, plot_out, &info)
+}
+
+/// Put the run's files in place: all of them after a complete run; after a run that stopped
+/// early, the trajectory up to the stop (and its plot); nothing when not one row was computed.
+fn finish(
+    result: robodyn::Result<robodyn::simulation::SimSummary>,
+    rows: usize,
+    rec: &Recorder,
+    csv: Output,
+    plot: Option<Output>,
+    info: &PlotInfo,
+) -> CliResult {
+    let csv_name = csv.name().to_string();
+    if rows == 0 {
+        let e = result.err().map_or_else(String::new, |e| e.to_string());
+        return Err(format!("{e}\n  nothing was written ({csv_name} is unchanged)").into());
+    }
+    let mut outputs = vec![csv];
+    let mut plotted = String::new();
+    if let Some(mut p) = plot.filter(|_| !rec.rows.is_empty()) {
+        match p.write_by_path(|path| plot_svg(path, rec, info)) {
+            Ok(()) => {
+                plotted = format!(", its plot in {}", p.name());
+                outputs.push(p);
+            }
+            // a complete run whose plot fails writes nothing
+            Err(e) if result.is_ok() => return Err(format!("{e} (nothing was written)").into()),
+            Err(e) => plotted = format!(" (the plot could not be written: {e})"),
+        }
+    }
+    commit_all(outputs)?;
     match result {
         Ok(s) => {
             eprintln!(
-                "simulated {} s: {} rows in {}, {} steps ({} rejected), {} model evaluations",
-                s.t_end, s.rows, out_name, s.stats.accepted, s.stats.rejected, s.stats.evaluations
+                "simulated {} s: {} rows in {csv_name}, {} steps ({} rejected), {} model \
+                 evaluations",
+                format_number(s.t_end),
+                s.rows,
+                s.stats.accepted,
+                s.stats.rejected,
+                s.stats.evaluations
             );
-            if let Some(r) = plotted {
-                r?;
-            }
             Ok(())
         }
         Err(e) => Err(format!(
-            "{e}\n  the trajectory computed up to the stop is in {}{}",
-            out_name,
-            match (&a.plot, plotted) {
-                (Some(p), Some(Ok(()))) => format!(", its plot in {}", p.display()),
-                _ => String::new(),
-            }
+            "{e}\n  the trajectory computed up to the stop is in {csv_name}{plotted}"
         )
         .into()),
     }

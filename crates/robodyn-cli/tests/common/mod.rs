@@ -1,6 +1,8 @@
 //! Helpers shared by the CLI tests: run the binary, locate bundled robots, temporary files, CSV.
 #![allow(dead_code)]
 
+pub mod process;
+
 use std::path::PathBuf;
 use std::process::Command;
 

@@ -12,8 +12,9 @@
 //! closed point reached on it. Every evaluation at q_a first moves the tracker to q_a by
 //! continuation along the straight path in q_a (predictor q_p + W dq_a, Newton corrector, steps
 //! halved on failure), checking at every step that det Wp keeps its sign, that Wp stays above the
-//! hard conditioning limit and that the corrector lands within the predictor's reach. A result
-//! therefore depends on (model, branch, inputs) only, never on a hidden history.
+//! hard conditioning limit and that the corrector lands within the predictor's reach, within a
+//! step budget (long moves are shortened where the model allows it: [`ClosedChain::step_budget`]). A
+//! result therefore depends on (model, branch, inputs) only, never on a hidden history.
 //!
 //! Public vectors: q_a, qd_a, qdd_a, Γ_cl over the actuated joints
 //! ([`ClosedChain::coordinates`]); q_p over the passive joints
@@ -26,14 +27,16 @@
 
 use crate::algorithms::inertia_matrix::composite_inertia_matrix;
 use crate::algorithms::inverse_dynamics::rnea_with_environment;
-use crate::algorithms::loop_closure::{LoopClosure, LoopConstraint, LoopWorkspace};
+use crate::algorithms::loop_closure::{fmt_vec, LoopClosure, LoopConstraint, LoopWorkspace};
 use crate::algorithms::regressor::{tree_regressor, tree_wrench_torques, PARAMS_PER_LINK};
 use crate::data::Data;
 use crate::error::{Error, Result};
 use crate::linalg::{norm1, rcond_cholesky, SmallLu};
-use crate::model::{Coordinates, Environment, Robot};
+use crate::model::{Coordinates, Environment, JointType, Robot};
 use crate::scalar::DynScalar;
 use nalgebra::{DMatrix, DVector};
+
+mod continuation;
 
 /// Conditioning limits of a closed chain: reciprocal 1-norm condition numbers
 /// 1 / (||M||_1 ||M^-1||_1) below which a result is flagged (`soft`) or refused (`hard`).
@@ -105,7 +108,17 @@ pub struct ClosedChain {
     passive: Coordinates,
     limits: ConditioningLimits,
     max_step: f64,
+    budget: usize,
+    /// Per actuated joint: on a loop (its value enters the closure equations).
+    in_loop: Vec<bool>,
+    /// Per actuated joint: revolute.
+    revolute: Vec<bool>,
+    /// Per passive joint: revolute.
+    passive_revolute: Vec<bool>,
 }
+
+/// Default [`ClosedChain::step_budget`].
+pub const DEFAULT_STEP_BUDGET: usize = 50_000;
 
 /// The branch tracker of a closed chain: the assembly branch (sign of det Wp) and the last
 /// closed configuration reached on it, owned by the caller. Made by
@@ -122,7 +135,18 @@ pub struct Branch {
 }
 
 impl Branch {
-    /// The actuated values of the tracker's point.
+    fn zeros(n: usize, p: usize) -> Branch {
+        Branch {
+            q_a: vec![0.0; n],
+            q_p: vec![0.0; p],
+            w: DMatrix::zeros(p, n),
+            sign: 1.0,
+            rcond: 0.0,
+        }
+    }
+
+    /// The actuated values of the tracker's point (after a long move, revolute loop joints hold
+    /// the equivalent angle in (-pi, pi]: see [`ClosedChain::step_budget`]).
     pub fn q_a(&self) -> &[f64] {
         &self.q_a
     }
@@ -169,6 +193,13 @@ pub struct ClosedData {
     start_qp: Vec<f64>,
     start_w: DMatrix<f64>,
     start_rcond: f64,
+    pred_step: f64,
+    /// The tracker before a long move, and before a full turn (continuation).
+    saved: Branch,
+    probe: Branch,
+    target: Vec<f64>,
+    turn_end: Vec<f64>,
+    turning: Vec<(usize, f64)>,
     a_cl: DMatrix<f64>,
     chol: DMatrix<f64>,
     h_cl: DVector<f64>,
@@ -212,6 +243,12 @@ impl ClosedData {
             start_qp: vec![0.0; p],
             start_w: DMatrix::zeros(p, n),
             start_rcond: 0.0,
+            pred_step: 0.0,
+            saved: Branch::zeros(n, p),
+            probe: Branch::zeros(n, p),
+            target: vec![0.0; n],
+            turn_end: vec![0.0; n],
+            turning: Vec::with_capacity(n),
             a_cl: DMatrix::zeros(n, n),
             chol: DMatrix::zeros(n, n),
             h_cl: DVector::zeros(n),
@@ -222,26 +259,6 @@ impl ClosedData {
             phi: DMatrix::zeros(0, 0),
         }
     }
-}
-
-/// Why a continuation step was refused.
-#[derive(Clone, Copy, Debug, PartialEq)]
-enum StepFailure {
-    NoConvergence,
-    Singular,
-    SignChange,
-    IllConditioned(f64),
-    Jump,
-}
-
-/// Largest corrector iterations of one continuation step.
-const CORRECTOR_ITERATIONS: usize = 12;
-/// The corrected q_p may differ from the prediction by half the predicted motion plus this.
-const JUMP_FLOOR: f64 = 1e-3;
-
-fn fmt_vec(v: &[f64]) -> String {
-    let s: Vec<String> = v.iter().map(|x| format!("{x:.6}")).collect();
-    format!("[{}]", s.join(", "))
 }
 
 impl ClosedChain {
@@ -257,13 +274,55 @@ impl ClosedChain {
                 robot.nl(),
             )
         };
+        let on_loop: std::collections::BTreeSet<usize> = robot
+            .structure()
+            .loops
+            .iter()
+            .flat_map(|l| l.tree_joints())
+            .collect();
+        let revolute = |js: &[usize]| -> Vec<bool> {
+            js.iter()
+                .map(|&j| robot.frame(j).joint == JointType::Revolute)
+                .collect()
+        };
         Ok(ClosedChain {
             coords: coords_of(closure.actuated_joints()),
             passive: coords_of(closure.passive_joints()),
+            in_loop: closure
+                .actuated_joints()
+                .iter()
+                .map(|j| on_loop.contains(j))
+                .collect(),
+            revolute: revolute(closure.actuated_joints()),
+            passive_revolute: revolute(closure.passive_joints()),
             closure,
             limits: ConditioningLimits::default(),
             max_step: 0.25,
+            budget: DEFAULT_STEP_BUDGET,
         })
+    }
+
+    /// The continuation's step budget: the most steps (each a predictor and a Newton corrector)
+    /// one evaluation may try to move the branch tracker to its q_a; more is
+    /// [`Error::ContinuationBudget`], so that every evaluation ends in bounded time (default
+    /// [`DEFAULT_STEP_BUDGET`]: at most about half a second for the bundled closed robots).
+    ///
+    /// A move whose straight path needs more than half the budget (steps of at most 0.25 rad or
+    /// m per joint) is shortened first: actuated joints on no loop are set at once (the closure
+    /// equations do not depend on them), and whole turns of a revolute joint on a loop are
+    /// dropped when one full turn of it, followed on the branch, comes back to the same
+    /// configuration. The angles of such a move are then held as their equivalents in
+    /// (-pi, pi] (reduced exactly, from their sine and cosine), and the passive revolute joints
+    /// keep the values reached on the short way. A joint that cannot turn fully on its branch
+    /// keeps its turns, and a move that is still too long is refused.
+    pub fn step_budget(&self) -> usize {
+        self.budget
+    }
+
+    /// The same chain with another step budget (at least 1).
+    pub fn with_step_budget(mut self, steps: usize) -> Self {
+        self.budget = steps.max(1);
+        self
     }
 
     /// The equivalent tree.
@@ -456,167 +515,6 @@ impl ClosedChain {
                 d.g[(j - 1, c)] = d.w[(r, c)];
             }
         }
-    }
-
-    /// Newton corrector at d.qa from d.pred into d.qp; on success the placements, the Jacobian
-    /// and the LU of Wp are those of the solution.
-    fn correct(&self, d: &mut ClosedData) -> std::result::Result<(), StepFailure> {
-        let lc = &self.closure;
-        d.qp.copy_from_slice(&d.pred);
-        let mut previous = f64::INFINITY;
-        for _ in 0..CORRECTOR_ITERATIONS {
-            lc.assemble(&d.qa, &d.qp, &mut d.q_tr);
-            lc.kinematics(&mut d.lw, &d.q_tr, None, None);
-            lc.residual(&d.lw, &mut d.r);
-            if d.r.amax() <= lc.tolerance {
-                self.factor_wp(d);
-                if !d.lu.regular {
-                    return Err(StepFailure::Singular);
-                }
-                if lc.flipped_loop(&d.lw).is_some() {
-                    return Err(StepFailure::Jump);
-                }
-                return Ok(());
-            }
-            self.factor_wp(d);
-            if !d.lu.regular {
-                return Err(StepFailure::Singular);
-            }
-            for (x, r) in d.dx.iter_mut().zip(d.r.iter()) {
-                *x = -r;
-            }
-            d.lu.solve(&mut d.dx);
-            let step = d.dx.iter().fold(0.0_f64, |a, b| a.max(b.abs()));
-            if !step.is_finite() || step > 0.5 * previous {
-                return Err(StepFailure::NoConvergence);
-            }
-            previous = step;
-            for (q, x) in d.qp.iter_mut().zip(&d.dx) {
-                *q += x;
-            }
-        }
-        Err(StepFailure::NoConvergence)
-    }
-
-    /// Move the tracker to q_a by continuation (see the module documentation). On success the
-    /// buffers of `d` hold the closed configuration (placements, Wp factors, W, G).
-    fn track(&self, d: &mut ClosedData, b: &mut Branch, q_a: &[f64]) -> Result<()> {
-        d.start_qa.copy_from_slice(&b.q_a);
-        d.start_qp.copy_from_slice(&b.q_p);
-        d.start_w.copy_from(&b.w);
-        d.start_rcond = b.rcond;
-        let dist = q_a
-            .iter()
-            .zip(&b.q_a)
-            .fold(0.0_f64, |m, (x, y)| m.max((x - y).abs()));
-        let max_h = if dist == 0.0 {
-            1.0
-        } else {
-            (self.max_step / dist).min(1.0)
-        };
-        let mut h = max_h;
-        let mut s = 0.0;
-        let mut failure: StepFailure;
-        loop {
-            let t = if s + h >= 1.0 - 1e-12 { 1.0 } else { s + h };
-            if t == 1.0 {
-                d.qa.copy_from_slice(q_a);
-            } else {
-                for k in 0..d.n {
-                    d.qa[k] = d.start_qa[k] + t * (q_a[k] - d.start_qa[k]);
-                }
-            }
-            // predictor (10.29): q_p + W (q_a - q_a_branch)
-            let mut pred_step: f64 = 0.0;
-            for r in 0..d.p {
-                let mut x = b.q_p[r];
-                for c in 0..d.n {
-                    x += b.w[(r, c)] * (d.qa[c] - b.q_a[c]);
-                }
-                pred_step = pred_step.max((x - b.q_p[r]).abs());
-                d.pred[r] = x;
-            }
-            let outcome = self.correct(d).and_then(|()| {
-                let jump =
-                    d.qp.iter()
-                        .zip(&d.pred)
-                        .fold(0.0_f64, |m, (x, y)| m.max((x - y).abs()));
-                if d.lu.det_sign() != b.sign {
-                    return Err(StepFailure::SignChange);
-                }
-                let rcond = d.lu.rcond();
-                if rcond < self.limits.wp_hard {
-                    return Err(StepFailure::IllConditioned(rcond));
-                }
-                if jump > 0.5 * pred_step + JUMP_FLOOR {
-                    return Err(StepFailure::Jump);
-                }
-                Ok(rcond)
-            });
-            match outcome {
-                Ok(rcond) => {
-                    self.compute_w(d);
-                    b.q_a.copy_from_slice(&d.qa);
-                    b.q_p.copy_from_slice(&d.qp);
-                    b.w.copy_from(&d.w);
-                    b.rcond = rcond;
-                    s = t;
-                    if t == 1.0 {
-                        return Ok(());
-                    }
-                    h = (2.0 * h).min(max_h);
-                }
-                Err(f) => {
-                    failure = f;
-                    if let (1.0, StepFailure::IllConditioned(rcond)) = (t, f) {
-                        // the target itself is singular (reached on the branch)
-                        if h <= max_h / 64.0 || s == 0.0 && dist == 0.0 {
-                            self.restore(d, b);
-                            return Err(self.singular_wp(rcond, &d.q_tr));
-                        }
-                    }
-                    h *= 0.5;
-                    if h * dist.max(1.0) < 1e-9 {
-                        break;
-                    }
-                }
-            }
-        }
-        // where it failed: the last tried q_a
-        let near = fmt_vec(&d.qa);
-        self.restore(d, b);
-        let reason = match failure {
-            StepFailure::SignChange => format!(
-                "the path crosses a singular configuration (det Wp changes sign near q_a = \
-                 {near}): the configuration belongs to another assembly branch or lies beyond \
-                 a singularity"
-            ),
-            StepFailure::IllConditioned(r) => format!(
-                "Wp is singular on the path near q_a = {near} (reciprocal condition number \
-                 {r:.1e} < {:.0e})",
-                self.limits.wp_hard
-            ),
-            StepFailure::Singular => format!("Wp is singular on the path near q_a = {near}"),
-            StepFailure::Jump => format!(
-                "the closure solution jumps to another assembly near q_a = {near} (a fold or \
-                 bifurcation of the branch)"
-            ),
-            StepFailure::NoConvergence => format!(
-                "the closure equations have no solution near q_a = {near} on the branch (beyond \
-                 the reach of the mechanism)"
-            ),
-        };
-        Err(Error::BranchLost {
-            at: fmt_vec(q_a),
-            reason,
-        })
-    }
-
-    fn restore(&self, d: &ClosedData, b: &mut Branch) {
-        b.q_a.copy_from_slice(&d.start_qa);
-        b.q_p.copy_from_slice(&d.start_qp);
-        b.w.copy_from(&d.start_w);
-        b.rcond = d.start_rcond;
     }
 
     fn conditioning(&self, b: &Branch, a_cl: Option<f64>) -> Conditioning {

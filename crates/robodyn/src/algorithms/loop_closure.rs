@@ -120,8 +120,19 @@ fn vee_antisym(m: &Matrix3<f64>) -> Vector3<f64> {
     )
 }
 
-fn fmt_vec(v: &[f64]) -> String {
-    let s: Vec<String> = v.iter().map(|x| format!("{x:.6}")).collect();
+/// Joint values in messages: six decimals, an exponent beyond a million (`1.000000e300`, not 300
+/// digits).
+pub(crate) fn fmt_vec(v: &[f64]) -> String {
+    let s: Vec<String> = v
+        .iter()
+        .map(|x| {
+            if x.abs() < 1e6 {
+                format!("{x:.6}")
+            } else {
+                format!("{x:.6e}")
+            }
+        })
+        .collect();
     format!("[{}]", s.join(", "))
 }
 

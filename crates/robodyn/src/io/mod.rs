@@ -113,16 +113,34 @@ pub fn is_stdio(path: &Path) -> bool {
     path.as_os_str() == "-"
 }
 
-/// Read a text file (see [`decode_text`]); `-` is standard input.
+/// The largest robot file read (64 MiB: the largest real URDF is a few hundred kB); a larger
+/// one, or an endless one (`/dev/zero`), is an error instead of exhausting memory.
+pub const MAX_FILE_BYTES: u64 = 64 << 20;
+
+/// Read a text file of at most [`MAX_FILE_BYTES`] (see [`decode_text`]); `-` is standard input.
 fn read(path: &Path) -> Result<String> {
-    let bytes = if is_stdio(path) {
-        let mut b = Vec::new();
-        std::io::Read::read_to_end(&mut std::io::stdin().lock(), &mut b)
-            .map_err(|e| Error::io("<stdin>", e))?;
-        b
+    let name = if is_stdio(path) {
+        "<stdin>".to_string()
     } else {
-        std::fs::read(path).map_err(|e| Error::io(path.display().to_string(), e))?
+        path.display().to_string()
     };
+    let input: Box<dyn std::io::Read> = if is_stdio(path) {
+        Box::new(std::io::stdin().lock())
+    } else {
+        Box::new(std::fs::File::open(path).map_err(|e| Error::io(name.clone(), e))?)
+    };
+    let mut bytes = Vec::new();
+    std::io::Read::read_to_end(
+        &mut std::io::Read::take(input, MAX_FILE_BYTES + 1),
+        &mut bytes,
+    )
+    .map_err(|e| Error::io(name.clone(), e))?;
+    if bytes.len() as u64 > MAX_FILE_BYTES {
+        return Err(Error::Input(format!(
+            "{name}: longer than {} MiB: not a robot file",
+            MAX_FILE_BYTES >> 20
+        )));
+    }
     Ok(decode_text(bytes))
 }
 
@@ -185,9 +203,9 @@ pub fn load(path: &Path) -> Result<Robot> {
     load_with(path, &BTreeMap::new())
 }
 
-/// Write a description in the format given by the file's extension.
-pub fn save_description(desc: &RobotDescription, path: &Path) -> Result<()> {
-    let text = match Format::from_path(path)? {
+/// The text of a description in a format (TOML or `.par`; URDF is not written).
+pub fn description_text(desc: &RobotDescription, format: Format) -> Result<String> {
+    Ok(match format {
         Format::Toml => toml_format::write_description(desc),
         Format::Par => par::write_description(desc),
         Format::Urdf => {
@@ -195,6 +213,11 @@ pub fn save_description(desc: &RobotDescription, path: &Path) -> Result<()> {
                 "writing URDF is not supported: convert to .toml or .par".into(),
             ))
         }
-    };
+    })
+}
+
+/// Write a description in the format given by the file's extension.
+pub fn save_description(desc: &RobotDescription, path: &Path) -> Result<()> {
+    let text = description_text(desc, Format::from_path(path)?)?;
     std::fs::write(path, text).map_err(|e| Error::io(path.display().to_string(), e))
 }

@@ -363,7 +363,10 @@ fn run(
     let stop = |t: f64, e: Error| -> Error {
         match e {
             Error::Io { .. } | Error::Input(_) | Error::Dimension { .. } => e,
-            other => Error::Numerical(format!("simulation stopped at t = {t}: {other}")),
+            other => Error::Numerical(format!(
+                "simulation stopped at t = {}: {other}",
+                output::Number(t)
+            )),
         }
     };
     loop {

@@ -6,6 +6,27 @@ use robodyn::Robot;
 use std::f64::consts::{FRAC_PI_2, PI};
 use std::path::PathBuf;
 
+/// Largest gap between each cut frame and its twin (rotation and position) at a solution, from
+/// the geometric model 0T_j (frames 1..NJ with the cut-joint variables).
+pub fn closure_gap(
+    r: &Robot,
+    cc: &robodyn::ClosedChain,
+    s: &robodyn::algorithms::closed_chain::ClosureSolution,
+) -> f64 {
+    let mut q: Vec<f64> = s.q_tree.iter().copied().collect();
+    q.extend(s.q_c.iter());
+    let t = robodyn::geometry::frame_transforms(r, &q);
+    cc.loops()
+        .iter()
+        .map(|l| {
+            let (k, tw) = (l.topology.cut, l.topology.twin);
+            (t[k - 1].rot - t[tw - 1].rot)
+                .amax()
+                .max((t[k - 1].pos - t[tw - 1].pos).amax())
+        })
+        .fold(0.0, f64::max)
+}
+
 /// A bundled robot by file name.
 pub fn robot(name: &str) -> Robot {
     let p = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
