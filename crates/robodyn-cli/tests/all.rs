@@ -23,6 +23,8 @@ mod cli_conventions;
 mod cli_generate;
 #[path = "cli_identify.rs"]
 mod cli_identify;
+#[path = "cli_identify_hostile.rs"]
+mod cli_identify_hostile;
 #[path = "cli_info.rs"]
 mod cli_info;
 #[path = "cli_info_assembly.rs"]

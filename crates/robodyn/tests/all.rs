@@ -53,6 +53,8 @@ mod fuzz_regressions;
 mod geometry;
 #[path = "identification_consistency.rs"]
 mod identification_consistency;
+#[path = "identification_hostile.rs"]
+mod identification_hostile;
 #[path = "identification_synthetic.rs"]
 mod identification_synthetic;
 #[path = "identification_tx40.rs"]

@@ -14,6 +14,27 @@ pub struct Table {
     pub file: String,
 }
 
+/// The header of a table of named columns: at least one name, none empty, none repeated (the
+/// reason names the columns). Shared with identification's logs.
+pub fn check_header(headers: &[String]) -> std::result::Result<(), String> {
+    if headers.is_empty() || headers.iter().all(String::is_empty) {
+        return Err("no header line (column names)".into());
+    }
+    for (k, h) in headers.iter().enumerate() {
+        if h.is_empty() {
+            return Err(format!("column {} has no name", k + 1));
+        }
+        if let Some(first) = headers[..k].iter().position(|o| o == h) {
+            return Err(format!(
+                "column `{h}` appears twice (columns {} and {})",
+                first + 1,
+                k + 1
+            ));
+        }
+    }
+    Ok(())
+}
+
 impl Table {
     /// Parse CSV text: a header line, then rows of numbers (fields are trimmed; `#` starts a
     /// comment line). Errors name the file, the line and the column: a repeated or empty column
@@ -43,24 +64,7 @@ impl Table {
             .iter()
             .map(str::to_string)
             .collect();
-        if headers.is_empty() || headers.iter().all(String::is_empty) {
-            return Err(err(Some(1), "no header line (column names)".into()));
-        }
-        for (k, h) in headers.iter().enumerate() {
-            if h.is_empty() {
-                return Err(err(Some(1), format!("column {} has no name", k + 1)));
-            }
-            if let Some(first) = headers[..k].iter().position(|o| o == h) {
-                return Err(err(
-                    Some(1),
-                    format!(
-                        "column `{h}` appears twice (columns {} and {})",
-                        first + 1,
-                        k + 1
-                    ),
-                ));
-            }
-        }
+        check_header(&headers).map_err(|reason| err(Some(1), reason))?;
         let mut rows = Vec::new();
         // one record reused for every row (no allocation per row but the row itself), fields
         // as bytes: a number is ASCII, anything else is refused below with its text
