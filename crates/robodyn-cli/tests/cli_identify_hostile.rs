@@ -592,3 +592,33 @@ fn warnings_are_printed_once() {
         1
     );
 }
+
+/// `excite` checked `--rate` and `--periods` after the design (minutes) and not the size of the
+/// output at all (`--rate 1e12` wrote until the disk was full): both are checked first, with the
+/// flags named; a period or rate that is not a positive number is refused by name.
+#[test]
+fn excite_checks_its_output_size_first() {
+    let rx90 = robot("rx90.toml");
+    let out = tmp("identify_hostile", "never.csv");
+    let out_arg = out.to_str().unwrap();
+    let excite = |extra: &[&str]| {
+        let mut a = vec!["excite", &rx90, "--qd-max", "1", "--qdd-max", "5"];
+        a.extend(["--output", out_arg, "--harmonics", "3"]);
+        if !extra.contains(&"--period") {
+            a.extend(["--period", "4"]);
+        }
+        a.extend(extra);
+        robodyn(&a)
+    };
+    for (extra, message) in [
+        (["--rate", "1e12"], "= 4e12 rows: at most 1e8"),
+        (["--periods", "0"], "--periods must be at least 1"),
+        (["--rate", "nan"], "invalid value 'nan' for '--rate"),
+        (["--period", "0"], "invalid value '0' for '--period"),
+    ] {
+        let o = excite(&extra);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success() && err.contains(message), "{extra:?}: {err}");
+    }
+    assert!(!out.exists());
+}

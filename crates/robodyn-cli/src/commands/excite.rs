@@ -106,7 +106,7 @@ pub fn run(a: Args) -> CliResult {
         return Err("--periods must be at least 1".into());
     }
     let rows = a.period * a.periods as f64 * a.rate;
-    if !(rows <= MAX_ROWS) {
+    if rows > MAX_ROWS {
         return Err(format!(
             "--period {} x --periods {} x --rate {} = {rows:e} rows: at most {MAX_ROWS:e}",
             a.period, a.periods, a.rate

@@ -128,7 +128,7 @@ pub fn check_log(data: &[u8]) {
         .expect("a recording reads back");
     assert_eq!(count, summary.samples);
     let opt = Options {
-        estimator: if data.len() % 2 == 0 {
+        estimator: if data.len().is_multiple_of(2) {
             Estimator::Ols
         } else {
             Estimator::Wls
