@@ -104,6 +104,50 @@ fn column(head: &[String], name: &str) -> usize {
     head.iter().position(|h| h == name).unwrap()
 }
 
+/// The SCARA log with the columns `names` set to `value` on every row.
+fn with_columns(file: &str, names: &[String], value: &str) -> String {
+    edited(file, |head, rows| {
+        let cols: Vec<usize> = names.iter().map(|n| column(head, n)).collect();
+        for r in rows.iter_mut() {
+            for &c in &cols {
+                r[c] = value.into();
+            }
+        }
+    })
+}
+
+/// The SCARA log with the sign of tau2 flipped (a torque channel wired the wrong way).
+fn flipped_tau2(file: &str) -> String {
+    edited(file, |head, rows| {
+        let c = column(head, "tau2");
+        for r in rows.iter_mut() {
+            let v: f64 = r[c].parse().unwrap();
+            r[c] = format!("{}", -v);
+        }
+    })
+}
+
+/// The SCARA log without its qd, qdd columns (positions and torques, as a robot logs them).
+fn positions_only(file: &str) -> String {
+    edited(file, |head, rows| {
+        let keep: Vec<usize> = (0..head.len())
+            .filter(|&c| !head[c].starts_with("qd"))
+            .collect();
+        *head = keep.iter().map(|&c| head[c].clone()).collect();
+        for r in rows.iter_mut() {
+            *r = keep.iter().map(|&c| r[c].clone()).collect();
+        }
+    })
+}
+
+/// `prefix<j>` for the SCARA's joints 1..4.
+fn names(prefixes: &[&str]) -> Vec<String> {
+    prefixes
+        .iter()
+        .flat_map(|p| (1..=4).map(move |j| format!("{p}{j}")))
+        .collect()
+}
+
 fn json(args: &[&str]) -> serde_json::Value {
     let mut a = args.to_vec();
     a.extend(["--format", "json"]);
@@ -214,14 +258,7 @@ fn gains_without_currents_are_refused() {
 #[test]
 fn zero_torques_are_nothing_to_fit() {
     let scara = robot("scara.toml");
-    let zero = edited("zero_torques.csv", |head, rows| {
-        let cols: Vec<usize> = (1..=4).map(|j| column(head, &format!("tau{j}"))).collect();
-        for r in rows.iter_mut() {
-            for &c in &cols {
-                r[c] = "0".into();
-            }
-        }
-    });
+    let zero = with_columns("zero_torques.csv", &names(&["tau"]), "0");
     for extra in [&[][..], &["--strict"][..]] {
         let mut args = vec!["identify", &scara, "--data", &zero, "--estimator", "ols"];
         args.extend(extra);
@@ -236,13 +273,7 @@ fn zero_torques_are_nothing_to_fit() {
 #[test]
 fn physically_impossible_values_are_warned_about() {
     let scara = robot("scara.toml");
-    let flipped = edited("flipped_tau2.csv", |head, rows| {
-        let c = column(head, "tau2");
-        for r in rows.iter_mut() {
-            let v: f64 = r[c].parse().unwrap();
-            r[c] = format!("{}", -v);
-        }
-    });
+    let flipped = flipped_tau2("flipped_tau2.csv");
     let args = ["identify", &scara, "--data", &flipped, "--estimator", "ols"];
     let v = json(&args);
     let impossible: Vec<&serde_json::Value> = v["warnings"]
@@ -466,30 +497,8 @@ fn repeated_columns_are_refused() {
 #[test]
 fn differentiate_replaces_the_logs_derivatives() {
     let scara = robot("scara.toml");
-    let wrong = edited("wrong_qd.csv", |head, rows| {
-        let cols: Vec<usize> = (1..=4)
-            .flat_map(|j| {
-                [
-                    column(head, &format!("qd{j}")),
-                    column(head, &format!("qdd{j}")),
-                ]
-            })
-            .collect();
-        for r in rows.iter_mut() {
-            for &c in &cols {
-                r[c] = "0".into();
-            }
-        }
-    });
-    let positions = edited("positions_for_differentiate.csv", |head, rows| {
-        let keep: Vec<usize> = (0..head.len())
-            .filter(|&c| !head[c].starts_with("qd"))
-            .collect();
-        *head = keep.iter().map(|&c| head[c].clone()).collect();
-        for r in rows.iter_mut() {
-            *r = keep.iter().map(|&c| r[c].clone()).collect();
-        }
-    });
+    let wrong = with_columns("wrong_qd.csv", &names(&["qd", "qdd"]), "0");
+    let positions = positions_only("positions_for_differentiate.csv");
     let identify = |data: &str, extra: &[&str]| {
         let mut args = vec!["identify", &scara, "--data", data, "--estimator", "ols"];
         args.extend(extra);
@@ -510,15 +519,7 @@ fn differentiate_replaces_the_logs_derivatives() {
 #[test]
 fn coulomb_dead_band_is_stated_and_settable() {
     let scara = robot("scara.toml");
-    let positions = edited("positions_only.csv", |head, rows| {
-        let keep: Vec<usize> = (0..head.len())
-            .filter(|&c| !head[c].starts_with("qd") && head[c] != "energy")
-            .collect();
-        *head = keep.iter().map(|&c| head[c].clone()).collect();
-        for r in rows.iter_mut() {
-            *r = keep.iter().map(|&c| r[c].clone()).collect();
-        }
-    });
+    let positions = positions_only("positions_only.csv");
     let band = |v: &serde_json::Value| v["processing"]["coulomb_band"].as_f64().unwrap();
     let args = [
         "identify",
@@ -550,13 +551,7 @@ fn coulomb_dead_band_is_stated_and_settable() {
 #[test]
 fn warnings_are_printed_once() {
     let scara = robot("scara.toml");
-    let flipped = edited("flipped_for_warnings.csv", |head, rows| {
-        let c = column(head, "tau2");
-        for r in rows.iter_mut() {
-            let v: f64 = r[c].parse().unwrap();
-            r[c] = format!("{}", -v);
-        }
-    });
+    let flipped = flipped_tau2("flipped_for_warnings.csv");
     // three warnings on FS2, FV2, IA2 (physically impossible)
     let out = robodyn(&["identify", &scara, "--data", &flipped, "--estimator", "ols"]);
     assert!(out.status.success());
@@ -618,7 +613,10 @@ fn excite_checks_its_output_size_first() {
     ] {
         let o = excite(&extra);
         let err = String::from_utf8_lossy(&o.stderr);
-        assert!(!o.status.success() && err.contains(message), "{extra:?}: {err}");
+        assert!(
+            !o.status.success() && err.contains(message),
+            "{extra:?}: {err}"
+        );
     }
     assert!(!out.exists());
 }

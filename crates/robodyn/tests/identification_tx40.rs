@@ -16,6 +16,18 @@ fn data() -> Option<PathBuf> {
     )
 }
 
+/// The bundled TX40 (with its transmission) and the log.
+fn tx40(path: &std::path::Path) -> (ModelAccess, CsvLog) {
+    let robot = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../robots/tx40.toml");
+    let acc = ModelAccess::new(load_description(&robot, &BTreeMap::new()).unwrap()).unwrap();
+    let labels = JointLabels {
+        numbers: acc.actuated_joints().to_vec(),
+        names: acc.joint_names(),
+    };
+    let log = CsvLog::open(path, &labels).unwrap();
+    (acc, log)
+}
+
 /// The README's command: WLS, constant offsets, validation on 60..80 % of the log. The real
 /// robot's torques are explained to within the per-joint errors measured when this test was
 /// written (5.0, 7.6, 8.7, 10.5, 10.5, 14.9 % with the default Coulomb dead band) with margin;
@@ -25,13 +37,7 @@ fn data() -> Option<PathBuf> {
 #[test]
 fn tx40_real_log() {
     let Some(path) = data() else { return };
-    let robot = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../robots/tx40.toml");
-    let mut acc = ModelAccess::new(load_description(&robot, &BTreeMap::new()).unwrap()).unwrap();
-    let labels = JointLabels {
-        numbers: acc.actuated_joints().to_vec(),
-        names: acc.joint_names(),
-    };
-    let log = CsvLog::open(&path, &labels).unwrap();
+    let (mut acc, log) = tx40(&path);
     let mut opt = Options {
         validation: Some((0.6, 0.8)),
         standard: true,
@@ -93,13 +99,7 @@ fn tx40_real_log() {
 #[test]
 fn tx40_coulomb_dead_band_at_rest() {
     let Some(path) = data() else { return };
-    let robot = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../robots/tx40.toml");
-    let mut acc = ModelAccess::new(load_description(&robot, &BTreeMap::new()).unwrap()).unwrap();
-    let labels = JointLabels {
-        numbers: acc.actuated_joints().to_vec(),
-        names: acc.joint_names(),
-    };
-    let log = CsvLog::open(&path, &labels).unwrap();
+    let (mut acc, log) = tx40(&path);
     let raw_error = |band: Option<f64>, acc: &mut ModelAccess| {
         let mut opt = Options {
             validation: Some((0.8, 1.0)),
