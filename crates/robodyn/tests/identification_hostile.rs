@@ -246,3 +246,48 @@ fn options_are_checked_before_reading() {
         }
     }
 }
+
+/// 24.2 (sizes before allocations): the validation rows kept for the plot grew with the log
+/// (N (p + 1) numbers per decimated sample: 57 GB for 100 M samples of a 6-joint robot without
+/// decimation); at most `MAX_KEPT_ROWS` are kept, evenly spaced over the segment.
+#[test]
+fn validation_rows_for_the_plot_are_bounded() {
+    use robodyn::identification::observation::MAX_KEPT_ROWS;
+    let mut acc = scara();
+    let one = scara_log(&acc);
+    let dt = one.samples[1].t - one.samples[0].t;
+    // 25 copies end to end: 50,025 samples
+    let samples: Vec<RawSample> = (0..25)
+        .flat_map(|_| one.samples.iter())
+        .enumerate()
+        .map(|(k, s)| RawSample {
+            t: k as f64 * dt,
+            ..s.clone()
+        })
+        .collect();
+    let count = samples.len();
+    let long = MemoryLog {
+        name: "long".into(),
+        samples,
+    };
+    let opt = Options {
+        estimator: Estimator::Ols,
+        decimation: Some(1),
+        validation: Some((0.1, 1.0)),
+        keep_validation_rows: true,
+        ..Options::default()
+    };
+    let id = identify(&mut acc, &long, &opt).unwrap();
+    let kept = id.validation_rows.t.len();
+    let segment = id.processing.validation_samples;
+    eprintln!("{count} samples, {segment} in the validation segment, {kept} kept for the plot");
+    assert!(segment > 2 * MAX_KEPT_ROWS, "{segment}");
+    assert!(
+        (MAX_KEPT_ROWS / 2..=MAX_KEPT_ROWS).contains(&kept),
+        "{kept}"
+    );
+    // evenly spaced over the whole segment
+    let span = id.validation_rows.t[kept - 1] - id.validation_rows.t[0];
+    assert!(span > 0.99 * 0.9 * (count - 1) as f64 * dt, "{span}");
+    assert_eq!(id.predicted_validation().len(), kept);
+}

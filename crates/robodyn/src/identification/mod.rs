@@ -109,7 +109,8 @@ pub struct Options {
     pub iv_iterations: usize,
     /// Bandwidth of the IDIM-IV tracking loop (Hz; default bandwidth / 4).
     pub iv_bandwidth: Option<f64>,
-    /// Keep the decimated rows of the validation segment in the result (for the plot).
+    /// Keep the decimated rows of the validation segment in the result (for the plot; at most
+    /// [`observation::MAX_KEPT_ROWS`], evenly spaced, whatever the log's length).
     pub keep_validation_rows: bool,
     /// Dead band of the sign of the Coulomb friction in W (rad/s or m/s; see
     /// [`model_access::coulomb_sign`]): None for the default, [`DEFAULT_COULOMB_BAND`] when
@@ -570,7 +571,14 @@ pub fn processing(summary: &LogSummary, opt: &Options) -> Result<(Processing, Pr
         gains: opt.gains.clone(),
         min_speed: opt.min_speed,
         coulomb_band,
-        keep_validation_rows: opt.keep_validation_rows,
+        validation_row_stride: if opt.keep_validation_rows {
+            // the decimated rows of the segment, estimated from its fraction of the log
+            let fraction = opt.validation.map_or(0.0, |(a, b)| b - a);
+            let expected = (fraction * samples as f64 / nd as f64).ceil() as usize;
+            expected.div_ceil(observation::MAX_KEPT_ROWS).max(1)
+        } else {
+            0
+        },
     };
     let report = ProcessingReport {
         source: summary.source.clone(),

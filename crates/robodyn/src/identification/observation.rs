@@ -38,9 +38,14 @@ pub struct Processing {
     pub min_speed: f64,
     /// Dead band of the sign of the Coulomb friction (rad/s or m/s; 0: the exact sign).
     pub coulomb_band: f64,
-    /// Rows of the validation segment kept for the plot.
-    pub keep_validation_rows: bool,
+    /// Rows of the validation segment kept for the plot: one decimated row in this many (0:
+    /// none), so that at most [`MAX_KEPT_ROWS`] are held whatever the log's length.
+    pub validation_row_stride: usize,
 }
+
+/// Most decimated validation rows kept for the plot (a plot shows no more; each holds N (p + 1)
+/// numbers).
+pub const MAX_KEPT_ROWS: usize = 20_000;
 
 /// Decimated validation rows (for the plot): t, Y (N per sample), W (N p per sample).
 #[derive(Clone, Debug, Default)]
@@ -394,7 +399,8 @@ impl Pass<'_> {
             for k in 0..n {
                 self.out.validation[k].push(&ch[k * p..(k + 1) * p], ch[n * p + k]);
             }
-            if self.proc.keep_validation_rows {
+            let stride = self.proc.validation_row_stride;
+            if stride > 0 && (self.out.validation_samples - 1).is_multiple_of(stride) {
                 self.out.validation_rows.t.push(s.t);
                 self.out
                     .validation_rows
