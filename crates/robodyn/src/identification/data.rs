@@ -340,8 +340,8 @@ impl std::fmt::Display for LineTooLong {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "line {} is longer than {} bytes: not a log of numbers (a binary or corrupted file?)",
-            self.line, self.limit
+            "a line longer than {} bytes: not a log of numbers (a binary or corrupted file?)",
+            self.limit
         )
     }
 }
@@ -349,7 +349,7 @@ impl std::fmt::Display for LineTooLong {
 impl std::error::Error for LineTooLong {}
 
 /// A reader that fails (with [`LineTooLong`]) as soon as a line exceeds `limit` bytes, so that
-/// no record grows without bound.
+/// no record grows without bound. A line ends at `\n` (counted) or `\r` (old Mac files).
 struct LineLimit<R> {
     inner: R,
     limit: usize,
@@ -372,8 +372,8 @@ impl<R: Read> Read for LineLimit<R> {
     fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
         let n = self.inner.read(buf)?;
         for &b in &buf[..n] {
-            if b == b'\n' {
-                self.line += 1;
+            if b == b'\n' || b == b'\r' {
+                self.line += u64::from(b == b'\n');
                 self.current = 0;
             } else {
                 self.current += 1;
@@ -395,21 +395,19 @@ impl<R: Read> Read for LineLimit<R> {
 /// A read error of the log (a CSV error keeps its underlying I/O error when it has one; a line
 /// too long is an input error with its line).
 fn io(file: &str, e: csv::Error) -> Error {
-    if let csv::ErrorKind::Io(source) = e.kind() {
-        if let Some(long) = source
-            .get_ref()
-            .and_then(|inner| inner.downcast_ref::<LineTooLong>())
-        {
-            return Error::Input(format!("{file}:{}: {long}", long.line));
-        }
+    if !e.is_io_error() {
+        return Error::Input(format!("{file}: {e}"));
     }
-    if let csv::ErrorKind::Io(_) = e.kind() {
-        if let csv::ErrorKind::Io(source) = e.into_kind() {
-            return Error::io(file, source);
-        }
-        unreachable!("an I/O error");
+    let csv::ErrorKind::Io(source) = e.into_kind() else {
+        unreachable!("an I/O error")
+    };
+    match source
+        .get_ref()
+        .and_then(|inner| inner.downcast_ref::<LineTooLong>())
+    {
+        Some(long) => Error::Input(format!("{file}:{}: {long}", long.line)),
+        None => Error::io(file, source),
     }
-    Error::Input(format!("{file}: {e}"))
 }
 
 impl LogSource for CsvLog {
@@ -710,5 +708,35 @@ impl LogSource for RecordedLog {
             })?;
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn read_all(bytes: Vec<u8>) -> std::io::Result<usize> {
+        let mut r = LineLimit::new(std::io::Cursor::new(bytes), 1000);
+        let mut out = Vec::new();
+        r.read_to_end(&mut out)?;
+        Ok(out.len())
+    }
+
+    /// Lines end at `\n` or `\r` (CRLF and old Mac files); a line beyond the limit fails with its
+    /// number, counted in `\n`.
+    #[test]
+    fn line_limit() {
+        let short = "1,2,3\r\n".repeat(10_000).into_bytes();
+        assert_eq!(read_all(short.clone()).unwrap(), short.len());
+        let mac = "1,2,3\r".repeat(10_000).into_bytes();
+        assert_eq!(read_all(mac.clone()).unwrap(), mac.len());
+        let mut long = b"t,q1\n0,0\n".to_vec();
+        long.extend(std::iter::repeat_n(b'7', 1001));
+        let e = read_all(long).unwrap_err();
+        let inner = e.get_ref().unwrap().downcast_ref::<LineTooLong>().unwrap();
+        assert_eq!((inner.line, inner.limit), (3, 1000));
+        let mut exact = b"t,q1\n".to_vec();
+        exact.extend(std::iter::repeat_n(b'7', 1000));
+        assert!(read_all(exact).is_ok());
     }
 }

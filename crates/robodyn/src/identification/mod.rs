@@ -526,7 +526,7 @@ pub fn processing(summary: &LogSummary, opt: &Options) -> Result<(Processing, Pr
         if settling >= samples {
             return Err(Error::Input(format!(
                 "{}: the position low-pass (cut-off {} Hz at {fs} Hz) settles in {settling} \
-                 samples, more than the log's {samples}: raise the cut-off",
+                 samples, more than the log's {samples}: the log is too short for this cut-off",
                 summary.source, f.cutoff
             )));
         }
