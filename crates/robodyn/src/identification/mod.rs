@@ -728,38 +728,7 @@ pub fn identify(
     preport.validation_samples = pass.validation_samples;
     preport.slow_rows = pass.slow_rows.clone();
     let ts: Vec<Mat<f64>> = pass.fit.iter_mut().map(|f| f.factor().clone()).collect();
-    let ols = least_squares(
-        &combine(&ts.iter().map(|t| (t, 1.0)).collect::<Vec<_>>()),
-        rows,
-        &names,
-    )?;
-    let (mut sol, sigma): (LsSolution, Option<Vec<f64>>) = match opt.estimator {
-        Estimator::Ols => (ols.clone(), None),
-        Estimator::Wls | Estimator::Iv => {
-            let sig = pass
-                .fit
-                .iter_mut()
-                .map(|f| {
-                    let r = f.rows();
-                    joint_sigma(f.factor(), r)
-                })
-                .collect::<Result<Vec<f64>>>()?;
-            if let Some(k) = sig.iter().position(|s| s.is_nan() || *s <= 0.0) {
-                return Err(Error::Numerical(format!(
-                    "joint {}: its equations are fitted exactly (sigma = 0), so Gautier's weight \
-                     1/sigma is infinite; use --estimator ols (noise-free data)",
-                    access.actuated_joints()[k]
-                )));
-            }
-            let tw = combine(
-                &ts.iter()
-                    .zip(&sig)
-                    .map(|(t, s)| (t, 1.0 / s))
-                    .collect::<Vec<_>>(),
-            );
-            (least_squares(&tw, rows, &names)?, Some(sig))
-        }
-    };
+    let (mut sol, sigma) = first_estimate(opt.estimator, &mut pass, &ts, rows, (&names, access))?;
     let mut estimator = match opt.estimator {
         Estimator::Ols => "OLS",
         Estimator::Wls => "WLS",
@@ -779,15 +748,7 @@ pub fn identify(
         warnings.extend(warning);
         iv_report = Some(report);
     }
-    let tw: Mat<f64> = match &sigma {
-        Some(sig) => combine(
-            &ts.iter()
-                .zip(sig)
-                .map(|(t, s)| (t, 1.0 / s))
-                .collect::<Vec<_>>(),
-        ),
-        None => combine(&ts.iter().map(|t| (t, 1.0)).collect::<Vec<_>>()),
-    };
+    let tw = weighted(&ts, sigma.as_deref());
     // physically consistent parameters: the constrained least squares, which is also the
     // consistent set nearest to the unconstrained estimate in the metric of its covariance
     let mut consistent = None;
@@ -855,28 +816,11 @@ pub fn identify(
         &relative_std,
         &ts,
     ));
-    if let Some((_, fd)) = preport.decimation_filter {
-        if fd < 2.0 * opt.bandwidth {
-            notes.push(format!(
-                "the decimation low-pass ({fd:.3} Hz) is below twice the bandwidth: the \
-                 dynamics are filtered too, consistently on both sides (parallel filtering)"
-            ));
-        }
-    }
-    let total_slow: usize = pass.slow_rows.iter().sum();
-    if total_slow > 0 {
-        notes.push(format!(
-            "{total_slow} joint rows of the fit left out by --min-speed {} (per joint {:?})",
-            opt.min_speed, pass.slow_rows
-        ));
-    }
-    if model.transmission.is_some() {
-        notes.push(
-            "with the transmission, IA/FS/FV of a joint's link are its motor's parameters in \
-             motor units (tau = R^T (Ia m_dd + Fv m_d + Fs sign(m_d)), m = R q)"
-                .into(),
-        );
-    }
+    notes.extend(processing_notes(
+        &preport,
+        opt,
+        model.transmission.is_some(),
+    ));
     Ok(Identification {
         robot: access.name().to_string(),
         joints: access.actuated_joints().to_vec(),
@@ -900,6 +844,76 @@ pub fn identify(
         validation_rows: std::mem::take(&mut pass.validation_rows),
         model,
     })
+}
+
+/// The triangular factor of the union of the joints' rows, joint k's weighted by 1 / sigma_k
+/// (unweighted without sigma).
+fn weighted(ts: &[Mat<f64>], sigma: Option<&[f64]>) -> Mat<f64> {
+    let parts: Vec<(&Mat<f64>, f64)> = match sigma {
+        Some(sig) => ts.iter().zip(sig).map(|(t, s)| (t, 1.0 / s)).collect(),
+        None => ts.iter().map(|t| (t, 1.0)).collect(),
+    };
+    combine(&parts)
+}
+
+/// OLS, or Gautier's WLS with each joint's sigma (the weights, returned); IDIM-IV starts from
+/// the WLS estimate.
+fn first_estimate(
+    estimator: Estimator,
+    pass: &mut PassResult,
+    ts: &[Mat<f64>],
+    rows: usize,
+    (names, access): (&[String], &ModelAccess),
+) -> Result<(LsSolution, Option<Vec<f64>>)> {
+    if estimator == Estimator::Ols {
+        return Ok((least_squares(&weighted(ts, None), rows, names)?, None));
+    }
+    let sig = pass
+        .fit
+        .iter_mut()
+        .map(|f| {
+            let r = f.rows();
+            joint_sigma(f.factor(), r)
+        })
+        .collect::<Result<Vec<f64>>>()?;
+    if let Some(k) = sig.iter().position(|s| s.is_nan() || *s <= 0.0) {
+        return Err(Error::Numerical(format!(
+            "joint {}: its equations are fitted exactly (sigma = 0), so Gautier's weight \
+             1/sigma is infinite; use --estimator ols (noise-free data)",
+            access.actuated_joints()[k]
+        )));
+    }
+    let sol = least_squares(&weighted(ts, Some(&sig)), rows, names)?;
+    Ok((sol, Some(sig)))
+}
+
+/// What the user should know about the processing: the decimation filtering the dynamics, the
+/// rows left out as slow, the motor units of a transmission.
+fn processing_notes(preport: &ProcessingReport, opt: &Options, transmission: bool) -> Vec<String> {
+    let mut notes = Vec::new();
+    if let Some((_, fd)) = preport.decimation_filter {
+        if fd < 2.0 * opt.bandwidth {
+            notes.push(format!(
+                "the decimation low-pass ({fd:.3} Hz) is below twice the bandwidth: the \
+                 dynamics are filtered too, consistently on both sides (parallel filtering)"
+            ));
+        }
+    }
+    let total_slow: usize = preport.slow_rows.iter().sum();
+    if total_slow > 0 {
+        notes.push(format!(
+            "{total_slow} joint rows of the fit left out by --min-speed {} (per joint {:?})",
+            opt.min_speed, preport.slow_rows
+        ));
+    }
+    if transmission {
+        notes.push(
+            "with the transmission, IA/FS/FV of a joint's link are its motor's parameters in \
+             motor units (tau = R^T (Ia m_dd + Fv m_d + Fs sign(m_d)), m = R q)"
+                .into(),
+        );
+    }
+    notes
 }
 
 /// The pass read every sample of the first read (the log did not change between reads), left
