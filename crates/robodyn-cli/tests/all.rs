@@ -29,6 +29,8 @@ mod cli_generate;
 mod cli_generate_names;
 #[path = "cli_identify.rs"]
 mod cli_identify;
+#[path = "cli_identify_hostile.rs"]
+mod cli_identify_hostile;
 #[path = "cli_info.rs"]
 mod cli_info;
 #[path = "cli_info_assembly.rs"]

@@ -59,6 +59,8 @@ mod geometry;
 mod identification_conic;
 #[path = "identification_consistency.rs"]
 mod identification_consistency;
+#[path = "identification_hostile.rs"]
+mod identification_hostile;
 #[path = "identification_synthetic.rs"]
 mod identification_synthetic;
 #[path = "identification_tx40.rs"]

@@ -55,7 +55,7 @@ fn written_robot_is_consistent_and_reproduces_the_base_parameters() {
     assert!(
         id.warnings
             .iter()
-            .all(|w| !w.contains("not physically consistent")),
+            .all(|w| !w.message.contains("not physically consistent")),
         "{:?}",
         id.warnings
     );
@@ -161,7 +161,7 @@ fn deliberately_inconsistent_estimates_are_projected_and_reported() {
     assert!(
         id.warnings
             .iter()
-            .any(|w| w.contains("not physically consistent")),
+            .any(|w| w.message.contains("not physically consistent")),
         "{:?}",
         id.warnings
     );

@@ -3,6 +3,7 @@
 //! condition number of the base-parameter observation matrix under position, velocity,
 //! acceleration and torque limits, starting and ending at rest.
 
+use crate::commands::identify::positive;
 use crate::common::format_number;
 use crate::common::{parse_list, CliResult, RobotArgs};
 use robodyn::identification::excitation::{design, DesignOptions, Limits};
@@ -24,7 +25,7 @@ pub struct Args {
     #[command(flatten)]
     pub robot: RobotArgs,
     /// Period T of the Fourier series (s).
-    #[arg(long)]
+    #[arg(long, value_parser = positive)]
     pub period: f64,
     /// Harmonics per joint (at least 2).
     #[arg(long)]
@@ -67,7 +68,7 @@ pub struct Args {
     #[arg(long)]
     pub offsets: bool,
     /// Rate of the CSV rows (Hz).
-    #[arg(long, default_value_t = 200.0)]
+    #[arg(long, default_value_t = 200.0, value_parser = positive)]
     pub rate: f64,
     /// Periods written to the CSV.
     #[arg(long, default_value_t = 1)]
@@ -95,12 +96,27 @@ fn per_joint(name: &str, s: Option<&str>, n: usize) -> CliResult<Option<Vec<f64>
     }
 }
 
+/// Rows of the CSV at most (a larger file is a mistake of --rate or --periods).
+const MAX_ROWS: f64 = 1e8;
+
 pub fn run(a: Args) -> CliResult {
     let files = [
         ("--output", Some(a.output.as_path())),
         ("--plot", a.plot.as_deref()),
     ];
     crate::output::check_distinct(&files)?;
+    // the output's size before the design (which takes a while)
+    if a.periods == 0 {
+        return Err("--periods must be at least 1".into());
+    }
+    let rows = a.period * a.periods as f64 * a.rate;
+    if rows > MAX_ROWS {
+        return Err(format!(
+            "--period {} x --periods {} x --rate {} = {rows:e} rows: at most {MAX_ROWS:e}",
+            a.period, a.periods, a.rate
+        )
+        .into());
+    }
     let desc = a.robot.description()?.0;
     let mut access = ModelAccess::new(desc)?;
     let joints = access.actuated_joints().to_vec();
@@ -161,11 +177,8 @@ pub fn run(a: Args) -> CliResult {
         seed: a.seed,
     };
     let d = design(&mut access, &mut params, &opt)?;
-    if !(a.rate.is_finite() && a.rate > 0.0) || a.periods == 0 {
-        return Err("--rate must be positive and --periods at least 1".into());
-    }
     // CSV
-    let rows = (a.period * a.periods as f64 * a.rate).round() as usize;
+    let rows = rows.round() as usize;
     // all or nothing: both files put in place once both are written
     let mut file = crate::output::Output::create(Some(&a.output))?;
     let mut plot_file = a

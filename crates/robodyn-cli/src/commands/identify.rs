@@ -3,8 +3,8 @@
 //! deviations, the condition number and the per-joint errors; optionally a fit plot on a
 //! validation segment and a physically consistent robot file.
 
-use crate::common::{parse_list, CliResult, RobotArgs};
-use robodyn::identification::data::{CsvLog, JointLabels};
+use crate::common::{parse_list, parse_value, CliResult, RobotArgs};
+use robodyn::identification::data::{CsvLog, Effort, JointLabels, LogSource};
 use robodyn::identification::model_access::ModelAccess;
 use robodyn::identification::parameters::ParameterOptions;
 use robodyn::identification::{identify, report, EssentialOptions, Estimator, Options, Rotors};
@@ -39,7 +39,7 @@ pub struct Args {
     #[command(flatten)]
     pub robot: RobotArgs,
     /// Log (CSV): t, q<j>, tau<j> (or i<j> with --gains), optionally qd<j>, qdd<j>; j the frame
-    /// number of each actuated joint, or `_<name>` with the joint's name.
+    /// number of each actuated joint, or `_<name>` with the joint's name; `-`: standard input.
     #[arg(long)]
     pub data: PathBuf,
     #[arg(long, value_enum, default_value = "wls")]
@@ -61,18 +61,18 @@ pub struct Args {
     #[arg(long)]
     pub essential: bool,
     /// Essential parameters: drop parameters while the largest relative std is above this (%).
-    #[arg(long, default_value_t = 10.0)]
+    #[arg(long, default_value_t = 10.0, value_parser = positive)]
     pub essential_max_std: f64,
     /// Essential parameters: ... and the relative error grows by less than this fraction.
-    #[arg(long, default_value_t = 0.02)]
+    #[arg(long, default_value_t = 0.02, value_parser = non_negative)]
     pub essential_tolerance: f64,
     /// Joint-space bandwidth of the robot's dynamics (Hz): the filter and decimation defaults
     /// follow from it.
-    #[arg(long, default_value_t = 10.0)]
+    #[arg(long, default_value_t = 10.0, value_parser = positive)]
     pub bandwidth: f64,
     /// Cut-off of the zero-phase position low-pass (Hz; default 10 x bandwidth, at most 0.4 x
     /// the sample rate).
-    #[arg(long)]
+    #[arg(long, value_parser = positive)]
     pub cutoff: Option<f64>,
     /// Order of the position low-pass.
     #[arg(long, default_value_t = 4)]
@@ -93,13 +93,18 @@ pub struct Args {
     #[arg(long, allow_hyphen_values = true)]
     pub gains: Option<String>,
     /// Leave out a joint's rows where |qd_j| is below this (rad/s or m/s).
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, default_value_t = 0.0, value_parser = non_negative)]
     pub min_speed: f64,
+    /// Dead band of the Coulomb friction's sign (rad/s or m/s): sign(qd) is 0 where |qd| is at
+    /// most this (default 1e-3 when qd is differentiated from the positions, 0 when the log
+    /// gives qd).
+    #[arg(long, value_parser = non_negative)]
+    pub coulomb_band: Option<f64>,
     /// IDIM-IV: iterations.
     #[arg(long, default_value_t = 8)]
     pub iv_iterations: usize,
     /// IDIM-IV: bandwidth of the tracking loop of the simulation (Hz; default bandwidth / 4).
-    #[arg(long)]
+    #[arg(long, value_parser = positive)]
     pub iv_bandwidth: Option<f64>,
     /// Seed of the numerical base-parameter method's random states.
     #[arg(long, default_value_t = 1)]
@@ -118,6 +123,50 @@ pub struct Args {
     /// Exit with an error (code 1) when the report has warnings.
     #[arg(long)]
     pub strict: bool,
+}
+
+/// A finite positive number (a constant expression as every value of the command line).
+pub fn positive(s: &str) -> Result<f64, String> {
+    let x = parse_value(s)?;
+    if x > 0.0 {
+        Ok(x)
+    } else {
+        Err(format!("{x}: a positive number expected"))
+    }
+}
+
+/// A finite number >= 0.
+fn non_negative(s: &str) -> Result<f64, String> {
+    let x = parse_value(s)?;
+    if x >= 0.0 {
+        Ok(x)
+    } else {
+        Err(format!("{x}: a number >= 0 expected"))
+    }
+}
+
+/// `--gains`: one per motor, and only for a log of motor currents.
+fn check_gains(gains: Option<&[f64]>, log: &CsvLog, motors: usize) -> CliResult {
+    match (gains, log.effort()) {
+        (None, Effort::Current) => Err(format!(
+            "{}: the log has motor currents (i<j>): give --gains (one per motor) to convert them \
+             to torques",
+            log.name()
+        )
+        .into()),
+        (Some(_), Effort::Torque) => Err(format!(
+            "{}: --gains given but the log has joint torques (tau<j>), not motor currents \
+             (i<j>): the gains would scale the torques; leave --gains out",
+            log.name()
+        )
+        .into()),
+        (Some(g), _) if g.len() != motors => Err(format!(
+            "--gains has {} values for {motors} motors: one per motor",
+            g.len()
+        )
+        .into()),
+        _ => Ok(()),
+    }
 }
 
 fn parse_validation(s: &str) -> CliResult<Option<(f64, f64)>> {
@@ -148,6 +197,12 @@ pub fn run(a: Args) -> CliResult {
         names: access.joint_names(),
     };
     let log = CsvLog::open(&a.data, &labels)?;
+    let gains = a
+        .gains
+        .as_deref()
+        .map(|g| parse_list("gains", g))
+        .transpose()?;
+    check_gains(gains.as_deref(), &log, labels.numbers.len())?;
     let opt = Options {
         parameters: ParameterOptions {
             rotors: match a.rotor {
@@ -178,12 +233,9 @@ pub fn run(a: Args) -> CliResult {
         border: a.border,
         validation: parse_validation(&a.validation)?,
         use_log_derivatives: !a.differentiate,
-        gains: a
-            .gains
-            .as_deref()
-            .map(|g| parse_list("gains", g))
-            .transpose()?,
+        gains,
         min_speed: a.min_speed,
+        coulomb_band: a.coulomb_band,
         iv_iterations: a.iv_iterations,
         iv_bandwidth: a.iv_bandwidth,
         keep_validation_rows: a.plot.is_some(),
@@ -224,8 +276,14 @@ pub fn run(a: Args) -> CliResult {
     for p in [&a.plot, &a.write_robot].into_iter().flatten() {
         eprintln!("wrote {}", p.display());
     }
-    for w in &id.warnings {
-        eprintln!("robodyn: warning: {w}");
+    // the warnings once: in the report when it goes to standard output with them (text, JSON),
+    // else on standard error
+    let report_shows = a.output.as_deref().is_none_or(robodyn::io::is_stdio)
+        && matches!(a.format, Format::Text | Format::Json);
+    if !report_shows {
+        for w in &id.warnings {
+            eprintln!("robodyn: warning: {w}");
+        }
     }
     if a.strict && !id.warnings.is_empty() {
         return Err(format!(

@@ -12,22 +12,27 @@
 //! - [`consistency`]: physically consistent standard parameters (SDP, pseudo-inertia PSD),
 //!   solved by [`conic`], a small interior-point method for 4x4 PSD blocks and bounds;
 //! - [`excitation`]: finite Fourier series minimizing the condition number;
+//! - [`signs`]: the signs physics fixes (friction, rotor inertias, sums of masses and moments
+//!   of inertia), checked on the estimate;
 //! - [`report`]: table (text, JSON, CSV) and SVG plots;
-//! - [`model_access`]: the only calls into the rest of the library.
+//! - [`model_access`]: the only calls into the rest of the library;
+//! - [`fuzz_checks`]: the properties the fuzz targets check (`fuzz/`).
 
 pub mod conic;
 pub mod consistency;
 pub mod data;
 pub mod estimators;
 pub mod excitation;
+pub mod fuzz_checks;
 pub mod model_access;
 pub mod observation;
 pub mod parameters;
 pub mod report;
 pub mod signal;
+pub mod signs;
 
 use crate::error::{Error, Result};
-use data::{summarize, Effort, LogSource, LogSummary};
+use data::{record, summarize, Effort, LogSource, LogSummary};
 use estimators::{
     combine, iv_solve, joint_sigma, least_squares, output_sq, residual_sq, restrict, LsSolution,
 };
@@ -109,8 +114,103 @@ pub struct Options {
     pub iv_iterations: usize,
     /// Bandwidth of the IDIM-IV tracking loop (Hz; default bandwidth / 4).
     pub iv_bandwidth: Option<f64>,
-    /// Keep the decimated rows of the validation segment in the result (for the plot).
+    /// Keep the decimated rows of the validation segment in the result (for the plot; at most
+    /// [`observation::MAX_KEPT_ROWS`], evenly spaced, whatever the log's length).
     pub keep_validation_rows: bool,
+    /// Dead band of the sign of the Coulomb friction in W (rad/s or m/s; see
+    /// [`model_access::coulomb_sign`]): None for the default, [`DEFAULT_COULOMB_BAND`] when
+    /// the velocities are differentiated from the positions and 0 (the exact sign) when the
+    /// log gives them.
+    pub coulomb_band: Option<f64>,
+}
+
+/// Default dead band of the Coulomb sign where the velocities are estimated (rad/s or m/s):
+/// below it an estimated velocity is taken as rest, sign 0, instead of a sign drawn by the
+/// noise of the differentiated positions (measured on the TX40 log: docs/models/
+/// identification.md).
+pub const DEFAULT_COULOMB_BAND: f64 = 1e-3;
+
+impl Options {
+    /// Check every number of the options (positive bandwidths and cut-off, a filter order of 1
+    /// to 12, fractions of the validation segment, finite non-zero gains, ...): an input error
+    /// naming the option and its value, before any reading.
+    pub fn validate(&self) -> Result<()> {
+        let bad = |what: &str, v: f64, expected: &str| {
+            Err(Error::Input(format!("{what} {v}: {expected} expected")))
+        };
+        let positive = |what: &str, v: f64| {
+            if v.is_finite() && v > 0.0 {
+                Ok(())
+            } else {
+                bad(what, v, "a positive number")
+            }
+        };
+        let non_negative = |what: &str, v: f64| {
+            if v.is_finite() && v >= 0.0 {
+                Ok(())
+            } else {
+                bad(what, v, "a finite number >= 0")
+            }
+        };
+        positive("the bandwidth (Hz)", self.bandwidth)?;
+        if let Some(fc) = self.cutoff {
+            positive("the cut-off of the position low-pass (Hz)", fc)?;
+        }
+        if !(1..=12).contains(&self.filter_order) {
+            return Err(Error::Input(format!(
+                "the order of the position low-pass {}: 1 to 12 expected",
+                self.filter_order
+            )));
+        }
+        if self.decimation == Some(0) {
+            return Err(Error::Input(
+                "the decimation factor 0: 1 or more expected".into(),
+            ));
+        }
+        if let Some((a, b)) = self.validation {
+            if !(0.0..=1.0).contains(&a) || !(0.0..=1.0).contains(&b) || a >= b {
+                return Err(Error::Input(format!(
+                    "validation segment {a}:{b}: fractions 0 <= from < to <= 1 of the log expected"
+                )));
+            }
+        }
+        if let Some(g) = &self.gains {
+            if let Some((k, v)) = g
+                .iter()
+                .enumerate()
+                .find(|(_, v)| !(v.is_finite() && **v != 0.0))
+            {
+                return bad(
+                    &format!("drive gain {} of {}", k + 1, g.len()),
+                    *v,
+                    "a finite non-zero number",
+                );
+            }
+        }
+        non_negative("the minimum speed (rad/s or m/s)", self.min_speed)?;
+        if self.iv_iterations == 0 {
+            return Err(Error::Input(
+                "0 IDIM-IV iterations: 1 or more expected".into(),
+            ));
+        }
+        if let Some(f) = self.iv_bandwidth {
+            positive("the bandwidth of the IDIM-IV tracking loop (Hz)", f)?;
+        }
+        if let Some(e) = &self.essential {
+            positive(
+                "the relative standard deviation above which essential parameters are dropped (%)",
+                e.max_relative_std,
+            )?;
+            non_negative(
+                "the tolerance on the growth of the relative error of the essential parameters",
+                e.tolerance,
+            )?;
+        }
+        if let Some(b) = self.coulomb_band {
+            non_negative("the dead band of the Coulomb sign (rad/s or m/s)", b)?;
+        }
+        Ok(())
+    }
 }
 
 impl Default for Options {
@@ -134,6 +234,7 @@ impl Default for Options {
             iv_iterations: 8,
             iv_bandwidth: None,
             keep_validation_rows: false,
+            coulomb_band: None,
         }
     }
 }
@@ -160,7 +261,7 @@ pub struct JointFit {
 pub struct ProcessingReport {
     /// The log (file name).
     pub source: String,
-    /// Samples in the log.
+    /// Samples in the log: those read (once) and used by every pass.
     pub samples: usize,
     /// Sample rate fs of the log (Hz).
     pub sample_rate: f64,
@@ -182,6 +283,8 @@ pub struct ProcessingReport {
     pub decimation_skip: usize,
     /// The `min_speed` applied (rad/s or m/s).
     pub min_speed: f64,
+    /// The dead band of the Coulomb sign applied (rad/s or m/s; 0: the exact sign).
+    pub coulomb_band: f64,
     /// Decimated samples in the fit.
     pub fit_samples: usize,
     /// Decimated samples in the validation segment.
@@ -203,6 +306,11 @@ pub struct Validation {
     pub relative_error: f64,
     /// The same per joint.
     pub per_joint: Vec<JointFit>,
+    /// ||Y - W X|| / ||Y|| on the raw torques: every sample of the segment at the log's rate,
+    /// before the decimation filter (torque ripple and noise included), as measured.
+    pub raw_relative_error: f64,
+    /// The same per joint.
+    pub raw_per_joint: Vec<JointFit>,
 }
 
 /// The essential parameters found.
@@ -258,6 +366,69 @@ pub struct Consistent {
     pub solver: String,
 }
 
+/// What a warning is about.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum WarningKind {
+    /// The observation matrix is ill-conditioned.
+    IllConditioned,
+    /// Parameters with relative standard deviations above 50 %.
+    PoorlyIdentified,
+    /// The model explains the torques poorly.
+    PoorFit,
+    /// The validation segment is predicted much worse than the fit.
+    Validation,
+    /// IDIM-IV did not converge.
+    IvNotConverged,
+    /// The unconstrained estimate is not physically consistent (squared Mahalanobis distance).
+    Inconsistent,
+    /// A parameter whose sign physics fixes has the other sign, significantly
+    /// ([`signs`]).
+    PhysicallyImpossible,
+}
+
+impl WarningKind {
+    /// Its name in the JSON report (`ill_conditioned`, `physically_impossible`, ...).
+    pub fn as_str(self) -> &'static str {
+        match self {
+            WarningKind::IllConditioned => "ill_conditioned",
+            WarningKind::PoorlyIdentified => "poorly_identified",
+            WarningKind::PoorFit => "poor_fit",
+            WarningKind::Validation => "validation",
+            WarningKind::IvNotConverged => "iv_not_converged",
+            WarningKind::Inconsistent => "inconsistent",
+            WarningKind::PhysicallyImpossible => "physically_impossible",
+        }
+    }
+}
+
+/// A warning of the identification: where the result may be unreliable, with the parameters
+/// concerned. Its `Display` is the message.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Warning {
+    /// What it is about.
+    pub kind: WarningKind,
+    /// The parameters concerned (names, as in [`Identification::parameters`]); may be empty.
+    pub parameters: Vec<String>,
+    /// The message, in words.
+    pub message: String,
+}
+
+impl Warning {
+    fn new(kind: WarningKind, parameters: Vec<String>, message: String) -> Warning {
+        Warning {
+            kind,
+            parameters,
+            message,
+        }
+    }
+}
+
+impl std::fmt::Display for Warning {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.message)
+    }
+}
+
 /// Result of [`identify`].
 #[derive(Clone, Debug)]
 pub struct Identification {
@@ -296,8 +467,9 @@ pub struct Identification {
     pub iv: Option<IvReport>,
     /// Physically consistent standard parameters, when asked for.
     pub consistent: Option<Consistent>,
-    /// Where the result may be unreliable (ill-conditioning, poor fit, ...).
-    pub warnings: Vec<String>,
+    /// Where the result may be unreliable (ill-conditioning, poor fit, physically impossible
+    /// values, ...).
+    pub warnings: Vec<Warning>,
     /// What the user should know about the processing.
     pub notes: Vec<String>,
     /// Decimated rows of the validation segment (empty unless `keep_validation_rows`).
@@ -332,13 +504,12 @@ impl Identification {
     }
 }
 
-/// Processing settings from the log's sample rate and the options.
+/// Processing settings from the log's sample rate and the options (checked by
+/// [`Options::validate`]; the filters' settling and the borders against the log's length).
 pub fn processing(summary: &LogSummary, opt: &Options) -> Result<(Processing, ProcessingReport)> {
+    opt.validate()?;
     let fs = summary.sample_rate();
     let bw = opt.bandwidth;
-    if !(bw.is_finite() && bw > 0.0) {
-        return Err(Error::Input(format!("bandwidth {bw} Hz must be positive")));
-    }
     let derivatives = summary.has_derivatives && opt.use_log_derivatives;
     let lowpass = if derivatives {
         None
@@ -346,48 +517,57 @@ pub fn processing(summary: &LogSummary, opt: &Options) -> Result<(Processing, Pr
         let fc = opt.cutoff.unwrap_or((10.0 * bw).min(0.4 * fs));
         Some(Butterworth::lowpass(opt.filter_order, fc, fs)?)
     };
-    let nd = match opt.decimation {
-        Some(0) => return Err(Error::Input("decimation factor 0: give 1 or more".into())),
-        Some(d) => d,
-        None => ((0.8 * fs / (4.0 * bw)).floor() as usize).max(1),
-    };
+    let nd = opt
+        .decimation
+        .unwrap_or_else(|| ((0.8 * fs / (4.0 * bw)).floor() as usize).max(1));
     let decimation_filter = if nd > 1 {
         Some(Butterworth::lowpass(8, 0.8 * fs / (2.0 * nd as f64), fs)?)
     } else {
         None
     };
+    let samples = summary.samples;
+    if let Some(f) = &lowpass {
+        // the zero-phase stream holds the filter's settling time: no longer than the log
+        let settling = f.settling_samples(1e-3);
+        if settling >= samples {
+            return Err(Error::Input(format!(
+                "{}: the position low-pass (cut-off {} Hz at {fs} Hz) settles in {settling} \
+                 samples, more than the log's {samples}: the log is too short for this cut-off",
+                summary.source, f.cutoff
+            )));
+        }
+    }
     let border = opt
         .border
         .unwrap_or_else(|| lowpass.as_ref().map_or(0, |f| f.settling_samples(1e-3)));
+    if border >= samples / 2 {
+        return Err(Error::Input(format!(
+            "{}: dropping {border} samples at each end (the border) leaves nothing of the \
+             log's {samples} samples",
+            summary.source
+        )));
+    }
     let decimation_skip = decimation_filter
         .as_ref()
         .map_or(0, |f| f.settling_samples(1e-3));
     let duration = summary.duration();
-    let validation = match opt.validation {
-        None => None,
-        Some((a, b)) => {
-            if !(0.0..=1.0).contains(&a) || !(0.0..=1.0).contains(&b) || a >= b {
-                return Err(Error::Input(format!(
-                    "validation segment {a}:{b}: fractions 0 <= from < to <= 1 of the log expected"
-                )));
-            }
-            let end = if b >= 1.0 {
-                f64::INFINITY
-            } else {
-                summary.t0 + b * duration
-            };
-            Some((summary.t0 + a * duration, end))
-        }
-    };
-    if summary.effort == Effort::Current && opt.gains.is_none() {
-        return Err(Error::Input(format!(
-            "{}: the log has motor currents (i<j>): give the drive gains (--gains) to convert \
-             them to torques",
-            summary.source
-        )));
-    }
+    let validation = opt.validation.map(|(a, b)| {
+        let end = if b >= 1.0 {
+            f64::INFINITY
+        } else {
+            summary.t0 + b * duration
+        };
+        (summary.t0 + a * duration, end)
+    });
+    check_efforts(summary, opt)?;
+    let coulomb_band = opt.coulomb_band.unwrap_or(if derivatives {
+        0.0
+    } else {
+        DEFAULT_COULOMB_BAND
+    });
     let proc = Processing {
         dt: summary.dt,
+        samples,
         lowpass: lowpass.clone(),
         decimation: nd,
         decimation_filter: decimation_filter.clone(),
@@ -396,11 +576,19 @@ pub fn processing(summary: &LogSummary, opt: &Options) -> Result<(Processing, Pr
         validation,
         gains: opt.gains.clone(),
         min_speed: opt.min_speed,
-        keep_validation_rows: opt.keep_validation_rows,
+        coulomb_band,
+        validation_row_stride: if opt.keep_validation_rows {
+            // the decimated rows of the segment, estimated from its fraction of the log
+            let fraction = opt.validation.map_or(0.0, |(a, b)| b - a);
+            let expected = (fraction * samples as f64 / nd as f64).ceil() as usize;
+            expected.div_ceil(observation::MAX_KEPT_ROWS).max(1)
+        } else {
+            0
+        },
     };
     let report = ProcessingReport {
         source: summary.source.clone(),
-        samples: summary.samples,
+        samples,
         sample_rate: fs,
         duration,
         bandwidth: bw,
@@ -411,12 +599,42 @@ pub fn processing(summary: &LogSummary, opt: &Options) -> Result<(Processing, Pr
         border,
         decimation_skip,
         min_speed: opt.min_speed,
+        coulomb_band,
         fit_samples: 0,
         validation_samples: 0,
         validation: validation.map(|(a, b)| (a, b.min(summary.t0 + duration))),
         slow_rows: Vec::new(),
     };
     Ok((proc, report))
+}
+
+/// Currents need gains and gains need currents (torques taken as currents would be scaled
+/// silently).
+fn check_efforts(summary: &LogSummary, opt: &Options) -> Result<()> {
+    match (summary.effort, &opt.gains) {
+        (Effort::Current, None) => Err(Error::Input(format!(
+            "{}: the log has motor currents (i<j>): give the drive gains to convert them to \
+             torques",
+            summary.source
+        ))),
+        (Effort::Torque, Some(_)) => Err(Error::Input(format!(
+            "{}: drive gains were given but the log has joint torques (tau<j> columns), not \
+             motor currents (i<j>): the gains would scale the torques",
+            summary.source
+        ))),
+        _ => Ok(()),
+    }
+}
+
+/// One gain per motor (actuated joint).
+fn check_gain_count(opt: &Options, motors: usize) -> Result<()> {
+    match &opt.gains {
+        Some(g) if g.len() != motors => Err(Error::Input(format!(
+            "{} drive gains for {motors} motors: one gain per motor expected",
+            g.len()
+        ))),
+        _ => Ok(()),
+    }
 }
 
 fn joint_fits(
@@ -490,149 +708,53 @@ pub fn identify(
     log: &dyn LogSource,
     opt: &Options,
 ) -> Result<Identification> {
+    opt.validate()?;
     let mut model = ParameterModel::build(access, &opt.parameters)?;
     let n = model.joints_count();
     let p = model.count();
     let names = model.names();
-    let summary = summarize(log, n)?;
+    check_gain_count(opt, n)?;
+    // the log is read once (recorded unless it is repeatable): every pass sees the same samples,
+    // whatever happens to the source (a file still being written, a pipe)
+    let recording;
+    let (summary, log): (LogSummary, &dyn LogSource) = if log.repeatable() {
+        (summarize(log, n)?, log)
+    } else {
+        let (summary, r) = record(log, n)?;
+        recording = r;
+        (summary, &recording)
+    };
     let (proc, mut preport) = processing(&summary, opt)?;
+    model.coulomb_band = proc.coulomb_band;
     let mut warnings = Vec::new();
     let mut notes = Vec::new();
     let mut pass = run_pass(log, &mut model, access, &proc, None)?;
+    let rows = check_pass(&mut pass, &summary, &proc, p)?;
     preport.fit_samples = pass.fit_samples;
     preport.validation_samples = pass.validation_samples;
     preport.slow_rows = pass.slow_rows.clone();
-    let rows: usize = pass.fit.iter().map(|f| f.rows()).sum();
-    if rows <= p {
-        return Err(Error::Input(format!(
-            "{rows} equations for {p} parameters after decimation (by {}) and border removal \
-             ({} samples at each end): the log ({} samples) is too short",
-            proc.decimation, proc.border, summary.samples
-        )));
-    }
     let ts: Vec<Mat<f64>> = pass.fit.iter_mut().map(|f| f.factor().clone()).collect();
-    let ols = least_squares(
-        &combine(&ts.iter().map(|t| (t, 1.0)).collect::<Vec<_>>()),
-        rows,
-        &names,
-    )?;
-    let (mut sol, sigma): (LsSolution, Option<Vec<f64>>) = match opt.estimator {
-        Estimator::Ols => (ols.clone(), None),
-        Estimator::Wls | Estimator::Iv => {
-            let sig = pass
-                .fit
-                .iter_mut()
-                .map(|f| {
-                    let r = f.rows();
-                    joint_sigma(f.factor(), r)
-                })
-                .collect::<Result<Vec<f64>>>()?;
-            if let Some(k) = sig.iter().position(|s| s.is_nan() || *s <= 0.0) {
-                return Err(Error::Numerical(format!(
-                    "joint {}: its equations are fitted exactly (sigma = 0), so Gautier's weight \
-                     1/sigma is infinite; use --estimator ols (noise-free data)",
-                    access.actuated_joints()[k]
-                )));
-            }
-            let tw = combine(
-                &ts.iter()
-                    .zip(&sig)
-                    .map(|(t, s)| (t, 1.0 / s))
-                    .collect::<Vec<_>>(),
-            );
-            (least_squares(&tw, rows, &names)?, Some(sig))
-        }
-    };
+    let (mut sol, sigma) = first_estimate(opt.estimator, &mut pass, &ts, rows, (&names, access))?;
     let mut estimator = match opt.estimator {
         Estimator::Ols => "OLS",
         Estimator::Wls => "WLS",
         Estimator::Iv => "IDIM-IV",
     }
     .to_string();
-    // IDIM-IV
     let mut iv_report = None;
     if opt.estimator == Estimator::Iv {
-        let sig = sigma.clone().expect("weights");
-        let wls_x = sol.x.clone();
-        let mut x = sol.x.clone();
-        let mut converged = false;
-        let mut last_change = f64::INFINITY;
-        let mut deviation = 0.0;
-        let mut it = 0;
-        let f_iv = opt.iv_bandwidth.unwrap_or(opt.bandwidth / 4.0);
-        let omega = 2.0 * std::f64::consts::PI * f_iv;
-        let substeps = ((proc.dt / 2e-4).ceil() as usize).max(1);
-        while it < opt.iv_iterations.max(1) {
-            it += 1;
-            let k = model.joint_side_drives(&model.base_robot_parameters(&x));
-            let mut tracking = access.tracking_model(&k, 0.05)?;
-            let a = tracking.inertia_diagonal(&access.reference_actuated()?)?;
-            let kp: Vec<f64> = a
-                .iter()
-                .map(|a| a.abs().max(1e-6) * omega * omega)
-                .collect();
-            let kd: Vec<f64> = a
-                .iter()
-                .map(|a| a.abs().max(1e-6) * 2.0 * 0.8 * omega)
-                .collect();
-            let mut ins = Instruments::new(tracking, kp, kd, model.offsets(&x), substeps);
-            let ivpass: PassResult = run_pass(log, &mut model, access, &proc, Some(&mut ins))?;
-            deviation = ivpass.instrument_deviation;
-            let acc = ivpass.iv.expect("instrument accumulators");
-            let (x_new, m) = iv_solve(
-                &acc.iter()
-                    .zip(&sig)
-                    .map(|(a, s)| (a, 1.0 / s))
-                    .collect::<Vec<_>>(),
-            )?;
-            // residual variance of the weighted rows at the IV estimate
-            let res_w: f64 = ts
-                .iter()
-                .zip(&sig)
-                .map(|(t, s)| residual_sq(t, &x_new) / (s * s))
-                .sum();
-            let s2 = res_w / (rows - p) as f64;
-            let std: Vec<f64> = (0..p).map(|i| (s2 * m[(i, i)]).max(0.0).sqrt()).collect();
-            last_change = x_new
-                .iter()
-                .zip(&x)
-                .zip(&std)
-                .map(|((a, b), s)| (a - b).abs() / s.max(f64::MIN_POSITIVE))
-                .fold(0.0, f64::max);
-            x = x_new;
-            sol.x = x.clone();
-            sol.std = std;
-            sol.sigma2 = s2;
-            if last_change < 0.02 {
-                converged = true;
-                break;
-            }
-        }
-        sol.residual_sq = ts.iter().map(|t| residual_sq(t, &x)).sum();
-        if !converged {
-            warnings.push(format!(
-                "IDIM-IV did not converge in {it} iterations: the last iteration changed a \
-                 parameter by {last_change:.2} standard deviations (more iterations: \
-                 --iv-iterations; a slower tracking loop: --iv-bandwidth)"
-            ));
-        }
-        iv_report = Some(IvReport {
-            iterations: it,
-            converged,
-            last_change,
-            deviation,
-            wls: wls_x,
-        });
+        let sig = sigma.as_deref().expect("weights");
+        let (report, warning) = idim_iv(
+            log,
+            (&mut model, access),
+            (&proc, opt),
+            (&ts, sig, rows),
+            &mut sol,
+        )?;
+        warnings.extend(warning);
+        iv_report = Some(report);
     }
-    let tw: Mat<f64> = match &sigma {
-        Some(sig) => combine(
-            &ts.iter()
-                .zip(sig)
-                .map(|(t, s)| (t, 1.0 / s))
-                .collect::<Vec<_>>(),
-        ),
-        None => combine(&ts.iter().map(|t| (t, 1.0)).collect::<Vec<_>>()),
-    };
+    let tw = weighted(&ts, sigma.as_deref());
     // physically consistent parameters: the constrained least squares, which is also the
     // consistent set nearest to the unconstrained estimate in the metric of its covariance
     let mut consistent = None;
@@ -656,12 +778,16 @@ pub fn identify(
                 .enumerate()
                 .max_by(|a, b| a.1.abs().partial_cmp(&b.1.abs()).unwrap())
                 .map_or(0, |(i, _)| i);
-            warnings.push(format!(
-                "the unconstrained estimate is not physically consistent: the nearest consistent \
-                 set is at a squared Mahalanobis distance {:.1} (above {bound:.1}, the 99.8 % \
-                 quantile of chi-square with {p} degrees of freedom); largest change {:.1} standard \
-                 deviations ({})",
-                c.result.distance2, c.result.max_deviation, names[worst]
+            warnings.push(Warning::new(
+                WarningKind::Inconsistent,
+                vec![names[worst].clone()],
+                format!(
+                    "the unconstrained estimate is not physically consistent: the nearest \
+                     consistent set is at a squared Mahalanobis distance {:.1} (above \
+                     {bound:.1}, the 99.8 % quantile of chi-square with {p} degrees of \
+                     freedom); largest change {:.1} standard deviations ({})",
+                    c.result.distance2, c.result.max_deviation, names[worst]
+                ),
             ));
         }
         if opt.consistent {
@@ -682,87 +808,26 @@ pub fn identify(
     };
     let relative_std = sol.relative_std();
     let (per_joint, relative_error) = joint_fits(access, &mut pass.fit, &sol.x, sigma.as_deref());
-    let validation = match proc.validation {
-        Some(_) if pass.validation_samples > 0 => {
-            let (pj, re) = joint_fits(access, &mut pass.validation, &sol.x, None);
-            let (a, b) = preport.validation.expect("validation segment");
-            Some(Validation {
-                from: a,
-                to: b,
-                relative_error: re,
-                per_joint: pj,
-            })
-        }
-        Some((a, _)) => {
-            warnings.push(format!(
-                "the validation segment (from t = {a:.3} s) has no sample after border removal"
-            ));
-            None
-        }
-        None => None,
-    };
-    // warnings
-    if sol.condition > 1e4 {
-        warnings.push(format!(
-            "the observation matrix is ill-conditioned (condition number {:.3e} with unit \
-             columns): the motion excites some parameters poorly; their values are unreliable \
-             (see the relative standard deviations; design an exciting motion: robodyn excite)",
-            sol.condition
-        ));
-    }
-    let poor: Vec<String> = names
-        .iter()
-        .zip(&relative_std)
-        .filter(|(_, r)| **r > 50.0)
-        .map(|(n, r)| format!("{n} ({r:.0} %)"))
-        .collect();
-    if !poor.is_empty() {
-        warnings.push(format!(
-            "{} parameter(s) poorly identified (relative standard deviation above 50 %): {} — \
-             their values are not significant (--essential drops them)",
-            poor.len(),
-            poor.join(", ")
-        ));
-    }
-    if relative_error > 0.5 {
-        warnings.push(format!(
-            "the model explains the torques poorly: relative error {:.1} % over the fit rows",
-            100.0 * relative_error
-        ));
-    }
-    if let Some(v) = &validation {
-        if v.relative_error > 2.0 * relative_error && v.relative_error > 0.05 {
-            warnings.push(format!(
-                "the validation segment is predicted much worse than the fit ({:.1} % vs {:.1} %): \
-                 the model may be over-fitted or the segment excites other effects",
-                100.0 * v.relative_error,
-                100.0 * relative_error
-            ));
-        }
-    }
-    if let Some((_, fd)) = preport.decimation_filter {
-        if fd < 2.0 * opt.bandwidth {
-            notes.push(format!(
-                "the decimation low-pass ({fd:.3} Hz) is below twice the bandwidth: the \
-                 dynamics are filtered too, consistently on both sides (parallel filtering)"
-            ));
-        }
-    }
-    let total_slow: usize = pass.slow_rows.iter().sum();
-    if total_slow > 0 {
-        notes.push(format!(
-            "{total_slow} joint rows of the fit left out by --min-speed {} (per joint {:?})",
-            opt.min_speed, pass.slow_rows
-        ));
-    }
-    if let Some(t) = &model.transmission {
-        let _ = t;
-        notes.push(
-            "with the transmission, IA/FS/FV of a joint's link are its motor's parameters in \
-             motor units (tau = R^T (Ia m_dd + Fv m_d + Fs sign(m_d)), m = R q)"
-                .into(),
-        );
-    }
+    let validation = validation(access, &mut pass, &sol.x, &preport);
+    warnings.extend(quality_warnings(
+        &sol,
+        &names,
+        &relative_std,
+        relative_error,
+        &validation,
+    ));
+    warnings.extend(signs::warnings(
+        &model,
+        &sol.x,
+        &sol.std,
+        &relative_std,
+        &ts,
+    ));
+    notes.extend(processing_notes(
+        &preport,
+        opt,
+        model.transmission.is_some(),
+    ));
     Ok(Identification {
         robot: access.name().to_string(),
         joints: access.actuated_joints().to_vec(),
@@ -776,7 +841,7 @@ pub fn identify(
         condition_number_unscaled: sol.condition_unscaled,
         relative_error,
         per_joint,
-        validation,
+        validation: validation.ok(),
         processing: preport,
         essential,
         iv: iv_report,
@@ -786,6 +851,300 @@ pub fn identify(
         validation_rows: std::mem::take(&mut pass.validation_rows),
         model,
     })
+}
+
+/// The triangular factor of the union of the joints' rows, joint k's weighted by 1 / sigma_k
+/// (unweighted without sigma).
+fn weighted(ts: &[Mat<f64>], sigma: Option<&[f64]>) -> Mat<f64> {
+    let parts: Vec<(&Mat<f64>, f64)> = match sigma {
+        Some(sig) => ts.iter().zip(sig).map(|(t, s)| (t, 1.0 / s)).collect(),
+        None => ts.iter().map(|t| (t, 1.0)).collect(),
+    };
+    combine(&parts)
+}
+
+/// OLS, or Gautier's WLS with each joint's sigma (the weights, returned); IDIM-IV starts from
+/// the WLS estimate.
+fn first_estimate(
+    estimator: Estimator,
+    pass: &mut PassResult,
+    ts: &[Mat<f64>],
+    rows: usize,
+    (names, access): (&[String], &ModelAccess),
+) -> Result<(LsSolution, Option<Vec<f64>>)> {
+    if estimator == Estimator::Ols {
+        return Ok((least_squares(&weighted(ts, None), rows, names)?, None));
+    }
+    let sig = pass
+        .fit
+        .iter_mut()
+        .map(|f| {
+            let r = f.rows();
+            joint_sigma(f.factor(), r)
+        })
+        .collect::<Result<Vec<f64>>>()?;
+    if let Some(k) = sig.iter().position(|s| s.is_nan() || *s <= 0.0) {
+        return Err(Error::Numerical(format!(
+            "joint {}: its equations are fitted exactly (sigma = 0), so Gautier's weight \
+             1/sigma is infinite; use --estimator ols (noise-free data)",
+            access.actuated_joints()[k]
+        )));
+    }
+    let sol = least_squares(&weighted(ts, Some(&sig)), rows, names)?;
+    Ok((sol, Some(sig)))
+}
+
+/// What the user should know about the processing: the decimation filtering the dynamics, the
+/// rows left out as slow, the motor units of a transmission.
+fn processing_notes(preport: &ProcessingReport, opt: &Options, transmission: bool) -> Vec<String> {
+    let mut notes = Vec::new();
+    if let Some((_, fd)) = preport.decimation_filter {
+        if fd < 2.0 * opt.bandwidth {
+            notes.push(format!(
+                "the decimation low-pass ({fd:.3} Hz) is below twice the bandwidth: the \
+                 dynamics are filtered too, consistently on both sides (parallel filtering)"
+            ));
+        }
+    }
+    let total_slow: usize = preport.slow_rows.iter().sum();
+    if total_slow > 0 {
+        notes.push(format!(
+            "{total_slow} joint rows of the fit left out by --min-speed {} (per joint {:?})",
+            opt.min_speed, preport.slow_rows
+        ));
+    }
+    if transmission {
+        notes.push(
+            "with the transmission, IA/FS/FV of a joint's link are its motor's parameters in \
+             motor units (tau = R^T (Ia m_dd + Fv m_d + Fs sign(m_d)), m = R q)"
+                .into(),
+        );
+    }
+    notes
+}
+
+/// The pass read every sample of the first read (the log did not change between reads), left
+/// enough rows, and the torques are not all zero (nothing to fit): the rows of the fit.
+fn check_pass(
+    pass: &mut PassResult,
+    summary: &LogSummary,
+    proc: &Processing,
+    p: usize,
+) -> Result<usize> {
+    if pass.samples_read != summary.samples {
+        return Err(Error::Input(format!(
+            "{}: the log changed while it was read ({} samples, then {})",
+            summary.source, summary.samples, pass.samples_read
+        )));
+    }
+    let rows: usize = pass.fit.iter().map(|f| f.rows()).sum();
+    if rows <= p {
+        return Err(Error::Input(format!(
+            "{rows} equations for {p} parameters after decimation (by {}) and border removal \
+             ({} samples at each end): the log ({} samples) is too short",
+            proc.decimation, proc.border, summary.samples
+        )));
+    }
+    let zero = pass.fit.iter_mut().all(|f| output_sq(f.factor()) == 0.0);
+    if zero {
+        return Err(Error::Input(format!(
+            "{}: the torques are zero on every row of the fit: there is nothing to identify",
+            summary.source
+        )));
+    }
+    Ok(rows)
+}
+
+/// IDIM-IV: instruments from a simulation of the current estimate tracking the measured motion,
+/// iterated from the weighted least-squares estimate `sol` until no parameter moves by more
+/// than 0.02 standard deviations; `sol` becomes the IV estimate.
+fn idim_iv(
+    log: &dyn LogSource,
+    (model, access): (&mut ParameterModel, &mut ModelAccess),
+    (proc, opt): (&Processing, &Options),
+    (ts, sig, rows): (&[Mat<f64>], &[f64], usize),
+    sol: &mut LsSolution,
+) -> Result<(IvReport, Option<Warning>)> {
+    let p = model.count();
+    let wls_x = sol.x.clone();
+    let mut x = sol.x.clone();
+    let mut converged = false;
+    let mut last_change = f64::INFINITY;
+    let mut deviation = 0.0;
+    let mut it = 0;
+    let f_iv = opt.iv_bandwidth.unwrap_or(opt.bandwidth / 4.0);
+    let omega = 2.0 * std::f64::consts::PI * f_iv;
+    let substeps = ((proc.dt / 2e-4).ceil() as usize).max(1);
+    while it < opt.iv_iterations {
+        it += 1;
+        let k = model.joint_side_drives(&model.base_robot_parameters(&x));
+        let mut tracking = access.tracking_model(&k, 0.05)?;
+        let a = tracking.inertia_diagonal(&access.reference_actuated()?)?;
+        let kp: Vec<f64> = a
+            .iter()
+            .map(|a| a.abs().max(1e-6) * omega * omega)
+            .collect();
+        let kd: Vec<f64> = a
+            .iter()
+            .map(|a| a.abs().max(1e-6) * 2.0 * 0.8 * omega)
+            .collect();
+        let mut ins = Instruments::new(tracking, kp, kd, model.offsets(&x), substeps);
+        let ivpass: PassResult = run_pass(log, model, access, proc, Some(&mut ins))?;
+        deviation = ivpass.instrument_deviation;
+        let acc = ivpass.iv.expect("instrument accumulators");
+        let (x_new, m) = iv_solve(
+            &acc.iter()
+                .zip(sig)
+                .map(|(a, s)| (a, 1.0 / s))
+                .collect::<Vec<_>>(),
+        )?;
+        // residual variance of the weighted rows at the IV estimate
+        let res_w: f64 = ts
+            .iter()
+            .zip(sig)
+            .map(|(t, s)| residual_sq(t, &x_new) / (s * s))
+            .sum();
+        let s2 = res_w / (rows - p) as f64;
+        let std: Vec<f64> = (0..p).map(|i| (s2 * m[(i, i)]).max(0.0).sqrt()).collect();
+        last_change = x_new
+            .iter()
+            .zip(&x)
+            .zip(&std)
+            .map(|((a, b), s)| (a - b).abs() / s.max(f64::MIN_POSITIVE))
+            .fold(0.0, f64::max);
+        x = x_new;
+        sol.x = x.clone();
+        sol.std = std;
+        sol.sigma2 = s2;
+        if last_change < 0.02 {
+            converged = true;
+            break;
+        }
+    }
+    sol.residual_sq = ts.iter().map(|t| residual_sq(t, &x)).sum();
+    let warning = (!converged).then(|| {
+        Warning::new(
+            WarningKind::IvNotConverged,
+            Vec::new(),
+            format!(
+                "IDIM-IV did not converge in {it} iterations: the last iteration changed a \
+                 parameter by {last_change:.2} standard deviations (more iterations: \
+                 --iv-iterations; a slower tracking loop: --iv-bandwidth)"
+            ),
+        )
+    });
+    let report = IvReport {
+        iterations: it,
+        converged,
+        last_change,
+        deviation,
+        wls: wls_x,
+    };
+    Ok((report, warning))
+}
+
+/// The prediction of the validation segment with the estimate `x` (decimated rows as fitted,
+/// and the raw torques at the log's rate); Err(Some(warning)) when the segment has no sample,
+/// Err(None) when there is no segment.
+fn validation(
+    access: &ModelAccess,
+    pass: &mut PassResult,
+    x: &[f64],
+    preport: &ProcessingReport,
+) -> std::result::Result<Validation, Option<Warning>> {
+    let (a, b) = preport.validation.ok_or(None)?;
+    if pass.validation_samples == 0 {
+        return Err(Some(Warning::new(
+            WarningKind::Validation,
+            Vec::new(),
+            format!(
+                "the validation segment (from t = {a:.3} s) has no sample after border removal"
+            ),
+        )));
+    }
+    let (per_joint, relative_error) = joint_fits(access, &mut pass.validation, x, None);
+    let (raw_per_joint, raw_relative_error) = joint_fits(access, &mut pass.validation_raw, x, None);
+    Ok(Validation {
+        from: a,
+        to: b,
+        relative_error,
+        per_joint,
+        raw_relative_error,
+        raw_per_joint,
+    })
+}
+
+/// Warnings on the quality of the fit: conditioning, poorly identified parameters, a poor fit,
+/// a validation much worse than the fit (or without samples).
+fn quality_warnings(
+    sol: &LsSolution,
+    names: &[String],
+    relative_std: &[f64],
+    relative_error: f64,
+    validation: &std::result::Result<Validation, Option<Warning>>,
+) -> Vec<Warning> {
+    let mut warnings = Vec::new();
+    if sol.condition > 1e4 {
+        warnings.push(Warning::new(
+            WarningKind::IllConditioned,
+            Vec::new(),
+            format!(
+                "the observation matrix is ill-conditioned (condition number {:.3e} with unit \
+                 columns): the motion excites some parameters poorly; their values are \
+                 unreliable (see the relative standard deviations; design an exciting motion: \
+                 robodyn excite)",
+                sol.condition
+            ),
+        ));
+    }
+    let poor: Vec<(String, f64)> = names
+        .iter()
+        .zip(relative_std)
+        .filter(|(_, r)| **r > 50.0)
+        .map(|(n, r)| (n.clone(), *r))
+        .collect();
+    if !poor.is_empty() {
+        let list: Vec<String> = poor
+            .iter()
+            .map(|(n, r)| format!("{n} ({r:.0} %)"))
+            .collect();
+        warnings.push(Warning::new(
+            WarningKind::PoorlyIdentified,
+            poor.into_iter().map(|(n, _)| n).collect(),
+            format!(
+                "{} parameter(s) poorly identified (relative standard deviation above 50 %): {} \
+                 — their values are not significant (--essential drops them)",
+                list.len(),
+                list.join(", ")
+            ),
+        ));
+    }
+    if relative_error > 0.5 {
+        warnings.push(Warning::new(
+            WarningKind::PoorFit,
+            Vec::new(),
+            format!(
+                "the model explains the torques poorly: relative error {:.1} % over the fit rows",
+                100.0 * relative_error
+            ),
+        ));
+    }
+    match validation {
+        Ok(v) if v.relative_error > 2.0 * relative_error && v.relative_error > 0.05 => warnings
+            .push(Warning::new(
+                WarningKind::Validation,
+                Vec::new(),
+                format!(
+                    "the validation segment is predicted much worse than the fit ({:.1} % vs \
+                     {:.1} %): the model may be over-fitted or the segment excites other effects",
+                    100.0 * v.relative_error,
+                    100.0 * relative_error
+                ),
+            )),
+        Err(Some(w)) => warnings.push(w.clone()),
+        _ => {}
+    }
+    warnings
 }
 
 /// Essential parameters (see [`EssentialOptions`]).

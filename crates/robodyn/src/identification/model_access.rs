@@ -37,6 +37,17 @@ pub const FS: usize = 11;
 /// Index of FV (viscous friction).
 pub const FV: usize = 12;
 
+/// The sign of a velocity in the Coulomb friction Fs sign(v), with a dead band: 0 where
+/// |v| <= `band` (rad/s or m/s), so that rounding noise of an estimated velocity at rest does not
+/// flip the friction between -Fs and +Fs. `band` = 0 is the exact sign (0 at v = 0).
+pub fn coulomb_sign(v: f64, band: f64) -> f64 {
+    if v.abs() <= band {
+        0.0
+    } else {
+        v.signum()
+    }
+}
+
 /// A coefficient for display, as `base-params` prints them (short rationals when they are).
 pub fn format_coefficient(x: f64) -> String {
     crate::algorithms::base_parameters::numeric::format_coefficient(x)
@@ -371,13 +382,16 @@ impl ModelAccess {
     /// Regressor rows of the standard parameters `cols` in the actuated coordinates at one
     /// sample (N x cols, row-major into `rows`), and the torques of the external wrenches
     /// `tau_e` (N): Gamma_a = rows K + tau_e (G^T Phi and G^T Gamma_e for a closed chain,
-    /// eq 10.40).
+    /// eq 10.40). The Coulomb columns are [`coulomb_sign`] of the joint velocities with the dead
+    /// band `coulomb_band` (0: the exact sign).
+    #[allow(clippy::too_many_arguments)]
     pub fn rows(
         &mut self,
         qa: &[f64],
         qda: &[f64],
         qdda: &[f64],
         cols: &[usize],
+        coulomb_band: f64,
         rows: &mut [f64],
         tau_e: &mut [f64],
     ) -> Result<()> {
@@ -393,6 +407,12 @@ impl ModelAccess {
             &self.qdd,
             &mut self.phi,
         );
+        if coulomb_band > 0.0 {
+            // the FS_j column is sign(qd_j) in row j alone (10.12)
+            for (j, qd) in self.qd.iter().enumerate() {
+                self.phi[(j, PER_LINK * j + FS)] = coulomb_sign(*qd, coulomb_band);
+            }
+        }
         tree_wrench_torques(model, &mut self.ws, env, &self.q, &mut self.tau_e);
         let m = cols.len();
         match g {

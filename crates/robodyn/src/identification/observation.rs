@@ -4,7 +4,7 @@
 //! rows of the instrument matrix from a simulation of the current model tracking the measured
 //! motion. Memory does not depend on the length of the log.
 
-use super::data::{LogSource, RawSample};
+use super::data::{LogSource, RawSample, MAX_MAGNITUDE};
 use super::estimators::{IvAccumulator, TriangularFactor};
 use super::model_access::{ModelAccess, TrackingModel};
 use super::parameters::ParameterModel;
@@ -17,6 +17,8 @@ use std::collections::VecDeque;
 pub struct Processing {
     /// Sample time of the log (s).
     pub dt: f64,
+    /// Samples in the log (the count of its first read).
+    pub samples: usize,
     /// Zero-phase low-pass of the positions (None when the log gives qd and qdd).
     pub lowpass: Option<Butterworth>,
     /// Keep every `decimation`-th sample after the parallel low-pass.
@@ -34,9 +36,16 @@ pub struct Processing {
     pub gains: Option<Vec<f64>>,
     /// A joint's row of a decimated sample is left out when |qd_j| is below this (rad/s or m/s).
     pub min_speed: f64,
-    /// Rows of the validation segment kept for the plot.
-    pub keep_validation_rows: bool,
+    /// Dead band of the sign of the Coulomb friction (rad/s or m/s; 0: the exact sign).
+    pub coulomb_band: f64,
+    /// Rows of the validation segment kept for the plot: one decimated row in this many (0:
+    /// none), so that at most [`MAX_KEPT_ROWS`] are held whatever the log's length.
+    pub validation_row_stride: usize,
 }
+
+/// Most decimated validation rows kept for the plot (a plot shows no more; each holds N (p + 1)
+/// numbers).
+pub const MAX_KEPT_ROWS: usize = 20_000;
 
 /// Decimated validation rows (for the plot): t, Y (N per sample), W (N p per sample).
 #[derive(Clone, Debug, Default)]
@@ -56,6 +65,9 @@ pub struct PassResult {
     pub fit: Vec<TriangularFactor>,
     /// The same for the validation rows.
     pub validation: Vec<TriangularFactor>,
+    /// The validation rows at the log's rate, before the decimation filter: W and the raw
+    /// torques as measured.
+    pub validation_raw: Vec<TriangularFactor>,
     /// Instrumental-variable accumulators per joint (fit rows) when instruments were given.
     pub iv: Option<Vec<IvAccumulator>>,
     /// Samples read from the log (input rate).
@@ -134,14 +146,22 @@ impl Instruments {
         self.model.accel(q, qd, &tau, out)
     }
 
-    /// Advance to the sample (t, q, qd, y) and return the simulated state there.
-    fn step(&mut self, t: f64, q: &[f64], qd: &[f64], y: &[f64]) -> Result<[Vec<f64>; 3]> {
+    /// Advance by `dt` to the sample (t, q, qd, y) and return the simulated state there.
+    fn step(
+        &mut self,
+        (t, dt): (f64, f64),
+        q: &[f64],
+        qd: &[f64],
+        y: &[f64],
+    ) -> Result<[Vec<f64>; 3]> {
         let n = q.len();
         let current = (t, q.to_vec(), qd.to_vec(), y.to_vec());
         let (mut qs, mut qds) = match (self.state.take(), self.previous.take()) {
             (Some(s), Some(prev)) => {
                 // RK4 with the previous sample's reference and torque held (zero-order hold)
-                let h = (t - prev.0) / self.substeps as f64;
+                // the step from the log's sample time, not from differences of time stamps
+                // (Unix times lose digits)
+                let h = dt / self.substeps as f64;
                 let (mut qs, mut qds) = s;
                 let mut k = [
                     vec![0.0; 2 * n],
@@ -210,8 +230,8 @@ struct Pass<'a> {
     stream: Option<ZeroPhaseStream>,
     pending: VecDeque<(f64, Vec<f64>)>,
     window: VecDeque<(f64, Vec<f64>, Vec<f64>)>,
-    tail: VecDeque<Processed>,
     processed: usize,
+    processed_total: usize,
     decimator: Option<ParallelFilter>,
     dec_count: usize,
     dec_skip: usize,
@@ -238,18 +258,19 @@ impl Pass<'_> {
             }
             None => s.y,
         };
-        match (s.qd, s.qdd) {
-            (Some(qd), Some(qdd)) => self.processed_sample(Processed {
+        // the processing decides (the log's qd, qdd or filtered differences), not the sample
+        match (self.stream.as_mut(), s.qd, s.qdd) {
+            (None, Some(qd), Some(qdd)) => self.processed_sample(Processed {
                 t: s.t,
                 q: s.q,
                 qd,
                 qdd,
                 y,
             }),
-            _ => {
-                let stream = self.stream.as_mut().ok_or_else(|| {
-                    Error::Input("the log has no qd/qdd and no position filter was set".into())
-                })?;
+            (None, _, _) => Err(Error::Input(
+                "the log has no qd/qdd and no position filter was set".into(),
+            )),
+            (Some(stream), _, _) => {
                 self.pending.push_back((s.t, y));
                 let mut outs = Vec::new();
                 stream.push(&s.q, &mut |v| outs.push(v.to_vec()));
@@ -288,16 +309,40 @@ impl Pass<'_> {
         Ok(())
     }
 
-    /// Border removal: the first `border` samples are dropped, the last `border` held back.
+    /// Border removal: the first and the last `border` processed samples are dropped (their
+    /// count is known from the log's first read: nothing is held back).
     fn processed_sample(&mut self, s: Processed) -> Result<()> {
         self.processed += 1;
-        if self.processed <= self.proc.border {
+        let border = self.proc.border;
+        if self.processed <= border || self.processed + border > self.processed_total {
             return Ok(());
         }
-        self.tail.push_back(s);
-        if self.tail.len() > self.proc.border {
-            let s = self.tail.pop_front().expect("non-empty");
-            self.kept(s)?;
+        self.kept(s)
+    }
+
+    /// Every entry of the rows of W and of Y at `t` finite and of magnitude at most
+    /// [`MAX_MAGNITUDE`] (else the sums of squares of the least squares overflow): an error
+    /// naming the parameter, the joint and the time.
+    fn check_rows(&self, t: f64, y: &[f64]) -> Result<()> {
+        let (n, p) = (self.n, self.p);
+        let bad = |v: f64| !(v.is_finite() && v.abs() <= MAX_MAGNITUDE);
+        if let Some(i) = self.w.iter().position(|&v| bad(v)) {
+            return Err(Error::Numerical(format!(
+                "at t = {t} s the observation matrix has {:e} in the column of {} and the row of \
+                 joint {} (not a finite number of magnitude at most {MAX_MAGNITUDE:e}: are the \
+                 positions, velocities or accelerations of the log in range?)",
+                self.w[i],
+                self.params.params[i % p].name,
+                self.params.joints[i / p]
+            )));
+        }
+        if let Some(k) = (0..n).position(|k| bad(y[k] - self.tau_e[k])) {
+            return Err(Error::Numerical(format!(
+                "at t = {t} s the torque of joint {} less that of the external wrenches is {:e} \
+                 (not a finite number of magnitude at most {MAX_MAGNITUDE:e})",
+                self.params.joints[k],
+                y[k] - self.tau_e[k]
+            )));
         }
         Ok(())
     }
@@ -313,15 +358,20 @@ impl Pass<'_> {
             &mut self.w,
             &mut self.tau_e,
         )?;
-        if self.w.iter().any(|v| !v.is_finite()) {
-            return Err(Error::Numerical(format!(
-                "the observation matrix is not finite at t = {} s",
-                s.t
-            )));
-        }
+        self.check_rows(s.t, &s.y)?;
         let iv = self.instruments.is_some();
+        let validation = self
+            .proc
+            .validation
+            .is_some_and(|(a, b)| s.t >= a && s.t < b);
+        if validation {
+            for k in 0..n {
+                self.out.validation_raw[k]
+                    .push(&self.w[k * p..(k + 1) * p], s.y[k] - self.tau_e[k]);
+            }
+        }
         if let Some(ins) = self.instruments.as_deref_mut() {
-            let [qs, qds, qdds] = ins.step(s.t, &s.q, &s.qd, &s.y)?;
+            let [qs, qds, qdds] = ins.step((s.t, self.proc.dt), &s.q, &s.qd, &s.y)?;
             let mut te = vec![0.0; n];
             self.params
                 .rows(self.access, &qs, &qds, &qdds, &mut self.z, &mut te)?;
@@ -343,17 +393,14 @@ impl Pass<'_> {
                 return Ok(());
             }
         }
-        let validation = self
-            .proc
-            .validation
-            .is_some_and(|(a, b)| s.t >= a && s.t < b);
         let ch = &self.channels;
         if validation {
             self.out.validation_samples += 1;
             for k in 0..n {
                 self.out.validation[k].push(&ch[k * p..(k + 1) * p], ch[n * p + k]);
             }
-            if self.proc.keep_validation_rows {
+            let stride = self.proc.validation_row_stride;
+            if stride > 0 && (self.out.validation_samples - 1).is_multiple_of(stride) {
                 self.out.validation_rows.t.push(s.t);
                 self.out
                     .validation_rows
@@ -409,8 +456,13 @@ pub fn run_pass(
         p,
         pending: VecDeque::new(),
         window: VecDeque::new(),
-        tail: VecDeque::new(),
         processed: 0,
+        // central differences give no sample at either end
+        processed_total: if proc.lowpass.is_some() {
+            proc.samples.saturating_sub(2)
+        } else {
+            proc.samples
+        },
         decimator,
         dec_count: 0,
         dec_skip: proc.decimation_skip,
@@ -421,6 +473,7 @@ pub fn run_pass(
         out: PassResult {
             fit: (0..n).map(|_| TriangularFactor::new(p)).collect(),
             validation: (0..n).map(|_| TriangularFactor::new(p)).collect(),
+            validation_raw: (0..n).map(|_| TriangularFactor::new(p)).collect(),
             iv: iv.then(|| (0..n).map(|_| IvAccumulator::new(p)).collect()),
             samples_read: 0,
             samples_used: 0,

@@ -11,7 +11,9 @@
 //! column in the span of the columns before it is grouped into them, e.g. the rotor of a first
 //! vertical axis into ZZR1 with the factor R_11^2).
 
-use super::model_access::{format_coefficient, BaseSet, ModelAccess, Rotors, FS, FV, IA, PER_LINK};
+use super::model_access::{
+    coulomb_sign, format_coefficient, BaseSet, ModelAccess, Rotors, FS, FV, IA, PER_LINK,
+};
 use crate::error::{Error, Result};
 use faer::linalg::solvers::SolveLstsq;
 use faer::Mat;
@@ -86,6 +88,10 @@ pub struct ParameterModel {
     pub motor_links: Vec<usize>,
     /// Actuated joints (rows of W per sample).
     pub joints: Vec<usize>,
+    /// Dead band of the Coulomb sign in the rows (rad/s or m/s of the joint; a motor's velocity
+    /// divided by its largest gear ratio): see [`coulomb_sign`]. 0 (the default): the exact
+    /// sign.
+    pub coulomb_band: f64,
     n: usize,
     /// Scratch: rows of the library's base columns at one sample.
     base_rows: Vec<f64>,
@@ -144,6 +150,7 @@ impl ParameterModel {
             transmission: transmission.clone(),
             motor_links: joints.clone(),
             joints: joints.clone(),
+            coulomb_band: 0.0,
             n,
         };
         if let Some(r) = &transmission {
@@ -253,13 +260,15 @@ impl ParameterModel {
     }
 
     /// Motor-joint drive columns of motor k at (qd_a, qdd_a): the joint torques of unit Ia_k,
-    /// Fs_k or Fv_k, R_k^T (R_k qdd), R_k^T sign(R_k qd), R_k^T (R_k qd).
+    /// Fs_k or Fv_k, R_k^T (R_k qdd), R_k^T s(R_k qd), R_k^T (R_k qd), with s the Coulomb sign of
+    /// dead band `band` times the motor's largest gear ratio max_j |R_kj| (the band is stated on
+    /// the joint side).
     fn motor_column(
         r: &[Vec<f64>],
         k: usize,
         which: usize,
-        qd: &[f64],
-        qdd: &[f64],
+        (qd, qdd): (&[f64], &[f64]),
+        band: f64,
         out: &mut [f64],
     ) {
         let row = &r[k];
@@ -268,14 +277,8 @@ impl ParameterModel {
             IA => dot(qdd),
             FV => dot(qd),
             _ => {
-                let m = dot(qd);
-                if m > 0.0 {
-                    1.0
-                } else if m < 0.0 {
-                    -1.0
-                } else {
-                    0.0
-                }
+                let ratio = row.iter().fold(0.0f64, |m, a| m.max(a.abs()));
+                coulomb_sign(dot(qd), band * ratio)
             }
         };
         for (o, a) in out.iter_mut().zip(row) {
@@ -311,7 +314,7 @@ impl ParameterModel {
                 }
             }
             for (c, &(k, which)) in wanted.iter().enumerate() {
-                Self::motor_column(r, k, which, qd, qdd, &mut col);
+                Self::motor_column(r, k, which, (qd, qdd), 0.0, &mut col);
                 for i in 0..self.n {
                     w[(s * self.n + i, nb + c)] = col[i];
                 }
@@ -384,6 +387,7 @@ impl ParameterModel {
             qda,
             qdda,
             &self.base.base,
+            self.coulomb_band,
             &mut self.base_rows,
             &mut self.tau_e,
         )?;
@@ -396,7 +400,8 @@ impl ParameterModel {
             match prm.kind {
                 Kind::Motor { motor, which } => {
                     let r = self.transmission.as_ref().expect("transmission");
-                    Self::motor_column(r, motor, which, qda, qdda, &mut col);
+                    let band = self.coulomb_band;
+                    Self::motor_column(r, motor, which, (qda, qdda), band, &mut col);
                     for i in 0..n {
                         out[i * p + c] = col[i];
                     }

@@ -66,6 +66,12 @@ pub fn to_text(id: &Identification) -> String {
         "Border: {} samples dropped at each end; decimation transient: {} samples\n",
         pr.border, pr.decimation_skip
     ));
+    if pr.coulomb_band > 0.0 {
+        s.push_str(&format!(
+            "Coulomb friction: sign(qd) with a dead band, 0 where |qd| <= {} (rad/s or m/s)\n",
+            pr.coulomb_band
+        ));
+    }
     match pr.validation {
         Some((a, b)) => s.push_str(&format!(
             "Fit: {} decimated samples outside [{a:.4}, {b:.4}) s; validation: {} samples in it\n",
@@ -85,7 +91,11 @@ pub fn to_text(id: &Identification) -> String {
         100.0 * id.relative_error
     ));
     if let Some(v) = &id.validation {
-        s.push_str(&format!(", {:.4} % (validation)", 100.0 * v.relative_error));
+        s.push_str(&format!(
+            ", {:.4} % (validation; {:.4} % on its raw torques at the log's rate)",
+            100.0 * v.relative_error,
+            100.0 * v.raw_relative_error
+        ));
     }
     s.push_str("\n\n");
     let rows: Vec<[String; 5]> = id
@@ -276,10 +286,15 @@ pub fn to_json(id: &Identification) -> serde_json::Value {
             "border": pr.border,
             "decimation_skip": pr.decimation_skip,
             "min_speed": pr.min_speed,
+            "coulomb_band": pr.coulomb_band,
             "fit_samples": pr.fit_samples,
             "validation_samples": pr.validation_samples,
         },
-        "warnings": id.warnings,
+        "warnings": id.warnings.iter().map(|w| json!({
+            "kind": w.kind.as_str(),
+            "parameters": w.parameters,
+            "message": w.message,
+        })).collect::<Vec<_>>(),
         "notes": id.notes,
     });
     if let Some(v) = &id.validation {
@@ -288,6 +303,10 @@ pub fn to_json(id: &Identification) -> serde_json::Value {
             "to": v.to,
             "relative_error": v.relative_error,
             "per_joint": joints(&v.per_joint),
+            "raw": {
+                "relative_error": v.raw_relative_error,
+                "per_joint": joints(&v.raw_per_joint),
+            },
         });
     }
     if let Some(e) = &id.essential {

@@ -151,7 +151,9 @@ impl Butterworth {
     /// the analog pole nearest the imaginary axis has real part -w sin(pi / 2N).
     pub fn settling_samples(&self, factor: f64) -> usize {
         let sigma = 2.0 * PI * self.cutoff * (PI / (2.0 * self.order as f64)).sin();
-        ((-factor.ln()) / sigma * self.sample_rate).ceil() as usize + 1
+        // a cut-off tiny against the sample rate saturates at usize::MAX (refused by the
+        // callers, which compare it with the log's length)
+        (((-factor.ln()) / sigma * self.sample_rate).ceil() as usize).saturating_add(1)
     }
 
     /// Zero-phase filtering of a whole signal (scipy's `sosfiltfilt` with its default odd
@@ -303,7 +305,7 @@ impl ZeroPhaseStream {
     /// A stream of samples of `channels` channels filtered forward and backward by `filter`.
     pub fn new(filter: Butterworth, channels: usize) -> ZeroPhaseStream {
         let overlap = filter.settling_samples(1e-15).max(filter.padlen() + 1);
-        let block = (4 * overlap).max(1024);
+        let block = overlap.saturating_mul(4).max(1024);
         ZeroPhaseStream {
             filter,
             channels,
@@ -327,7 +329,12 @@ impl ZeroPhaseStream {
         debug_assert_eq!(x.len(), self.channels);
         self.buf.push_back(x.to_vec());
         self.received += 1;
-        if self.received >= self.next + self.block + self.overlap {
+        if self.received
+            >= self
+                .next
+                .saturating_add(self.block)
+                .saturating_add(self.overlap)
+        {
             self.emit(self.next + self.block, false, out);
         }
     }
@@ -354,7 +361,7 @@ impl ZeroPhaseStream {
         let hi = if last {
             self.received
         } else {
-            (end + self.overlap).min(self.received)
+            end.saturating_add(self.overlap).min(self.received)
         };
         let first = lo == 0;
         let pad = self.filter.padlen();

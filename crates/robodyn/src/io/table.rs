@@ -88,7 +88,7 @@ impl<R: Read> TableReader<R> {
             Ok(h) => h.iter().map(str::to_string).collect(),
             Err(e) => return Err(t.csv_error(e)),
         };
-        check_headers(&headers).map_err(|reason| t.error(Some(1), reason))?;
+        check_header(&headers).map_err(|reason| t.error(Some(1), reason))?;
         t.headers = headers;
         Ok(t)
     }
@@ -174,8 +174,20 @@ impl<R: Read> TableReader<R> {
     }
 }
 
-/// The header's names must be there, named and unique.
-fn check_headers(headers: &[String]) -> std::result::Result<(), String> {
+/// A table of named numeric columns.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Table {
+    /// Column names, in file order (unique).
+    pub headers: Vec<String>,
+    /// Data rows, each with one value per column.
+    pub rows: Vec<Vec<f64>>,
+    /// The file the table came from (for messages).
+    pub file: String,
+}
+
+/// The header of a table of named columns: at least one name, none empty, none repeated (the
+/// reason names the columns). Shared with identification's logs.
+pub fn check_header(headers: &[String]) -> std::result::Result<(), String> {
     if headers.is_empty() || headers.iter().all(String::is_empty) {
         return Err("no header line (column names)".into());
     }
@@ -192,17 +204,6 @@ fn check_headers(headers: &[String]) -> std::result::Result<(), String> {
         }
     }
     Ok(())
-}
-
-/// A table of named numeric columns.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Table {
-    /// Column names, in file order (unique).
-    pub headers: Vec<String>,
-    /// Data rows, each with one value per column.
-    pub rows: Vec<Vec<f64>>,
-    /// The file the table came from (for messages).
-    pub file: String,
 }
 
 impl Table {
