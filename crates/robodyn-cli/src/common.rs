@@ -63,14 +63,16 @@ impl RobotArgs {
     }
 
     /// Load the robot's description with the `--set` values (each must name a symbol the file
-    /// uses).
+    /// uses); what the loader warns about (physical consistency with those values, the
+    /// reader's notes) is printed on standard error.
     pub fn description(
         &self,
     ) -> CliResult<(robodyn::model::RobotDescription, robodyn::io::SourceMap)> {
-        let (mut desc, map) = robodyn::io::load_description_mapped(&self.robot)?;
+        let (mut desc, mut map) = robodyn::io::load_description_mapped(&self.robot)?;
         let o = self.overrides()?;
         check_overrides(&desc, &o)?;
-        desc.symbols.extend(o);
+        robodyn::io::set_symbols(&mut desc, &mut map, &o);
+        print_warnings(&map);
         Ok((desc, map))
     }
 
@@ -101,6 +103,13 @@ impl RobotArgs {
             }
         }
         Ok(robot)
+    }
+}
+
+/// The loader's warnings, one `robodyn: warning: FILE:LINE: link 3: ...` line each.
+pub fn print_warnings(map: &robodyn::io::SourceMap) {
+    for w in &map.warnings {
+        eprintln!("robodyn: warning: {w}");
     }
 }
 
@@ -192,8 +201,10 @@ impl Table {
 /// Output format of tables.
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum TableFormat {
+    /// CSV with a header line, one row per state (numbers in the shortest form that reads back).
     #[default]
     Csv,
+    /// JSON: an array of objects, one per row, keyed by column name.
     Json,
 }
 
@@ -203,6 +214,7 @@ pub struct TableOutput {
     /// Output file (default or `-`: standard output).
     #[arg(long)]
     pub output: Option<PathBuf>,
+    /// Format of the output table.
     #[arg(long, value_enum, default_value = "csv")]
     pub format: TableFormat,
 }

@@ -8,7 +8,8 @@ use crate::common::{parse_list, CliResult, RobotArgs};
 use robodyn::identification::excitation::{design, DesignOptions, Limits};
 use robodyn::identification::model_access::ModelAccess;
 use robodyn::identification::parameters::{ParameterModel, ParameterOptions};
-use robodyn::identification::report::plot_panels;
+use robodyn::report::figure::{write_svg, Curve, Figure, Panel, Style};
+use robodyn::report::Sig;
 use robodyn::identification::Rotors;
 use serde_json::json;
 use std::io::Write;
@@ -16,7 +17,9 @@ use std::path::PathBuf;
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Format {
+    /// Text for reading.
     Text,
+    /// JSON for programs (every number a full double).
     Json,
 }
 
@@ -58,13 +61,16 @@ pub struct Args {
     /// Random starting trajectories tried before the optimization.
     #[arg(long, default_value_t = 20)]
     pub restarts: usize,
+    /// Seed of the random starting trajectories and of the base-parameter method's samples.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// Which rotor inertias are parameters (as identify).
     #[arg(long, value_enum, default_value = "actuated")]
     pub rotor: crate::commands::identify::RotorArg,
+    /// Leave out the Coulomb and viscous friction parameters (as identify).
     #[arg(long)]
     pub no_friction: bool,
+    /// Add a constant torque offset per joint to the parameters (as identify).
     #[arg(long)]
     pub offsets: bool,
     /// Rate of the CSV rows (Hz).
@@ -77,9 +83,11 @@ pub struct Args {
     /// controller, e.g. `robodyn simulate --track`).
     #[arg(long)]
     pub output: PathBuf,
-    /// SVG plot of the positions, velocities and accelerations.
+    /// SVG plot of the positions, velocities and accelerations (one panel per quantity and
+    /// unit: revolute and prismatic joints apart).
     #[arg(long)]
     pub plot: Option<PathBuf>,
+    /// Format of the report on standard output (the trajectory goes to --output).
     #[arg(long, value_enum, default_value = "text")]
     pub format: Format,
 }
@@ -186,36 +194,15 @@ pub fn run(a: Args) -> CliResult {
     out.flush()?;
     eprintln!("wrote {}", a.output.display());
     if let Some(p) = &a.plot {
-        let names = ["q", "qd", "qdd"];
-        let panels: Vec<robodyn::identification::report::Panel> = (0..3)
-            .map(|k| {
-                (
-                    format!(
-                        "{} of the actuated joints",
-                        ["positions", "velocities", "accelerations"][k]
-                    ),
-                    joints
-                        .iter()
-                        .enumerate()
-                        .map(|(i, j)| (format!("{}{j}", names[k]), series[k][i].clone()))
-                        .collect(),
-                )
-            })
-            .collect();
-        plot_panels(
-            p,
-            &format!(
-                "{}: excitation, {} harmonics, period {} s, condition number {:.1}",
-                access.name(),
-                a.harmonics,
-                a.period,
-                d.condition
-            ),
-            &times,
-            &panels,
-            "rad, rad/s, rad/s^2",
-            false,
-        )?;
+        let prismatic: Vec<bool> = joints.iter().map(|&j| access.is_prismatic(j)).collect();
+        let title = format!(
+            "{}: exciting trajectory, {} harmonics, period {} s, condition number {}",
+            access.name(),
+            a.harmonics,
+            format_number(a.period),
+            Sig(d.condition, 4)
+        );
+        excitation_figure(p, &title, &times, &series, &joints, &prismatic)?;
         eprintln!("wrote {}", p.display());
     }
     let mut out = String::new();
@@ -229,10 +216,14 @@ pub fn run(a: Args) -> CliResult {
                 a.period,
                 params.count()
             );
-            outln!(out,
-                "condition number of W (unit columns, {} samples): {:.4} (best random start {:.4}; \
-                 {} evaluations)",
-                a.samples, d.condition, d.initial_condition, d.evaluations
+            outln!(
+                out,
+                "condition number of W (unit columns, {} samples): {} (best random start {}; {} \
+                 evaluations)",
+                a.samples,
+                Sig(d.condition, 4),
+                Sig(d.initial_condition, 4),
+                d.evaluations
             );
             outln!(
                 out,
@@ -242,13 +233,15 @@ pub fn run(a: Args) -> CliResult {
             );
             outln!(
                 out,
-                "  joint  max|q-start|       max|qd|      max|qdd|      max|tau|"
+                "  joint  max|q-start|       max|qd|      max|qdd|      max|tau|  (units: rad, \
+                 rad/s, rad/s^2, N m; m, m/s, m/s^2, N for a prismatic joint)"
             );
             for (k, j) in joints.iter().enumerate() {
-                let p = d.peaks[k];
+                let p = d.peaks[k].map(|x| Sig(x, 6).to_string());
+                let kind = if access.is_prismatic(*j) { " (prismatic)" } else { "" };
                 outln!(
                     out,
-                    "  {j:<5} {:>13.5} {:>13.5} {:>13.5} {:>13.5}",
+                    "  {j:<5} {:>13} {:>13} {:>13} {:>13}{kind}",
                     p[0],
                     p[1],
                     p[2],
@@ -276,4 +269,56 @@ pub fn run(a: Args) -> CliResult {
         ),
     }
     crate::common::print_out(&out)
+}
+
+/// The figure of an exciting trajectory: positions, velocities and accelerations of the
+/// actuated joints, one panel per quantity and unit (revolute and prismatic joints apart),
+/// joint k in colour k in every panel.
+fn excitation_figure(
+    path: &std::path::Path,
+    title: &str,
+    t: &[f64],
+    series: &[Vec<Vec<f64>>],
+    joints: &[usize],
+    prismatic: &[bool],
+) -> CliResult {
+    const QUANTITIES: [(&str, &str, [&str; 2]); 3] = [
+        ("positions", "q", ["rad", "m"]),
+        ("velocities", "qd", ["rad/s", "m/s"]),
+        ("accelerations", "qdd", ["rad/s^2", "m/s^2"]),
+    ];
+    let mut panels = Vec::new();
+    for (k, (what, symbol, units)) in QUANTITIES.iter().enumerate() {
+        for (kind, unit, is_prismatic) in [("revolute", units[0], false), ("prismatic", units[1], true)] {
+            let curves: Vec<Curve> = joints
+                .iter()
+                .enumerate()
+                .filter(|(i, _)| prismatic[*i] == is_prismatic)
+                .map(|(i, j)| Curve::new(format!("{symbol}{j}"), series[k][i].clone(), i, Style::Solid))
+                .collect();
+            if curves.is_empty() {
+                continue;
+            }
+            let kind = if prismatic.iter().all(|&p| p == is_prismatic) {
+                String::new()
+            } else {
+                format!(", {kind} joints")
+            };
+            panels.push(Panel {
+                title: format!("{what}{kind}"),
+                y_label: format!("{symbol} [{unit}]"),
+                curves,
+                ..Panel::default()
+            });
+        }
+    }
+    let fig = Figure {
+        title: title.to_string(),
+        x_label: "t [s]".into(),
+        panels,
+        colors: joints.len(),
+        ..Figure::default()
+    };
+    write_svg(path, t, &fig)?;
+    Ok(())
 }

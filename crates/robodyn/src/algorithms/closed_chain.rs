@@ -240,8 +240,7 @@ const CORRECTOR_ITERATIONS: usize = 12;
 const JUMP_FLOOR: f64 = 1e-3;
 
 fn fmt_vec(v: &[f64]) -> String {
-    let s: Vec<String> = v.iter().map(|x| format!("{x:.6}")).collect();
-    format!("[{}]", s.join(", "))
+    crate::report::number::vector(v, 6)
 }
 
 impl ClosedChain {

@@ -121,8 +121,7 @@ fn vee_antisym(m: &Matrix3<f64>) -> Vector3<f64> {
 }
 
 fn fmt_vec(v: &[f64]) -> String {
-    let s: Vec<String> = v.iter().map(|x| format!("{x:.6}")).collect();
-    format!("[{}]", s.join(", "))
+    crate::report::number::vector(v, 6)
 }
 
 /// Rank of a matrix by SVD (singular values above `tol` times the largest, or above `tol`).
