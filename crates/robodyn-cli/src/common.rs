@@ -68,18 +68,26 @@ impl RobotArgs {
     pub fn description(
         &self,
     ) -> CliResult<(robodyn::model::RobotDescription, robodyn::io::SourceMap)> {
-        let (mut desc, mut map) = robodyn::io::load_description_mapped(&self.robot)?;
-        let o = self.overrides()?;
-        check_overrides(&desc, &o)?;
-        robodyn::io::set_symbols(&mut desc, &mut map, &o);
+        let (desc, map) = self.read()?;
         print_warnings(&map);
         Ok((desc, map))
     }
 
+    /// [`RobotArgs::description`] without printing the warnings.
+    fn read(&self) -> CliResult<(robodyn::model::RobotDescription, robodyn::io::SourceMap)> {
+        let (mut desc, mut map) = robodyn::io::load_description_mapped(&self.robot)?;
+        let o = self.overrides()?;
+        check_overrides(&desc, &o)?;
+        robodyn::io::set_symbols(&mut desc, &mut map, &o);
+        Ok((desc, map))
+    }
+
     /// Load and validate the robot (all symbols need values). A motor-joint transmission with
-    /// nonzero motor drive parameters is refused: only `identify` and `excite` apply it.
+    /// nonzero motor drive parameters is refused: only `identify` and `excite` apply it. The
+    /// loader's warnings are printed once the robot is valid (an invalid one is an error that
+    /// says why).
     pub fn load(&self) -> CliResult<Robot> {
-        let (desc, map) = self.description()?;
+        let (desc, map) = self.read()?;
         let robot = Robot::new(desc).map_err(|e| map.locate(e))?;
         if let Some(t) = &robot.description().transmission {
             let k = robot.standard_parameters();
@@ -102,6 +110,7 @@ impl RobotArgs {
                 .into());
             }
         }
+        print_warnings(&map);
         Ok(robot)
     }
 }

@@ -27,6 +27,8 @@ mod cli_identify;
 mod cli_info;
 #[path = "cli_info_assembly.rs"]
 mod cli_info_assembly;
+#[path = "cli_presentation.rs"]
+mod cli_presentation;
 #[path = "cli_simulate_names.rs"]
 mod cli_simulate_names;
 

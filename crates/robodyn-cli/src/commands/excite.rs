@@ -8,9 +8,9 @@ use crate::common::{parse_list, CliResult, RobotArgs};
 use robodyn::identification::excitation::{design, DesignOptions, Limits};
 use robodyn::identification::model_access::ModelAccess;
 use robodyn::identification::parameters::{ParameterModel, ParameterOptions};
+use robodyn::identification::Rotors;
 use robodyn::report::figure::{write_svg, Curve, Figure, Panel, Style};
 use robodyn::report::Sig;
-use robodyn::identification::Rotors;
 use serde_json::json;
 use std::io::Write;
 use std::path::PathBuf;
@@ -238,7 +238,11 @@ pub fn run(a: Args) -> CliResult {
             );
             for (k, j) in joints.iter().enumerate() {
                 let p = d.peaks[k].map(|x| Sig(x, 6).to_string());
-                let kind = if access.is_prismatic(*j) { " (prismatic)" } else { "" };
+                let kind = if access.is_prismatic(*j) {
+                    " (prismatic)"
+                } else {
+                    ""
+                };
                 outln!(
                     out,
                     "  {j:<5} {:>13} {:>13} {:>13} {:>13}{kind}",
@@ -289,12 +293,21 @@ fn excitation_figure(
     ];
     let mut panels = Vec::new();
     for (k, (what, symbol, units)) in QUANTITIES.iter().enumerate() {
-        for (kind, unit, is_prismatic) in [("revolute", units[0], false), ("prismatic", units[1], true)] {
+        for (kind, unit, is_prismatic) in
+            [("revolute", units[0], false), ("prismatic", units[1], true)]
+        {
             let curves: Vec<Curve> = joints
                 .iter()
                 .enumerate()
                 .filter(|(i, _)| prismatic[*i] == is_prismatic)
-                .map(|(i, j)| Curve::new(format!("{symbol}{j}"), series[k][i].clone(), i, Style::Solid))
+                .map(|(i, j)| {
+                    Curve::new(
+                        format!("{symbol}{j}"),
+                        series[k][i].clone(),
+                        i,
+                        Style::Solid,
+                    )
+                })
                 .collect();
             if curves.is_empty() {
                 continue;

@@ -220,8 +220,8 @@ pub fn run(a: Args) -> CliResult {
     }
     // said once: the text report on standard output ends with them; a report elsewhere (a
     // file, JSON, CSV) leaves them to standard error
-    let text_on_stdout = a.format == Format::Text
-        && a.output.as_deref().is_none_or(robodyn::io::is_stdio);
+    let text_on_stdout =
+        a.format == Format::Text && a.output.as_deref().is_none_or(robodyn::io::is_stdio);
     if !text_on_stdout {
         for w in &id.warnings {
             eprintln!("robodyn: warning: {w}");

@@ -27,8 +27,8 @@ pub enum Format {
 
 pub fn run(a: Args) -> CliResult {
     let (desc, map) = robodyn::io::load_description_mapped(&a.robot)?;
-    crate::common::print_warnings(&map);
     let s = validate_structure(&desc)?;
+    crate::common::print_warnings(&map);
     let text = match a.format {
         Format::Json => format!("{}\n", serde_json::to_string_pretty(&to_json(&desc, &s))?),
         Format::Text => text(&desc, &s),

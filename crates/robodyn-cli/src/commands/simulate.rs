@@ -13,8 +13,8 @@ use crate::commands::ddm::MethodArg;
 use crate::common::{
     create_output, format_number, parse_list, CliResult, NamesArg, RobotArgs, Table,
 };
-use robodyn::model::param;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use robodyn::model::param;
 use robodyn::simulation::{
     plot_svg, simulate, ClosedChainDynamics, CsvSink, Dynamics, EnergyBalance, Integrator,
     PlotInfo, Recorder, SimOptions, Tee, TimeSeries, TorqueInput, TrajectorySink, TreeDynamics,
@@ -549,7 +549,8 @@ fn energy_balance(robot: &robodyn::Robot, input: &TorqueInput) -> EnergyBalance 
         _ => true,
     };
     let k = robot.standard_parameters();
-    let friction = (0..robot.nl()).any(|j| k[13 * j + param::FS] != 0.0 || k[13 * j + param::FV] != 0.0);
+    let friction =
+        (0..robot.nl()).any(|j| k[13 * j + param::FS] != 0.0 || k[13 * j + param::FV] != 0.0);
     match (driven, friction) {
         (true, _) => EnergyBalance::Work,
         (false, true) => EnergyBalance::Friction,

@@ -126,12 +126,18 @@ pub fn to_text(id: &Identification) -> String {
     s
 }
 
-/// A relative standard deviation in %, or `inf` (a parameter estimated as 0).
+/// A relative standard deviation in %: 3 significant digits, all the digits of its whole part
+/// (`1.48`, `26.3`, `2894`), or `inf` (a parameter estimated as 0).
 fn percent(v: f64) -> String {
-    if v.is_finite() {
-        rough(v).to_string()
-    } else {
+    if !v.is_finite() {
         "inf".into()
+    } else {
+        let whole = if v.abs() >= 1.0 {
+            v.abs().log10().floor() as usize + 1
+        } else {
+            0
+        };
+        Sig(v, whole.max(3)).to_string()
     }
 }
 
@@ -461,8 +467,18 @@ pub fn plot_fit(path: &Path, id: &Identification) -> Result<()> {
                 title: format!("joint {j} ({}){err}", id.joint_names[k]),
                 y_label: format!("tau{j} [{}]", torque_unit(prismatic)),
                 curves: vec![
-                    Curve::new("measured", rows.y.iter().map(|y| y[k]).collect(), 0, Style::Solid),
-                    Curve::new("predicted", pred.iter().map(|y| y[k]).collect(), 1, Style::Dashed),
+                    Curve::new(
+                        "measured",
+                        rows.y.iter().map(|y| y[k]).collect(),
+                        0,
+                        Style::Solid,
+                    ),
+                    Curve::new(
+                        "predicted",
+                        pred.iter().map(|y| y[k]).collect(),
+                        1,
+                        Style::Dashed,
+                    ),
                 ],
                 ..Panel::default()
             }

@@ -35,8 +35,8 @@ pub fn physical_consistency(desc: &RobotDescription) -> Vec<Warning> {
         let inertial: Option<Vec<f64>> = v[..=param::M].iter().copied().collect();
         if let Some(p) = inertial {
             // a negative M is reported above
-            if let Some(reason) = body_inconsistency(&p)
-                .filter(|r| !matches!(r, Inconsistency::NegativeMass(_)))
+            if let Some(reason) =
+                body_inconsistency(&p).filter(|r| !matches!(r, Inconsistency::NegativeMass(_)))
             {
                 out.push(Warning::new(Item::Link(j, None), reason.to_string()));
             }

@@ -78,7 +78,9 @@ impl std::fmt::Display for Inconsistency {
         match self {
             Inconsistency::NotFinite => f.write_str("the inertial parameters are not finite"),
             Inconsistency::NegativeMass(m) => write!(f, "the mass M = {} is negative", g(*m)),
-            Inconsistency::Massless { first_moments: [x, y, z] } => write!(
+            Inconsistency::Massless {
+                first_moments: [x, y, z],
+            } => write!(
                 f,
                 "a link without mass (M = 0) must have no first moments and no inertia (MX MY \
                  MZ = {} {} {})",
@@ -186,7 +188,11 @@ fn central_moments(p: &[f64], tol: f64) -> ([f64; 3], Option<[&'static str; 3]>)
         .iter()
         .all(|&(r, k)| jg[(r, k)].abs() <= tol);
     if diagonal {
-        let mut named = [(jg[(0, 0)], "Ixx"), (jg[(1, 1)], "Iyy"), (jg[(2, 2)], "Izz")];
+        let mut named = [
+            (jg[(0, 0)], "Ixx"),
+            (jg[(1, 1)], "Iyy"),
+            (jg[(2, 2)], "Izz"),
+        ];
         named.sort_by(|a, b| a.0.total_cmp(&b.0));
         return (named.map(|n| n.0), Some(named.map(|n| n.1)));
     }
@@ -226,29 +232,39 @@ mod tests {
         // positive definite about G, but 0.1 + 0.2 < 0.5: no body has it
         let p = body(2.0, [0.1, -0.05, 0.2], [0.1, 0.2, 0.5]);
         let e = body_inconsistency(&p).expect("inconsistent");
-        assert!(matches!(e, Inconsistency::Triangle { axes: Some(_), .. }), "{e:?}");
+        assert!(
+            matches!(e, Inconsistency::Triangle { axes: Some(_), .. }),
+            "{e:?}"
+        );
         let text = e.to_string();
         assert!(
             text.starts_with("Ixx + Iyy < Izz at the centre of mass (0.1 + 0.2 < 0.5)"),
             "{text}"
         );
         // the same body, realizable (0.2 + 0.35 >= 0.5), and a thin rod (equality) pass
-        assert_eq!(body_inconsistency(&body(2.0, [0.1, 0.0, 0.2], [0.2, 0.35, 0.5])), None);
-        assert_eq!(body_inconsistency(&body(1.0, [0.0; 3], [0.0, 0.3, 0.3])), None);
+        assert_eq!(
+            body_inconsistency(&body(2.0, [0.1, 0.0, 0.2], [0.2, 0.35, 0.5])),
+            None
+        );
+        assert_eq!(
+            body_inconsistency(&body(1.0, [0.0; 3], [0.0, 0.3, 0.3])),
+            None
+        );
     }
 
     #[test]
     fn the_other_cases() {
         let neg = body(1.0, [0.0; 3], [-0.1, 0.3, 0.3]);
-        assert!(
-            body_inconsistency(&neg)
-                .unwrap()
-                .to_string()
-                .starts_with("Ixx < 0 at the centre of mass"),
-        );
+        assert!(body_inconsistency(&neg)
+            .unwrap()
+            .to_string()
+            .starts_with("Ixx < 0 at the centre of mass"),);
         let mut p = body(1.0, [0.0; 3], [0.1, 0.1, 0.1]);
         p[9] = -1.0;
-        assert_eq!(body_inconsistency(&p), Some(Inconsistency::NegativeMass(-1.0)));
+        assert_eq!(
+            body_inconsistency(&p),
+            Some(Inconsistency::NegativeMass(-1.0))
+        );
         let mut p = [0.0; 10];
         p[6] = 0.5;
         assert!(matches!(
@@ -266,8 +282,13 @@ mod tests {
         p[3] = s * s * a + c * c * b;
         p[1] = c * s * (a - b);
         let e = body_inconsistency(&p).unwrap();
-        assert!(matches!(e, Inconsistency::Triangle { axes: None, .. }), "{e:?}");
-        assert!(e.to_string().starts_with("I1 + I2 < I3 at the centre of mass (0.1 + 0.2 < 0.5)"));
+        assert!(
+            matches!(e, Inconsistency::Triangle { axes: None, .. }),
+            "{e:?}"
+        );
+        assert!(e
+            .to_string()
+            .starts_with("I1 + I2 < I3 at the centre of mass (0.1 + 0.2 < 0.5)"));
     }
 
     /// P's quadratic form is the second moment of the body's points in homogeneous

@@ -262,7 +262,8 @@ pub fn render(x: &[f64], fig: &Figure) -> std::io::Result<String> {
     let xt = ticks(x[0], *x.last().expect("two samples"), 0.0);
     let mut svg = String::new();
     {
-        let root = SVGBackend::with_string(&mut svg, (WIDTH * SCALE, h * SCALE)).into_drawing_area();
+        let root =
+            SVGBackend::with_string(&mut svg, (WIDTH * SCALE, h * SCALE)).into_drawing_area();
         root.fill(&WHITE).map_err(|e| err(&e))?;
         let (header, body) = root.split_vertically(header_h * SCALE);
         header
@@ -314,12 +315,9 @@ fn font(size: f64) -> (&'static str, f64) {
     ("sans-serif", size * f64::from(SCALE))
 }
 
-type Area<'a> = plotters::drawing::DrawingArea<
-    plotters::backend::SVGBackend<'a>,
-    plotters::coord::Shift,
->;
-type DrawResult =
-    std::result::Result<(), plotters::drawing::DrawingAreaErrorKind<std::io::Error>>;
+type Area<'a> =
+    plotters::drawing::DrawingArea<plotters::backend::SVGBackend<'a>, plotters::coord::Shift>;
+type DrawResult = std::result::Result<(), plotters::drawing::DrawingAreaErrorKind<std::io::Error>>;
 
 /// The y ticks of a panel: around its finite values, 3 % margin.
 fn y_ticks(p: &Panel) -> Ticks {

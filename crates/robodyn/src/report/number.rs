@@ -62,7 +62,9 @@ impl fmt::Display for Sig {
         // the exponent after rounding to `digits` (9.9996 with 4 digits is 10.00: e = 1)
         let sci = format!("{x:.*e}", digits - 1);
         let (mantissa, exp) = sci.split_once('e').expect("`e` formatting has an exponent");
-        let exp: i32 = exp.parse().expect("`e` formatting writes an integer exponent");
+        let exp: i32 = exp
+            .parse()
+            .expect("`e` formatting writes an integer exponent");
         if exp < -4 || exp >= digits as i32 {
             write!(f, "{}e{exp}", trim_zeros(mantissa))
         } else {
@@ -167,7 +169,10 @@ mod tests {
             }
             for d in [1, 3, 6, 12] {
                 let s = significant(v, d);
-                assert!(!s.contains("e0") && !s.contains("e+") && !s.ends_with('.'), "{s}");
+                assert!(
+                    !s.contains("e0") && !s.contains("e+") && !s.ends_with('.'),
+                    "{s}"
+                );
                 let back: f64 = s.parse().unwrap();
                 assert!(back != 0.0, "{v:e} with {d} digits: {s}");
                 let tol = 10f64.powi(1 - d as i32) * v.abs();

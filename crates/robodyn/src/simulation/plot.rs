@@ -71,7 +71,10 @@ pub fn plot_svg(path: &Path, rec: &Recorder, info: &PlotInfo) -> Result<()> {
             if why.chars().count() > 140 {
                 why = why.chars().take(137).collect::<String>() + "...";
             }
-            format!("stopped early at t = {} s: {why}", format_number(*t.last().unwrap()))
+            format!(
+                "stopped early at t = {} s: {why}",
+                format_number(*t.last().unwrap())
+            )
         }),
         x_label: "t [s]".into(),
         panels: Vec::new(),
@@ -106,11 +109,13 @@ pub fn plot_svg(path: &Path, rec: &Recorder, info: &PlotInfo) -> Result<()> {
             } else {
                 (format!("q{l}"), Style::Solid)
             };
-            positions.curves.push(Curve::new(label, q.clone(), k, style));
+            positions
+                .curves
+                .push(Curve::new(label, q.clone(), k, style));
             if let Some(r) = reference.iter().find(|(rl, _)| rl == l).map(|(_, r)| r) {
-                positions.curves.push(
-                    Curve::new(format!("q{l} ref"), r.clone(), k, Style::Dashed).unlisted(),
-                );
+                positions
+                    .curves
+                    .push(Curve::new(format!("q{l} ref"), r.clone(), k, Style::Dashed).unlisted());
                 let e = r.iter().zip(&q).map(|(r, q)| r - q).collect();
                 errors
                     .curves
@@ -156,7 +161,9 @@ pub fn plot_svg(path: &Path, rec: &Recorder, info: &PlotInfo) -> Result<()> {
         fig.colors = fig.colors.max(1);
     }
     if fig.panels.is_empty() {
-        return Err(err("the trajectory has no q or energy column: nothing to plot".into()));
+        return Err(err(
+            "the trajectory has no q or energy column: nothing to plot".into(),
+        ));
     }
     write_svg(path, &t, &fig)
 }

@@ -143,7 +143,10 @@ pub fn tool(key: &str, program: &str, args: &[&str], what: &str) -> bool {
 pub fn numpy(what: &str) -> bool {
     let ok = runs("python3", &["-c", "import numpy"]);
     if !ok {
-        skip("numpy", &numpy_missing(runs("python3", &["--version"]), what));
+        skip(
+            "numpy",
+            &numpy_missing(runs("python3", &["--version"]), what),
+        );
     }
     ok
 }
