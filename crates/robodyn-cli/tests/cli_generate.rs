@@ -88,7 +88,7 @@ fn generated_closed_models_agree_with_the_cli() {
         "--output",
         out_s,
     ]);
-    let wg = run_python(&out, "w5", &[q.clone()]);
+    let wg = run_python(&out, "w5", std::slice::from_ref(&q));
     // W2_1 W2_3 W4_1 W4_3: passive rows, actuated columns, as `closure` prints W
     let flat: Vec<f64> = w.iter().flatten().copied().collect();
     for (a, b) in wg.iter().zip(&flat) {

@@ -619,13 +619,26 @@ impl Names {
     }
 }
 
-fn emit_code(p: &Program, lang: Lang) -> String {
-    let mut s = header(p, lang);
-    let names = &Names::new(p);
+/// What comes before the function's body: the preamble (includes, helpers, the parameter record
+/// type of C and Rust, the parameter names of Python), the signature and the output's allocation.
+fn prologue(p: &Program, lang: Lang) -> String {
+    let mut s = String::new();
     let name = &p.name;
     let groups: Vec<&str> = p.inputs.iter().map(|g| g.name.as_str()).collect();
-    let base = lang.first_index();
     let ind = "    ";
+    // C and Rust: the arguments with their types, `array(name)` for an array, `record(name,
+    // type)` for the parameter record
+    let typed = |array: &dyn Fn(&str) -> String, record: &dyn Fn(&str, &str) -> String| {
+        let args: Vec<String> = p
+            .inputs
+            .iter()
+            .map(|g| match parameter_type(p, lang).filter(|_| g.by_name) {
+                Some(t) => record(&g.name, &t),
+                None => array(&g.name),
+            })
+            .collect();
+        args.join(", ")
+    };
     match lang {
         Lang::Rust => {
             if let Some(t) = parameter_type(p, lang) {
@@ -640,19 +653,11 @@ fn emit_code(p: &Program, lang: Lang) -> String {
                 }
                 s.push_str("}\n\n");
             }
-            let args: Vec<String> = p
-                .inputs
-                .iter()
-                .map(|g| match parameter_type(p, lang).filter(|_| g.by_name) {
-                    Some(t) => format!("{}: &{t}", g.name),
-                    None => format!("{}: &[f64]", g.name),
-                })
-                .collect();
             let _ = writeln!(
                 s,
                 "#[allow(non_snake_case, unused_variables, unused_parens, clippy::all)]\n\
                  pub fn {name}({}, out: &mut [f64]) {{",
-                args.join(", ")
+                typed(&|g| format!("{g}: &[f64]"), &|g, t| format!("{g}: &{t}"))
             );
             let _ = writeln!(
                 s,
@@ -671,15 +676,13 @@ fn emit_code(p: &Program, lang: Lang) -> String {
                 }
                 let _ = writeln!(s, "}} {t};\n");
             }
-            let args: Vec<String> = p
-                .inputs
-                .iter()
-                .map(|g| match parameter_type(p, lang).filter(|_| g.by_name) {
-                    Some(t) => format!("const {t} *{}", g.name),
-                    None => format!("const double *{}", g.name),
+            let _ = writeln!(
+                s,
+                "void {name}({}, double *out) {{",
+                typed(&|g| format!("const double *{g}"), &|g, t| {
+                    format!("const {t} *{g}")
                 })
-                .collect();
-            let _ = writeln!(s, "void {name}({}, double *out) {{", args.join(", "));
+            );
         }
         Lang::Python => {
             s.push_str("import numpy as np\n");
@@ -709,6 +712,15 @@ fn emit_code(p: &Program, lang: Lang) -> String {
         }
         _ => unreachable!(),
     }
+    s
+}
+
+fn emit_code(p: &Program, lang: Lang) -> String {
+    let mut s = header(p, lang);
+    s.push_str(&prologue(p, lang));
+    let names = &Names::new(p);
+    let base = lang.first_index();
+    let ind = "    ";
     let decl = match lang {
         Lang::Rust => "let ",
         Lang::C => "const double ",

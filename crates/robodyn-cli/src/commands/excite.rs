@@ -287,9 +287,9 @@ fn excitation_figure(
     prismatic: &[bool],
 ) -> CliResult {
     const QUANTITIES: [(&str, &str, [&str; 2]); 3] = [
-        ("positions", "q", ["rad", "m"]),
-        ("velocities", "qd", ["rad/s", "m/s"]),
-        ("accelerations", "qdd", ["rad/s^2", "m/s^2"]),
+        ("joint positions", "q", ["rad", "m"]),
+        ("joint velocities", "qd", ["rad/s", "m/s"]),
+        ("joint accelerations", "qdd", ["rad/s^2", "m/s^2"]),
     ];
     let mut panels = Vec::new();
     for (k, (what, symbol, units)) in QUANTITIES.iter().enumerate() {

@@ -147,11 +147,11 @@ impl std::fmt::Display for Inconsistency {
 /// `p`) are not a rigid body's, if they are not: the pseudo-inertia test of the
 /// [module](self) with relative tolerance [`TOLERANCE`], and the violated condition named.
 pub fn body_inconsistency(p: &[f64]) -> Option<Inconsistency> {
-    let pseudo = pseudo_inertia(p);
-    let scale = pseudo.amax();
-    if !scale.is_finite() {
+    if p[..10].iter().any(|x| !x.is_finite()) {
         return Some(Inconsistency::NotFinite);
     }
+    let pseudo = pseudo_inertia(p);
+    let scale = pseudo.amax();
     let tol = TOLERANCE * scale;
     let smallest = pseudo.symmetric_eigenvalues().min();
     if smallest >= -tol {

@@ -65,7 +65,10 @@ impl fmt::Display for Sig {
         let exp: i32 = exp
             .parse()
             .expect("`e` formatting writes an integer exponent");
-        if exp < -4 || exp >= digits as i32 {
+        if exp >= 308 && sci.parse::<f64>().is_ok_and(f64::is_infinite) {
+            // rounded past the largest double (1.8e308 with 1 digit): the data form
+            write!(f, "{}", Number(x))
+        } else if exp < -4 || exp >= digits as i32 {
             write!(f, "{}e{exp}", trim_zeros(mantissa))
         } else {
             let decimals = (digits as i32 - 1 - exp).max(0) as usize;
