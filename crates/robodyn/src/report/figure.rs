@@ -41,7 +41,7 @@ pub struct Curve {
     /// Values, one per x (non-finite values are skipped).
     pub y: Vec<f64>,
     /// Colour: index into the palette of [`Figure::colors`] entries (the same index in two
-    /// panels is the same colour).
+    /// panels is the same colour; an index beyond it is near-black).
     pub color: usize,
     /// Line style.
     pub style: Style,
@@ -111,9 +111,13 @@ const PANEL_H: u32 = 260;
 const LEGEND_W: u32 = 170;
 
 /// Colour k of a palette of n: the ten "tab10" colours, or n evenly spaced hues (alternating
-/// lightness) when there are more, so no colour repeats.
+/// lightness) when there are more, so no colour repeats; k >= n is near-black (a curve that is
+/// no joint's, such as the energy).
 pub fn color(k: usize, n: usize) -> plotters::style::RGBColor {
     use plotters::style::{HSLColor, RGBColor};
+    if k >= n {
+        return RGBColor(40, 40, 40);
+    }
     const TAB10: [(u8, u8, u8); 10] = [
         (31, 119, 180),
         (255, 127, 14),

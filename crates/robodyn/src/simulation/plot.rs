@@ -149,16 +149,16 @@ pub fn plot_svg(path: &Path, rec: &Recorder, info: &PlotInfo) -> Result<()> {
         fig.panels.push(Panel {
             title: format!("{what} (E(0) = {} J)", Sig(e0, 4)),
             y_label: "E - E(0) [J]".into(),
+            // near-black: no joint's colour
             curves: vec![Curve::new(
                 "E - E(0)",
                 e.iter().map(|x| x - e0).collect(),
-                0,
+                joints.len(),
                 Style::Solid,
             )
             .unlisted()],
             ..Panel::default()
         });
-        fig.colors = fig.colors.max(1);
     }
     if fig.panels.is_empty() {
         return Err(err(
