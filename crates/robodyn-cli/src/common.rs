@@ -43,20 +43,32 @@ impl RobotArgs {
     }
 
     /// Load the robot's description with the `--set` values (the library's rule,
-    /// `robodyn::io::set_values`: each names a symbol or a standard parameter of the robot).
+    /// `robodyn::io::set_values`: each names a symbol or a standard parameter of the robot);
+    /// what the loader warns about (physical consistency with those values, the reader's notes)
+    /// is printed on standard error.
     pub fn description(
         &self,
     ) -> CliResult<(robodyn::model::RobotDescription, robodyn::io::SourceMap)> {
-        let (mut desc, map) = robodyn::io::load_description_mapped(&self.robot)?;
+        let (desc, map) = self.read()?;
+        print_warnings(&map);
+        Ok((desc, map))
+    }
+
+    /// [`RobotArgs::description`] without printing the warnings.
+    fn read(&self) -> CliResult<(robodyn::model::RobotDescription, robodyn::io::SourceMap)> {
+        let (mut desc, mut map) = robodyn::io::load_description_mapped(&self.robot)?;
         let o = self.overrides()?;
-        robodyn::io::set_values(&mut desc, &o).map_err(|e| format!("--set: {e}"))?;
+        robodyn::io::set_values_mapped(&mut desc, &mut map, &o)
+            .map_err(|e| format!("--set: {e}"))?;
         Ok((desc, map))
     }
 
     /// Load and validate the robot (all symbols need values). A motor-joint transmission with
-    /// nonzero motor drive parameters is refused: only `identify` and `excite` apply it.
+    /// nonzero motor drive parameters is refused: only `identify` and `excite` apply it. The
+    /// loader's warnings are printed once the robot is valid (an invalid one is an error that
+    /// says why).
     pub fn load(&self) -> CliResult<Robot> {
-        let (desc, map) = self.description()?;
+        let (desc, map) = self.read()?;
         let robot = Robot::new(desc).map_err(|e| map.locate(e))?;
         if let Some(t) = &robot.description().transmission {
             let k = robot.standard_parameters();
@@ -79,7 +91,15 @@ impl RobotArgs {
                 .into());
             }
         }
+        print_warnings(&map);
         Ok(robot)
+    }
+}
+
+/// The loader's warnings, one `robodyn: warning: FILE:LINE: link 3: ...` line each.
+pub fn print_warnings(map: &robodyn::io::SourceMap) {
+    for w in &map.warnings {
+        eprintln!("robodyn: warning: {w}");
     }
 }
 

@@ -25,7 +25,8 @@ use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 #[command(
     name = "robodyn",
     version,
-    about = "Dynamic modeling of robots with complex structure (Khalil-Kleinfinger notation)"
+    about = "Dynamic modeling of robots with complex structure (Khalil-Kleinfinger notation)",
+    after_help = GETTING_STARTED
 )]
 struct Cli {
     #[command(subcommand)]
@@ -59,6 +60,17 @@ enum Command {
     /// Design an exciting trajectory (finite Fourier series minimizing the condition number).
     Excite(commands::excite::Args),
 }
+
+/// Printed after `robodyn --help`: a first command and where the documentation is.
+const GETTING_STARTED: &str = "Examples (robot files of the repository's robots/ directory):
+  robodyn info robots/sr400.toml
+  robodyn idm robots/rx90.toml --q 0.1,0.2,0.3,0.4,0.5,0.6 --qd 1,1,1,1,1,1
+  robodyn base-params robots/sr400.toml --no-friction
+  robodyn simulate robots/scara.toml --duration 1 --output run.csv --plot run.svg
+
+`robodyn COMMAND --help` lists a command's options, their values and units. Documentation: \
+README.md and docs/ of the repository (docs/cli.md: conventions common to all commands; \
+docs/robot-format.md: robot files; docs/models/: the models and their checks).";
 
 /// Printed after every command's `--help`: the units of every value and column.
 const UNITS: &str = "Units (SI): q<j> rad (revolute) or m (prismatic); qd<j> rad/s or m/s; \

@@ -39,6 +39,8 @@ mod cli_info_assembly;
 mod cli_long_inputs;
 #[path = "cli_outputs.rs"]
 mod cli_outputs;
+#[path = "cli_presentation.rs"]
+mod cli_presentation;
 #[path = "cli_random_options.rs"]
 mod cli_random_options;
 #[path = "cli_simulate_names.rs"]

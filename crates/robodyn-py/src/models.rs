@@ -302,6 +302,10 @@ pub struct Generated {
     pub additions: usize,
     /// Elementary function calls (sin, cos...).
     pub functions: usize,
+    /// The values of the code's parameters `p`, as (name, value) pairs in the order of its
+    /// header (`None` for a symbol the robot file leaves free; empty with `numeric=True`): the
+    /// generated Python takes `dict(parameters)`.
+    pub parameters: Vec<(String, Option<f64>)>,
 }
 
 #[pymethods]
@@ -389,6 +393,7 @@ pub fn generate(
         multiplications: c.mul,
         additions: c.add,
         functions: c.func,
+        parameters: robodyn::codegen::parameter_values(desc, &opt, &prog),
     })
 }
 

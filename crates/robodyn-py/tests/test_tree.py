@@ -183,8 +183,17 @@ def test_generated_python_code_equals_idm(name, rng):
     exec(compile(g.code, "<generated>", "exec"), ns)
     q, qd, qdd = random_states(rng, robot.nq)
     # the generated code takes tree vectors over frames 1..NL (movable joints here)
-    out = np.asarray(ns["gen_idm"](q, qd, qdd, np.zeros(0)), dtype=float).reshape(-1)
+    out = np.asarray(ns["gen_idm"](q, qd, qdd), dtype=float).reshape(-1)
     np.testing.assert_allclose(out, robot.idm(q, qd, qdd), atol=1e-9)
+    assert g.parameters == []  # numeric: the values are in the code, no p
+    # symbolic: the parameters by name, their values from Generated.parameters
+    g = robot.generate(model="idm", lang="python", name="gen_sym")
+    names = [n for n, _ in g.parameters]
+    ns = {}
+    exec(compile(g.code, "<generated>", "exec"), ns)
+    assert list(ns["GEN_SYM_PARAMETERS"]) == names
+    out = np.asarray(ns["gen_sym"](q, qd, qdd, dict(g.parameters)), dtype=float)
+    np.testing.assert_allclose(out.reshape(-1), robot.idm(q, qd, qdd), atol=1e-9)
     text = robot.generate(model="inertia", lang="text")
     assert text.multiplications > 0 and "A" in text.code
 

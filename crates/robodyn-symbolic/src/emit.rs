@@ -78,6 +78,64 @@ pub fn emit(p: &Program, lang: Lang) -> String {
     }
 }
 
+/// How a group passed by name is given, for the header.
+fn by_name_how(p: &Program, lang: Lang) -> String {
+    match (lang, parameter_type(p, lang)) {
+        (Lang::C | Lang::Rust, Some(t)) => format!("by name: a struct {t} with these fields"),
+        (Lang::Python, _) => format!(
+            "by name: a mapping from these names to values, e.g. dict(zip({}, values))",
+            python_names_constant(p)
+        ),
+        (Lang::Julia, _) => "by name: any value with these fields, e.g. a NamedTuple".into(),
+        (Lang::Matlab, _) => "by name: a struct with these fields".into(),
+        _ => "by name".into(),
+    }
+}
+
+/// The symbols of the program's groups passed by name, with the field (and variable) name the
+/// generated code gives each: the symbol itself, or with a trailing underscore when the code
+/// needs the name or a language reserves it (`end` -> `end_`). In the order of the header.
+pub fn parameter_fields(p: &Program) -> Vec<(String, String)> {
+    let names = Names::new(p);
+    p.inputs
+        .iter()
+        .filter(|g| g.by_name)
+        .flat_map(|g| g.symbols.iter().flatten())
+        .map(|sym| (sym.clone(), names.get(sym)))
+        .collect()
+}
+
+/// The type of the parameter record of C and Rust code (`NAME_params`, `NameParams`), when the
+/// program has a group passed by name.
+pub fn parameter_type(p: &Program, lang: Lang) -> Option<String> {
+    if !p.inputs.iter().any(|g| g.by_name) {
+        return None;
+    }
+    match lang {
+        Lang::C => Some(format!("{}_params", p.name)),
+        Lang::Rust => {
+            let camel: String = p
+                .name
+                .split('_')
+                .filter(|w| !w.is_empty())
+                .map(|w| {
+                    let mut c = w.chars();
+                    c.next()
+                        .map(|f| f.to_ascii_uppercase().to_string() + c.as_str())
+                        .unwrap_or_default()
+                })
+                .collect();
+            Some(format!("{camel}Params"))
+        }
+        _ => None,
+    }
+}
+
+/// The Python constant listing the parameter names in order (`NAME_PARAMETERS`).
+fn python_names_constant(p: &Program) -> String {
+    format!("{}_PARAMETERS", p.name.to_uppercase())
+}
+
 fn header(p: &Program, lang: Lang) -> String {
     let c = lang.comment();
     let mut s = String::new();
@@ -92,7 +150,28 @@ fn header(p: &Program, lang: Lang) -> String {
     );
     let base = lang.first_index();
     let _ = writeln!(s, "{c}Inputs:");
+    let names = Names::new(p);
     for g in &p.inputs {
+        if g.by_name {
+            let fields: Vec<String> = g
+                .symbols
+                .iter()
+                .flatten()
+                .map(|sym| match names.get(sym) {
+                    f if f == *sym => f,
+                    f => format!("{sym} (field {f})"),
+                })
+                .collect();
+            let _ = writeln!(
+                s,
+                "{c}  {} ({}; {}): {}",
+                g.name,
+                g.doc,
+                by_name_how(p, lang),
+                fields.join(" ")
+            );
+            continue;
+        }
         let names: Vec<String> = g
             .symbols
             .iter()
@@ -644,21 +723,45 @@ impl Names {
     }
 }
 
-fn emit_code(p: &Program, lang: Lang) -> String {
-    let mut s = header(p, lang);
-    let names = &Names::new(p);
+/// What comes before the function's body: the preamble (includes, helpers, the parameter record
+/// type of C and Rust, the parameter names of Python), the signature and the output's allocation.
+fn prologue(p: &Program, lang: Lang) -> String {
+    let mut s = String::new();
     let name = &p.name;
     let groups: Vec<&str> = p.inputs.iter().map(|g| g.name.as_str()).collect();
-    let base = lang.first_index();
     let ind = "    ";
+    // C and Rust: the arguments with their types, `array(name)` for an array, `record(name,
+    // type)` for the parameter record
+    let typed = |array: &dyn Fn(&str) -> String, record: &dyn Fn(&str, &str) -> String| {
+        let args: Vec<String> = p
+            .inputs
+            .iter()
+            .map(|g| match parameter_type(p, lang).filter(|_| g.by_name) {
+                Some(t) => record(&g.name, &t),
+                None => array(&g.name),
+            })
+            .collect();
+        args.join(", ")
+    };
     match lang {
         Lang::Rust => {
-            let args: Vec<String> = groups.iter().map(|g| format!("{g}: &[f64]")).collect();
+            if let Some(t) = parameter_type(p, lang) {
+                let _ = writeln!(
+                    s,
+                    "/// The parameters of `{name}`, by name (fields in the order of the header).\n\
+                     #[allow(non_snake_case)]\n#[derive(Clone, Copy, Debug, PartialEq)]\n\
+                     pub struct {t} {{"
+                );
+                for (_, f) in parameter_fields(p) {
+                    let _ = writeln!(s, "{ind}pub {f}: f64,");
+                }
+                s.push_str("}\n\n");
+            }
             let _ = writeln!(
                 s,
                 "#[allow(non_snake_case, unused_variables, unused_parens, clippy::all)]\n\
                  pub fn {name}({}, out: &mut [f64]) {{",
-                args.join(", ")
+                typed(&|g| format!("{g}: &[f64]"), &|g, t| format!("{g}: &{t}"))
             );
             let _ = writeln!(
                 s,
@@ -670,14 +773,36 @@ fn emit_code(p: &Program, lang: Lang) -> String {
             s.push_str(
                 "static inline double rd_sign(double x) { return (x > 0.0) - (x < 0.0); }\n\n",
             );
-            let args: Vec<String> = groups
-                .iter()
-                .map(|g| format!("const double *{g}"))
-                .collect();
-            let _ = writeln!(s, "void {name}({}, double *out) {{", args.join(", "));
+            if let Some(t) = parameter_type(p, lang) {
+                s.push_str("typedef struct {\n");
+                for (_, f) in parameter_fields(p) {
+                    let _ = writeln!(s, "{ind}double {f};");
+                }
+                let _ = writeln!(s, "}} {t};\n");
+            }
+            let _ = writeln!(
+                s,
+                "void {name}({}, double *out) {{",
+                typed(&|g| format!("const double *{g}"), &|g, t| {
+                    format!("const {t} *{g}")
+                })
+            );
         }
         Lang::Python => {
-            s.push_str("import numpy as np\n\n\n");
+            s.push_str("import numpy as np\n");
+            if p.inputs.iter().any(|g| g.by_name) {
+                let quoted: Vec<String> = parameter_fields(p)
+                    .iter()
+                    .map(|(sym, _)| format!("{sym:?}"))
+                    .collect();
+                let _ = writeln!(
+                    s,
+                    "\n# the names of the parameters p, in the order of the header\n{} = ({},)",
+                    python_names_constant(p),
+                    quoted.join(", ")
+                );
+            }
+            s.push_str("\n\n");
             let _ = writeln!(s, "def {name}({}, out=None):", groups.join(", "));
             let _ = writeln!(s, "{ind}if out is None:");
             let _ = writeln!(s, "{ind}{ind}out = np.zeros({})", p.outputs.len());
@@ -691,6 +816,15 @@ fn emit_code(p: &Program, lang: Lang) -> String {
         }
         _ => unreachable!(),
     }
+    s
+}
+
+fn emit_code(p: &Program, lang: Lang) -> String {
+    let mut s = header(p, lang);
+    s.push_str(&prologue(p, lang));
+    let names = &Names::new(p);
+    let base = lang.first_index();
+    let ind = "    ";
     let decl = match lang {
         Lang::Rust => "let ",
         Lang::C => "const double ",
@@ -714,12 +848,14 @@ fn emit_code(p: &Program, lang: Lang) -> String {
         }
         for (i, sym) in g.symbols.iter().enumerate() {
             if let Some(sym) = sym.as_ref().filter(|s| read.contains(*s)) {
-                let _ = writeln!(
-                    s,
-                    "{ind}{decl}{} = {}{end}",
-                    names.get(sym),
-                    lang.index(&g.name, i + base)
-                );
+                let var = names.get(sym);
+                let value = match (g.by_name, lang) {
+                    (false, _) => lang.index(&g.name, i + base),
+                    (true, Lang::C) => format!("{}->{var}", g.name),
+                    (true, Lang::Python) => format!("{}[{sym:?}]", g.name),
+                    (true, _) => format!("{}.{var}", g.name),
+                };
+                let _ = writeln!(s, "{ind}{decl}{var} = {value}{end}");
             }
         }
     }

@@ -40,7 +40,7 @@ mod parse;
 mod print;
 pub mod program;
 
-pub use emit::{check_function_name, emit, Lang};
+pub use emit::{check_function_name, emit, parameter_fields, parameter_type, Lang};
 pub use expr::{cmp_expr, EvalError, Expr, Func, Node};
 pub use parse::ParseError;
 pub use program::{count_ops, Assignment, InputGroup, OpCount, Program};

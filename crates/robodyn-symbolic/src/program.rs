@@ -22,15 +22,19 @@ pub struct Assignment {
     pub expr: Expr,
 }
 
-/// A group of input symbols passed to generated code as one array (`q`, `qd`, `p`...).
+/// A group of input symbols passed to generated code as one argument: an array (`q`, `qd`),
+/// or, for a group `by_name` (the parameters `p`), a record whose fields are the symbols (a
+/// struct in C and Rust, a mapping in Python, any value with those fields in Julia and MATLAB).
 #[derive(Clone, Debug, PartialEq)]
 pub struct InputGroup {
-    /// Array name in generated code.
+    /// Argument name in generated code.
     pub name: String,
-    /// What the array holds (for the header comment).
+    /// What the group holds (for the header comment).
     pub doc: String,
     /// Symbol at each index; `None` for an entry the program does not read.
     pub symbols: Vec<Option<String>>,
+    /// Passed by name (a record of named fields) rather than by position (an array).
+    pub by_name: bool,
 }
 
 /// A straight-line program: inputs, assignments in evaluation order, named outputs.

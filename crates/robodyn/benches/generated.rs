@@ -25,7 +25,7 @@ mod gen_fivebar {
     include!("generated/fivebar_closed.rs");
 }
 
-type GenFn = fn(&[f64], &[f64], &[f64], &[f64], &mut [f64]);
+type GenFn = fn(&[f64], &[f64], &[f64], &mut [f64]);
 
 fn bench_robot(c: &mut Criterion, label: &str, robot: Robot, f: GenFn) {
     let n = robot.nl();
@@ -36,7 +36,7 @@ fn bench_robot(c: &mut Criterion, label: &str, robot: Robot, f: GenFn) {
     let mut out = vec![0.0; n];
     // same numbers (movable joints only in `out`; both robots have no fixed tree frame)
     rnea(model, &mut ws, &q, &qd, &qdd, &mut tau);
-    f(&q, &qd, &qdd, &[], &mut out);
+    f(&q, &qd, &qdd, &mut out);
     for (a, b) in tau.iter().zip(&out) {
         assert!(
             (a - b).abs() <= 1e-9 * (1.0 + a.abs()),
@@ -61,7 +61,7 @@ fn bench_robot(c: &mut Criterion, label: &str, robot: Robot, f: GenFn) {
     g.finish();
 }
 
-/// The "generated" member of a group: `f(q, qd, qdd, [], out)` (numeric values baked in).
+/// The "generated" member of a group: `f(q, qd, qdd, out)` (numeric values baked in).
 fn bench_generated(
     g: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
     f: GenFn,
@@ -70,13 +70,7 @@ fn bench_generated(
 ) {
     g.bench_function("generated", |b| {
         b.iter(|| {
-            f(
-                black_box(q),
-                black_box(qd),
-                black_box(qdd),
-                black_box(&[]),
-                out,
-            );
+            f(black_box(q), black_box(qd), black_box(qdd), out);
             black_box(&*out);
         })
     });
@@ -109,7 +103,7 @@ fn bench_closed(c: &mut Criterion) {
     let v = |x: &nalgebra::DVector<f64>| -> Vec<f64> { x.iter().copied().collect() };
     let (q, qd, qdd) = (v(&st.q), v(&st.qd), v(&st.qdd));
     let mut out = vec![0.0; cc.dof()];
-    gen_fivebar::fivebar_closed(&q, &qd, &qdd, &[], &mut out);
+    gen_fivebar::fivebar_closed(&q, &qd, &qdd, &mut out);
     for (a, b) in idm.gamma_cl.iter().zip(&out) {
         assert!((a - b).abs() <= 1e-9 * (1.0 + a.abs()), "{a} vs {b}");
     }

@@ -43,6 +43,8 @@ mod codegen_errors;
 mod codegen_latex;
 #[path = "codegen_opcount.rs"]
 mod codegen_opcount;
+#[path = "codegen_parameters.rs"]
+mod codegen_parameters;
 #[path = "continuation.rs"]
 mod continuation;
 #[path = "direct_dynamics.rs"]
@@ -69,6 +71,8 @@ mod identification_tx40;
 mod inertia_matrix;
 #[path = "inverse_dynamics.rs"]
 mod inverse_dynamics;
+#[path = "io_consistency.rs"]
+mod io_consistency;
 #[path = "io_external.rs"]
 mod io_external;
 #[path = "io_hostile.rs"]

@@ -25,7 +25,7 @@ use robodyn::codegen::{constant_g, generate, GenOptions, ModelKind};
 use robodyn::model::STANDARD_PARAMETERS;
 use robodyn::testing::{random_state, random_tree_description, rng, TreeOptions};
 use robodyn::{Data, Expr, Robot, RobotDescription};
-use robodyn_symbolic::{emit, Lang, Program};
+use robodyn_symbolic::{emit, parameter_fields, parameter_type, Lang, Program};
 use std::collections::HashMap;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -67,14 +67,31 @@ struct Case {
     what: String,
 }
 
+/// The values of the program's parameters `p` (its group passed by name, last), or none when
+/// the program has no parameters (`--numeric`).
 fn parameter_values(prog: &Program, env: &dyn Fn(&str) -> Option<f64>) -> Vec<f64> {
     prog.inputs
-        .last()
-        .unwrap()
-        .symbols
         .iter()
+        .filter(|g| g.by_name)
+        .flat_map(|g| &g.symbols)
         .map(|s| env(s.as_deref().unwrap()).unwrap_or_else(|| panic!("no value for {s:?}")))
         .collect()
+}
+
+/// The input sets of every case without the `p` entry of a program that takes none, and the
+/// library's `codegen::parameter_values` checked against the test's own values of `p`.
+fn finish_cases(mut cases: Vec<Case>) -> Vec<Case> {
+    for c in &mut cases {
+        let groups = c.prog.inputs.len();
+        let takes_p = c.prog.inputs.iter().any(|g| g.by_name);
+        for set in &mut c.inputs {
+            if !takes_p {
+                assert!(set.last().is_some_and(Vec::is_empty), "{}: no p", c.what);
+            }
+            set.truncate(groups);
+        }
+    }
+    cases
 }
 
 fn numeric_rnea(robot: &Robot, q: &[f64], qd: &[f64], qdd: &[f64]) -> Vec<f64> {
@@ -360,7 +377,7 @@ fn all_cases() -> Vec<Case> {
         cases.extend(tree_cases(&d, false, seed, &format!("tree{seed}")));
     }
     cases.extend(fixed_frame_cases());
-    cases
+    finish_cases(cases)
 }
 
 /// Robots whose frames include fixed joints: the generated code's joint arrays hold the movable
@@ -509,12 +526,24 @@ fn rust_harness(cases: &[Case]) -> String {
         s += &format!("            {i} => {{\n");
         let mut args = Vec::new();
         for (k, g) in c.prog.inputs.iter().enumerate() {
-            s += &format!(
-                "                let g{k} = &v[pos..pos + {}]; pos += {};\n",
-                g.symbols.len(),
-                g.symbols.len()
-            );
-            args.push(format!("g{k}"));
+            let n = g.symbols.len();
+            if g.by_name {
+                // the parameter struct, field by field
+                let fields: Vec<String> = parameter_fields(&c.prog)
+                    .iter()
+                    .enumerate()
+                    .map(|(i, (_, f))| format!("{f}: v[pos + {i}]"))
+                    .collect();
+                let t = parameter_type(&c.prog, Lang::Rust).unwrap();
+                s += &format!(
+                    "                let g{k} = {t} {{ {} }}; pos += {n};\n",
+                    fields.join(", ")
+                );
+                args.push(format!("&g{k}"));
+            } else {
+                s += &format!("                let g{k} = &v[pos..pos + {n}]; pos += {n};\n");
+                args.push(format!("g{k}"));
+            }
         }
         s += &format!(
             "                let mut out = [0.0f64; {}];\n                {}({}, &mut out);\n",
@@ -552,7 +581,18 @@ fn c_harness(cases: &[Case]) -> String {
         let mut off = 0;
         let mut args = Vec::new();
         for g in &c.prog.inputs {
-            args.push(format!("buf + {off}"));
+            if g.by_name {
+                let fields: Vec<String> = parameter_fields(&c.prog)
+                    .iter()
+                    .enumerate()
+                    .map(|(i, (_, f))| format!(".{f} = buf[{}]", off + i))
+                    .collect();
+                let t = parameter_type(&c.prog, Lang::C).unwrap();
+                s += &format!("            {t} p = {{ {} }};\n", fields.join(", "));
+                args.push("&p".to_string());
+            } else {
+                args.push(format!("buf + {off}"));
+            }
             off += g.symbols.len();
         }
         let no = c.prog.outputs.len();
@@ -656,6 +696,7 @@ fn interpreted_and_python_agree() {
         py.push('\n');
     }
     py += "import sys\nwhich = int(sys.argv[1])\nv = [float(x) for x in sys.stdin.read().split()]\nn = int(v[0]); pos = 1\nfuns = [";
+    // (function, [(size, names of a group passed by name or None)])
     let sizes: Vec<String> = cases
         .iter()
         .map(|c| {
@@ -663,13 +704,20 @@ fn interpreted_and_python_agree() {
                 .prog
                 .inputs
                 .iter()
-                .map(|g| g.symbols.len().to_string())
+                .map(|g| {
+                    let names = if g.by_name {
+                        format!("{}_PARAMETERS", c.prog.name.to_uppercase())
+                    } else {
+                        "None".into()
+                    };
+                    format!("({}, {names})", g.symbols.len())
+                })
                 .collect();
             format!("({}, [{}])", c.prog.name, s.join(", "))
         })
         .collect();
     py += &sizes.join(", ");
-    py += "]\nf, sz = funs[which]\nfor _ in range(n):\n    args = []\n    for k in sz:\n        args.append(np.array(v[pos:pos + k])); pos += k\n    print(' '.join(repr(float(x)) for x in f(*args)))\n";
+    py += "]\nf, sz = funs[which]\nfor _ in range(n):\n    args = []\n    for k, names in sz:\n        x = v[pos:pos + k]; pos += k\n        args.append(np.array(x) if names is None else dict(zip(names, x)))\n    print(' '.join(repr(float(x)) for x in f(*args)))\n";
     let file = dir.join("gen.py");
     std::fs::write(&file, py).unwrap();
     let outs: Vec<Vec<Vec<f64>>> = cases
@@ -721,7 +769,7 @@ fn matlab_code_runs_in_octave_and_agrees() {
     let dir = tmp_dir("m");
     // one driver script: read the states of a case, call the function, print its outputs
     let mut driver = String::from(
-        "1;\nfunction run_case(name, sz, infile, outfile)\n\
+        "1;\nfunction run_case(name, sz, fields, infile, outfile)\n\
          \x20 f = str2func(name);\n\
          \x20 fid = fopen(infile, 'r'); v = fscanf(fid, '%f'); fclose(fid);\n\
          \x20 n = v(1); pos = 2; fo = fopen(outfile, 'w');\n\
@@ -729,6 +777,9 @@ fn matlab_code_runs_in_octave_and_agrees() {
          \x20   args = cell(1, numel(sz));\n\
          \x20   for k = 1:numel(sz)\n\
          \x20     args{k} = v(pos:pos + sz(k) - 1); pos = pos + sz(k);\n\
+         \x20   end\n\
+         \x20   if ~isempty(fields)\n\
+         \x20     args{end} = cell2struct(num2cell(args{end}), fields, 1);\n\
          \x20   end\n\
          \x20   out = f(args{:});\n\
          \x20   fprintf(fo, '%.17g ', out); fprintf(fo, '\\n');\n\
@@ -751,10 +802,16 @@ fn matlab_code_runs_in_octave_and_agrees() {
             .iter()
             .map(|g| g.symbols.len().to_string())
             .collect();
+        // the fields of the parameter struct (the last argument), if the function takes one
+        let fields: Vec<String> = parameter_fields(&c.prog)
+            .iter()
+            .map(|(_, f)| format!("'{f}'"))
+            .collect();
         driver += &format!(
-            "run_case('{}', [{}], 'in{i}.txt', 'out{i}.txt');\n",
+            "run_case('{}', [{}], {{{}}}, 'in{i}.txt', 'out{i}.txt');\n",
             c.prog.name,
-            sizes.join(" ")
+            sizes.join(" "),
+            fields.join("; ")
         );
     }
     std::fs::write(dir.join("driver.m"), driver).unwrap();
@@ -819,7 +876,7 @@ fn sr400_base_parameters_reproduce_the_closed_chain_torques() {
         .iter()
         .map(|g| (g.name.clone(), g.expr.eval(&std_env).unwrap()))
         .collect();
-    let params = prog.inputs.last().unwrap();
+    let params = prog.inputs.iter().find(|g| g.by_name).unwrap();
     let n_base = params
         .symbols
         .iter()

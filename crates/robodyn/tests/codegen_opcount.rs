@@ -66,8 +66,8 @@ fn check(prog: &robodyn_symbolic::Program) {
         let line = line.trim();
         let body = if let Some(rest) = line.strip_prefix("const double ") {
             let (name, e) = rest.split_once(" = ").unwrap();
-            // input reads `q1 = q[0]` cost nothing
-            if e.contains('[') && !e.contains(' ') {
+            // input reads `q1 = q[0]`, `XX1 = p->XX1` cost nothing
+            if (e.contains('[') || e.contains("->")) && !e.contains(' ') {
                 continue;
             }
             let _ = name;

@@ -617,8 +617,7 @@ fn plot_is_written() {
     let path = tmp("plot.svg");
     let info = robodyn::simulation::PlotInfo {
         title: "robot6: zero torques".into(),
-        stopped: None,
-        prismatic: Vec::new(),
+        ..Default::default()
     };
     plot_svg(&path, &rec, &info).unwrap();
     let svg = std::fs::read_to_string(&path).unwrap();
@@ -644,7 +643,7 @@ fn plot_is_written() {
     };
     plot_svg(&path, &rec, &stopped).unwrap();
     let svg = std::fs::read_to_string(&path).unwrap();
-    assert!(svg.contains("stopped early at t = 0.5: step size underflow"));
+    assert!(svg.contains("stopped early at t = 0.5 s: step size underflow"));
     std::fs::remove_file(&path).ok();
     assert!(plot_svg(
         &path,

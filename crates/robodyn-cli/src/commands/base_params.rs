@@ -13,15 +13,21 @@ use std::path::PathBuf;
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Method {
+    /// Grouping rules on the robot's symbols (§10.3): equations in its symbols.
     Symbolic,
+    /// Stacked regressor of random states, QR: works for any robot, numeric coefficients.
     Numeric,
+    /// The symbolic output, checked against the numerical count and set.
     Both,
 }
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Format {
+    /// Text: the table (like Table 10.2), the lists, the grouping equations, the values.
     Text,
+    /// A LaTeX fragment (amsmath): tabular, legend, align* equations, values.
     Latex,
+    /// JSON for programs.
     Json,
 }
 
@@ -51,6 +57,7 @@ pub struct Args {
     /// both (symbolic output, checked against the numerical count and set).
     #[arg(long, value_enum, default_value = "both")]
     pub method: Method,
+    /// Output format.
     #[arg(long, value_enum, default_value = "text")]
     pub format: Format,
     /// Leave out the Coulomb and viscous friction parameters FS, FV.

@@ -6,6 +6,7 @@ use crate::common::{
     conditioning_json, format_number, parse_list, print_out, start_branch, warn_conditioning,
     CliResult, Names, NamesArg, RobotArgs,
 };
+use robodyn::report::Sig;
 use robodyn::{loop_closure, ClosedChain};
 use serde_json::json;
 
@@ -24,6 +25,7 @@ pub struct Args {
     /// Also print W = d q_p / d q_a.
     #[arg(long)]
     pub jacobian: bool,
+    /// Output format.
     #[arg(long, value_enum, default_value = "text")]
     pub format: Format,
     #[command(flatten)]
@@ -32,7 +34,9 @@ pub struct Args {
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Format {
+    /// Text for reading.
     Text,
+    /// JSON for programs (every number a full double).
     Json,
 }
 
@@ -104,8 +108,8 @@ pub fn run(a: Args) -> CliResult {
             list(&mut out, &cuts, q_c);
             outln!(
                 out,
-                "closure residual {:.3e}; {}",
-                s.residual,
+                "closure residual {}; {}",
+                Sig(s.residual, 3),
                 s.conditioning.describe(cc.limits())
             );
             if let Some(w) = &w {
@@ -113,11 +117,10 @@ pub fn run(a: Args) -> CliResult {
                 outln!(out, "W = d q_p / d q_a (10.30):");
                 outln!(out, "       {}", cols.join(" "));
                 for (r, j) in pas.iter().enumerate() {
-                    // (+ 0.0 turns -0 into 0)
                     let v: Vec<String> = w
                         .row(r)
                         .iter()
-                        .map(|x| format!("{:>14.6e}", x + 0.0))
+                        .map(|&x| format!("{:>14}", Sig(x, 6).to_string()))
                         .collect();
                     outln!(out, "  {:<5}{}", var(j), v.join(" "));
                 }

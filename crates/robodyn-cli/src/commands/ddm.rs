@@ -48,6 +48,7 @@ pub struct Args {
     /// Joint torques (default zeros).
     #[arg(long, allow_hyphen_values = true)]
     pub tau: Option<String>,
+    /// Direct model of a tree robot (closed chains always use A_cl, H_cl of 10.46-10.48).
     #[arg(long, value_enum, default_value = "composite")]
     pub method: MethodArg,
     #[command(flatten)]

@@ -9,14 +9,17 @@ use crate::common::{parse_list, CliResult, RobotArgs};
 use robodyn::identification::excitation::{design, DesignOptions, Limits};
 use robodyn::identification::model_access::ModelAccess;
 use robodyn::identification::parameters::{ParameterModel, ParameterOptions};
-use robodyn::identification::report::plot_panels;
 use robodyn::identification::Rotors;
+use robodyn::report::figure::{write_svg, Curve, Figure, Panel, Style};
+use robodyn::report::Sig;
 use serde_json::json;
 use std::path::PathBuf;
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Format {
+    /// Text for reading.
     Text,
+    /// JSON for programs (every number a full double).
     Json,
 }
 
@@ -58,13 +61,16 @@ pub struct Args {
     /// Random starting trajectories tried before the optimization.
     #[arg(long, default_value_t = 20)]
     pub restarts: usize,
+    /// Seed of the random starting trajectories and of the base-parameter method's samples.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// Which rotor inertias are parameters (as identify).
     #[arg(long, value_enum, default_value = "actuated")]
     pub rotor: crate::commands::identify::RotorArg,
+    /// Leave out the Coulomb and viscous friction parameters (as identify).
     #[arg(long)]
     pub no_friction: bool,
+    /// Add a constant torque offset per joint to the parameters (as identify).
     #[arg(long)]
     pub offsets: bool,
     /// Rate of the CSV rows (Hz).
@@ -77,9 +83,11 @@ pub struct Args {
     /// controller, e.g. `robodyn simulate --track`).
     #[arg(long)]
     pub output: PathBuf,
-    /// SVG plot of the positions, velocities and accelerations.
+    /// SVG plot of the positions, velocities and accelerations (one panel per quantity and
+    /// unit: revolute and prismatic joints apart).
     #[arg(long)]
     pub plot: Option<PathBuf>,
+    /// Format of the report on standard output (the trajectory goes to --output).
     #[arg(long, value_enum, default_value = "text")]
     pub format: Format,
 }
@@ -209,37 +217,16 @@ pub fn run(a: Args) -> CliResult {
     }
     out.flush()?;
     if let Some(plot_file) = &mut plot_file {
-        let names = ["q", "qd", "qdd"];
-        let panels: Vec<robodyn::identification::report::Panel> = (0..3)
-            .map(|k| {
-                (
-                    format!(
-                        "{} of the actuated joints",
-                        ["positions", "velocities", "accelerations"][k]
-                    ),
-                    joints
-                        .iter()
-                        .enumerate()
-                        .map(|(i, j)| (format!("{}{j}", names[k]), series[k][i].clone()))
-                        .collect(),
-                )
-            })
-            .collect();
+        let prismatic: Vec<bool> = joints.iter().map(|&j| access.is_prismatic(j)).collect();
+        let title = format!(
+            "{}: exciting trajectory, {} harmonics, period {} s, condition number {}",
+            access.name(),
+            a.harmonics,
+            format_number(a.period),
+            Sig(d.condition, 4)
+        );
         plot_file.write_by_path(|p| {
-            plot_panels(
-                p,
-                &format!(
-                    "{}: excitation, {} harmonics, period {} s, condition number {:.1}",
-                    access.name(),
-                    a.harmonics,
-                    a.period,
-                    d.condition
-                ),
-                &times,
-                &panels,
-                "rad, rad/s, rad/s^2",
-                false,
-            )
+            excitation_figure(p, &title, &times, &series, &joints, &prismatic)
         })?;
     }
     crate::output::commit_all([Some(file), plot_file].into_iter().flatten().collect())?;
@@ -258,10 +245,14 @@ pub fn run(a: Args) -> CliResult {
                 a.period,
                 params.count()
             );
-            outln!(out,
-                "condition number of W (unit columns, {} samples): {:.4} (best random start {:.4}; \
-                 {} evaluations)",
-                a.samples, d.condition, d.initial_condition, d.evaluations
+            outln!(
+                out,
+                "condition number of W (unit columns, {} samples): {} (best random start {}; {} \
+                 evaluations)",
+                a.samples,
+                Sig(d.condition, 4),
+                Sig(d.initial_condition, 4),
+                d.evaluations
             );
             outln!(
                 out,
@@ -271,13 +262,19 @@ pub fn run(a: Args) -> CliResult {
             );
             outln!(
                 out,
-                "  joint  max|q-start|       max|qd|      max|qdd|      max|tau|"
+                "  joint  max|q-start|       max|qd|      max|qdd|      max|tau|  (units: rad, \
+                 rad/s, rad/s^2, N m; m, m/s, m/s^2, N for a prismatic joint)"
             );
             for (k, j) in joints.iter().enumerate() {
-                let p = d.peaks[k];
+                let p = d.peaks[k].map(|x| Sig(x, 6).to_string());
+                let kind = if access.is_prismatic(*j) {
+                    " (prismatic)"
+                } else {
+                    ""
+                };
                 outln!(
                     out,
-                    "  {j:<5} {:>13.5} {:>13.5} {:>13.5} {:>13.5}",
+                    "  {j:<5} {:>13} {:>13} {:>13} {:>13}{kind}",
                     p[0],
                     p[1],
                     p[2],
@@ -305,4 +302,65 @@ pub fn run(a: Args) -> CliResult {
         ),
     }
     crate::common::print_out(&out)
+}
+
+/// The figure of an exciting trajectory: positions, velocities and accelerations of the
+/// actuated joints, one panel per quantity and unit (revolute and prismatic joints apart),
+/// joint k in colour k in every panel.
+fn excitation_figure(
+    path: &std::path::Path,
+    title: &str,
+    t: &[f64],
+    series: &[Vec<Vec<f64>>],
+    joints: &[usize],
+    prismatic: &[bool],
+) -> CliResult {
+    const QUANTITIES: [(&str, &str, [&str; 2]); 3] = [
+        ("joint positions", "q", ["rad", "m"]),
+        ("joint velocities", "qd", ["rad/s", "m/s"]),
+        ("joint accelerations", "qdd", ["rad/s^2", "m/s^2"]),
+    ];
+    let mut panels = Vec::new();
+    for (k, (what, symbol, units)) in QUANTITIES.iter().enumerate() {
+        for (kind, unit, is_prismatic) in
+            [("revolute", units[0], false), ("prismatic", units[1], true)]
+        {
+            let curves: Vec<Curve> = joints
+                .iter()
+                .enumerate()
+                .filter(|(i, _)| prismatic[*i] == is_prismatic)
+                .map(|(i, j)| {
+                    Curve::new(
+                        format!("{symbol}{j}"),
+                        series[k][i].clone(),
+                        i,
+                        Style::Solid,
+                    )
+                })
+                .collect();
+            if curves.is_empty() {
+                continue;
+            }
+            let kind = if prismatic.iter().all(|&p| p == is_prismatic) {
+                String::new()
+            } else {
+                format!(", {kind} joints")
+            };
+            panels.push(Panel {
+                title: format!("{what}{kind}"),
+                y_label: format!("{symbol} [{unit}]"),
+                curves,
+                ..Panel::default()
+            });
+        }
+    }
+    let fig = Figure {
+        title: title.to_string(),
+        x_label: "t [s]".into(),
+        panels,
+        colors: joints.len(),
+        ..Figure::default()
+    };
+    write_svg(path, t, &fig)?;
+    Ok(())
 }

@@ -25,19 +25,29 @@ pub enum Model {
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug)]
 pub enum Params {
+    /// The 13 standard parameters of every link as symbols.
     Standard,
+    /// Base parameters as symbols (the symbolic method's grouping, or --base-file).
     Base,
 }
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug)]
 pub enum Language {
+    /// SYMORO-style equations, one `NAME = expression` per line.
     Text,
+    /// Rows of a LaTeX align* environment (amsmath).
     Latex,
+    /// A Rust function over slices (and a parameter struct unless --numeric).
     Rust,
+    /// A C99 function over double arrays (and a parameter struct unless --numeric).
     C,
+    /// A Python function over NumPy arrays (parameters by keyword unless --numeric).
     Python,
+    /// A Julia function `NAME!(out, ...)`, 1-based (parameters as a named tuple unless
+    /// --numeric).
     Julia,
-    /// MATLAB / GNU Octave function file (named after --output's file stem).
+    /// A MATLAB / GNU Octave function file, named after --output's file stem (parameters as
+    /// a struct unless --numeric).
     Matlab,
 }
 
@@ -48,8 +58,10 @@ pub struct Args {
     /// Give or override a symbol value, e.g. `--set d3=0.6` (repeatable).
     #[arg(long = "set", value_name = "NAME=VALUE")]
     pub set: Vec<String>,
+    /// The model to generate.
     #[arg(long, value_enum, default_value = "idm")]
     pub model: Model,
+    /// Which inertial parameters are the model's symbols.
     #[arg(long, value_enum, default_value = "standard")]
     pub params: Params,
     /// Grouping list for --params base: lines `XXR2 = XX2 - YY2 + ...` and `zero: XX1 XY1 ...`
@@ -68,6 +80,7 @@ pub struct Args {
     /// Substitute the robot's numeric values for all symbols.
     #[arg(long)]
     pub numeric: bool,
+    /// Output language (operation counts in the header of every one).
     #[arg(long, value_enum, default_value = "text")]
     pub lang: Language,
     /// Function name in the generated code (an identifier of the language that is not one of its

@@ -22,15 +22,22 @@ pub enum EstimatorArg {
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Format {
+    /// Text for reading: processing, the parameter table (units, values, standard deviations,
+    /// grouping equations), per-joint errors, warnings.
     Text,
+    /// JSON: every value as a full double, with the processing and the validation.
     Json,
+    /// CSV of the parameters: name, value, std, relative_std, equation, unit.
     Csv,
 }
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum RotorArg {
+    /// Rotor inertia IA_j of the actuated joints.
     Actuated,
+    /// Of every movable joint.
     All,
+    /// No rotor inertia.
     None,
 }
 
@@ -42,6 +49,7 @@ pub struct Args {
     /// number of each actuated joint, or `_<name>` with the joint's name; `-`: standard input.
     #[arg(long)]
     pub data: PathBuf,
+    /// Estimator of the parameters.
     #[arg(long, value_enum, default_value = "wls")]
     pub estimator: EstimatorArg,
     /// Identify under the physical-consistency constraints (pseudo-inertia PSD, friction and
@@ -109,12 +117,14 @@ pub struct Args {
     /// Seed of the numerical base-parameter method's random states.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// Format of the report.
     #[arg(long, value_enum, default_value = "text")]
     pub format: Format,
     /// Write the report to a file instead of standard output.
     #[arg(long)]
     pub output: Option<PathBuf>,
-    /// SVG of measured and predicted torques on the validation segment.
+    /// SVG plot of measured and predicted torques on the validation segment, one panel per
+    /// joint.
     #[arg(long)]
     pub plot: Option<PathBuf>,
     /// Write a physically consistent robot file (.toml) with the identified parameters.

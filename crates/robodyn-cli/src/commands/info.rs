@@ -4,6 +4,7 @@ use crate::common::CliResult;
 use robodyn::model::{
     validate_structure, RobotDescription, GEOMETRIC_PARAMETERS, STANDARD_PARAMETERS,
 };
+use robodyn::report::number::{format_number, significant, vector, Sig};
 use serde_json::json;
 use std::path::PathBuf;
 
@@ -18,13 +19,16 @@ pub struct Args {
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug)]
 pub enum Format {
+    /// Text for reading.
     Text,
+    /// JSON for programs (every number a full double).
     Json,
 }
 
 pub fn run(a: Args) -> CliResult {
-    let desc = robodyn::io::load_description(&a.robot)?;
+    let (desc, map) = robodyn::io::load_description_mapped(&a.robot)?;
     let s = validate_structure(&desc)?;
+    crate::common::print_warnings(&map);
     let text = match a.format {
         Format::Json => format!("{}\n", serde_json::to_string_pretty(&to_json(&desc, &s))?),
         Format::Text => text(&desc, &s),
@@ -104,7 +108,7 @@ fn assembly_note(d: &RobotDescription, s: &robodyn::model::Structure) -> Option<
         return None;
     }
     if let Some(a) = &d.assembly {
-        let q: Vec<String> = a.iter().map(|x| format!("{x}")).collect();
+        let q: Vec<String> = a.iter().map(|&x| format_number(x)).collect();
         return Some(format!(
             "assembly (start of loop closure): q = [{}]",
             q.join(", ")
@@ -117,18 +121,18 @@ fn assembly_note(d: &RobotDescription, s: &robodyn::model::Structure) -> Option<
         .and_then(|r| robodyn::ClosedChain::new(&r)?.assembly_branch());
     Some(match start {
         Ok(b) => {
-            let qp: Vec<String> = b.q_p().iter().map(|x| format!("{x:.6}")).collect();
             format!(
-                "assembly: none; the start is q_a = 0, where the loops close (q_p = [{}]) with Wp \
-                 regular (reciprocal condition number {:.1e}): results follow that branch; \
-                 if it is not the intended one, {HOW}",
-                qp.join(", "),
-                b.rcond()
+                "assembly: none; the start is q_a = 0, where the loops close (q_p = {}) with Wp \
+                 regular (reciprocal condition number {}): results follow that branch; if it is \
+                 not the intended one, {HOW}",
+                vector(b.q_p(), 6),
+                Sig(b.rcond(), 2)
             )
         }
         Err(robodyn::Error::SingularStart { rcond, .. }) => format!(
-            "assembly: none, and q = 0 is singular (Wp reciprocal condition number {rcond:.1e}): \
-             closed-chain evaluation refuses to start there; {HOW}"
+            "assembly: none, and q = 0 is singular (Wp reciprocal condition number {}): \
+             closed-chain evaluation refuses to start there; {HOW}",
+            Sig(rcond, 2)
         ),
         Err(e) => format!("assembly: none, and q = 0 cannot serve as the start ({e}); {HOW}"),
     })
@@ -212,7 +216,7 @@ fn text(d: &RobotDescription, s: &robodyn::model::Structure) -> String {
         }
     }
     if let Some(note) = assembly_note(d, s) {
-        println!("{note}");
+        outln!(out, "{note}");
     }
     let act: Vec<String> = (1..=d.nl)
         .filter(|&j| d.frame(j).actuated)
@@ -259,16 +263,10 @@ fn text(d: &RobotDescription, s: &robodyn::model::Structure) -> String {
     out
 }
 
-/// A number for reading: the shortest decimal within 1e-12 (relative) of `x`, so that float
-/// noise of an import (`0.22094100000000003`) reads `0.220941`.
+/// A number for reading: 12 significant digits, so that float noise of an import
+/// (`0.22094100000000003`) reads `0.220941` (the report form of `robodyn::report::number`).
 fn short(x: f64) -> String {
-    for p in 0..16 {
-        let y: f64 = format!("{x:.p$e}").parse().unwrap_or(x);
-        if (y - x).abs() <= 1e-12 * x.abs() {
-            return crate::common::format_number(y);
-        }
-    }
-    crate::common::format_number(x)
+    significant(x, 12)
 }
 
 /// An expression for reading: a float (`0.22094100000000003`) by [`short`], a rational by its

@@ -14,9 +14,10 @@ use crate::common::{format_number, parse_list, CliResult, NamesArg, RobotArgs};
 use crate::output::{check_distinct, commit_all, Output};
 use crate::states::{classify, known_columns, ColumnSpec, Group};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use robodyn::model::param;
 use robodyn::simulation::{
-    plot_svg, simulate, ClosedChainDynamics, CsvSink, Dynamics, Integrator, PlotInfo, Recorder,
-    SimOptions, Tee, TimeSeries, TorqueInput, TrajectorySink, TreeDynamics,
+    plot_svg, simulate, ClosedChainDynamics, CsvSink, Dynamics, EnergyBalance, Integrator,
+    PlotInfo, Recorder, SimOptions, Tee, TimeSeries, TorqueInput, TrajectorySink, TreeDynamics,
 };
 use std::collections::HashMap;
 use std::io::IsTerminal;
@@ -540,6 +541,12 @@ pub fn run(a: Args) -> CliResult {
         title: plot_title(&robot, &a),
         stopped: result.as_ref().err().map(|e| e.to_string()),
         prismatic: prismatic_labels(&robot, &label),
+        passive: passive_labels(&robot, &joints, &label),
+        reference: match &input {
+            TorqueInput::Pd { reference, .. } => Some(reference.clone()),
+            _ => None,
+        },
+        energy: energy_balance(&robot, &input),
     };
     finish(result, rows, &rec, csv_out, plot_out, &info)
 }
@@ -613,6 +620,35 @@ fn plot_title(robot: &robodyn::Robot, a: &Args) -> String {
         ),
     };
     format!("{}: {input}, {scheme}", robot.name())
+}
+
+/// Labels (as in the q<l> columns) of the movable joints that are not simulated coordinates:
+/// a closed chain's passive joints.
+fn passive_labels(
+    robot: &robodyn::Robot,
+    simulated: &[usize],
+    label: &HashMap<usize, String>,
+) -> Vec<String> {
+    (1..=robot.nl())
+        .filter(|j| robot.description().frame(*j).joint.is_movable() && !simulated.contains(j))
+        .filter_map(|j| label.get(&j).cloned())
+        .collect()
+}
+
+/// What E - E(0) measures: the work of the torques, of friction alone, or the drift.
+fn energy_balance(robot: &robodyn::Robot, input: &TorqueInput) -> EnergyBalance {
+    let driven = match input {
+        TorqueInput::Constant(tau) => tau.iter().any(|&x| x != 0.0),
+        _ => true,
+    };
+    let k = robot.standard_parameters();
+    let friction =
+        (0..robot.nl()).any(|j| k[13 * j + param::FS] != 0.0 || k[13 * j + param::FV] != 0.0);
+    match (driven, friction) {
+        (true, _) => EnergyBalance::Work,
+        (false, true) => EnergyBalance::Friction,
+        (false, false) => EnergyBalance::Drift,
+    }
 }
 
 /// Labels (as in the q<l> columns) of the prismatic joints.

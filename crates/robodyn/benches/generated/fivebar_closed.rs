@@ -8,10 +8,9 @@
 //   q (joint positions, movable joints in frame order: q<frame number>): q[0]=q1 q[1]=q2 q[2]=q3 q[3]=q4
 //   qd (joint velocities, movable joints in frame order: QP<frame number>): qd[0]=QP1 qd[1]=QP2 qd[2]=QP3 qd[3]=QP4
 //   qdd (joint accelerations, movable joints in frame order: QDP<frame number>): qdd[0]=QDP1 qdd[1]=QDP2 qdd[2]=QDP3 qdd[3]=QDP4
-//   p (parameters (geometry, inertial, drive, gravity)): 
 // Outputs: out[0]=GAMCL1 out[1]=GAMCL3
 #[allow(non_snake_case, unused_variables, unused_parens, clippy::all)]
-pub fn fivebar_closed(q: &[f64], qd: &[f64], qdd: &[f64], p: &[f64], out: &mut [f64]) {
+pub fn fivebar_closed(q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
     #[allow(dead_code)]
     fn sgn(x: f64) -> f64 {
         if x > 0.0 { 1.0 } else if x < 0.0 { -1.0 } else { 0.0 }

@@ -6,10 +6,9 @@
 //   q (joint positions, movable joints in frame order: q<frame number>): q[0]=q1 q[1]=q2 q[2]=q3 q[3]=q4 q[4]=q5 q[5]=q6
 //   qd (joint velocities, movable joints in frame order: QP<frame number>): qd[0]=QP1 qd[1]=QP2 qd[2]=QP3 qd[3]=QP4 qd[4]=QP5 qd[5]=QP6
 //   qdd (joint accelerations, movable joints in frame order: QDP<frame number>): qdd[0]=QDP1 qdd[1]=QDP2 qdd[2]=QDP3 qdd[3]=QDP4 qdd[4]=QDP5 qdd[5]=QDP6
-//   p (parameters (geometry, inertial, drive, gravity)): 
 // Outputs: out[0]=GAM1 out[1]=GAM2 out[2]=GAM3 out[3]=GAM4 out[4]=GAM5 out[5]=GAM6
 #[allow(non_snake_case, unused_variables, unused_parens, clippy::all)]
-pub fn rx90_idm(q: &[f64], qd: &[f64], qdd: &[f64], p: &[f64], out: &mut [f64]) {
+pub fn rx90_idm(q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
     #[allow(dead_code)]
     fn sgn(x: f64) -> f64 {
         if x > 0.0 { 1.0 } else if x < 0.0 { -1.0 } else { 0.0 }

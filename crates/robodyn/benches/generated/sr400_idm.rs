@@ -7,10 +7,9 @@
 //   q (joint positions, movable joints in frame order: q<frame number>): q[0]=q1 q[1]=q2 q[2]=q3 q[3]=q4 q[4]=q5 q[5]=q6 q[6]=q7 q[7]=q8
 //   qd (joint velocities, movable joints in frame order: QP<frame number>): qd[0]=QP1 qd[1]=QP2 qd[2]=QP3 qd[3]=QP4 qd[4]=QP5 qd[5]=QP6 qd[6]=QP7 qd[7]=QP8
 //   qdd (joint accelerations, movable joints in frame order: QDP<frame number>): qdd[0]=QDP1 qdd[1]=QDP2 qdd[2]=QDP3 qdd[3]=QDP4 qdd[4]=QDP5 qdd[5]=QDP6 qdd[6]=QDP7 qdd[7]=QDP8
-//   p (parameters (geometry, inertial, drive, gravity)): 
 // Outputs: out[0]=GAM1 out[1]=GAM2 out[2]=GAM3 out[3]=GAM4 out[4]=GAM5 out[5]=GAM6 out[6]=GAM7 out[7]=GAM8
 #[allow(non_snake_case, unused_variables, unused_parens, clippy::all)]
-pub fn sr400_idm(q: &[f64], qd: &[f64], qdd: &[f64], p: &[f64], out: &mut [f64]) {
+pub fn sr400_idm(q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
     #[allow(dead_code)]
     fn sgn(x: f64) -> f64 {
         if x > 0.0 { 1.0 } else if x < 0.0 { -1.0 } else { 0.0 }

@@ -1,7 +1,7 @@
 /* Generated code, side by side: Pinocchio + CppADCodeGen against robodyn's `generate --lang c`
  * (driven by codegen.py; NOT run by CI). Linked with, for one robot:
  *   cg_rnea(x, y), cg_crba(x, y), cg_aba(x, y)   wrappers of CppADCodeGen's forward_zero functions
- *   rd_idm(q, qd, qdd, p, out), rd_inertia(q, p, out), rd_ddm(q, qd, gam, p, out)   robodyn's
+ *   rd_idm(q, qd, qdd, out), rd_inertia(q, out), rd_ddm(q, qd, gam, out)   robodyn's
  * every generated function in its own translation unit, all compiled with the same flags.
  *
  *   cg_timing STATES RESULTS [samples] [target_us]
@@ -20,9 +20,9 @@
 void cg_rnea(const double *x, double *y);
 void cg_crba(const double *x, double *y);
 void cg_aba(const double *x, double *y);
-void rd_idm(const double *q, const double *qd, const double *qdd, const double *p, double *out);
-void rd_inertia(const double *q, const double *p, double *out);
-void rd_ddm(const double *q, const double *qd, const double *gam, const double *p, double *out);
+void rd_idm(const double *q, const double *qd, const double *qdd, double *out);
+void rd_inertia(const double *q, double *out);
+void rd_ddm(const double *q, const double *qd, const double *gam, double *out);
 
 static int nv, nl, ns;
 static int *idx, *rank_;
@@ -101,20 +101,20 @@ static void write_results(const char *path) {
     const double *q = rq + s * nl, *qd = rqd + s * nl;
     cg_rnea(x_rnea + s * 3 * nv, y);
     put(f, "cg_rnea", y, nv);
-    rd_idm(q, qd, rqdd + s * nl, NULL, out);
+    rd_idm(q, qd, rqdd + s * nl, out);
     for (int k = 0; k < nv; ++k) v[k] = out[rank_[k]];
     put(f, "rd_rnea", v, nv);
     cg_crba(x_rnea + s * 3 * nv, y);
     for (int i = 0; i < nv; ++i)
       for (int j = 0; j < nv; ++j) m[i * nv + j] = y[upper(i, j)];
     put(f, "cg_crba", m, nv * nv);
-    rd_inertia(q, NULL, out);
+    rd_inertia(q, out);
     for (int i = 0; i < nv; ++i)
       for (int j = 0; j < nv; ++j) m[i * nv + j] = out[lower(i, j)];
     put(f, "rd_crba", m, nv * nv);
     cg_aba(x_aba + s * 3 * nv, y);
     put(f, "cg_aba", y, nv);
-    rd_ddm(q, qd, rtau + s * nl, NULL, out);
+    rd_ddm(q, qd, rtau + s * nl, out);
     for (int k = 0; k < nv; ++k) v[k] = out[rank_[k]];
     put(f, "rd_ddm", v, nv);
   }
@@ -162,10 +162,10 @@ int main(int argc, char **argv) {
   read_states(argv[1]);
   write_results(argv[2]);
   TIME("cg_rnea", cg_rnea(x_rnea + s * 3 * nv, y));
-  TIME("rd_idm_c", rd_idm(rq + s * nl, rqd + s * nl, rqdd + s * nl, NULL, out));
+  TIME("rd_idm_c", rd_idm(rq + s * nl, rqd + s * nl, rqdd + s * nl, out));
   TIME("cg_crba", cg_crba(x_rnea + s * 3 * nv, y));
-  TIME("rd_inertia_c", rd_inertia(rq + s * nl, NULL, out));
+  TIME("rd_inertia_c", rd_inertia(rq + s * nl, out));
   TIME("cg_aba", cg_aba(x_aba + s * 3 * nv, y));
-  TIME("rd_ddm_c", rd_ddm(rq + s * nl, rqd + s * nl, rtau + s * nl, NULL, out));
+  TIME("rd_ddm_c", rd_ddm(rq + s * nl, rqd + s * nl, rtau + s * nl, out));
   return 0;
 }

@@ -84,26 +84,26 @@ fn main() {
         r * (r + 1) / 2 + c
     };
     for s in 0..ns {
-        rd_idm(&st.q[s], &st.qd[s], &st.qdd[s], &[], &mut out);
+        rd_idm(&st.q[s], &st.qd[s], &st.qdd[s], &mut out);
         put(&mut text, "rs_rnea", &mut st.rank.iter().map(|&r| out[r]));
-        rd_inertia(&st.q[s], &[], &mut out);
+        rd_inertia(&st.q[s], &mut out);
         let m: Vec<f64> = (0..nv * nv).map(|k| out[lower(k / nv, k % nv)]).collect();
         put(&mut text, "rs_crba", &mut m.into_iter());
-        rd_ddm(&st.q[s], &st.qd[s], &st.tau[s], &[], &mut out);
+        rd_ddm(&st.q[s], &st.qd[s], &st.tau[s], &mut out);
         put(&mut text, "rs_ddm", &mut st.rank.iter().map(|&r| out[r]));
     }
     std::fs::write(&args[2], text).expect("results file");
     let states: Vec<usize> = (0..ns).collect();
     time("rd_idm_rust", &states, samples, target_us, |&s| {
-        rd_idm(black_box(&st.q[s]), &st.qd[s], &st.qdd[s], &[], &mut out);
+        rd_idm(black_box(&st.q[s]), &st.qd[s], &st.qdd[s], &mut out);
         black_box(&out);
     });
     time("rd_inertia_rust", &states, samples, target_us, |&s| {
-        rd_inertia(black_box(&st.q[s]), &[], &mut out);
+        rd_inertia(black_box(&st.q[s]), &mut out);
         black_box(&out);
     });
     time("rd_ddm_rust", &states, samples, target_us, |&s| {
-        rd_ddm(black_box(&st.q[s]), &st.qd[s], &st.tau[s], &[], &mut out);
+        rd_ddm(black_box(&st.q[s]), &st.qd[s], &st.tau[s], &mut out);
         black_box(&out);
     });
 }

@@ -120,20 +120,10 @@ fn vee_antisym(m: &Matrix3<f64>) -> Vector3<f64> {
     )
 }
 
-/// Joint values in messages: six decimals, an exponent beyond a million (`1.000000e300`, not 300
+/// Joint values in messages: six significant digits, the shortest form (`1e300`, not 300
 /// digits).
 pub(crate) fn fmt_vec(v: &[f64]) -> String {
-    let s: Vec<String> = v
-        .iter()
-        .map(|x| {
-            if x.abs() < 1e6 {
-                format!("{x:.6}")
-            } else {
-                format!("{x:.6e}")
-            }
-        })
-        .collect();
-    format!("[{}]", s.join(", "))
+    crate::report::number::vector(v, 6)
 }
 
 /// Rank of a matrix by SVD (singular values above `tol` times the largest, or above `tol`).

@@ -450,6 +450,7 @@ fn joint_inputs(joints: &[usize], model: ModelKind) -> Vec<InputGroup> {
             .iter()
             .map(|&j| Some(joint_symbol(kind, j)))
             .collect(),
+        by_name: false,
     };
     let mut inputs = vec![group("q", "q", "joint positions")];
     match model {
@@ -557,7 +558,9 @@ fn record_model(
     }
 }
 
-/// The parameter input `p`: every symbol that is neither an input nor an intermediate.
+/// The parameter input `p`: every symbol that is neither an input nor an intermediate, passed
+/// by name (a struct, a mapping); none when there is none (`--numeric`: every value is in the
+/// code, and the functions take no `p`).
 fn add_parameter_inputs(prog: &mut Program) {
     let known: BTreeSet<String> = prog
         .input_symbols()
@@ -574,6 +577,9 @@ fn add_parameter_inputs(prog: &mut Program) {
         .filter(|s| !known.contains(s))
         .map(Expr::symbol)
         .collect();
+    if params.is_empty() {
+        return;
+    }
     params.sort_by(cmp_expr);
     prog.inputs.push(InputGroup {
         name: "p".into(),
@@ -582,7 +588,48 @@ fn add_parameter_inputs(prog: &mut Program) {
             .iter()
             .map(|e| e.as_symbol().map(str::to_string))
             .collect(),
+        by_name: true,
     });
+}
+
+/// The values of a program's parameters `p`, by name in the order of its header, from the
+/// robot description it was generated from (with the same options): the file's symbol values,
+/// the standard parameters (`XX3`: link 3's entry) and the grouped base parameters of
+/// `opt.base` (`XXR2`: its grouping expression over the standard parameters and the geometry).
+/// `None` for a parameter without a numeric value (a symbol the file leaves free). Empty for a
+/// program without parameters (`--numeric`).
+pub fn parameter_values(
+    desc: &RobotDescription,
+    opt: &GenOptions,
+    prog: &Program,
+) -> Vec<(String, Option<f64>)> {
+    let symbol = |s: &str| desc.symbols.get(s).copied();
+    let standard = |s: &str| -> Option<Expr> {
+        let (p, j) = split_param(s)?;
+        let k = STANDARD_PARAMETERS.iter().position(|&x| x == p)?;
+        Some(desc.links.get(j.checked_sub(1)?)?.params[k].clone())
+    };
+    let value = |name: &str| -> Option<f64> {
+        if let Some(v) = symbol(name) {
+            return Some(v);
+        }
+        let grouped = opt
+            .base
+            .iter()
+            .flat_map(|b| &b.grouped)
+            .find(|g| g.name == name);
+        let e = match grouped {
+            Some(g) => g.expr.substitute(&standard),
+            None => standard(name)?,
+        };
+        e.eval(&symbol).ok()
+    };
+    prog.inputs
+        .iter()
+        .filter(|g| g.by_name)
+        .flat_map(|g| g.symbols.iter().flatten())
+        .map(|s| (s.clone(), value(s)))
+        .collect()
 }
 
 /// Helper so that the closed-chain model names the tree torques GAM<j>.

@@ -438,6 +438,9 @@ pub struct Identification {
     pub joints: Vec<usize>,
     /// Their names.
     pub joint_names: Vec<String>,
+    /// Whether the joint of frame j is prismatic (entry j - 1, j = 1..=NL): forces in N and
+    /// positions in m rather than N m and rad (the units of the report and the plot).
+    pub prismatic: Vec<bool>,
     /// The identified parameters (names, kinds), in the order of `x`.
     pub parameters: Vec<Parameter>,
     /// The estimator used (`OLS`, `WLS` or `IDIM-IV`, with "under physical-consistency
@@ -832,6 +835,7 @@ pub fn identify(
         robot: access.name().to_string(),
         joints: access.actuated_joints().to_vec(),
         joint_names: access.joint_names(),
+        prismatic: (1..=access.nl()).map(|j| access.is_prismatic(j)).collect(),
         parameters: model.params.clone(),
         estimator,
         x: sol.x.clone(),

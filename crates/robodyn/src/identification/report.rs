@@ -1,220 +1,114 @@
 //! The identification report: the table of parameters (name as in the base-parameter report,
-//! grouping equation, value, standard deviation, relative standard deviation %) with the fit
-//! statistics, as text, JSON or CSV; SVG plots of measured and predicted torques.
+//! SI unit, value, standard deviation, relative standard deviation %, grouping equation) with
+//! the fit statistics, as text, JSON or CSV; the SVG plot of measured and predicted torques.
+//!
+//! Numbers follow [`crate::report::number`]: the text report writes the report form (6
+//! significant digits for values, 3 for standard deviations and percentages), JSON keeps the
+//! full doubles and CSV writes the data form (shortest round-trip).
 
+use super::parameters::Kind;
 use super::Identification;
-use crate::error::{Error, Result};
+use crate::error::Result;
+use crate::model::param;
+use crate::report::number::{format_number, Sig};
 use serde_json::json;
+#[cfg(feature = "plot")]
 use std::path::Path;
 
-fn fmt_num(v: f64) -> String {
-    if v == 0.0 {
-        "0".into()
-    } else if v.abs() >= 1e-3 && v.abs() < 1e5 {
-        format!("{v:.6}")
-    } else {
-        format!("{v:.4e}")
+/// A value of the table: 6 significant digits.
+fn value(v: f64) -> Sig {
+    Sig(v, 6)
+}
+
+/// A standard deviation, a percentage, an error: 3 or 4 significant digits.
+fn rough(v: f64) -> Sig {
+    Sig(v, 3)
+}
+
+/// The SI unit of identified parameter `i`: that of the standard parameter a base parameter
+/// is named after (`XXR2`: kg m^2, `MXR2`: kg m, `FV3`: N m s/rad or N s/m by joint 3's type), a
+/// motor's drive parameters in motor units (kg m^2, N m, N m s/rad), an offset's N m or N.
+pub fn parameter_unit(id: &Identification, i: usize) -> &'static str {
+    let prismatic = |j: usize| id.prismatic.get(j - 1).copied().unwrap_or(false);
+    match id.parameters[i].kind {
+        Kind::Base(r) => {
+            let index = id.model.base.base[r];
+            param::unit(
+                index % STANDARD_COUNT,
+                prismatic(index / STANDARD_COUNT + 1),
+            )
+        }
+        Kind::Motor { which, .. } => param::unit(which, false),
+        Kind::Offset(k) => torque_unit(prismatic(id.joints[k])),
     }
 }
 
-fn fmt_pct(v: f64) -> String {
-    if v.is_finite() {
-        format!("{v:.2}")
+/// Standard parameters per link.
+const STANDARD_COUNT: usize = crate::model::STANDARD_PARAMETERS.len();
+
+/// N for a prismatic joint's force, N m for a revolute joint's torque.
+fn torque_unit(prismatic: bool) -> &'static str {
+    if prismatic {
+        "N"
     } else {
-        "inf".into()
+        "N m"
     }
 }
 
 /// Plain-text report.
 pub fn to_text(id: &Identification) -> String {
-    let mut s = String::new();
-    let pr = &id.processing;
-    s.push_str(&format!(
-        "{}: {} parameters identified ({}) from {}\n\n",
-        id.robot,
-        id.x.len(),
-        id.estimator,
-        pr.source
-    ));
-    s.push_str(&format!(
-        "Log: {} samples at {:.6} Hz ({:.4} s)\n",
-        pr.samples, pr.sample_rate, pr.duration
-    ));
-    if pr.derivatives_from_log {
-        s.push_str(
-            "Velocities and accelerations: the log's qd, qdd columns (not differentiated)\n",
-        );
-    }
-    if let Some((o, fc)) = pr.lowpass {
-        s.push_str(&format!(
-            "Positions: zero-phase Butterworth low-pass, order {o} forward and backward, cut-off \
-             {fc:.4} Hz (default 10 x bandwidth {:.4} Hz, at most 0.4 x sample rate); qd, qdd by \
-             central differences\n",
-            pr.bandwidth
-        ));
-    }
-    match pr.decimation_filter {
-        Some((o, fd)) => s.push_str(&format!(
-            "Parallel decimation of W and Y: Butterworth order {o}, cut-off {fd:.4} Hz (0.8 x the \
-             new Nyquist frequency), then 1 sample in {} (default floor(0.8 fs / (4 x \
-             bandwidth)))\n",
-            pr.decimation
-        )),
-        None => s.push_str("No decimation\n"),
-    }
-    s.push_str(&format!(
-        "Border: {} samples dropped at each end; decimation transient: {} samples\n",
-        pr.border, pr.decimation_skip
-    ));
-    if pr.coulomb_band > 0.0 {
-        s.push_str(&format!(
-            "Coulomb friction: sign(qd) with a dead band, 0 where |qd| <= {} (rad/s or m/s)\n",
-            pr.coulomb_band
-        ));
-    }
-    match pr.validation {
-        Some((a, b)) => s.push_str(&format!(
-            "Fit: {} decimated samples outside [{a:.4}, {b:.4}) s; validation: {} samples in it\n",
-            pr.fit_samples, pr.validation_samples
-        )),
-        None => s.push_str(&format!(
-            "Fit: {} decimated samples (no validation segment)\n",
-            pr.fit_samples
-        )),
-    }
-    s.push_str(&format!(
-        "Condition number of W (unit columns): {:.4e} (as given: {:.4e})\n",
-        id.condition_number, id.condition_number_unscaled
-    ));
-    s.push_str(&format!(
-        "Relative error ||Y - W X|| / ||Y||: {:.4} % (fit)",
-        100.0 * id.relative_error
-    ));
-    if let Some(v) = &id.validation {
-        s.push_str(&format!(
-            ", {:.4} % (validation; {:.4} % on its raw torques at the log's rate)",
-            100.0 * v.relative_error,
-            100.0 * v.raw_relative_error
-        ));
-    }
-    s.push_str("\n\n");
-    let rows: Vec<[String; 5]> = id
-        .parameters
-        .iter()
-        .enumerate()
-        .map(|(i, p)| {
-            [
-                p.name.clone(),
-                fmt_num(id.x[i]),
-                fmt_num(id.std[i]),
-                fmt_pct(id.relative_std[i]),
-                p.equation.clone(),
-            ]
-        })
-        .collect();
-    let head = ["parameter", "value", "std", "rel.std %", "equation"];
-    let w: Vec<usize> = (0..4)
-        .map(|c| {
-            rows.iter()
-                .map(|r| r[c].len())
-                .chain([head[c].len()])
-                .max()
-                .unwrap_or(1)
-        })
-        .collect();
-    let line = |r: [&str; 5]| {
-        format!(
-            "{:<w0$}  {:>w1$}  {:>w2$}  {:>w3$}  {}\n",
-            r[0],
-            r[1],
-            r[2],
-            r[3],
-            r[4],
-            w0 = w[0],
-            w1 = w[1],
-            w2 = w[2],
-            w3 = w[3]
-        )
-    };
-    s.push_str(&line(head));
-    for r in &rows {
-        s.push_str(&line([&r[0], &r[1], &r[2], &r[3], &r[4]]));
-    }
-    s.push_str("\nPer joint:\n");
-    s.push_str(&format!(
-        "  {:<6} {:<12} {:>7} {:>12} {:>10} {:>12}{}\n",
-        "joint",
-        "name",
-        "rows",
-        "RMS",
-        "rel.err %",
-        "sigma (WLS)",
-        if id.validation.is_some() {
-            "  valid. rel.err %"
-        } else {
-            ""
-        }
-    ));
-    for (k, f) in id.per_joint.iter().enumerate() {
-        let v = id
-            .validation
-            .as_ref()
-            .map(|v| format!("  {:>17.4}", 100.0 * v.per_joint[k].relative_error))
-            .unwrap_or_default();
-        s.push_str(&format!(
-            "  {:<6} {:<12} {:>7} {:>12.5e} {:>10.4} {:>12}{v}\n",
-            f.joint,
-            f.name,
-            f.rows,
-            f.rms,
-            100.0 * f.relative_error,
-            f.sigma
-                .map(|x| format!("{x:.5e}"))
-                .unwrap_or_else(|| "-".into()),
-        ));
-    }
+    let mut s = processing_text(id);
+    s.push_str(&parameter_table(id));
+    s.push_str(&joint_table(id));
     if let Some(iv) = &id.iv {
         s.push_str(&format!(
-            "\nIDIM-IV: {} iteration(s), {}; last change {:.3e} std; simulated motion within \
-             {:.3e} of the measured one\n",
+            "\nIDIM-IV: {} iteration(s), {}; last change {} std; simulated motion within {} of \
+             the measured one\n",
             iv.iterations,
             if iv.converged {
                 "converged"
             } else {
                 "NOT converged"
             },
-            iv.last_change,
-            iv.deviation
+            rough(iv.last_change),
+            rough(iv.deviation)
         ));
     }
     if let Some(e) = &id.essential {
         s.push_str(&format!(
-            "\nEssential parameters ({} of {}; relative error {:.4} % vs {:.4} % with all):\n",
+            "\nEssential parameters ({} of {}; relative error {} % vs {} % with all):\n",
             e.kept.len(),
             id.x.len(),
-            100.0 * e.relative_error,
-            100.0 * e.full_relative_error
+            Sig(100.0 * e.relative_error, 4),
+            Sig(100.0 * e.full_relative_error, 4)
         ));
+        let w = e
+            .kept
+            .iter()
+            .map(|&i| id.parameters[i].name.len())
+            .max()
+            .unwrap_or(0);
         for (k, &i) in e.kept.iter().enumerate() {
             s.push_str(&format!(
-                "  {:<10} {:>14}  {:>8} %\n",
+                "  {:<w$}  {:>12} {:<9}  {:>8} %\n",
                 id.parameters[i].name,
-                fmt_num(e.x[k]),
-                fmt_pct(e.relative_std[k])
+                value(e.x[k]).to_string(),
+                parameter_unit(id, i),
+                percent(e.relative_std[k])
             ));
         }
     }
     if let Some(c) = &id.consistent {
         s.push_str(&format!(
-            "\nPhysically consistent standard parameters ({}): pseudo-inertia eigenvalues >= \
-             {:.3e}, inertia matrix eigenvalues >= {:.3e} (30 random configurations); the \
-             consistent values differ from the unconstrained estimate by at most {:.3} standard \
-             deviations (squared Mahalanobis distance {:.3})\n",
+            "\nPhysically consistent standard parameters ({}): pseudo-inertia eigenvalues >= {}, \
+             inertia matrix eigenvalues >= {} (30 random configurations); the consistent values \
+             differ from the unconstrained estimate by at most {} standard deviations (squared \
+             Mahalanobis distance {})\n",
             c.solver,
-            c.min_pseudo_inertia_eigenvalue,
-            c.min_inertia_eigenvalue,
-            c.max_deviation,
-            c.distance2
+            rough(c.min_pseudo_inertia_eigenvalue),
+            rough(c.min_inertia_eigenvalue),
+            rough(c.max_deviation),
+            rough(c.distance2)
         ));
     }
     for n in &id.notes {
@@ -232,6 +126,197 @@ pub fn to_text(id: &Identification) -> String {
     s
 }
 
+/// A relative standard deviation in %: 3 significant digits, all the digits of its whole part
+/// (`1.48`, `26.3`, `2894`), or `inf` (a parameter estimated as 0).
+fn percent(v: f64) -> String {
+    if !v.is_finite() {
+        "inf".into()
+    } else {
+        let whole = if v.abs() >= 1.0 {
+            v.abs().log10().floor() as usize + 1
+        } else {
+            0
+        };
+        Sig(v, whole.max(3)).to_string()
+    }
+}
+
+/// The title, the log and its processing, the fit's condition number and error.
+fn processing_text(id: &Identification) -> String {
+    let pr = &id.processing;
+    let hz = |f: f64| Sig(f, 6);
+    let mut s = format!(
+        "{}: {} parameters identified ({}) from {}\n\n",
+        id.robot,
+        id.x.len(),
+        id.estimator,
+        pr.source
+    );
+    s.push_str(&format!(
+        "Log: {} samples at {} Hz ({} s)\n",
+        pr.samples,
+        hz(pr.sample_rate),
+        Sig(pr.duration, 6)
+    ));
+    if pr.derivatives_from_log {
+        s.push_str(
+            "Velocities and accelerations: the log's qd, qdd columns (not differentiated)\n",
+        );
+    }
+    if let Some((o, fc)) = pr.lowpass {
+        s.push_str(&format!(
+            "Positions: zero-phase Butterworth low-pass, order {o} forward and backward, cut-off \
+             {} Hz (default 10 x bandwidth {} Hz, at most 0.4 x sample rate); qd, qdd by \
+             central differences\n",
+            hz(fc),
+            hz(pr.bandwidth)
+        ));
+    }
+    match pr.decimation_filter {
+        Some((o, fd)) => s.push_str(&format!(
+            "Parallel decimation of W and Y: Butterworth order {o}, cut-off {} Hz (0.8 x the new \
+             Nyquist frequency), then 1 sample in {} (default floor(0.8 fs / (4 x bandwidth)))\n",
+            hz(fd),
+            pr.decimation
+        )),
+        None => s.push_str("No decimation\n"),
+    }
+    s.push_str(&format!(
+        "Border: {} samples dropped at each end; decimation transient: {} samples\n",
+        pr.border, pr.decimation_skip
+    ));
+    if pr.coulomb_band > 0.0 {
+        s.push_str(&format!(
+            "Coulomb friction: sign(qd) with a dead band, 0 where |qd| <= {} (rad/s or m/s)\n",
+            Sig(pr.coulomb_band, 6)
+        ));
+    }
+    match pr.validation {
+        Some((a, b)) => s.push_str(&format!(
+            "Fit: {} decimated samples outside [{}, {}) s; validation: {} samples in it\n",
+            pr.fit_samples,
+            Sig(a, 6),
+            Sig(b, 6),
+            pr.validation_samples
+        )),
+        None => s.push_str(&format!(
+            "Fit: {} decimated samples (no validation segment)\n",
+            pr.fit_samples
+        )),
+    }
+    s.push_str(&format!(
+        "Condition number of W (unit columns): {} (as given: {})\n",
+        Sig(id.condition_number, 4),
+        Sig(id.condition_number_unscaled, 4)
+    ));
+    s.push_str(&format!(
+        "Relative error ||Y - W X|| / ||Y||: {} % (fit)",
+        Sig(100.0 * id.relative_error, 4)
+    ));
+    if let Some(v) = &id.validation {
+        s.push_str(&format!(
+            ", {} % (validation; {} % on its raw torques at the log's rate)",
+            Sig(100.0 * v.relative_error, 4),
+            Sig(100.0 * v.raw_relative_error, 4)
+        ));
+    }
+    s.push_str("\n\n");
+    s
+}
+
+/// The parameter table: name, unit, value, std, rel.std %, equation.
+fn parameter_table(id: &Identification) -> String {
+    let rows: Vec<[String; 6]> = id
+        .parameters
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            [
+                p.name.clone(),
+                parameter_unit(id, i).to_string(),
+                value(id.x[i]).to_string(),
+                rough(id.std[i]).to_string(),
+                percent(id.relative_std[i]),
+                p.equation.clone(),
+            ]
+        })
+        .collect();
+    let head = ["parameter", "unit", "value", "std", "rel.std %", "equation"].map(String::from);
+    let w: Vec<usize> = (0..5)
+        .map(|c| {
+            rows.iter()
+                .chain([&head])
+                .map(|r| r[c].len())
+                .max()
+                .unwrap_or(1)
+        })
+        .collect();
+    let mut s = String::new();
+    for r in std::iter::once(&head).chain(&rows) {
+        s.push_str(&format!(
+            "{:<w0$}  {:<w1$}  {:>w2$}  {:>w3$}  {:>w4$}  {}\n",
+            r[0],
+            r[1],
+            r[2],
+            r[3],
+            r[4],
+            r[5],
+            w0 = w[0],
+            w1 = w[1],
+            w2 = w[2],
+            w3 = w[3],
+            w4 = w[4]
+        ));
+    }
+    s
+}
+
+/// The per-joint fit: rows, RMS error, relative error, WLS sigma (validation error).
+fn joint_table(id: &Identification) -> String {
+    let mut s = String::from("\nPer joint (RMS and sigma in the joint's unit):\n");
+    s.push_str(&format!(
+        "  {:<6} {:<12} {:<4} {:>7} {:>10} {:>10} {:>12}{}\n",
+        "joint",
+        "name",
+        "unit",
+        "rows",
+        "RMS",
+        "rel.err %",
+        "sigma (WLS)",
+        if id.validation.is_some() {
+            "  valid. rel.err %"
+        } else {
+            ""
+        }
+    ));
+    for (k, f) in id.per_joint.iter().enumerate() {
+        let v = id
+            .validation
+            .as_ref()
+            .map(|v| {
+                format!(
+                    "  {:>17}",
+                    Sig(100.0 * v.per_joint[k].relative_error, 4).to_string()
+                )
+            })
+            .unwrap_or_default();
+        let prismatic = id.prismatic.get(f.joint - 1).copied().unwrap_or(false);
+        s.push_str(&format!(
+            "  {:<6} {:<12} {:<4} {:>7} {:>10} {:>10} {:>12}{v}\n",
+            f.joint,
+            f.name,
+            torque_unit(prismatic),
+            f.rows,
+            Sig(f.rms, 4).to_string(),
+            Sig(100.0 * f.relative_error, 4).to_string(),
+            f.sigma
+                .map(|x| Sig(x, 4).to_string())
+                .unwrap_or_else(|| "-".into()),
+        ));
+    }
+    s
+}
+
 fn finite(v: f64) -> serde_json::Value {
     if v.is_finite() {
         json!(v)
@@ -240,7 +325,7 @@ fn finite(v: f64) -> serde_json::Value {
     }
 }
 
-/// JSON report: `parameters[{name, value, relative_std, std, equation}]`, `condition_number`,
+/// JSON report: `parameters[{name, unit, value, relative_std, std, equation}]`, `condition_number`,
 /// `relative_error` and `per_joint[{joint, rms, relative_error}]`, with the processing, the
 /// validation, the essential parameters, IDIM-IV and the consistent parameters when computed.
 pub fn to_json(id: &Identification) -> serde_json::Value {
@@ -264,6 +349,7 @@ pub fn to_json(id: &Identification) -> serde_json::Value {
         "estimator": id.estimator,
         "parameters": id.parameters.iter().enumerate().map(|(i, p)| json!({
             "name": p.name,
+            "unit": parameter_unit(id, i),
             "equation": p.equation,
             "value": id.x[i],
             "std": id.std[i],
@@ -344,115 +430,31 @@ pub fn to_json(id: &Identification) -> serde_json::Value {
     o
 }
 
-/// CSV table: name, value, std, relative_std, equation.
+/// CSV table: name, value, std, relative_std (%), equation, unit; numbers in the data form
+/// (shortest round-trip), `inf` for the relative standard deviation of a zero estimate.
 pub fn to_csv(id: &Identification) -> String {
-    let mut s = String::from("name,value,std,relative_std,equation\n");
+    let mut s = String::from("name,value,std,relative_std,equation,unit\n");
     for (i, p) in id.parameters.iter().enumerate() {
         s.push_str(&format!(
-            "{},{:.12e},{:.6e},{},\"{}\"\n",
+            "{},{},{},{},\"{}\",{}\n",
             p.name,
-            id.x[i],
-            id.std[i],
-            if id.relative_std[i].is_finite() {
-                format!("{:.6e}", id.relative_std[i])
-            } else {
-                "inf".into()
-            },
-            p.equation.replace('"', "'")
+            format_number(id.x[i]),
+            format_number(id.std[i]),
+            format_number(id.relative_std[i]),
+            p.equation.replace('"', "'"),
+            parameter_unit(id, i)
         ));
     }
     s
 }
 
-/// A panel: its title and its curves (label, values).
-pub type Panel = (String, Vec<(String, Vec<f64>)>);
-
-/// One panel per joint: curves (label, values) against t.
-pub fn plot_panels(
-    path: &Path,
-    title: &str,
-    t: &[f64],
-    panels: &[Panel],
-    y_label: &str,
-    bold_first: bool,
-) -> Result<()> {
-    use plotters::prelude::*;
-    let err = |e: String| Error::io(path.display().to_string(), std::io::Error::other(e));
-    if t.len() < 2 {
-        return Err(err("fewer than two samples to plot".into()));
-    }
-    let ds = |e: &dyn std::fmt::Display| err(e.to_string());
-    let height = 60 + 220 * panels.len() as u32;
-    let root = SVGBackend::new(path, (1100, height)).into_drawing_area();
-    root.fill(&WHITE).map_err(|e| ds(&e))?;
-    let root = root.titled(title, ("sans-serif", 22)).map_err(|e| ds(&e))?;
-    let areas = root.split_evenly((panels.len(), 1));
-    let colors = [
-        RGBColor(20, 20, 20),
-        RGBColor(220, 50, 40),
-        RGBColor(40, 90, 200),
-        RGBColor(30, 150, 60),
-        RGBColor(230, 140, 0),
-        RGBColor(150, 60, 170),
-        RGBColor(0, 160, 170),
-        RGBColor(140, 100, 60),
-    ];
-    let (t0, t1) = (t[0], *t.last().unwrap());
-    for (area, (name, curves)) in areas.iter().zip(panels) {
-        let (lo, hi) = curves
-            .iter()
-            .flat_map(|(_, v)| v.iter().copied())
-            .filter(|v| v.is_finite())
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
-                (a.min(v), b.max(v))
-            });
-        let (lo, hi) = if !lo.is_finite() {
-            (-1.0, 1.0)
-        } else if hi - lo < 1e-12 * (1.0 + lo.abs()) {
-            (lo - 1.0, hi + 1.0)
-        } else {
-            let m = 0.05 * (hi - lo);
-            (lo - m, hi + m)
-        };
-        let mut chart = ChartBuilder::on(area)
-            .caption(name.as_str(), ("sans-serif", 16))
-            .margin(8)
-            .x_label_area_size(30)
-            .y_label_area_size(70)
-            .build_cartesian_2d(t0..t1, lo..hi)
-            .map_err(|e| ds(&e))?;
-        chart
-            .configure_mesh()
-            .x_desc("t [s]")
-            .y_desc(y_label)
-            .draw()
-            .map_err(|e| ds(&e))?;
-        for (k, (label, v)) in curves.iter().enumerate() {
-            let color = colors[k % colors.len()];
-            chart
-                .draw_series(LineSeries::new(
-                    t.iter().copied().zip(v.iter().copied()),
-                    color.stroke_width(if bold_first && k == 0 { 2 } else { 1 }),
-                ))
-                .map_err(|e| ds(&e))?
-                .label(label.as_str())
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color));
-        }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .position(SeriesLabelPosition::UpperRight)
-            .draw()
-            .map_err(|e| ds(&e))?;
-    }
-    root.present().map_err(|e| ds(&e))?;
-    Ok(())
-}
-
-/// Measured and predicted torques of the validation segment, one panel per joint (the torques
-/// after the parallel decimation filter, as fitted).
+/// Measured and predicted torques of the validation segment, one panel per joint in its unit
+/// (the torques after the parallel decimation filter, as fitted): measured solid, predicted
+/// dashed, the panel's title with the joint's validation error.
+#[cfg(feature = "plot")]
 pub fn plot_fit(path: &Path, id: &Identification) -> Result<()> {
+    use crate::error::Error;
+    use crate::report::figure::{write_svg, Curve, Figure, Panel, Style};
     let rows = &id.validation_rows;
     if rows.t.len() < 2 {
         return Err(Error::Input(
@@ -463,40 +465,50 @@ pub fn plot_fit(path: &Path, id: &Identification) -> Result<()> {
     }
     let pred = id.predicted_validation();
     let v = id.validation.as_ref();
-    let panels: Vec<Panel> = id
+    let panels = id
         .joints
         .iter()
         .enumerate()
-        .map(|(k, j)| {
+        .map(|(k, &j)| {
             let err = v
                 .map(|v| {
                     format!(
-                        " (relative error {:.2} %)",
-                        100.0 * v.per_joint[k].relative_error
+                        ", validation error {} %",
+                        Sig(100.0 * v.per_joint[k].relative_error, 3)
                     )
                 })
                 .unwrap_or_default();
-            (
-                format!("joint {j} ({}){err}", id.joint_names[k]),
-                vec![
-                    (
-                        "measured".to_string(),
+            let prismatic = id.prismatic.get(j - 1).copied().unwrap_or(false);
+            Panel {
+                title: format!("joint {j} ({}){err}", id.joint_names[k]),
+                y_label: format!("tau{j} [{}]", torque_unit(prismatic)),
+                curves: vec![
+                    Curve::new(
+                        "measured",
                         rows.y.iter().map(|y| y[k]).collect(),
+                        0,
+                        Style::Solid,
                     ),
-                    ("predicted".to_string(), pred.iter().map(|y| y[k]).collect()),
+                    Curve::new(
+                        "predicted",
+                        pred.iter().map(|y| y[k]).collect(),
+                        1,
+                        Style::Dashed,
+                    ),
                 ],
-            )
+                ..Panel::default()
+            }
         })
         .collect();
-    plot_panels(
-        path,
-        &format!(
-            "{}: measured and predicted torques on the validation segment ({})",
+    let fig = Figure {
+        title: format!(
+            "{}: measured and predicted joint torques on the validation segment ({})",
             id.robot, id.estimator
         ),
-        &rows.t,
-        &panels,
-        "torque [N m] / force [N]",
-        true,
-    )
+        x_label: "t [s]".into(),
+        panels,
+        colors: 2,
+        ..Figure::default()
+    };
+    write_svg(path, &rows.t, &fig)
 }

@@ -12,7 +12,8 @@ pub mod toml_format;
 pub mod urdf;
 mod values;
 
-pub use consistency::{body_inconsistency, physical_consistency};
+pub use crate::model::inertial::body_inconsistency;
+pub use consistency::physical_consistency;
 pub use source::{LineIndex, SourceMap};
 pub use values::{known_symbols, set_values};
 
@@ -158,13 +159,22 @@ pub fn decode_text(bytes: Vec<u8>) -> String {
 /// ([`physical_consistency`]) found, with their lines. The path `-` reads standard input, the
 /// format found by [`Format::sniff`].
 pub fn load_description_mapped(path: &Path) -> Result<(RobotDescription, SourceMap)> {
+    load_description_with(path, &BTreeMap::new())
+}
+
+/// [`load_description_mapped`] with symbol values given or replaced (`overrides`, the CLI's
+/// `--set`) before the physical-consistency check, so that the check sees the values used.
+pub fn load_description_with(
+    path: &Path,
+    overrides: &BTreeMap<String, f64>,
+) -> Result<(RobotDescription, SourceMap)> {
     let text = read(path)?;
     let (file, format) = if is_stdio(path) {
         ("<stdin>".to_string(), Format::sniff(&text))
     } else {
         (path.display().to_string(), Format::from_path(path)?)
     };
-    let (desc, mut map) = match format {
+    let (mut desc, mut map) = match format {
         Format::Toml => toml_format::parse_description(&text, Some(&file)),
         Format::Par => par::parse_description(&text, Some(&file)),
         Format::Urdf => urdf::parse_description(&text, Some(&file)),
@@ -172,17 +182,40 @@ pub fn load_description_mapped(path: &Path) -> Result<(RobotDescription, SourceM
     for w in physical_consistency(&desc) {
         map.warn(w);
     }
+    set_values_mapped(&mut desc, &mut map, overrides)?;
     Ok((desc, map))
 }
 
-/// Read and validate a robot, with the warnings of [`load_description_mapped`]; `overrides`
+/// [`set_values`] on a loaded description, with the physical consistency checked again on the
+/// new values: its warnings replace those of the old values in `map` (the reader's own warnings
+/// stay).
+pub fn set_values_mapped(
+    desc: &mut RobotDescription,
+    map: &mut SourceMap,
+    values: &BTreeMap<String, f64>,
+) -> Result<()> {
+    if values.is_empty() {
+        return Ok(());
+    }
+    let old = physical_consistency(desc);
+    set_values(desc, values)?;
+    map.warnings.retain(|w| {
+        !old.iter()
+            .any(|o| o.item == w.item && o.message == w.message)
+    });
+    for w in physical_consistency(desc) {
+        map.warn(w);
+    }
+    Ok(())
+}
+
+/// Read and validate a robot, with the warnings of [`load_description_with`]; `overrides`
 /// give values by name as [`set_values`] does.
 pub fn load_with_warnings(
     path: &Path,
     overrides: &BTreeMap<String, f64>,
 ) -> Result<(Robot, Vec<Warning>)> {
-    let (mut desc, map) = load_description_mapped(path)?;
-    set_values(&mut desc, overrides)?;
+    let (desc, map) = load_description_with(path, overrides)?;
     let robot = Robot::new(desc).map_err(|e| map.locate(e))?;
     Ok((robot, map.warnings))
 }

@@ -159,6 +159,22 @@ pub mod param {
     pub const FS: usize = 11;
     /// FV: viscous friction (N m s/rad or N s/m).
     pub const FV: usize = 12;
+
+    /// The SI unit of standard parameter `k` (an index above) of a link whose joint is
+    /// prismatic or not: `kg m^2`, `kg m`, `kg`; IA `kg m^2` or `kg`, FS `N m` or `N`, FV
+    /// `N m s/rad` or `N s/m`.
+    pub fn unit(k: usize, prismatic: bool) -> &'static str {
+        match (k, prismatic) {
+            (XX..=ZZ, _) | (IA, false) => "kg m^2",
+            (MX..=MZ, _) => "kg m",
+            (M, _) | (IA, true) => "kg",
+            (FS, false) => "N m",
+            (FS, true) => "N",
+            (FV, false) => "N m s/rad",
+            (FV, true) => "N s/m",
+            _ => "",
+        }
+    }
 }
 
 /// Names of the external wrench components (exerted by the link on the environment, in R_j).

@@ -6,6 +6,7 @@ mod constants;
 mod coordinates;
 mod description;
 mod environment;
+pub mod inertial;
 mod structure;
 
 pub(crate) use constants::form_row;

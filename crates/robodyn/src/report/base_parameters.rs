@@ -1,6 +1,6 @@
 //! Text, LaTeX and JSON writers of a base-parameter [`Summary`].
 
-use crate::algorithms::base_parameters::summary::{short, Summary, LEGEND};
+use crate::algorithms::base_parameters::summary::{Summary, LEGEND};
 use serde_json::json;
 
 /// Plain-text report: title, comparison block (when the methods differ), the table like
@@ -66,19 +66,11 @@ pub fn text(r: &Summary) -> String {
     s
 }
 
-/// A value for display: rounded to 12 significant digits (the rounding of the sums that make
-/// it, 10.899999999999999 -> 10.9), then the shortest decimal; integers without a point, -0 as
-/// 0. JSON keeps the full double.
+/// A value for display: 12 significant digits (the rounding of the sums that make it,
+/// 10.899999999999999 -> 10.9), the report form of [`crate::report::number`]; integers without
+/// a point, -0 as 0. JSON keeps the full double.
 pub fn value_text(v: f64) -> String {
-    if v == 0.0 || !v.is_finite() {
-        return if v.is_finite() {
-            "0".into()
-        } else {
-            format!("{v}")
-        };
-    }
-    let r: f64 = format!("{v:.11e}").parse().unwrap_or(v);
-    short(r)
+    crate::report::number::significant(v, 12)
 }
 
 /// LaTeX fragment (needs amsmath): the table (tabular, math cells), its legend, the grouping

@@ -2,3 +2,8 @@
 //! algorithms that compute them.
 
 pub mod base_parameters;
+#[cfg(feature = "plot")]
+pub mod figure;
+pub mod number;
+
+pub use number::{format_number, significant, Number, Sig};

@@ -61,13 +61,15 @@ pub(crate) mod energy;
 pub mod input;
 pub mod integrators;
 pub mod output;
+#[cfg(feature = "plot")]
+pub mod plot;
 
 pub use closed::ClosedChainDynamics;
 pub use input::{TimeSeries, TorqueInput};
 pub use integrators::{Integrator, Ode, Stats, Stepper};
 pub use output::{format_number, CsvSink, Recorder, Tee, TrajectorySink};
 #[cfg(feature = "plot")]
-pub use output::{plot_svg, PlotInfo};
+pub use plot::{plot_svg, EnergyBalance, PlotInfo};
 
 use crate::algorithms::direct_dynamics::{ddm, Method};
 use crate::data::Data;

@@ -139,14 +139,25 @@ pub fn tool(key: &str, program: &str, args: &[&str], what: &str) -> bool {
 }
 
 /// Whether `python3` can import NumPy; if not, skips the optional check `numpy` (generated
-/// Python `what` not run).
+/// Python `what` not run), saying which is missing: python3 itself, or NumPy.
 pub fn numpy(what: &str) -> bool {
-    tool(
-        "numpy",
-        "python3",
-        &["-c", "import numpy"],
-        &format!("python3 with NumPy: {what}"),
-    )
+    let ok = runs("python3", &["-c", "import numpy"]);
+    if !ok {
+        skip(
+            "numpy",
+            &numpy_missing(runs("python3", &["--version"]), what),
+        );
+    }
+    ok
+}
+
+/// The skip reason of [`numpy`]: `python3` not found, or found without NumPy.
+pub fn numpy_missing(python_runs: bool, what: &str) -> String {
+    if python_runs {
+        format!("python3 cannot import NumPy (pip install numpy): {what} not checked")
+    } else {
+        format!("python3 not found: {what} not checked")
+    }
 }
 
 /// `shared/SUB` in the first ancestor of the crate that has it, if any (the project's shared

@@ -37,6 +37,7 @@ use super::names::ParameterNames;
 use crate::data::Data;
 use crate::error::{Error, Result};
 use crate::model::Robot;
+use crate::report::number::{format_number, significant};
 use faer::reborrow::{Reborrow, ReborrowMut};
 use faer::{Mat, MatRef, Par};
 use nalgebra::DMatrix;
@@ -190,23 +191,26 @@ impl NumericBase {
     /// `names`. Coefficients are shown as short rationals when they are (display only).
     pub fn equation(&self, r: usize, names: &ParameterNames) -> String {
         let b = self.base[r];
+        let terms: Vec<(f64, usize)> = self
+            .grouped
+            .iter()
+            .enumerate()
+            .map(|(c, &g)| (self.beta[(r, c)], g))
+            .filter(|(v, _)| v.abs() >= 1e-9)
+            .collect();
+        let magnitudes: Vec<f64> = terms.iter().map(|(v, _)| v.abs()).collect();
         let mut s = if self.absent.contains(&b) {
             String::new()
         } else {
             names.name(b).to_string()
         };
-        for (c, &g) in self.grouped.iter().enumerate() {
-            let v = self.beta[(r, c)];
-            if v.abs() < 1e-9 {
-                continue;
-            }
-            let mag = format_coefficient(v.abs());
+        for ((v, g), mag) in terms.iter().zip(format_coefficients(&magnitudes)) {
             let term = if mag == "1" {
-                names.name(g).to_string()
+                names.name(*g).to_string()
             } else {
-                format!("{mag}*{}", names.name(g))
+                format!("{mag}*{}", names.name(*g))
             };
-            s = match (s.is_empty(), v < 0.0) {
+            s = match (s.is_empty(), *v < 0.0) {
                 (true, false) => term,
                 (true, true) => format!("-{term}"),
                 (false, neg) => format!("{s} {} {term}", if neg { "-" } else { "+" }),
@@ -220,21 +224,49 @@ impl NumericBase {
     }
 }
 
-/// A coefficient for display: a short rational (p/q with q <= 64) when it is one to 1e-9,
-/// otherwise the shortest decimal that round-trips the value rounded to 12 significant digits.
+/// A coefficient for display, alone: [`format_coefficients`] of one value.
 pub fn format_coefficient(x: f64) -> String {
-    for q in 1..=64i64 {
-        let p = (x * q as f64).round();
-        if (x - p / q as f64).abs() <= 1e-9 * x.abs().max(1.0) {
-            return if q == 1 {
-                format!("{}", p as i64)
-            } else {
-                format!("{}/{}", p as i64, q)
-            };
+    format_coefficients(&[x]).remove(0)
+}
+
+/// The coefficients of one grouping equation for display, in one style for the whole line
+/// (issue 30 found `9/40*MZ3` next to `0.007875*M3`):
+///
+/// - decimals by default: a coefficient within 1e-9 of a fraction p/q (q <= 64) with a finite
+///   decimal expansion is written as that decimal, exactly (`9/40` is `0.225`, the geometry's own
+///   number), any other one with 12 significant digits (the rounding of the sums that made it);
+/// - fractions when every coefficient of the line is within 1e-9 of a fraction with q <= 64
+///   and one of them has no finite decimal (`1/3*M3 + 1/2*M4`, not `0.333333333333*M3`);
+/// - integers as integers in either style.
+pub fn format_coefficients(values: &[f64]) -> Vec<String> {
+    // the fraction p/q (q <= 64) within 1e-9 of x, if any
+    let fraction = |x: f64| -> Option<(i64, i64)> {
+        (1..=64i64).find_map(|q| {
+            let p = (x * q as f64).round();
+            ((x - p / q as f64).abs() <= 1e-9 * x.abs().max(1.0)).then_some((p as i64, q))
+        })
+    };
+    let terminates = |mut q: i64| {
+        for f in [2, 5] {
+            while q % f == 0 {
+                q /= f;
+            }
         }
-    }
-    let v: f64 = format!("{x:.11e}").parse().unwrap_or(x);
-    format!("{v}")
+        q == 1
+    };
+    let fractions: Vec<Option<(i64, i64)>> = values.iter().map(|&x| fraction(x)).collect();
+    let as_fractions = fractions.iter().all(Option::is_some)
+        && fractions.iter().flatten().any(|&(_, q)| !terminates(q));
+    values
+        .iter()
+        .zip(&fractions)
+        .map(|(&x, f)| match *f {
+            Some((p, 1)) => p.to_string(),
+            Some((p, q)) if as_fractions => format!("{p}/{q}"),
+            Some((p, q)) if terminates(q) => format_number(p as f64 / q as f64),
+            _ => significant(x, 12),
+        })
+        .collect()
 }
 
 /// Parallelism of the dense factorizations (every core rayon has).

@@ -11,6 +11,7 @@ use super::symbolic::{collect_by_coefficient, SymbolicBase};
 use crate::algorithms::regressor::PARAMS_PER_LINK;
 use crate::error::{Error, Item, Result};
 use crate::model::{param, RobotDescription, STANDARD_PARAMETERS};
+use crate::report::number::{format_number, significant};
 use robodyn_symbolic::Expr;
 
 /// One base parameter.
@@ -105,13 +106,13 @@ impl Summary {
         }
         if sb.dropped_float_terms > 0 {
             notes.push(format!(
-                "{} grouping term(s) with a float coefficient below the tolerance {:e} L^k were \
+                "{} grouping term(s) with a float coefficient below the tolerance {} L^k were \
                  taken as 0 (rounding noise of the file's floats; L = {} m the robot's largest \
                  length, k the length power the coefficient's unit has; exact coefficients are \
                  never dropped)",
                 sb.dropped_float_terms,
-                super::symbolic::FLOAT_TERM_TOLERANCE,
-                short((sb.length_scale * 1e6).round() / 1e6)
+                significant(super::symbolic::FLOAT_TERM_TOLERANCE, 3),
+                significant(sb.length_scale, 6)
             ));
         }
         Summary {
@@ -168,9 +169,9 @@ impl Summary {
              value {}; grouped columns: residual {}); coefficients are numbers for the robot's \
              geometry (rounded for display only)",
             nb.rows,
-            short(nb.tolerance),
-            short(nb.sigma_min_kept),
-            short(nb.residual_grouped)
+            significant(nb.tolerance, 3),
+            significant(nb.sigma_min_kept, 3),
+            significant(nb.residual_grouped, 3)
         );
         if !nb.absent.is_empty() {
             note.push_str(&format!(
@@ -255,22 +256,9 @@ fn entry_name(names: &ParameterNames, i: usize, regrouped: bool) -> String {
     }
 }
 
-/// Shortest round-trip text of a float, integers without a decimal point.
+/// Shortest round-trip text of a float (the data form of [`crate::report::number`]).
 pub fn short(x: f64) -> String {
-    if x == 0.0 {
-        return "0".into();
-    }
-    if x.fract() == 0.0 && x.abs() < 1e15 {
-        return format!("{}", x as i64);
-    }
-    let plain = format!("{x}");
-    let sci = format!("{x:e}");
-    // plain decimals between 1e-4 and 1e15 (0.0008, not 8e-4), else the shorter
-    if (1e-4..1e15).contains(&x.abs()) || plain.len() <= sci.len() {
-        plain
-    } else {
-        sci
-    }
+    format_number(x)
 }
 
 /// The base robot: same geometry, every standard parameter zero except the base parameters,
