@@ -55,6 +55,8 @@ enum Command {
     Identify(commands::identify::Args),
     /// Design an exciting trajectory (finite Fourier series minimizing the condition number).
     Excite(commands::excite::Args),
+    /// 3D view of the frames, links and joints (one HTML page; PNG with --png); trajectories.
+    View(commands::view::Args),
 }
 
 /// Printed after every command's `--help`: the units of every value and column.
@@ -79,6 +81,7 @@ fn main() {
         Command::Generate(a) => commands::generate::run(a),
         Command::Identify(a) => commands::identify::run(a),
         Command::Excite(a) => commands::excite::run(a),
+        Command::View(a) => commands::view::run(a),
     };
     if let Err(e) = result {
         // `robodyn ... | head -1`: the reader has all it wanted; end quietly

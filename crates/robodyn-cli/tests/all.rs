@@ -29,6 +29,8 @@ mod cli_info;
 mod cli_info_assembly;
 #[path = "cli_simulate_names.rs"]
 mod cli_simulate_names;
+#[path = "cli_view.rs"]
+mod cli_view;
 
 /// The guard: a `tests/*.rs` file that is not a module above would never be compiled or run.
 #[test]
