@@ -322,6 +322,53 @@ fn trajectory_rows(r: &Robot, csv: &Path) -> Vec<Vec<f64>> {
         .collect()
 }
 
+/// example-robot-data's robots folder (installed with Pinocchio), or None after a visible skip.
+fn example_robot_data() -> Option<PathBuf> {
+    let python = std::env::var("ROBODYN_PYTHON").unwrap_or_else(|_| "python3".into());
+    let out = Command::new(python)
+        .args([
+            "-c",
+            "import cmeel, os; print(os.path.join(os.path.dirname(os.path.dirname(cmeel.__file__)), \
+             'cmeel.prefix', 'share', 'example-robot-data', 'robots'))",
+        ])
+        .output();
+    let found = out
+        .ok()
+        .filter(|o| o.status.success())
+        .map(|o| PathBuf::from(String::from_utf8_lossy(&o.stdout).trim()))
+        .filter(|p| p.is_dir());
+    if found.is_none() {
+        crate::harness::skip(
+            "pinocchio",
+            "example-robot-data not found (pip install pin example-robot-data): Talos' page with \
+             its STL meshes not checked in the browser",
+        );
+    }
+    found
+}
+
+/// Talos (example-robot-data) with its 48 STL meshes, at q = 0 and a random q.
+fn talos_case(dir: &Path, rng: &mut Rng) -> Option<(Case, PathBuf)> {
+    let urdf = example_robot_data()?.join("talos_data/robots/talos_full_v2.urdf");
+    let r = robodyn::io::load(&urdf).unwrap();
+    let page = make_page(dir, "talos", &[urdf.to_str().unwrap()]);
+    let html = std::fs::read_to_string(&page).unwrap();
+    assert!(
+        html.contains(r#""shape":"stl""#),
+        "Talos' meshes are not in its page"
+    );
+    let q = (0..r.dof()).map(|_| rng.uniform(-1.0, 1.0)).collect();
+    let case = Case {
+        name: "talos_full_v2.urdf".into(),
+        initial: Some(vec![0.0; r.nj()]),
+        joints: vec![q],
+        slider: true,
+        trajectory: None,
+        robot: r,
+    };
+    Some((case, page))
+}
+
 /// Run the browser on the pages; the report per page.
 fn drive(chromium: &Path, cases: &[Case], pages: &[PathBuf]) -> Vec<Value> {
     let specs: Vec<Value> = cases
@@ -398,21 +445,6 @@ fn check(c: &Case, r: &Value) {
         );
         largest = largest.max(e);
     }
-    // (shown with --nocapture)
-    println!(
-        "{name}: {} pose(s) compared, largest difference {largest:.1e}; picture {:.1} % drawn, \
-         {} red and {} blue pixels; slider changed {}; trajectory [t0, t1, changed] {}",
-        usize::from(c.initial.is_some()) + c.joints.len(),
-        100.0 * non_white,
-        s["red"],
-        s["blue"],
-        r["slider"]["changed"],
-        json!([
-            &r["trajectory"]["t0"],
-            &r["trajectory"]["t1"],
-            &r["trajectory"]["changed"]
-        ])
-    );
     assert_eq!(
         r["joint_transforms"].as_array().unwrap().len(),
         c.joints.len()
@@ -441,6 +473,7 @@ fn check(c: &Case, r: &Value) {
             e < TOL,
             "{name}: at sample {k} the drawn frames differ by {e:e}"
         );
+        largest = largest.max(e);
         if !c.robot.is_tree() {
             closed_drawn(c, &t["transforms"]);
         }
@@ -453,6 +486,21 @@ fn check(c: &Case, r: &Value) {
             "{name}: playing changed {changed} of the picture"
         );
     }
+    // (shown with --nocapture)
+    println!(
+        "{name}: {} pose(s) compared, largest difference {largest:.1e}; picture {:.1} % drawn, \
+         {} red and {} blue pixels; slider changed {}; trajectory [t0, t1, changed] {}",
+        usize::from(c.initial.is_some()) + c.joints.len() + usize::from(c.trajectory.is_some()),
+        100.0 * non_white,
+        s["red"],
+        s["blue"],
+        r["slider"]["changed"],
+        json!([
+            &r["trajectory"]["t0"],
+            &r["trajectory"]["t1"],
+            &r["trajectory"]["changed"]
+        ])
+    );
 }
 
 /// A closed robot's loops drawn closed: R_k on its twin R_{k+B}.
@@ -483,6 +531,10 @@ fn every_bundled_robot_and_trajectory_in_a_browser() {
     let (c, p) = trajectory_cases(&dir);
     cases.extend(c);
     pages.extend(p);
+    if let Some((c, p)) = talos_case(&dir, &mut rng) {
+        cases.push(c);
+        pages.push(p);
+    }
     let reports = drive(&chromium, &cases, &pages);
     assert_eq!(reports.len(), cases.len());
     for (c, r) in cases.iter().zip(&reports) {

@@ -29,19 +29,10 @@ impl View {
         self.warnings.clone()
     }
 
-    /// Write the page to `path` (through a temporary file beside it, renamed over it).
+    /// Write the page to `path` (a temporary file beside it renamed over it: a failure never
+    /// leaves a partial file).
     fn save(&self, path: PathBuf) -> PyResult<()> {
-        let name = path
-            .file_name()
-            .map_or_else(|| "view.html".into(), |n| n.to_string_lossy().into_owned());
-        let tmp = path.with_file_name(format!(".{name}.robodyn-{}.tmp", std::process::id()));
-        std::fs::write(&tmp, &self.html)
-            .and_then(|()| std::fs::rename(&tmp, &path))
-            .map_err(|e| {
-                let _ = std::fs::remove_file(&tmp);
-                robodyn::Error::io(path.display().to_string(), e)
-            })
-            .py()
+        v::save(&path, self.html.as_bytes()).py()
     }
 
     /// The page in an iframe (Jupyter's inline display).

@@ -66,8 +66,8 @@
 //! - `view` (feature `view`): a 3D view of the frames, links and trajectories in one HTML page;
 //! - [`geometry`]: iT_j and 0T_j.
 //!
-//! Cargo features (default `io`, `plot`, `codegen`, `view`): `--no-default-features` builds the numeric
-//! dynamics alone; `testing` exposes the random-robot generator of the tests.
+//! Cargo features (default `io`, `plot`, `codegen`, `view`): `--no-default-features` builds the
+//! numeric dynamics alone; `testing` exposes the random-robot generator of the tests.
 
 // Joint and link numbers are 1-based indices into several parallel arrays (a(j), frames, links):
 // index loops read like the equations.

@@ -97,7 +97,7 @@ pub fn run(a: Args) -> CliResult {
         if robodyn::io::is_stdio(path) {
             crate::common::print_out(&p.html)?;
         } else {
-            write_atomically(path, p.html.as_bytes())?;
+            p.save(path)?;
             eprintln!(
                 "robodyn: wrote {} ({:.1} MB): open it in a web browser (it needs no network)",
                 path.display(),
@@ -174,26 +174,6 @@ fn parse_size(s: &str) -> CliResult<(u32, u32)> {
     Ok((w, h))
 }
 
-/// Write `bytes` to `path` through a temporary file in the same directory renamed over it, so
-/// that a failure never leaves a partial file in place of the user's.
-fn write_atomically(path: &Path, bytes: &[u8]) -> CliResult {
-    let tmp = sibling(path, "tmp");
-    std::fs::write(&tmp, bytes)
-        .and_then(|()| std::fs::rename(&tmp, path))
-        .map_err(|e| {
-            let _ = std::fs::remove_file(&tmp);
-            format!("{}: {e}", path.display()).into()
-        })
-}
-
-/// `DIR/.NAME.robodyn-PID.EXT` beside `path`.
-fn sibling(path: &Path, ext: &str) -> PathBuf {
-    let name = path
-        .file_name()
-        .map_or_else(|| "out".into(), |n| n.to_string_lossy().into_owned());
-    path.with_file_name(format!(".{name}.robodyn-{}.{ext}", std::process::id()))
-}
-
 /// The Chromium-based browser to render with: `ROBODYN_CHROMIUM`, else the first of the usual
 /// names on the PATH.
 fn browser() -> CliResult<PathBuf> {
@@ -217,16 +197,17 @@ fn browser() -> CliResult<PathBuf> {
         .find(|p| p.is_file())
         .ok_or_else(|| {
             "--png renders the page in a headless Chromium, and none was found (chromium, \
-             chromium-browser, google-chrome on the PATH; or set ROBODYN_CHROMIUM=/path/to/chrome). \
-             Install one (Debian/Ubuntu: `apt-get install chromium`), or write the page with \
+             chromium-browser, google-chrome on the PATH; or set \
+             ROBODYN_CHROMIUM=/path/to/chrome). Install one (Debian/Ubuntu: `apt-get install chromium`), or write the page with \
              --output robot.html and take the picture from a browser"
                 .into()
         })
 }
 
 /// Render `html` in a headless Chromium at `width` x `height` and write the picture to `png`
-/// (through a temporary file beside it). The page is robodyn's own and loads nothing, so the
-/// browser runs without its sandbox (which refuses to start as root) and with software WebGL.
+/// (the browser writes into a temporary directory; `robodyn::view::save` replaces `png`). The
+/// page is robodyn's own and loads nothing, so the browser runs without its sandbox (which
+/// refuses to start as root) and with software WebGL.
 fn screenshot(html: &str, png: &Path, width: u32, height: u32) -> CliResult {
     let program = browser()?;
     let dir = std::env::temp_dir().join(format!(
@@ -240,7 +221,7 @@ fn screenshot(html: &str, png: &Path, width: u32, height: u32) -> CliResult {
     let result = (|| -> CliResult {
         let page = dir.join("page.html");
         std::fs::write(&page, html).map_err(|e| format!("{}: {e}", page.display()))?;
-        let tmp = sibling(png, "png");
+        let tmp = dir.join("shot.png");
         let mut child = Command::new(&program)
             .args([
                 "--headless",
@@ -274,7 +255,6 @@ fn screenshot(html: &str, png: &Path, width: u32, height: u32) -> CliResult {
             if start.elapsed() > Duration::from_secs(180) {
                 let _ = child.kill();
                 let _ = child.wait();
-                let _ = std::fs::remove_file(&tmp);
                 return Err(format!("{}: no picture after 180 s", program.display()).into());
             }
             std::thread::sleep(Duration::from_millis(50));
@@ -285,7 +265,6 @@ fn screenshot(html: &str, png: &Path, width: u32, height: u32) -> CliResult {
         }
         let written = std::fs::metadata(&tmp).is_ok_and(|m| m.len() > 0);
         if !status.success() || !written {
-            let _ = std::fs::remove_file(&tmp);
             let tail: Vec<&str> = err.lines().rev().take(5).collect();
             return Err(format!(
                 "{} could not take the picture ({status}): {}",
@@ -294,10 +273,8 @@ fn screenshot(html: &str, png: &Path, width: u32, height: u32) -> CliResult {
             )
             .into());
         }
-        std::fs::rename(&tmp, png).map_err(|e| {
-            let _ = std::fs::remove_file(&tmp);
-            format!("{}: {e}", png.display()).into()
-        })
+        let bytes = std::fs::read(&tmp).map_err(|e| format!("{}: {e}", tmp.display()))?;
+        Ok(robodyn::view::save(png, &bytes)?)
     })();
     let _ = std::fs::remove_dir_all(&dir);
     result

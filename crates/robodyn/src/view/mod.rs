@@ -50,7 +50,7 @@ mod scene;
 mod trajectory;
 
 pub use meshes::{urdf_visuals, MeshOptions, Visuals, DEFAULT_MESH_BYTES};
-pub use page::{page, Page};
+pub use page::{page, save, Page};
 pub use trajectory::{JointColumns, Trajectory, MAX_SAMPLES};
 
 /// The joint values the page starts from.

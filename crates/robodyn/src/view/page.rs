@@ -3,9 +3,10 @@
 
 use super::scene::scene;
 use super::ViewOptions;
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::Robot;
 use base64::Engine as _;
+use std::path::Path;
 
 /// The page's layout and styles, with the markers `@TITLE@`, `@IMPORTMAP@`, `@SCENE@`,
 /// `@STYLE@` and `@SCRIPT@`.
@@ -41,6 +42,40 @@ pub struct Page {
     pub html: String,
     /// Loops that are not closed at the pose shown, and why (they are drawn open).
     pub warnings: Vec<String>,
+}
+
+impl Page {
+    /// Write the page to `path` ([`save`]).
+    pub fn save(&self, path: &Path) -> Result<()> {
+        save(path, self.html.as_bytes())
+    }
+}
+
+/// Write `bytes` to the file `path` without ever leaving a partial file in place of the old
+/// one: a regular file (or a new one) is written as a temporary file in the same directory,
+/// then renamed over it; a symbolic link is followed (its target is replaced the same way); a
+/// path that exists and is not a regular file (`/dev/stdout`, a named pipe) is written in
+/// place, never replaced.
+pub fn save(path: &Path, bytes: &[u8]) -> Result<()> {
+    let err = |p: &Path, e| Error::io(p.display().to_string(), e);
+    match std::fs::symlink_metadata(path) {
+        Ok(m) if m.file_type().is_symlink() => {
+            let target = std::fs::canonicalize(path).map_err(|e| err(path, e))?;
+            return save(&target, bytes);
+        }
+        Ok(m) if !m.is_file() => return std::fs::write(path, bytes).map_err(|e| err(path, e)),
+        _ => {}
+    }
+    let name = path
+        .file_name()
+        .map_or_else(|| "page".into(), |n| n.to_string_lossy().into_owned());
+    let tmp = path.with_file_name(format!(".{name}.robodyn-{}.tmp", std::process::id()));
+    std::fs::write(&tmp, bytes)
+        .and_then(|()| std::fs::rename(&tmp, path))
+        .map_err(|e| {
+            let _ = std::fs::remove_file(&tmp);
+            err(path, e)
+        })
 }
 
 /// The self-contained HTML page showing `robot` (see the [module](super) documentation).

@@ -6,7 +6,7 @@ use super::{Pose, ViewOptions};
 use crate::algorithms::closed_chain::ClosureSolution;
 use crate::error::{Error, Result};
 use crate::geometry::{frame_transforms, Transform};
-use crate::model::{ClosedLoop, JointType, Robot, GEOMETRIC_PARAMETERS};
+use crate::model::{param, ClosedLoop, JointType, Robot, GEOMETRIC_PARAMETERS};
 use crate::{loop_closure, ClosedChain};
 use serde_json::{json, Value};
 
@@ -78,13 +78,18 @@ fn frames(robot: &Robot) -> Result<Vec<Value>> {
             for (v, e) in values.iter_mut().zip(f.geometric()) {
                 *v = robot.value(e)?;
             }
-            let text: Vec<String> = f.geometric().iter().map(|e| e.to_string()).collect();
+            let text: Vec<String> = f
+                .geometric()
+                .iter()
+                .map(|e| e.decimal().to_string())
+                .collect();
             let limits = robot
                 .description()
                 .limits
                 .get(&j)
                 .and_then(|l| Some([l.q_min?, l.q_max?]));
             Ok(json!({
+                "com": (j <= nl).then(|| centre_of_mass(robot, j)).flatten(),
                 "j": j,
                 "name": f.name,
                 "ant": f.ant,
@@ -99,6 +104,14 @@ fn frames(robot: &Robot) -> Result<Vec<Value>> {
             }))
         })
         .collect()
+}
+
+/// The centre of mass of link j in R_j (MS / M), when its mass is positive.
+fn centre_of_mass(robot: &Robot, j: usize) -> Option<[f64; 3]> {
+    let k = &robot.link(j).params;
+    let v = |p: usize| robot.value(&k[p]).ok();
+    let m = v(param::M)?;
+    (m > 0.0).then_some([v(param::MX)? / m, v(param::MY)? / m, v(param::MZ)? / m])
 }
 
 /// The joint values of frames 1..NJ for a pose.

@@ -50,6 +50,10 @@ const T0 = forward(q);
 const V = (a) => new THREE.Vector3(a[0], a[1], a[2]);
 const box = new THREE.Box3();
 T0.forEach((t) => box.expandByPoint(V(t.p)));
+if (S.trajectory) { // the view frames the whole motion (up to 500 samples of it)
+  const rows = S.trajectory.q, step = Math.max(1, Math.floor(rows.length / 500));
+  for (let i = 0; i < rows.length; i += step) forward(rows[i]).forEach((t) => box.expandByPoint(V(t.p)));
+}
 const L = Math.max(box.getSize(new THREE.Vector3()).length(), 0.05); // robot size (m)
 const links = F.map((f) => V(T0[f.j].p).distanceTo(V(T0[f.ant].p))).filter((x) => x > 1e-6 * L).sort((a, b) => a - b);
 const AX = Math.min(Math.max(0.6 * (links[links.length >> 1] || L), 0.035 * L), 0.1 * L); // axis length
@@ -88,7 +92,6 @@ controls.addEventListener('change', requestRender);
 // A view from the side where the robot is widest: the horizontal direction of least spread of
 // the frame origins, turned 30 degrees and raised.
 function defaultCamera() {
-  const center = box.getCenter(new THREE.Vector3());
   let e1 = new THREE.Vector3(1, 0, 0).projectOnPlane(up);
   if (e1.length() < 1e-6) e1 = new THREE.Vector3(0, 1, 0).projectOnPlane(up);
   e1.normalize();
@@ -102,11 +105,11 @@ function defaultCamera() {
   let m = e1.clone().multiplyScalar(-Math.sin(major)).add(e2.clone().multiplyScalar(Math.cos(major)));
   if (m.dot(e1.clone().sub(e2.clone().multiplyScalar(0.6))) < 0) m.negate();
   const dir = m.clone().add(new THREE.Vector3().crossVectors(up, m).multiplyScalar(0.55)).add(up.clone().multiplyScalar(0.35)).normalize();
-  const dist = (0.5 * L) / Math.sin(THREE.MathUtils.degToRad(camera.fov / 2));
+  const dist = (0.46 * VIEW) / Math.sin(THREE.MathUtils.degToRad(camera.fov / 2));
   camera.position.copy(center).addScaledVector(dir, dist);
   controls.target.copy(center);
   controls.update();
-  sun.position.copy(dir).add(up).multiplyScalar(L * 3);
+  sun.position.copy(dir).add(up).multiplyScalar(VIEW * 3);
   return dir;
 }
 
@@ -147,7 +150,7 @@ function label(html, cls, position) {
 }
 
 // ---------------------------------------------------------------- the robot
-const layers = { frames: [], labels: [], sketch: [], meshes: [] };
+const layers = { frames: [], labels: [], sketch: [], meshes: [], com: [] };
 const frameObj = [];      // frameObj[j]: group at 0T_j (j = 0: the base)
 const pickable = [];      // joint solids, for the frame under the mouse
 const axisLabels = [];    // { obj, axis, j, leader }: the x_j and z_j labels
@@ -205,6 +208,20 @@ function addLink(f) {
   layers.sketch.push(seg);
   rSegments.push([f, seg, r0]);
 }
+// The centre of mass of link j (a small dark ball); a terminal link (no frame on it) is drawn
+// from O_j to it, so that its extent shows.
+function addMass(f) {
+  if (!f.com) return;
+  const g = V(f.com), ball = new THREE.Mesh(new THREE.SphereGeometry(0.7 * R_JOINT, 16, 12), material(0x333333));
+  ball.position.copy(g);
+  frameObj[f.j].add(ball);
+  layers.com.push(ball);
+  if (!F.some((c) => c.ant === f.j) && g.length() > 1e-9) {
+    const seg = cylinder(new THREE.Vector3(), g, 0.7 * R_LINK, material(COLORS.link));
+    frameObj[f.j].add(seg);
+    layers.sketch.push(seg);
+  }
+}
 addAxes(0, 'base');
 {
   const base = new THREE.Mesh(new THREE.CylinderGeometry(2.4 * R_JOINT, 2.8 * R_JOINT, 0.8 * R_JOINT, 32), material(COLORS.base));
@@ -216,23 +233,16 @@ addAxes(0, 'base');
   frameObj[0].add(lab);
   layers.labels.push(lab);
 }
-F.forEach((f) => { addAxes(f.j, f.kind); addJoint(f); addLink(f); });
+F.forEach((f) => { addAxes(f.j, f.kind); addJoint(f); addLink(f); addMass(f); });
 
-// gravity and ground
-const groundLevel = Math.min(...T0.map((t) => V(t.p).dot(up))) - H_JOINT;
-const center = box.getCenter(new THREE.Vector3());
-const grid = new THREE.GridHelper(Math.ceil(2.4 * L * 10) / 10, 12, 0xc8c8c8, 0xe4e4e4);
-grid.quaternion.setFromUnitVectors(Y, up);
-grid.position.copy(center).addScaledVector(up, groundLevel - center.dot(up));
-scene.add(grid);
 // the gravity vector, beside the robot as the first view sees it (dir: towards the camera)
 function gravityArrow(dir) {
   if (!(gNorm > 0)) return;
   const right = new THREE.Vector3().crossVectors(up, dir).normalize();
-  const reach = Math.max(...T0.map((t) => V(t.p).sub(center).dot(right)));
-  const gd = g.clone().normalize(), length = 0.16 * L;
-  const start = center.clone().addScaledVector(right, reach + 0.12 * L).addScaledVector(up, 0.5 * length);
-  const ga = arrow(gd, length, 0.006 * L, COLORS.g);
+  const reach = Math.max(...corners.map((c) => c.clone().sub(center).dot(right)));
+  const gd = g.clone().normalize(), length = 0.16 * VIEW;
+  const start = center.clone().addScaledVector(right, reach + 0.06 * VIEW).addScaledVector(up, 0.5 * length);
+  const ga = arrow(gd, length, 0.006 * VIEW, COLORS.g);
   ga.position.copy(start);
   scene.add(ga);
   scene.add(label(`g = ${+gNorm.toFixed(3)} m/s²`, 'g', start.clone().addScaledVector(gd, 1.18 * length)));
@@ -240,14 +250,18 @@ function gravityArrow(dir) {
 
 // URDF visuals: STL meshes and shapes, in the frame of their link
 const visuals = (S.visuals && S.visuals.items) || [];
-const meshMaterials = [];
+const meshMaterials = [], brokenMeshes = [];
 if (visuals.length) {
   const loader = new STLLoader();
   for (const v of visuals) {
     let geom;
     if (v.shape === 'stl') {
-      const bytes = Uint8Array.from(atob(v.data), (c) => c.charCodeAt(0));
-      geom = loader.parse(bytes.buffer);
+      try {
+        geom = loader.parse(Uint8Array.from(atob(v.data), (c) => c.charCodeAt(0)).buffer);
+      } catch (e) {
+        brokenMeshes.push(`${v.file}: not a valid STL file (${e.message}); its link is drawn as the sketch`);
+        continue;
+      }
     } else if (v.shape === 'box') {
       geom = new THREE.BoxGeometry(...v.size);
     } else if (v.shape === 'cylinder') {
@@ -266,8 +280,19 @@ if (visuals.length) {
       .multiply(new THREE.Matrix4().makeScale(s[0], s[1], s[2]));
     frameObj[v.frame].add(mesh);
     layers.meshes.push(mesh);
+    geom.computeBoundingBox(); // the view frames the meshes too
+    box.union(geom.boundingBox.clone().applyMatrix4(toMatrix(T0[v.frame]).multiply(mesh.matrix)));
   }
 }
+
+// the ground, perpendicular to gravity, under the robot
+const corners = [0, 1, 2, 3, 4, 5, 6, 7].map((k) => new THREE.Vector3(k & 1 ? box.max.x : box.min.x, k & 2 ? box.max.y : box.min.y, k & 4 ? box.max.z : box.min.z));
+const center = box.getCenter(new THREE.Vector3()), VIEW = Math.max(box.getSize(new THREE.Vector3()).length(), L);
+const groundLevel = Math.min(...corners.map((c) => c.dot(up))) - 0.5 * H_JOINT;
+const grid = new THREE.GridHelper(Math.ceil(2.4 * VIEW * 10) / 10, 12, 0xc8c8c8, 0xe4e4e4);
+grid.quaternion.setFromUnitVectors(Y, up);
+grid.position.copy(center).addScaledVector(up, groundLevel - center.dot(up));
+scene.add(grid);
 
 // highlight: a halo at the frame's origin, its labels and its table row
 const halo = new THREE.Mesh(new THREE.SphereGeometry(2.2 * R_JOINT, 24, 16), new THREE.MeshBasicMaterial({ color: COLORS.halo, transparent: true, opacity: 0.45, depthTest: false }));
@@ -340,11 +365,14 @@ function buildPanels() {
   F.forEach((f) => kinds[f.kind]++);
   $('summary').textContent = `NL = ${S.nl}, NJ = ${NJ}, NF = ${NF}: ${S.coordinates.length} movable joints` +
     (S.closed ? `, ${S.loops.length} loop(s) (cut joints ${S.loops.map((l) => l.cut).join(', ')})` : ', tree') +
-    (kinds.fixed ? `, ${kinds.fixed} fixed frame(s)` : '') + `. Pose: ${S.pose.note}.`;
+    (kinds.fixed ? `, ${kinds.fixed} fixed frame(s)` : '') +
+    (S.trajectory ? `. Trajectory: ${S.trajectory.t.length} samples, t = ${fmt(S.trajectory.t[0])} to ${fmt(S.trajectory.t[S.trajectory.t.length - 1])} s.` : `. Pose: ${S.pose.note}.`);
   $('caption').textContent = picture ? S.robot : '';
   // toggles
-  const toggles = [['frames', 'frames', true], ['labels', 'labels', NF <= 30], ['sketch', 'links and joints', true]];
-  if (visuals.length) toggles.push(['meshes', 'meshes', true], ['xray', 'translucent meshes', true]);
+  const toggles = [['frames', 'frames', true], ['labels', 'labels', NF <= 30], ['sketch', 'links and joints', true],
+    ['com', 'centres of mass', NF <= 30]];
+  // meshes translucent in the page (the frames inside show), opaque in a picture
+  if (visuals.length) toggles.push(['meshes', 'meshes', true], ['xray', 'translucent meshes', !picture]);
   toggles.push(['grid', 'ground grid', true]);
   for (const [key, text, on] of toggles) {
     const lab = document.createElement('label');
@@ -392,7 +420,7 @@ function buildPanels() {
   // notes
   const notes = [...(S.notes || [])];
   S.loops.forEach((l) => notes.push(`Loop of cut joint ${l.cut} (links ${l.link_i} and ${l.link_j}, twin frame ${l.twin}): frames ${l.cut} and ${l.twin} are ${l.gap.toExponential(1)} m and ${l.angle.toExponential(1)} rad apart${l.gap < 1e-6 && l.angle < 1e-6 ? ' (closed)' : ' (OPEN)'}.`));
-  if (S.visuals) notes.push(...S.visuals.notes, `${visuals.length} visual(s) embedded from the URDF.`);
+  if (S.visuals) notes.push(...S.visuals.notes, ...brokenMeshes, `${visuals.length} visual(s) embedded from the URDF.`);
   if (S.trajectory) notes.push(...S.trajectory.notes);
   for (const n of notes) { const li = document.createElement('li'); li.textContent = n; $('note-list').appendChild(li); }
 }
@@ -444,7 +472,7 @@ function drawPlot() {
   ctx.clearRect(0, 0, w, h);
   const units = [...new Set(TR.plots.map((p) => p.unit))];
   const t0 = TR.t[0], t1 = TR.t[TR.t.length - 1], ph = h / units.length;
-  const X = (t) => 48 + ((t - t0) / (t1 - t0 || 1)) * (w - 60);
+  const X = (t) => 62 + ((t - t0) / (t1 - t0 || 1)) * (w - 74);
   const palette = ['#1f77b4', '#ff7f0e', '#2ca02c', '#d62728', '#9467bd', '#8c564b', '#e377c2', '#7f7f7f', '#bcbd22', '#17becf'];
   ctx.font = '11px system-ui, sans-serif';
   units.forEach((unit, u) => {
@@ -455,16 +483,16 @@ function drawPlot() {
     const top = u * ph + 8, bottom = (u + 1) * ph - 16;
     const Yp = (x) => bottom - ((x - lo) / (hi - lo)) * (bottom - top);
     ctx.strokeStyle = '#ccc'; ctx.fillStyle = '#555';
-    ctx.strokeRect(48, top, w - 60, bottom - top);
+    ctx.strokeRect(62, top, w - 74, bottom - top);
     ctx.fillText(`${fmt(hi, 3)} ${unit}`, 2, top + 9);
     ctx.fillText(`${fmt(lo, 3)} ${unit}`, 2, bottom);
-    if (u === units.length - 1) { ctx.fillText(`${fmt(t0, 3)} s`, 48, bottom + 12); ctx.fillText(`${fmt(t1, 3)} s`, w - 60, bottom + 12); }
+    if (u === units.length - 1) { ctx.fillText(`${fmt(t0, 3)} s`, 62, bottom + 12); ctx.fillText(`${fmt(t1, 3)} s`, w - 60, bottom + 12); }
     plots.forEach(([p, k], n) => {
       ctx.strokeStyle = ctx.fillStyle = palette[k % palette.length];
       ctx.beginPath();
       TR.q.forEach((row, i) => { const x = X(TR.t[i]), y = Yp(row[p.frame - 1]); if (i) ctx.lineTo(x, y); else ctx.moveTo(x, y); });
       ctx.stroke();
-      ctx.fillText(p.label, 54 + 70 * n, top + 11);
+      ctx.fillText(p.label, 68 + 70 * n, top + 11);
     });
   });
   ctx.strokeStyle = '#000';
@@ -479,7 +507,7 @@ function buildPlayer() {
     const r = $('plot').getBoundingClientRect();
     const t0 = TR.t[0], t1 = TR.t[TR.t.length - 1];
     pause();
-    setTime(t0 + ((e.clientX - r.left - 48) / (r.width - 60)) * (t1 - t0));
+    setTime(t0 + ((e.clientX - r.left - 62) / (r.width - 74)) * (t1 - t0));
   };
   $('plot').addEventListener('pointerdown', seek);
   $('plot').addEventListener('pointermove', (e) => { if (e.buttons) seek(e); });
