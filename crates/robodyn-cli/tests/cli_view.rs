@@ -248,7 +248,7 @@ fn trajectory_cases(dir: &Path) -> (Vec<Case>, Vec<PathBuf>) {
             0.2 * s,
             0.5 * s,
             s,
-            1.5708 + 0.2 * s
+            std::f64::consts::FRAC_PI_2 + 0.2 * s
         );
     }
     let sr = tmp("view", "sr400_actuated.csv");
@@ -540,4 +540,91 @@ fn every_bundled_robot_and_trajectory_in_a_browser() {
     for (c, r) in cases.iter().zip(&reports) {
         check(c, r);
     }
+}
+
+/// `robodyn ARGS` in `dir` with `env`, expected to fail: its standard error.
+fn fails(dir: &Path, args: &[&str], env: &[(&str, &str)]) -> String {
+    let out = Command::new(env!("CARGO_BIN_EXE_robodyn"))
+        .args(args)
+        .current_dir(dir)
+        .envs(env.iter().copied())
+        .output()
+        .unwrap();
+    assert!(!out.status.success(), "robodyn {args:?} succeeded");
+    assert!(out.stdout.is_empty(), "robodyn {args:?} printed something");
+    String::from_utf8(out.stderr).unwrap()
+}
+
+#[test]
+fn the_page_is_written_where_asked_and_nothing_else() {
+    let dir = tmp("view_out", "d");
+    std::fs::create_dir_all(&dir).unwrap();
+    let sr400 = robot("sr400.toml");
+    let out = Command::new(env!("CARGO_BIN_EXE_robodyn"))
+        .args(["view", &sr400])
+        .current_dir(&dir)
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let names: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert_eq!(
+        names,
+        ["sr400.html"],
+        "default output, no temporary file left"
+    );
+    let page = run(&["view", &sr400, "--output", "-"]);
+    assert_eq!(
+        page,
+        std::fs::read_to_string(dir.join("sr400.html")).unwrap()
+    );
+    assert!(page.starts_with("<!DOCTYPE html>") && page.contains(r#"<script type="importmap">"#));
+}
+
+#[test]
+fn errors_say_what_is_wrong() {
+    let dir = tmp("view_err", "d");
+    std::fs::create_dir_all(&dir).unwrap();
+    let rx90 = robot("rx90.toml");
+    let e = fails(&dir, &["view", &rx90, "--q", "0.1,0.2"], &[]);
+    assert!(
+        e.contains("q has 2 entries") || e.contains("expected 6"),
+        "{e}"
+    );
+    let e = fails(
+        &dir,
+        &["view", &rx90, "--png", "a.png", "--size", "12x"],
+        &[],
+    );
+    assert!(e.contains("WIDTHxHEIGHT"), "{e}");
+    let e = fails(
+        &dir,
+        &["view", &rx90, "--png", "a.png"],
+        &[("ROBODYN_CHROMIUM", "/no/chrome")],
+    );
+    assert!(
+        e.contains("ROBODYN_CHROMIUM=/no/chrome: no such program"),
+        "{e}"
+    );
+    let e = fails(
+        &dir,
+        &["view", &rx90, "--png", "a.png"],
+        &[("PATH", "/nonexistent")],
+    );
+    assert!(
+        e.contains("apt-get install chromium") && e.contains("--output"),
+        "{e}"
+    );
+    let csv = dir.join("t.csv");
+    std::fs::write(&csv, "t,q1,q2\n0,0,0\n").unwrap();
+    let e = fails(
+        &dir,
+        &["view", &rx90, "--trajectory", csv.to_str().unwrap()],
+        &[],
+    );
+    assert!(e.contains("t.csv") && e.contains("`q3`"), "{e}");
+    // nothing written on failure
+    assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1, "only t.csv");
 }

@@ -312,8 +312,8 @@ fn closed_trajectories_close_their_loops() {
         .collect();
     let given =
         Trajectory::from_table(&r, &table(&headers, rows.clone()), JointColumns::Frame).unwrap();
-    for i in 0..given.len() {
-        assert!((given.values(i)[2] - rows[i][3]).abs() == 0.0); // q3 as given
+    for (i, row) in rows.iter().enumerate() {
+        assert_eq!(given.values(i)[2], row[3]); // q3 as given
         let d = given
             .values(i)
             .iter()
