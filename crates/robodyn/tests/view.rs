@@ -167,6 +167,14 @@ fn poses_are_checked() {
         ),
         "{e}"
     );
+    let tr = Trajectory::from_samples(&rx90, &[0.0], &[vec![0.0; 6]], JointColumns::Frame).unwrap();
+    let both = ViewOptions {
+        pose: Pose::Tree(vec![0.0; 6]),
+        trajectory: Some(tr),
+        ..Default::default()
+    };
+    let e = page(&rx90, &both).unwrap_err();
+    assert!(e.to_string().contains("give one or the other"), "{e}");
     let e = page(
         &rx90,
         &ViewOptions {

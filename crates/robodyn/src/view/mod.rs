@@ -82,7 +82,8 @@ pub struct Picture {
 /// What the page shows besides the robot.
 #[derive(Clone, Debug, Default)]
 pub struct ViewOptions {
-    /// The joint values shown first.
+    /// The joint values shown first (with a trajectory: [`Pose::Default`], the page starts at
+    /// its first sample).
     pub pose: Pose,
     /// A motion to play back (time slider, play/pause, speed, joint curves).
     pub trajectory: Option<Trajectory>,

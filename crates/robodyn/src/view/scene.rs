@@ -23,6 +23,13 @@ pub(crate) struct PoseValues {
 /// The scene of `robot` with `options`, as the page reads it, and the warnings for the reader
 /// (loops not closed at the pose).
 pub(crate) fn scene(robot: &Robot, options: &ViewOptions) -> Result<(Value, Vec<String>)> {
+    if options.trajectory.is_some() && options.pose != Pose::Default {
+        return Err(Error::Input(
+            "joint values and a trajectory were both given: the page starts at the trajectory's \
+             first sample; give one or the other"
+                .into(),
+        ));
+    }
     let pose = pose_values(robot, &options.pose)?;
     let mut warnings: Vec<String> = pose.warning.iter().cloned().collect();
     for (l, gap, angle) in loop_gaps(robot, &pose.q) {
