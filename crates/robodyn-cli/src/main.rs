@@ -59,6 +59,8 @@ enum Command {
     Identify(commands::identify::Args),
     /// Design an exciting trajectory (finite Fourier series minimizing the condition number).
     Excite(commands::excite::Args),
+    /// 3D view of the frames, links and joints (one HTML page; PNG with --png); trajectories.
+    View(commands::view::Args),
 }
 
 /// Printed after `robodyn --help`: a first command and where the documentation is.
@@ -94,6 +96,7 @@ fn main() {
         Command::Generate(a) => commands::generate::run(a),
         Command::Identify(a) => commands::identify::run(a),
         Command::Excite(a) => commands::excite::run(a),
+        Command::View(a) => commands::view::run(a),
     };
     if let Err(e) = result {
         // `robodyn ... | head -1`: the reader has all it wanted; end quietly

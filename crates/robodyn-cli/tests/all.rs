@@ -45,6 +45,8 @@ mod cli_presentation;
 mod cli_random_options;
 #[path = "cli_simulate_names.rs"]
 mod cli_simulate_names;
+#[path = "cli_view.rs"]
+mod cli_view;
 
 /// The guard: a `tests/*.rs` file that is not a module above would never be compiled or run.
 #[test]

@@ -8,6 +8,7 @@ mod closed;
 mod errors;
 mod models;
 mod robot;
+mod view;
 
 use errors::IntoPy;
 use pyo3::prelude::*;
@@ -106,6 +107,7 @@ fn _robodyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<closed::ClosedChain>()?;
     m.add_class::<models::BaseParameters>()?;
     m.add_class::<models::Generated>()?;
+    m.add_class::<view::View>()?;
     m.add_function(wrap_pyfunction!(load, m)?)?;
     m.add_function(wrap_pyfunction!(models::base_parameters_of_file, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;

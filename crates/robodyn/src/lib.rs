@@ -63,10 +63,11 @@
 //! - [`simulation`]: integrators over the direct models;
 //! - `io` (feature `io`): robot files (TOML, SYMORO .par, URDF) with positioned errors;
 //! - `codegen` (feature `codegen`): customized symbolic models;
+//! - `view` (feature `view`): a 3D view of the frames, links and trajectories in one HTML page;
 //! - [`geometry`]: iT_j and 0T_j.
 //!
-//! Cargo features (default `io`, `plot`, `codegen`): `--no-default-features` builds the numeric
-//! dynamics alone; `testing` exposes the random-robot generator of the tests.
+//! Cargo features (default `io`, `plot`, `codegen`, `view`): `--no-default-features` builds the
+//! numeric dynamics alone; `testing` exposes the random-robot generator of the tests.
 
 // Joint and link numbers are 1-based indices into several parallel arrays (a(j), frames, links):
 // index loops read like the equations.
@@ -90,6 +91,8 @@ pub mod scalar;
 pub mod simulation;
 #[cfg(feature = "testing")]
 pub mod testing;
+#[cfg(feature = "view")]
+pub mod view;
 // The library's own samplers use the seeded generator without exposing the test helpers.
 #[cfg(not(feature = "testing"))]
 #[allow(dead_code)]

@@ -101,6 +101,8 @@ mod rnea_allocations;
 mod rotation_forms;
 #[path = "simulation.rs"]
 mod simulation;
+#[path = "view.rs"]
+mod view;
 
 /// The guard: a `tests/*.rs` file that is not a module above would never be compiled or run.
 #[test]

@@ -12,3 +12,4 @@ pub mod inertia;
 pub mod info;
 pub mod regressor;
 pub mod simulate;
+pub mod view;

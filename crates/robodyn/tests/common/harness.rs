@@ -11,6 +11,8 @@
 //! | `pinocchio` | Python `pin` and `example-robot-data`        | dynamics of real URDFs vs rnea  |
 //! | `shared`    | the project's `shared/` directory (above the | external SYMORO `.par` files,   |
 //! |             | repository)                                  | the real TX40 log               |
+//! | `browser`   | node.js, Chromium, `npm ci` in               | the page of `robodyn view` in a |
+//! |             | `crates/robodyn-cli/tests/browser`           | browser                         |
 //!
 //! Where one is missing the check is SKIPPED, visibly in cargo's default output: a `SKIPPED`
 //! line when it happens and a summary after the binary's `test result:` line. (libtest hides
@@ -26,7 +28,7 @@ use std::process::{Command, Stdio};
 use std::sync::{Mutex, Once};
 
 /// The optional checks' keys (the table above).
-pub const KEYS: &[&str] = &["octave", "latex", "numpy", "pinocchio", "shared"];
+pub const KEYS: &[&str] = &["octave", "latex", "numpy", "pinocchio", "shared", "browser"];
 
 /// The skips so far: (test, reason).
 static SKIPPED: Mutex<Vec<(String, String)>> = Mutex::new(Vec::new());
