@@ -171,9 +171,6 @@ def test_ctrl_c_stops_a_closed_chain_batch():
     assert 0 < int(out.split()[1]) < rows
 
 
-@pytest.mark.xfail(strict=False, reason="needs the bounded branch continuation of "
-                   "algorithms/closed_chain.rs (issue 24 item 1, another branch): a single "
-                   "state's loop closure runs in the library, between signal checks")
 def test_a_huge_closed_chain_value_errors_or_finishes_promptly():
     """`ClosedChain(...).idm([1e7, 0, ...])` followed the branch for minutes (1e6: 11 s)."""
     code = f"""

@@ -2,7 +2,8 @@
 //! a 3D view of the robot's frames, links and joints in one self-contained HTML page
 //! (`robodyn::view`; docs/view.md), and a PNG picture of it by a headless Chromium.
 
-use crate::common::{parse_list, CliResult, Names, NamesArg, RobotArgs, Table};
+use crate::common::{parse_list, CliResult, Names, NamesArg, RobotArgs};
+use robodyn::io::table::Table;
 use robodyn::io::Format;
 use robodyn::view::{
     page, urdf_visuals, JointColumns, MeshOptions, Picture, Pose, Trajectory, ViewOptions,
@@ -60,11 +61,11 @@ pub fn run(a: Args) -> CliResult {
     let trajectory = match &a.trajectory {
         None => None,
         Some(p) => {
-            let t = Table::read(p)?;
-            let table = robodyn::io::table::Table {
-                headers: t.headers,
-                rows: t.rows,
-                file: t.file,
+            // `-`: standard input
+            let table = if robodyn::io::is_stdio(p) {
+                Table::from_reader(std::io::stdin().lock(), "<stdin>")?
+            } else {
+                Table::read(p)?
             };
             let columns = match a.names.names {
                 Names::Frame => JointColumns::Frame,
