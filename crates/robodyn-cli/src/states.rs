@@ -70,19 +70,20 @@ pub struct Columns {
 
 /// Lowercase, without separators and leading zeros of numbers: `QDD_01` -> `qdd1`.
 fn normalized(s: &str) -> String {
-    let mut out = String::new();
-    let mut prev_digit = false;
-    for c in s
+    let chars: Vec<char> = s
         .chars()
         .filter(|c| !matches!(c, '_' | '-' | ' ' | '.' | '(' | ')' | '[' | ']'))
-    {
-        let c = c.to_ascii_lowercase();
-        if c == '0' && !prev_digit {
-            // a leading zero of a number (`qdd01`), but `0` itself stays
-            prev_digit = false;
+        .map(|c| c.to_ascii_lowercase())
+        .collect();
+    let mut out = String::new();
+    for (k, &c) in chars.iter().enumerate() {
+        let prev_digit =
+            k > 0 && chars[k - 1].is_ascii_digit() && out.ends_with(|p: char| p.is_ascii_digit());
+        let next_digit = chars.get(k + 1).is_some_and(char::is_ascii_digit);
+        // a leading zero of a number (`qdd01`) goes; `0` itself (`q0`) and `10` stay
+        if c == '0' && !prev_digit && next_digit {
             continue;
         }
-        prev_digit = c.is_ascii_digit();
         out.push(c);
     }
     out
