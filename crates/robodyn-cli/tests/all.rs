@@ -43,6 +43,8 @@ mod cli_outputs;
 mod cli_presentation;
 #[path = "cli_random_options.rs"]
 mod cli_random_options;
+#[path = "cli_readme.rs"]
+mod cli_readme;
 #[path = "cli_simulate_names.rs"]
 mod cli_simulate_names;
 #[path = "cli_view.rs"]

@@ -876,8 +876,11 @@ fn first_estimate(
     rows: usize,
     (names, access): (&[String], &ModelAccess),
 ) -> Result<(LsSolution, Option<Vec<f64>>)> {
+    // OLS first for every estimator: its rank check names the parameters without effect (a
+    // log that excites nothing) before the weights are formed
+    let ols = least_squares(&weighted(ts, None), rows, names)?;
     if estimator == Estimator::Ols {
-        return Ok((least_squares(&weighted(ts, None), rows, names)?, None));
+        return Ok((ols, None));
     }
     let sig = pass
         .fit
