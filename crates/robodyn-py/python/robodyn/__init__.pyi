@@ -143,6 +143,15 @@ class Robot:
         ``urdf_robot.with_values(M3=12.0)`` changes the mass of link 3 (kg)."""
     def save(self, path: Union[str, PathLike]) -> None:
         """Write the description (format by extension: .toml or .par)."""
+    def view(self, q: Optional[Sequence[float]] = None, trajectory: Optional[Union[str, PathLike, Tuple[Sequence[float], ArrayLike]]] = None, names: str = "frame") -> View:
+        """A 3D view of the robot (the page of ``robodyn view``): every frame's x and z axes
+        labelled j, the links along the geometric parameters, joints, fixed frames, cut joints
+        and their twin frames, the base and gravity, URDF meshes (STL) when found. ``q``: the
+        movable joints (rad or m), or a closed robot's actuated joints (passive joints by loop
+        closure); default q = 0, or a closed robot's assembly. ``trajectory``: a CSV file
+        (column ``t`` and ``q<j>``, or ``q_<name>`` with ``names="joint"``), or a pair
+        ``(t, Q)``, one row of Q (N, nq) per time in s. Returns a ``View`` (``.save(path)``,
+        shown inline in Jupyter)."""
     def to_toml(self) -> str:
         """The description as TOML text."""
 
@@ -282,6 +291,16 @@ class BaseParameters:
     json: str
     """The report as JSON text."""
     def __len__(self) -> int: ...
+
+class View:
+    """The page of ``robot.view()``: one self-contained HTML file (three.js embedded)."""
+    html: str
+    """The HTML text."""
+    warnings: List[str]
+    """What was drawn differently from the request (loops left open, meshes not found)."""
+    def save(self, path: Union[str, PathLike]) -> None:
+        """Write the page (all or nothing: a temporary file renamed into place)."""
+    def _repr_html_(self) -> str: ...
 
 class Generated:
     """A generated customized model."""
