@@ -7,9 +7,9 @@
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use robodyn::algorithms::energy::lagrangian_torques;
 use robodyn::algorithms::inverse_dynamics::rnea;
-use robodyn::testing::{self, random_state, random_tree, TreeOptions};
 use robodyn::{inverse_dynamics, inverse_dynamics_into};
 use robodyn::{Data, Robot};
+use robodyn_testing::{self as testing, random_state, random_tree, TreeOptions};
 use std::hint::black_box;
 use std::path::PathBuf;
 

@@ -64,10 +64,12 @@
 //! - `io` (feature `io`): robot files (TOML, SYMORO .par, URDF) with positioned errors;
 //! - `codegen` (feature `codegen`): customized symbolic models;
 //! - `view` (feature `view`): a 3D view of the frames, links and trajectories in one HTML page;
+//! - `identification` (feature `identification`): dynamic parameters from measured logs;
 //! - [`geometry`]: iT_j and 0T_j.
 //!
-//! Cargo features (default `io`, `plot`, `codegen`, `view`): `--no-default-features` builds the
-//! numeric dynamics alone; `testing` exposes the random-robot generator of the tests.
+//! Cargo features (default `io`, `plot`, `codegen`, `view`, `identification`):
+//! `--no-default-features` builds the numeric dynamics alone, and each feature builds alone. The
+//! random robots of the tests and benches are the separate crate `robodyn-testing`.
 
 // Joint and link numbers are 1-based indices into several parallel arrays (a(j), frames, links):
 // index loops read like the equations.
@@ -81,22 +83,18 @@ pub mod codegen;
 pub mod data;
 pub mod error;
 pub mod geometry;
+#[cfg(feature = "identification")]
 pub mod identification;
 #[cfg(feature = "io")]
 pub mod io;
 pub(crate) mod linalg;
 pub mod model;
 pub mod report;
+pub(crate) mod sampling;
 pub mod scalar;
 pub mod simulation;
-#[cfg(feature = "testing")]
-pub mod testing;
 #[cfg(feature = "view")]
 pub mod view;
-// The library's own samplers use the seeded generator without exposing the test helpers.
-#[cfg(not(feature = "testing"))]
-#[allow(dead_code)]
-pub(crate) mod testing;
 
 pub use algorithms::closed_chain::{
     closed_direct_dynamics, closed_direct_dynamics_into, closed_inertia_matrix_into,

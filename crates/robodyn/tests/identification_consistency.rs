@@ -190,7 +190,7 @@ fn gauss(r: &mut impl rand::Rng) -> f64 {
 /// inertias are not all consistent, so constraints are active) and the RX-90 with ZZ6 < 0,
 /// each with torque noise of 2 % of the joint's RMS torque (WLS).
 fn cross_check_problems() -> Vec<(String, ModelAccess, MemoryLog)> {
-    use robodyn::testing::{random_tree_description, rng, TreeOptions};
+    use robodyn_testing::{random_tree_description, rng, TreeOptions};
     let mut out = Vec::new();
     let mut noisy = |name: String, acc: ModelAccess, seed: u64| {
         let mut log = log(&acc);

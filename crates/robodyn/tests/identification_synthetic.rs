@@ -8,7 +8,7 @@ use robodyn::identification::data::{MemoryLog, RawSample};
 use robodyn::identification::excitation::{simulated_log, FourierTrajectory};
 use robodyn::identification::model_access::{load_description, ModelAccess};
 use robodyn::identification::{identify, Estimator, Identification, Options};
-use robodyn::testing::{random_tree_description, rng, TreeOptions};
+use robodyn_testing::{random_tree_description, rng, TreeOptions};
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 

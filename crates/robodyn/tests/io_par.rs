@@ -6,8 +6,8 @@ use rand::Rng;
 use robodyn::algorithms::inverse_dynamics::inverse_dynamics;
 use robodyn::io::{par, toml_format};
 use robodyn::model::param;
-use robodyn::testing::{self, TreeOptions};
 use robodyn::{Error, Expr, Robot, RobotDescription};
+use robodyn_testing::{self as testing, TreeOptions};
 use std::path::Path;
 
 fn robots() -> &'static Path {

@@ -5,12 +5,12 @@
 
 use nalgebra::DMatrix;
 use robodyn::algorithms::inverse_dynamics::rnea;
-use robodyn::testing::{self, random_state, random_tree, TreeOptions};
 use robodyn::{
     closed_direct_dynamics_into, closed_inverse_dynamics_into, direct_dynamics_into, h_vector_into,
     inertia_matrix_into, inverse_dynamics_into, loop_closure_into, regressor_into, ClosedChain,
     ClosedData, Data, Method,
 };
+use robodyn_testing::{self as testing, random_state, random_tree, TreeOptions};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 use std::path::PathBuf;

@@ -27,9 +27,9 @@ pub fn rx90_description() -> robodyn::RobotDescription {
     d.symbols.insert("RL4".into(), 0.45);
     d.symbols.insert("G3".into(), 9.81);
     d.gravity = [Expr::zero(), Expr::zero(), Expr::parse("-G3").unwrap()];
-    let mut r = robodyn::testing::rng(90);
+    let mut r = robodyn_testing::rng(90);
     for j in 1..=6 {
-        let p = robodyn::testing::random_inertial(&mut r);
+        let p = robodyn_testing::random_inertial(&mut r);
         let l = d.link_mut(j);
         for (k, v) in p.iter().enumerate() {
             l.params[k] = Expr::num(*v);

@@ -441,7 +441,7 @@ pub fn design(
         }),
         opt,
     };
-    let mut rng = crate::identification::model_access::seeded_rng(opt.seed);
+    let mut rng = crate::sampling::rng(opt.seed);
     let mut best: Option<(f64, Vec<f64>)> = None;
     for _ in 0..opt.restarts.max(1) {
         let x: Vec<f64> = (0..dim).map(|_| rng.random_range(-1.0..1.0)).collect();

@@ -287,7 +287,7 @@ impl ModelAccess {
         seed: u64,
         cols: &[usize],
     ) -> Result<Vec<([Vec<f64>; 3], Vec<f64>)>> {
-        let mut rng = seeded_rng(seed);
+        let mut rng = crate::sampling::rng(seed);
         let mut sampler: Box<dyn Sampler> = if self.robot.is_tree() {
             Box::new(TreeSampler)
         } else {
@@ -475,7 +475,7 @@ impl ModelAccess {
     /// configuration where it is smallest.
     pub fn min_inertia_eigenvalue(&self, k: &[f64], count: usize, seed: u64) -> Result<f64> {
         let robot = self.robot.with_standard_parameters(k)?;
-        let mut rng = seeded_rng(seed);
+        let mut rng = crate::sampling::rng(seed);
         let mut sampler: Box<dyn Sampler> = if robot.is_tree() {
             Box::new(TreeSampler)
         } else {
@@ -684,10 +684,4 @@ impl TrackingModel {
             TrackingModel::Closed(d) => d.accel(0.0, qa, qda, taua, qdda),
         }
     }
-}
-
-/// The seeded random generator of the sampled states (ChaCha8, as the tests' generator).
-pub fn seeded_rng(seed: u64) -> rand_chacha::ChaCha8Rng {
-    use rand::SeedableRng;
-    rand_chacha::ChaCha8Rng::seed_from_u64(seed)
 }

@@ -8,6 +8,7 @@
 
 use super::parameters::Kind;
 use super::Identification;
+#[cfg(feature = "plot")]
 use crate::error::Result;
 use crate::model::param;
 use crate::report::number::{format_number, Sig};

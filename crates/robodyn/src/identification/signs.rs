@@ -300,7 +300,7 @@ mod tests {
     #[test]
     fn signs_agree_with_point_masses() {
         use rand::Rng;
-        let mut rng = crate::identification::model_access::seeded_rng(3);
+        let mut rng = crate::sampling::rng(3);
         let (mut psd, mut indefinite) = (0, 0);
         for trial in 0..400 {
             let a = Matrix4::from_fn(|_, _| rng.random_range(-1.0..1.0));

@@ -527,7 +527,7 @@ pub fn numeric_base_parameters(
             MAX_OBSERVATION_BYTES as f64 / (1u64 << 30) as f64
         )));
     }
-    let mut rng = crate::testing::rng(opt.seed);
+    let mut rng = crate::sampling::rng(opt.seed);
     let model = robot.numeric();
     let mut ws = Data::new(robot);
     let mut phi = DMatrix::zeros(nl, PARAMS_PER_LINK * nl);
