@@ -15,7 +15,7 @@ use std::path::PathBuf;
 
 fn robots() -> Vec<(&'static str, Robot)> {
     let sr400 = robodyn::io::load(
-        &PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../robots/sr400.toml"),
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../robots/sr400.toml"),
     )
     .expect("robots/sr400.toml loads");
     // All 30 joints movable (revolute or prismatic), branching, general frames, friction and

@@ -18,7 +18,7 @@
 //! let robots = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots");
 //!
 //! // A serial robot from URDF: vectors hold its 6 movable joints in frame order.
-//! let rx90 = robodyn::io::load(format!("{robots}/rx90.urdf").as_ref())?;
+//! let rx90 = robodyn::io::load(format!("{robots}/rx90.urdf"))?;
 //! let n = rx90.dof();
 //! println!("joints: {:?}", rx90.coordinates().names());
 //! let (q, qd, qdd) = (vec![0.1; n], vec![0.2; n], vec![0.3; n]);
@@ -29,7 +29,7 @@
 //! assert_eq!(a.shape(), (n, n));
 //!
 //! // The Acma SR400, a closed chain: vectors hold the actuated joints (1, 2, 4, 5, 6, 7).
-//! let sr400 = robodyn::io::load(format!("{robots}/sr400.toml").as_ref())?;
+//! let sr400 = robodyn::io::load(format!("{robots}/sr400.toml"))?;
 //! let chain = ClosedChain::new(&sr400)?;
 //! let mut branch = chain.assembly_branch()?; // the parallelogram assembly of the file
 //! let qa = [0.1, 0.2, 0.3, 0.4, 0.5, 1.6];

@@ -15,7 +15,7 @@ fn robots() -> &'static Path {
 }
 
 fn load(name: &str) -> Robot {
-    robodyn::io::load(&robots().join(name)).unwrap_or_else(|e| panic!("{name}: {e}"))
+    robodyn::io::load(robots().join(name)).unwrap_or_else(|e| panic!("{name}: {e}"))
 }
 
 /// Largest torque difference over random states, relative to the largest torque.

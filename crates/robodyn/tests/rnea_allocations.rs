@@ -61,7 +61,7 @@ fn counter_counts() {
 
 fn robots() -> Vec<robodyn::Robot> {
     let sr400 = robodyn::io::load(
-        &PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../robots/sr400.toml"),
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../robots/sr400.toml"),
     )
     .unwrap();
     let mut rng = testing::rng(5);
@@ -162,7 +162,7 @@ fn closed_chain_steady_state_allocates_nothing() {
         ("twoloops.toml", 1.0),
     ] {
         let robot = robodyn::io::load(
-            &PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+            PathBuf::from(env!("CARGO_MANIFEST_DIR"))
                 .join("../../robots")
                 .join(file),
         )
@@ -234,7 +234,7 @@ fn closed_chain_steady_state_allocates_nothing() {
 #[test]
 fn closed_chain_long_moves_allocate_nothing() {
     let robot = robodyn::io::load(
-        &PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../robots/fourbar.toml"),
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../robots/fourbar.toml"),
     )
     .unwrap();
     let chain = ClosedChain::new(&robot).unwrap();

@@ -10,7 +10,7 @@ pub fn sr400_description() -> robodyn::RobotDescription {
     .expect("robots/sr400.toml loads")
 }
 
-/// Stäubli RX-90 geometry (conventions.md): alpha = {0, pi/2, 0, -pi/2, pi/2, -pi/2}, d3 = D3,
+/// Stäubli RX-90 geometry (as robots/rx90.toml): alpha = {0, pi/2, 0, -pi/2, pi/2, -pi/2}, d3 = D3,
 /// r4 = RL4; inertial parameters of a random physically consistent robot (fixed seed 90), rotor
 /// inertia and friction on every joint.
 #[allow(dead_code)]

@@ -21,10 +21,12 @@
 
 use super::conic;
 use super::estimators::LsSolution;
-use super::model_access::{ModelAccess, FS, FV, IA, PER_LINK};
+use super::model_access::ModelAccess;
 use super::parameters::{Kind, ParameterModel};
 use super::Consistent;
+use crate::algorithms::regressor::PARAMS_PER_LINK;
 use crate::error::{Error, Result};
+use crate::model::param::{FS, FV, IA};
 use faer::Mat;
 use nalgebra::{DMatrix, DVector, Matrix4};
 
@@ -54,9 +56,9 @@ struct Variables {
 
 impl Variables {
     fn new(model: &ParameterModel) -> Variables {
-        let nl = model.standard_count / PER_LINK;
+        let nl = model.standard_count / PARAMS_PER_LINK;
         let mut standard: Vec<usize> = (0..nl)
-            .flat_map(|j| (0..10).map(move |p| PER_LINK * j + p))
+            .flat_map(|j| (0..10).map(move |p| PARAMS_PER_LINK * j + p))
             .collect();
         let mut drives = Vec::new();
         let mut used: Vec<usize> = model
@@ -64,7 +66,7 @@ impl Variables {
             .iter()
             .flatten()
             .map(|(i, _)| *i)
-            .filter(|i| matches!(i % PER_LINK, IA | FS | FV))
+            .filter(|i| matches!(i % PARAMS_PER_LINK, IA | FS | FV))
             .collect();
         used.sort_unstable();
         used.dedup();
@@ -127,13 +129,13 @@ impl Variables {
 fn prior_weights(vars: &Variables, prior: &[f64]) -> Vec<f64> {
     let kind_max = |p: usize| -> f64 {
         (0..vars.nl)
-            .map(|j| prior[PER_LINK * j + p].abs())
+            .map(|j| prior[PARAMS_PER_LINK * j + p].abs())
             .fold(0.0, f64::max)
     };
     vars.standard
         .iter()
         .map(|&i| {
-            let m = kind_max(i % PER_LINK);
+            let m = kind_max(i % PARAMS_PER_LINK);
             if m > 0.0 {
                 let s = prior[i].abs().max(1e-3 * m);
                 1.0 / (s * s)
@@ -171,9 +173,9 @@ pub fn pseudo_inertia(k: &[f64]) -> Matrix4<f64> {
 
 /// Smallest eigenvalue of the pseudo-inertia matrices of all links.
 pub fn min_pseudo_inertia_eigenvalue(k: &[f64]) -> f64 {
-    (0..k.len() / PER_LINK)
+    (0..k.len() / PARAMS_PER_LINK)
         .map(|j| {
-            pseudo_inertia(&k[PER_LINK * j..PER_LINK * j + 10])
+            pseudo_inertia(&k[PARAMS_PER_LINK * j..PARAMS_PER_LINK * j + 10])
                 .symmetric_eigenvalues()
                 .min()
         })

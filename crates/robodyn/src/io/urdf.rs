@@ -4,7 +4,8 @@
 //! node, so each error names the line of the offending `<joint>`/`<link>`, and it does not reject
 //! the extension tags real URDFs carry (`<gazebo>`, `<transmission>`, ...).
 //!
-//! Conversion (exact, derived from first principles; conventions.md, eq 10.18):
+//! Conversion (exact, derived from first principles; frames as in §10.1 of the chapter, iT_j by
+//! gamma, b, alpha, d, theta, r, its position iP_j by eq 10.18):
 //! - joints are numbered depth-first from the root link (children in file order), so a(j) < j;
 //!   frame j keeps the URDF joint's name, link j the child link's name;
 //! - frame R_j is placed at the joint origin with z_j along the axis (minimal rotation S_j taking
