@@ -387,7 +387,7 @@ pub fn generate_with_progress(
     } else if desc.nj > desc.nl {
         description.push(
             "Closed robot: this is the model of the equivalent tree (loops cut); \
-             the closed-chain model (ModelKind::Closed) gives Gamma_cl"
+             the closed-chain model gives Gamma_cl"
                 .into(),
         );
     }
