@@ -35,7 +35,7 @@ pub fn warning_hint(w: &Warning) -> Option<&'static str> {
         WarningKind::IvNotConverged => {
             Some("more iterations: --iv-iterations; a slower tracking loop: --iv-bandwidth")
         }
-        WarningKind::PoorlyIdentified => Some("--essential drops the poorly identified parameters"),
+        WarningKind::PoorlyIdentified => Some("--essential drops them"),
         _ => None,
     }
 }
