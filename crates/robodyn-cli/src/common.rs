@@ -167,7 +167,7 @@ impl TableOutput {
     }
 }
 
-pub use robodyn::simulation::format_number;
+pub use robodyn::report::number::format_number;
 
 /// Write text to standard output (a closed pipe is an error [`is_broken_pipe`] recognizes).
 pub fn print_out(text: &str) -> CliResult {

@@ -15,6 +15,7 @@ macro_rules! outln {
 
 mod commands;
 mod common;
+mod hint;
 mod output;
 mod rows;
 mod states;
@@ -104,6 +105,9 @@ fn main() {
             std::process::exit(0);
         }
         eprintln!("robodyn: error: {e}");
+        if let Some(h) = hint::library_error(e.as_ref()).and_then(hint::hint) {
+            eprintln!("robodyn: hint: {h}");
+        }
         std::process::exit(1);
     }
 }

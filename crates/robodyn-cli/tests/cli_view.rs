@@ -278,7 +278,7 @@ fn trajectory_cases(dir: &Path) -> (Vec<Case>, Vec<PathBuf>) {
         ];
         let args: Vec<&str> = args.iter().map(String::as_str).collect();
         pages.push(make_page(dir, &name.replace(' ', "_"), &args));
-        let r = robodyn::io::load(robot(file).as_ref()).unwrap();
+        let r = robodyn::io::load(robot(file)).unwrap();
         cases.push(Case {
             name: name.into(),
             trajectory: Some(trajectory_rows(&r, csv)),

@@ -197,6 +197,10 @@ fn build(py: Python<'_>, e: Error) -> PyErr {
         }
         Error::BranchLost { .. } => BranchLost::new_err(msg),
         Error::Input(_) => InputError::new_err(msg),
+        Error::Setting { option, .. } => {
+            attrs.push(("option", s(option)));
+            InputError::new_err(msg)
+        }
         Error::Numerical(_) => NumericalError::new_err(msg),
         _ => RobodynError::new_err(msg),
     };

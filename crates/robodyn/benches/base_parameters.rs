@@ -9,8 +9,8 @@ use robodyn::algorithms::base_parameters::{
 use robodyn::algorithms::regressor::{
     tree_regressor, ParameterSelection, RotorMode, PARAMS_PER_LINK,
 };
-use robodyn::testing::{random_state, random_tree, rng, TreeOptions};
 use robodyn::Data;
+use robodyn_testing::{random_state, random_tree, rng, TreeOptions};
 
 fn bench(c: &mut Criterion) {
     let mut r = rng(30);

@@ -49,7 +49,7 @@ fn ur5() -> (String, Robot) {
 fn bench(c: &mut Criterion) {
     let (name, robot) = ur5();
     let n = robot.dof();
-    let mut r = robodyn::testing::rng(1);
+    let mut r = robodyn_testing::rng(1);
     let mut v = |s: f64| {
         (0..STATES * n)
             .map(|_| r.random_range(-s..s))

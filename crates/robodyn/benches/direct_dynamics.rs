@@ -4,8 +4,8 @@ use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use nalgebra::DMatrix;
 use robodyn::algorithms::direct_dynamics::{ddm_aba, ddm_composite};
 use robodyn::algorithms::inertia_matrix::composite_inertia_matrix;
-use robodyn::testing::{random_state, random_tree, rng, TreeOptions};
 use robodyn::{direct_dynamics_into, Data, Method};
+use robodyn_testing::{random_state, random_tree, rng, TreeOptions};
 use std::hint::black_box;
 
 fn bench(c: &mut Criterion) {

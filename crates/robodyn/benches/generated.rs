@@ -6,10 +6,10 @@
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use robodyn::algorithms::inverse_dynamics::rnea;
-use robodyn::testing::{random_state, rng};
 use robodyn::{
     closed_inverse_dynamics, closed_inverse_dynamics_into, ClosedChain, ClosedData, Data, Robot,
 };
+use robodyn_testing::{random_state, rng};
 use std::hint::black_box;
 
 mod robots {

@@ -7,10 +7,10 @@
 use criterion::{criterion_group, criterion_main, Criterion};
 use robodyn::identification::data::{MemoryLog, RawSample};
 use robodyn::identification::excitation::FourierTrajectory;
-use robodyn::identification::model_access::{load_description, ModelAccess};
+use robodyn::identification::model_access::ModelAccess;
 use robodyn::identification::parameters::{ParameterModel, ParameterOptions};
 use robodyn::identification::{identify, Estimator, Options};
-use std::collections::BTreeMap;
+use robodyn::io::load_description;
 
 const SAMPLES: usize = 100_000;
 
@@ -19,7 +19,7 @@ fn bench(c: &mut Criterion) {
         env!("CARGO_MANIFEST_DIR"),
         "/../../robots/rx90.toml"
     ));
-    let mut acc = ModelAccess::new(load_description(path, &BTreeMap::new()).unwrap()).unwrap();
+    let mut acc = ModelAccess::new(load_description(path).unwrap()).unwrap();
     let n = acc.actuated_joints().len();
     let free: Vec<f64> = (0..n * 8)
         .map(|k| 0.8 * ((k * 37 % 17) as f64 / 8.0 - 1.0))

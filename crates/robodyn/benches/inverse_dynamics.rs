@@ -7,15 +7,15 @@
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use robodyn::algorithms::energy::lagrangian_torques;
 use robodyn::algorithms::inverse_dynamics::rnea;
-use robodyn::testing::{self, random_state, random_tree, TreeOptions};
 use robodyn::{inverse_dynamics, inverse_dynamics_into};
 use robodyn::{Data, Robot};
+use robodyn_testing::{self as testing, random_state, random_tree, TreeOptions};
 use std::hint::black_box;
 use std::path::PathBuf;
 
 fn robots() -> Vec<(&'static str, Robot)> {
     let sr400 = robodyn::io::load(
-        &PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../robots/sr400.toml"),
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../robots/sr400.toml"),
     )
     .expect("robots/sr400.toml loads");
     // All 30 joints movable (revolute or prismatic), branching, general frames, friction and

@@ -4,7 +4,7 @@
 //!  cargo run --release -p robodyn --example base_parameters_scale -- N [write FILE.toml]
 //! ```
 //!
-//! Builds a random tree of N links (`robodyn::testing::random_tree`, seed 13) and runs the
+//! Builds a random tree of N links (`robodyn_testing::random_tree`, seed 13) and runs the
 //! numerical method with the selection of `robodyn base-params --method numeric` (rotor
 //! inertias on the actuated joints, friction), printing the count, the size of W and the time.
 //! With `write FILE.toml` it writes the tree instead, to time the CLI on it (with
@@ -13,7 +13,7 @@
 
 use robodyn::algorithms::base_parameters::{numeric_base_parameters, NumericOptions, TreeSampler};
 use robodyn::algorithms::regressor::{ParameterSelection, RotorMode};
-use robodyn::testing::{random_tree, rng, TreeOptions};
+use robodyn_testing::{random_tree, rng, TreeOptions};
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();

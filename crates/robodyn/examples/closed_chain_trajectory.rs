@@ -10,7 +10,7 @@ use robodyn::{closed_inverse_dynamics_into, ClosedChain, ClosedData};
 
 fn main() -> robodyn::Result<()> {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots/sr400.toml");
-    let robot = robodyn::io::load(path.as_ref())?;
+    let robot = robodyn::io::load(path)?;
     let chain = ClosedChain::new(&robot)?;
     let mut branch = chain.assembly_branch()?; // explicit branch state, owned here
     let mut data = ClosedData::new(&chain);

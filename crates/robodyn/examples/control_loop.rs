@@ -9,7 +9,7 @@ use robodyn::{inverse_dynamics_into, Data};
 
 fn main() -> robodyn::Result<()> {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots/rx90.urdf");
-    let robot = robodyn::io::load(path.as_ref())?;
+    let robot = robodyn::io::load(path)?;
     let n = robot.dof(); // the movable joints, in frame order
     let mut data = Data::new(&robot); // one per thread
     let mut env = robot.environment().clone(); // gravity, base motion, wrenches of the file

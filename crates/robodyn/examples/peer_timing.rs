@@ -105,7 +105,7 @@ fn batch(path: &Path, rows: usize) -> Result<(), Error> {
     use rand::Rng;
     let robot = load_robot(path)?;
     let n = robot.dof();
-    let mut r = robodyn::testing::rng(1);
+    let mut r = robodyn_testing::rng(1);
     let mut v = |s: f64| {
         (0..rows * n)
             .map(|_| r.random_range(-s..s))

@@ -13,7 +13,7 @@ use robodyn::{inverse_dynamics, regressor};
 
 fn main() -> robodyn::Result<()> {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots/rx90.urdf");
-    let robot = robodyn::io::load(path.as_ref())?;
+    let robot = robodyn::io::load(path)?;
     // inertial parameters only (URDF damping/friction would add FV, FS)
     let selection = ParameterSelection::new(&robot, RotorMode::None, false);
     let opt = NumericOptions {

@@ -189,6 +189,16 @@ pub enum Error {
         /// The operating system's error.
         source: Arc<std::io::Error>,
     },
+    /// An option of a computation does not fit the robot or the data: `option` names the field
+    /// of the options struct (`"identification::Options::estimator"`, ...), so that a front end
+    /// can say which of its own settings to change; the message says why in library terms.
+    #[error("{reason}")]
+    Setting {
+        /// The options field, as `module::Struct::field` (stable: front ends match on it).
+        option: &'static str,
+        /// Why, and what to choose instead.
+        reason: String,
+    },
     /// Other input data that do not fit the robot (message only).
     #[error("{0}")]
     Input(String),

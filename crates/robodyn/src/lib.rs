@@ -18,7 +18,7 @@
 //! let robots = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots");
 //!
 //! // A serial robot from URDF: vectors hold its 6 movable joints in frame order.
-//! let rx90 = robodyn::io::load(format!("{robots}/rx90.urdf").as_ref())?;
+//! let rx90 = robodyn::io::load(format!("{robots}/rx90.urdf"))?;
 //! let n = rx90.dof();
 //! println!("joints: {:?}", rx90.coordinates().names());
 //! let (q, qd, qdd) = (vec![0.1; n], vec![0.2; n], vec![0.3; n]);
@@ -29,7 +29,7 @@
 //! assert_eq!(a.shape(), (n, n));
 //!
 //! // The Acma SR400, a closed chain: vectors hold the actuated joints (1, 2, 4, 5, 6, 7).
-//! let sr400 = robodyn::io::load(format!("{robots}/sr400.toml").as_ref())?;
+//! let sr400 = robodyn::io::load(format!("{robots}/sr400.toml"))?;
 //! let chain = ClosedChain::new(&sr400)?;
 //! let mut branch = chain.assembly_branch()?; // the parallelogram assembly of the file
 //! let qa = [0.1, 0.2, 0.3, 0.4, 0.5, 1.6];
@@ -64,10 +64,12 @@
 //! - `io` (feature `io`): robot files (TOML, SYMORO .par, URDF) with positioned errors;
 //! - `codegen` (feature `codegen`): customized symbolic models;
 //! - `view` (feature `view`): a 3D view of the frames, links and trajectories in one HTML page;
+//! - `identification` (feature `identification`): dynamic parameters from measured logs;
 //! - [`geometry`]: iT_j and 0T_j.
 //!
-//! Cargo features (default `io`, `plot`, `codegen`, `view`): `--no-default-features` builds the
-//! numeric dynamics alone; `testing` exposes the random-robot generator of the tests.
+//! Cargo features (default `io`, `plot`, `codegen`, `view`, `identification`):
+//! `--no-default-features` builds the numeric dynamics alone, and each feature builds alone. The
+//! random robots of the tests and benches are the separate crate `robodyn-testing`.
 
 // Joint and link numbers are 1-based indices into several parallel arrays (a(j), frames, links):
 // index loops read like the equations.
@@ -81,22 +83,18 @@ pub mod codegen;
 pub mod data;
 pub mod error;
 pub mod geometry;
+#[cfg(feature = "identification")]
 pub mod identification;
 #[cfg(feature = "io")]
 pub mod io;
 pub(crate) mod linalg;
 pub mod model;
 pub mod report;
+pub(crate) mod sampling;
 pub mod scalar;
 pub mod simulation;
-#[cfg(feature = "testing")]
-pub mod testing;
 #[cfg(feature = "view")]
 pub mod view;
-// The library's own samplers use the seeded generator without exposing the test helpers.
-#[cfg(not(feature = "testing"))]
-#[allow(dead_code)]
-pub(crate) mod testing;
 
 pub use algorithms::closed_chain::{
     closed_direct_dynamics, closed_direct_dynamics_into, closed_inertia_matrix_into,

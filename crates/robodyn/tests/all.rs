@@ -89,6 +89,8 @@ mod io_urdf_pinocchio;
 mod loop_closure;
 #[path = "named_values.rs"]
 mod named_values;
+#[path = "no_cli_flags.rs"]
+mod no_cli_flags;
 #[path = "parallel_links.rs"]
 mod parallel_links;
 #[path = "properties.rs"]

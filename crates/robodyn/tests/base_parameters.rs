@@ -10,8 +10,8 @@ use robodyn::algorithms::base_parameters::{
 use robodyn::algorithms::regressor::{
     parameter_name, tree_regressor, ParameterSelection, RotorMode, PARAMS_PER_LINK,
 };
-use robodyn::testing::{random_inertial, random_tree, rng, TreeOptions};
 use robodyn::{Data, Expr, Robot, RobotDescription};
+use robodyn_testing::{random_inertial, random_tree, rng, TreeOptions};
 use std::f64::consts::FRAC_PI_2;
 
 fn sr400() -> Robot {

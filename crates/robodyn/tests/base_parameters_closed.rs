@@ -15,9 +15,9 @@ use robodyn::algorithms::regressor::{
     parameter_name, tree_regressor, tree_wrench_torques, ParameterSelection, RotorMode,
     PARAMS_PER_LINK,
 };
-use robodyn::testing::{random_inertial, rng};
 use robodyn::{closed_inverse_dynamics, inverse_dynamics, ClosedChain};
 use robodyn::{Data, Robot};
+use robodyn_testing::{random_inertial, rng};
 
 fn load(file: &str) -> Robot {
     let path = format!("{}/../../robots/{file}", env!("CARGO_MANIFEST_DIR"));

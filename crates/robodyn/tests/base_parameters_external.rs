@@ -281,7 +281,7 @@ fn symbols_of(d: &robodyn::RobotDescription) -> std::collections::BTreeSet<Strin
 fn idm_matches_lagrangian(desc: &robodyn::RobotDescription) -> f64 {
     use rand::Rng;
     let mut d = desc.clone();
-    let mut rng = robodyn::testing::rng(1212);
+    let mut rng = robodyn_testing::rng(1212);
     for s in symbols_of(&d) {
         d.symbols
             .entry(s)
@@ -445,7 +445,7 @@ fn external_description(file: &str) -> Option<(std::path::PathBuf, robodyn::Robo
 fn regular_assembly(robot: &robodyn::Robot) -> Vec<f64> {
     use rand::Rng;
     let chain = robodyn::ClosedChain::new(robot).unwrap();
-    let mut rng = robodyn::testing::rng(7);
+    let mut rng = robodyn_testing::rng(7);
     for _ in 0..200 {
         let qa: Vec<f64> = (0..chain.dof())
             .map(|_| rng.random_range(-1.5..1.5))
@@ -540,7 +540,7 @@ fn twoloops_twin_frame_on_a_twin_frame_closes_on_its_link() {
         );
         let b0 = chain.branch_from(&qa0, &qp0).unwrap();
         let fb0 = flat_chain.branch_from(&qa0, &qp0).unwrap();
-        let mut rng = robodyn::testing::rng(12);
+        let mut rng = robodyn_testing::rng(12);
         let mut worst_w: f64 = 0.0;
         for _ in 0..8 {
             let qa: Vec<f64> = qa0
@@ -675,7 +675,7 @@ fn generated_idm_drops_literal_zero_parameters_of_a_par() {
         "{cd:?} vs {ck:?}: dropping parameters must cut operations"
     );
     // numeric check against the IDM of the file (the literal zeros are zeros there)
-    let mut rng = robodyn::testing::rng(124);
+    let mut rng = robodyn_testing::rng(124);
     for _ in 0..5 {
         let mut d = desc.clone();
         for s in symbols_of(&d) {

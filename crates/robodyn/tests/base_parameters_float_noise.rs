@@ -49,14 +49,14 @@ fn check(label: &str, robot: &Robot) -> SymbolicBase {
 
 #[test]
 fn rx90_urdf_noise_is_dropped_and_the_rules_still_agree_with_numeric() {
-    let robot = robodyn::io::load(&bundled("rx90.urdf")).unwrap();
+    let robot = robodyn::io::load(bundled("rx90.urdf")).unwrap();
     check("rx90.urdf", &robot);
     // the RX-90 with its alpha = +-pi/2 as the floats +-1.5707963267948966 (cos = 6e-17)
     let float = Robot::new(float_rx90()).unwrap();
     let sb = check("rx90 (float angles)", &float);
     assert!(sb.dropped_float_terms > 0, "the float angles make noise");
     // the same robot from its exact .par: nothing to drop, same number of base parameters
-    let exact = robodyn::io::load(&bundled("rx90.par")).unwrap();
+    let exact = robodyn::io::load(bundled("rx90.par")).unwrap();
     let sel = ParameterSelection::new(&exact, RotorMode::Actuated, true);
     let se = symbolic_base_parameters(exact.description(), &sel).unwrap();
     assert_eq!(se.dropped_float_terms, 0);
@@ -72,7 +72,7 @@ fn exact_inputs_drop_nothing() {
         "tx40.toml",
         "torso2arms.toml",
     ] {
-        let desc = robodyn::io::load_description(&bundled(name)).unwrap();
+        let desc = robodyn::io::load_description(bundled(name)).unwrap();
         let sel = ParameterSelection::from_description(&desc, RotorMode::Actuated, true);
         let sb = symbolic_base_parameters(&desc, &sel).unwrap();
         assert_eq!(sb.dropped_float_terms, 0, "{name}");
@@ -96,7 +96,7 @@ fn the_tolerance_does_not_depend_on_the_length_unit() {
 
 /// robots/rx90.par with its angles as floats, its lengths as numbers.
 fn float_rx90() -> RobotDescription {
-    let mut d = robodyn::io::load_description(&bundled("rx90.par")).unwrap();
+    let mut d = robodyn::io::load_description(bundled("rx90.par")).unwrap();
     let env = d.symbols.clone();
     for f in d.frames.iter_mut() {
         for e in [&mut f.alpha, &mut f.b, &mut f.d, &mut f.r] {
@@ -120,7 +120,7 @@ fn scaled(desc: &RobotDescription, s: f64) -> RobotDescription {
 /// geometry, not noise (the numerical method sees it too, as a change of the grouping values).
 #[test]
 fn a_term_above_the_tolerance_is_kept() {
-    let desc = robodyn::io::load_description(&bundled("rx90.par")).unwrap();
+    let desc = robodyn::io::load_description(bundled("rx90.par")).unwrap();
     let sel = ParameterSelection::from_description(&desc, RotorMode::Actuated, true);
     let mut tilted = desc.clone();
     tilted.frame_mut(3).alpha = Expr::num(1e-7 + 1e-15);

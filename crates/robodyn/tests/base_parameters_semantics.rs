@@ -12,8 +12,8 @@ use robodyn::algorithms::base_parameters::{
     Summary, TreeSampler,
 };
 use robodyn::algorithms::regressor::{ParameterSelection, RotorMode, ZeroParameters};
-use robodyn::testing::{random_tree, rng, TreeOptions};
 use robodyn::{Expr, RobotDescription};
+use robodyn_testing::{random_tree, rng, TreeOptions};
 use std::path::Path;
 
 fn bundled(name: &str) -> RobotDescription {

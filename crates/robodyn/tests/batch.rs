@@ -4,11 +4,11 @@
 //! regressor times parameters plus wrench torques gives the Newton–Euler torques).
 
 use rand::Rng;
-use robodyn::testing::{random_tree, rng, TreeOptions};
 use robodyn::{
     direct_dynamics_batch, inverse_dynamics_batch, inverse_dynamics_into, regressor_batch, Data,
     Error, Method, Robot,
 };
+use robodyn_testing::{random_tree, rng, TreeOptions};
 
 fn states(robot: &Robot, rows: usize, seed: u64) -> [Vec<f64>; 3] {
     let mut r = rng(seed);

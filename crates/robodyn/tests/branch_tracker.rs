@@ -36,7 +36,7 @@ fn far_apart_rows(r: &Robot, range: f64, rows: usize, seed: u64) -> (f64, f64) {
     let qa0 = b.q_a().to_vec();
     let sign0 = det_sign(&cc, &mut b);
     assert_eq!(sign0, b.det_sign());
-    let mut rng = robodyn::testing::rng(seed);
+    let mut rng = robodyn_testing::rng(seed);
     let (mut gap, mut far): (f64, f64) = (0.0, 0.0);
     let mut previous = qa0.clone();
     let mut data = ClosedData::new(&cc);
@@ -102,7 +102,7 @@ fn sr400_rows_keep_the_parallelogram() {
     let r = robot("sr400.toml");
     let cc = ClosedChain::new(&r).unwrap();
     let mut b = cc.assembly_branch().unwrap();
-    let mut rng = robodyn::testing::rng(71);
+    let mut rng = robodyn_testing::rng(71);
     let wrap = |x: f64| (x + PI).rem_euclid(2.0 * PI) - PI;
     for row in 0..40 {
         let qa: Vec<f64> = b
@@ -186,7 +186,7 @@ fn external_or_skip(what: &str) -> Option<PathBuf> {
 /// consistent inertial parameters, no external wrench.
 fn opensymoro_sr400(path: &Path) -> robodyn::RobotDescription {
     let mut d = robodyn::io::load_description(path).unwrap();
-    let mut rng = robodyn::testing::rng(400);
+    let mut rng = robodyn_testing::rng(400);
     for (name, v) in [
         ("d2", 0.15),
         ("d3", 0.6),
@@ -198,7 +198,7 @@ fn opensymoro_sr400(path: &Path) -> robodyn::RobotDescription {
         d.symbols.insert(name.into(), v);
     }
     for j in 1..=d.nl {
-        let inertial = robodyn::testing::random_inertial(&mut rng);
+        let inertial = robodyn_testing::random_inertial(&mut rng);
         for (k, p) in ["XX", "XY", "XZ", "YY", "YZ", "ZZ", "MX", "MY", "MZ", "M"]
             .iter()
             .enumerate()

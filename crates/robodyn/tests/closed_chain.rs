@@ -58,7 +58,7 @@ fn rel(a: f64, b: f64, scale: f64) -> f64 {
 fn sr400_example_10_1_torque_relations() {
     let r = robot("sr400.toml");
     let cc = ClosedChain::new(&r).unwrap();
-    let mut rng = robodyn::testing::rng(10);
+    let mut rng = robodyn_testing::rng(10);
     let (qa0, qp0, range) = (ROBOTS[0].1, ROBOTS[0].2, ROBOTS[0].3);
     let mut worst: f64 = 0.0;
     for _ in 0..30 {
@@ -91,7 +91,7 @@ fn sr400_example_10_1_torque_relations() {
 
 #[test]
 fn virtual_power_and_lagrange_form() {
-    let mut rng = robodyn::testing::rng(11);
+    let mut rng = robodyn_testing::rng(11);
     for (name, r, qa0, qp0, range) in cases() {
         let cc = ClosedChain::new(&r).unwrap();
         let (mut w_vp, mut w_l): (f64, f64) = (0.0, 0.0);
@@ -136,7 +136,7 @@ fn energy(r: &Robot, s: &ClosedState) -> (f64, f64) {
 
 #[test]
 fn kinetic_energy_matches_a_cl() {
-    let mut rng = robodyn::testing::rng(12);
+    let mut rng = robodyn_testing::rng(12);
     for (name, r, qa0, qp0, range) in cases() {
         let cc = ClosedChain::new(&r).unwrap();
         let mut worst: f64 = 0.0;
@@ -168,7 +168,7 @@ fn kinetic_energy_matches_a_cl() {
 fn power_balance_matches_gamma_cl_along_smooth_paths() {
     // dE/dt = Γ_cl' qd_a without friction and external wrenches: checks G, Ψ and the projection
     // against energies computed from link velocities (no Newton–Euler involved).
-    let mut rng = robodyn::testing::rng(13);
+    let mut rng = robodyn_testing::rng(13);
     for (name, r, qa0, qp0, range) in cases() {
         let mut d = r.into_description();
         for l in d.links.iter_mut() {
@@ -217,7 +217,7 @@ fn power_balance_matches_gamma_cl_along_smooth_paths() {
 
 #[test]
 fn idm_of_ddm_is_identity() {
-    let mut rng = robodyn::testing::rng(14);
+    let mut rng = robodyn_testing::rng(14);
     for (name, r, qa0, qp0, range) in cases() {
         let cc = ClosedChain::new(&r).unwrap();
         let mut worst: f64 = 0.0;
@@ -283,10 +283,10 @@ fn bad_inputs_are_errors() {
         "{e}"
     );
     // a tree is not a closed chain
-    let tree = robodyn::testing::random_tree(
-        &mut robodyn::testing::rng(1),
+    let tree = robodyn_testing::random_tree(
+        &mut robodyn_testing::rng(1),
         3,
-        &robodyn::testing::TreeOptions::default(),
+        &robodyn_testing::TreeOptions::default(),
     );
     assert!(ClosedChain::new(&tree).is_err());
 }
@@ -408,7 +408,7 @@ fn a_cl_and_h_cl_match_newton_euler_columns() {
     // A_cl (10.46) uses the composite-link A_tr; here A_tr column i is rebuilt by Newton–Euler as
     // Γ_tr(q, 0, e_i) - Γ_tr(q, 0, 0) (gravity and wrenches cancel, friction is zero at qd = 0),
     // and H_cl (10.47) = G^T Γ_tr(q, qd_tr, qdd_tr(qdd_a = 0)).
-    let mut rng = robodyn::testing::rng(23);
+    let mut rng = robodyn_testing::rng(23);
     for (name, r, qa0, qp0, range) in cases() {
         let cc = ClosedChain::new(&r).unwrap();
         let nl = r.nl();

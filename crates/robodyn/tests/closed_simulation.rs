@@ -292,7 +292,7 @@ fn sr400_as_in_its_file_dissipates_its_friction_power() {
 fn idm_of_ddm_is_tau_for_all_bundled_closed_robots() {
     // The CLI's route: one branch tracker from the reference assembly, rows continued from the
     // previous row, ddm, then idm at the same state.
-    let mut rng = robodyn::testing::rng(41);
+    let mut rng = robodyn_testing::rng(41);
     for name in [
         "sr400.toml",
         "fourbar.toml",

@@ -23,9 +23,9 @@ use robodyn::algorithms::closed_chain::ClosedChain;
 use robodyn::algorithms::inverse_dynamics::rnea;
 use robodyn::codegen::{constant_g, generate, GenOptions, ModelKind};
 use robodyn::model::STANDARD_PARAMETERS;
-use robodyn::testing::{random_state, random_tree_description, rng, TreeOptions};
 use robodyn::{Data, Expr, Robot, RobotDescription};
 use robodyn_symbolic::{emit, parameter_fields, parameter_type, Lang, Program};
+use robodyn_testing::{random_state, random_tree_description, rng, TreeOptions};
 use std::collections::HashMap;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -851,7 +851,7 @@ fn sr400_constant_g_matches_example_10_1() {
     let g = constant_g(&robot).unwrap();
     assert_eq!(g, sr400_g());
     // a random tree has no loop: a clear error
-    let t = robodyn::testing::random_tree(&mut rng(5), 4, &TreeOptions::default());
+    let t = robodyn_testing::random_tree(&mut rng(5), 4, &TreeOptions::default());
     assert!(constant_g(&t).is_err());
 }
 

@@ -20,10 +20,10 @@ fn four_bar() -> RobotDescription {
     set(&mut d, 4, 2, 1.5, false);
     set(&mut d, 5, 3, 1.2, false);
     d.frame_mut(5).joint = JointType::Fixed;
-    let mut r = robodyn::testing::rng(4);
+    let mut r = robodyn_testing::rng(4);
     for j in 1..=3 {
         let mut l = LinkDesc::zero(format!("l{j}"));
-        for (k, v) in robodyn::testing::random_inertial(&mut r).iter().enumerate() {
+        for (k, v) in robodyn_testing::random_inertial(&mut r).iter().enumerate() {
             l.params[k] = Expr::num(*v);
         }
         d.links[j - 1] = l;
@@ -63,8 +63,8 @@ fn general_closed_chain_needs_a_closed_reference() {
     assert_eq!(prog.outputs.len(), 1);
     assert_eq!(prog.outputs[0].name, "GAMCL1");
     // the closed model of a tree is refused
-    let t = robodyn::testing::random_tree_description(
-        &mut robodyn::testing::rng(1),
+    let t = robodyn_testing::random_tree_description(
+        &mut robodyn_testing::rng(1),
         3,
         &Default::default(),
     );
@@ -115,8 +115,8 @@ fn base_file_errors_name_the_line() {
 
 #[test]
 fn emitters_are_well_formed() {
-    let d = robodyn::testing::random_tree_description(
-        &mut robodyn::testing::rng(3),
+    let d = robodyn_testing::random_tree_description(
+        &mut robodyn_testing::rng(3),
         3,
         &Default::default(),
     );

@@ -2,8 +2,8 @@
 //! code (an independent route: counting tokens of the printed code, not walking expressions).
 
 use robodyn::codegen::{generate, GenOptions, ModelKind};
-use robodyn::testing::{random_tree_description, rng, TreeOptions};
 use robodyn_symbolic::{emit, Lang};
+use robodyn_testing::{random_tree_description, rng, TreeOptions};
 
 /// Multiplications (`*`, `/`) and additions (binary `+`, `-`) of one C expression; a numeric
 /// literal `(p.0/q.0)` is one constant, a leading or nested unary minus is a sign change.

@@ -6,9 +6,9 @@
 
 use robodyn::codegen::{generate, parameter_values, BaseParameters, GenOptions};
 use robodyn::model::STANDARD_PARAMETERS;
-use robodyn::testing::{random_state, rng};
 use robodyn::{Robot, RobotDescription};
 use robodyn_symbolic::{emit, parameter_fields, parameter_type, Lang};
+use robodyn_testing::{random_state, rng};
 use std::path::Path;
 
 fn load(name: &str) -> RobotDescription {

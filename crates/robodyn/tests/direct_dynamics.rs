@@ -3,11 +3,11 @@
 
 use nalgebra::{DMatrix, DVector};
 use robodyn::model::{param, JointType};
-use robodyn::testing::{random_state, random_tree_description, rng, TreeOptions};
 use robodyn::{
     direct_dynamics, direct_dynamics_into, h_vector, inertia_matrix, inverse_dynamics_into, Data,
     Error, Expr, Method, Robot,
 };
+use robodyn_testing::{random_state, random_tree_description, rng, TreeOptions};
 
 const METHODS: [Method; 2] = [Method::Composite, Method::ArticulatedBody];
 

@@ -16,7 +16,7 @@ use std::collections::BTreeMap;
 
 fn rx90(values: &[(&str, f64)]) -> Robot {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots/rx90.toml");
-    let mut d = robodyn::io::load_description(path.as_ref()).unwrap();
+    let mut d = robodyn::io::load_description(path).unwrap();
     let v: BTreeMap<String, f64> = values.iter().map(|(k, x)| (k.to_string(), *x)).collect();
     set_values(&mut d, &v).unwrap();
     Robot::new(d).unwrap()

@@ -8,7 +8,7 @@
 mod folding;
 
 use rand::Rng;
-use robodyn::testing::{random_tree, rng, TreeOptions};
+use robodyn_testing::{random_tree, rng, TreeOptions};
 
 #[test]
 fn folded_model_equals_full_frame_list_on_random_trees() {

@@ -8,8 +8,8 @@ use nalgebra::{Matrix4, Vector3};
 use rand::Rng;
 use robodyn::geometry::{frame_transforms, local_transform};
 use robodyn::model::JointType;
-use robodyn::testing::{self, random_tree, TreeOptions};
 use robodyn::Robot;
+use robodyn_testing::{self as testing, random_tree, TreeOptions};
 use std::f64::consts::FRAC_PI_2;
 use std::path::PathBuf;
 

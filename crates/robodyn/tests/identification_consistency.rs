@@ -7,16 +7,16 @@
 use robodyn::identification::consistency::{min_pseudo_inertia_eigenvalue, pseudo_inertia};
 use robodyn::identification::data::MemoryLog;
 use robodyn::identification::excitation::{simulated_log, FourierTrajectory};
-use robodyn::identification::model_access::{load_description, save_description, ModelAccess};
+use robodyn::identification::model_access::ModelAccess;
 use robodyn::identification::{identify, Estimator, Options};
-use std::collections::BTreeMap;
+use robodyn::io::{load_description, save_description};
 use std::path::PathBuf;
 
 /// The RX-90 with friction on every joint (the file has none: true values at the boundary
 /// FS = FV = 0 of the consistent set would make rounding-level estimates "inconsistent").
 fn rx90() -> robodyn::RobotDescription {
     let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../robots/rx90.toml");
-    let mut d = load_description(&p, &BTreeMap::new()).unwrap();
+    let mut d = load_description(&p).unwrap();
     for (j, l) in d.links.iter_mut().enumerate() {
         l.params[11] = robodyn::Expr::num(0.5 + 0.1 * j as f64);
         l.params[12] = robodyn::Expr::num(0.3 + 0.05 * j as f64);
@@ -68,7 +68,7 @@ fn written_robot_is_consistent_and_reproduces_the_base_parameters() {
     let path = std::env::temp_dir().join(format!("robodyn-identified-{}.toml", std::process::id()));
     let desc = acc.description_with(&id.standard_parameters()).unwrap();
     save_description(&desc, &path).unwrap();
-    let reloaded = ModelAccess::new(load_description(&path, &BTreeMap::new()).unwrap()).unwrap();
+    let reloaded = ModelAccess::new(load_description(&path).unwrap()).unwrap();
     std::fs::remove_file(&path).ok();
     let k = reloaded.standard_parameters();
     let x = id.model.values(&k);
@@ -190,7 +190,7 @@ fn gauss(r: &mut impl rand::Rng) -> f64 {
 /// inertias are not all consistent, so constraints are active) and the RX-90 with ZZ6 < 0,
 /// each with torque noise of 2 % of the joint's RMS torque (WLS).
 fn cross_check_problems() -> Vec<(String, ModelAccess, MemoryLog)> {
-    use robodyn::testing::{random_tree_description, rng, TreeOptions};
+    use robodyn_testing::{random_tree_description, rng, TreeOptions};
     let mut out = Vec::new();
     let mut noisy = |name: String, acc: ModelAccess, seed: u64| {
         let mut log = log(&acc);

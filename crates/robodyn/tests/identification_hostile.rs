@@ -5,16 +5,16 @@
 
 use robodyn::identification::data::{Effort, LogSource, MemoryLog, RawSample};
 use robodyn::identification::excitation::{simulated_log, FourierTrajectory};
-use robodyn::identification::model_access::{load_description, ModelAccess};
+use robodyn::identification::model_access::ModelAccess;
 use robodyn::identification::{identify, EssentialOptions, Estimator, Options};
+use robodyn::io::load_description;
 use robodyn::{Error, Result};
 use std::cell::Cell;
-use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 fn scara() -> ModelAccess {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../robots/scara.toml");
-    ModelAccess::new(load_description(&path, &BTreeMap::new()).unwrap()).unwrap()
+    ModelAccess::new(load_description(&path).unwrap()).unwrap()
 }
 
 /// 8 s of the SCARA tracking a Fourier trajectory, sampled at 250 Hz (noise-free: every row

@@ -6,10 +6,10 @@
 use rand::Rng;
 use robodyn::identification::data::{MemoryLog, RawSample};
 use robodyn::identification::excitation::{simulated_log, FourierTrajectory};
-use robodyn::identification::model_access::{load_description, ModelAccess};
+use robodyn::identification::model_access::ModelAccess;
 use robodyn::identification::{identify, Estimator, Identification, Options};
-use robodyn::testing::{random_tree_description, rng, TreeOptions};
-use std::collections::BTreeMap;
+use robodyn::io::load_description;
+use robodyn_testing::{random_tree_description, rng, TreeOptions};
 use std::path::PathBuf;
 
 fn robot_path(name: &str) -> PathBuf {
@@ -19,7 +19,7 @@ fn robot_path(name: &str) -> PathBuf {
 }
 
 fn access(name: &str) -> ModelAccess {
-    ModelAccess::new(load_description(&robot_path(name), &BTreeMap::new()).unwrap()).unwrap()
+    ModelAccess::new(load_description(robot_path(name)).unwrap()).unwrap()
 }
 
 /// A random Fourier trajectory (seeded) around `start`, velocity amplitude ~ `amp` w.

@@ -4,9 +4,9 @@
 //! fails where `ROBODYN_REQUIRE` requires the `shared` check (CI: `tests/common/harness.rs`).
 
 use robodyn::identification::data::{CsvLog, JointLabels};
-use robodyn::identification::model_access::{load_description, ModelAccess};
+use robodyn::identification::model_access::ModelAccess;
 use robodyn::identification::{identify, Options};
-use std::collections::BTreeMap;
+use robodyn::io::load_description;
 use std::path::PathBuf;
 
 fn data() -> Option<PathBuf> {
@@ -21,7 +21,7 @@ fn data() -> Option<PathBuf> {
 fn tx40() -> Option<(ModelAccess, CsvLog)> {
     let path = data()?;
     let robot = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../robots/tx40.toml");
-    let acc = ModelAccess::new(load_description(&robot, &BTreeMap::new()).unwrap()).unwrap();
+    let acc = ModelAccess::new(load_description(&robot).unwrap()).unwrap();
     let labels = JointLabels {
         numbers: acc.actuated_joints().to_vec(),
         names: acc.joint_names(),

@@ -6,11 +6,11 @@ use nalgebra::{DMatrix, DVector, Vector3};
 use robodyn::algorithms::inertia_matrix::composite_inertia_matrix;
 use robodyn::algorithms::inverse_dynamics::rnea;
 use robodyn::model::{param, DynModel, JointType, LinkDesc, RobotDescription};
-use robodyn::testing::{random_state, random_tree, random_tree_description, rng, TreeOptions};
 use robodyn::{
     h_vector, h_vector_into, inertia_matrix, inertia_matrix_into, inverse_dynamics, Data, Expr,
     Robot,
 };
+use robodyn_testing::{random_state, random_tree, random_tree_description, rng, TreeOptions};
 
 /// The same robot with g = 0, no friction and no external wrench (rotor inertia kept), fixed base.
 fn inertial_only(robot: &Robot) -> Robot {

@@ -18,9 +18,9 @@ use robodyn::algorithms::energy::{
     wrench_power,
 };
 use robodyn::model::JointType;
-use robodyn::testing::{self, random_state, random_tree_description, TreeOptions};
 use robodyn::{inverse_dynamics, inverse_dynamics_into};
 use robodyn::{Data, Error, Expr, Robot, RobotDescription};
+use robodyn_testing::{self as testing, random_state, random_tree_description, TreeOptions};
 use std::path::PathBuf;
 
 /// Tolerance of the Lagrangian vs Newton–Euler comparison (issue 2).

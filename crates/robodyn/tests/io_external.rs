@@ -97,14 +97,14 @@ fn python_booleans_and_atan2_are_read_as_opensymoro_reads_them() {
     let dir = external();
     // `is_mobile = False`
     let (d, _) =
-        robodyn::io::load_description_mapped(&dir.join("symoro-robots/planar2r.par")).unwrap();
+        robodyn::io::load_description_mapped(dir.join("symoro-robots/planar2r.par")).unwrap();
     let (d0, _) =
-        robodyn::io::load_description_mapped(&dir.join("derived/planar2r_is_mobile0.par")).unwrap();
+        robodyn::io::load_description_mapped(dir.join("derived/planar2r_is_mobile0.par")).unwrap();
     assert!(!d.mobile_base);
     assert_eq!(d, d0);
     // `gamma = {..., -atan2(b, d6) + pi}`: the twin frame 12 points back along the link
     let (d, _) = robodyn::io::load_description_mapped(
-        &dir.join("opensymoro-symoro-history/TwoLoops_0e10e3e.par"),
+        dir.join("opensymoro-symoro-history/TwoLoops_0e10e3e.par"),
     )
     .unwrap();
     let g = &d.frames[11].gamma;

@@ -6,8 +6,8 @@ use rand::Rng;
 use robodyn::algorithms::inverse_dynamics::inverse_dynamics;
 use robodyn::io::{par, toml_format};
 use robodyn::model::param;
-use robodyn::testing::{self, TreeOptions};
 use robodyn::{Error, Expr, Robot, RobotDescription};
+use robodyn_testing::{self as testing, TreeOptions};
 use std::path::Path;
 
 fn robots() -> &'static Path {
@@ -15,7 +15,7 @@ fn robots() -> &'static Path {
 }
 
 fn load(name: &str) -> Robot {
-    robodyn::io::load(&robots().join(name)).unwrap_or_else(|e| panic!("{name}: {e}"))
+    robodyn::io::load(robots().join(name)).unwrap_or_else(|e| panic!("{name}: {e}"))
 }
 
 /// Largest torque difference over random states, relative to the largest torque.

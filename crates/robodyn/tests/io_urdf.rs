@@ -8,7 +8,8 @@ use nalgebra::{Matrix3, Vector3};
 use rand::Rng;
 use robodyn::geometry::frame_transforms;
 use robodyn::model::param;
-use robodyn::{testing, Robot};
+use robodyn::Robot;
+use robodyn_testing as testing;
 use std::f64::consts::FRAC_PI_2;
 
 fn rx(a: f64) -> Matrix3<f64> {

@@ -7,7 +7,8 @@
 
 use robodyn::algorithms::inverse_dynamics::inverse_dynamics;
 use robodyn::model::param;
-use robodyn::{testing, Expr, Robot};
+use robodyn::{Expr, Robot};
+use robodyn_testing as testing;
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 use std::process::Command;

@@ -59,7 +59,7 @@ fn sr400_example_10_1() {
     let lc = ClosedChain::new(&r).unwrap();
     assert_eq!(lc.coordinates().frames(), &[1, 2, 4, 5, 6, 7]);
     assert_eq!(lc.passive_coordinates().frames(), &[3, 8]);
-    let mut rng = robodyn::testing::rng(1);
+    let mut rng = robodyn_testing::rng(1);
     let mut worst: f64 = 0.0;
     for _ in 0..50 {
         let qa: Vec<f64> = (0..6).map(|_| rng.random_range(-1.5..1.5)).collect();
@@ -109,7 +109,7 @@ fn bundled_robots_close_at_reference_with_rank_chosen_rows() {
 
 #[test]
 fn random_solutions_close_the_loops_as_frames() {
-    let mut rng = robodyn::testing::rng(2);
+    let mut rng = robodyn_testing::rng(2);
     for (name, r, qa0, qp0, range) in cases() {
         let lc = ClosedChain::new(&r).unwrap();
         for _ in 0..10 {
@@ -135,7 +135,7 @@ fn random_solutions_close_the_loops_as_frames() {
 
 #[test]
 fn w_matches_finite_differences_of_the_closure_solution() {
-    let mut rng = robodyn::testing::rng(3);
+    let mut rng = robodyn_testing::rng(3);
     for (name, r, qa0, qp0, range) in cases() {
         let lc = ClosedChain::new(&r).unwrap().with_tolerance(1e-14);
         let mut worst: f64 = 0.0;
@@ -169,7 +169,7 @@ fn w_matches_finite_differences_of_the_closure_solution() {
 
 #[test]
 fn psi_matches_second_derivative_along_smooth_paths() {
-    let mut rng = robodyn::testing::rng(4);
+    let mut rng = robodyn_testing::rng(4);
     for (name, r, qa0, qp0, range) in cases() {
         let lc = ClosedChain::new(&r).unwrap().with_tolerance(1e-14);
         let mut worst: f64 = 0.0;
@@ -298,7 +298,7 @@ fn prismatic_cut_slider_crank_closed_form() {
     let r = slider_crank();
     let lc = ClosedChain::new(&r).unwrap();
     assert_eq!(lc.loops()[0].rows.len(), 2);
-    let mut rng = robodyn::testing::rng(5);
+    let mut rng = robodyn_testing::rng(5);
     let mut b = lc.branch_from(&[0.0], &[0.0, 0.0]).unwrap();
     let mut worst: f64 = 0.0;
     for s in 1..=36 {

@@ -21,7 +21,7 @@ fn values(v: &[(&str, f64)]) -> BTreeMap<String, f64> {
 
 #[test]
 fn urdf_standard_parameters_are_set_by_name() {
-    let mut d = load_description(&file("rx90.urdf")).unwrap();
+    let mut d = load_description(file("rx90.urdf")).unwrap();
     let before = Robot::new(d.clone()).unwrap().standard_parameters();
     let names = ParameterNames::of(&d);
     set_values(&mut d, &values(&[("M3", 100.0), ("FS2", 0.7)])).unwrap();
@@ -37,7 +37,7 @@ fn urdf_standard_parameters_are_set_by_name() {
 
 #[test]
 fn symbols_are_set_and_unknown_names_refused() {
-    let mut d = load_description(&file("rx90.toml")).unwrap();
+    let mut d = load_description(file("rx90.toml")).unwrap();
     set_values(&mut d, &values(&[("D3", 0.5)])).unwrap();
     assert_eq!(d.symbols["D3"], 0.5);
     let kept = d.clone();
@@ -55,9 +55,9 @@ fn symbols_are_set_and_unknown_names_refused() {
     let e = set_values(&mut d, &values(&[("D3", f64::NAN)])).unwrap_err();
     assert!(e.to_string().contains("not a finite number"), "{e}");
     // the loaders apply the same rule
-    let e = robodyn::io::load_with(&file("rx90.urdf"), &values(&[("FOO", 1.0)])).unwrap_err();
+    let e = robodyn::io::load_with(file("rx90.urdf"), &values(&[("FOO", 1.0)])).unwrap_err();
     assert!(e.to_string().contains("no symbol `FOO`"), "{e}");
-    let r = robodyn::io::load_with(&file("rx90.urdf"), &values(&[("M3", 7.0)])).unwrap();
+    let r = robodyn::io::load_with(file("rx90.urdf"), &values(&[("M3", 7.0)])).unwrap();
     assert_eq!(r.standard_parameters()[13 * 2 + 9], 7.0);
 }
 

@@ -8,8 +8,8 @@ use robodyn::algorithms::inverse_dynamics::{
     backward_recursion, backward_recursion_sharing, forward_recursion_sharing, rnea,
 };
 use robodyn::codegen::parallel_links;
-use robodyn::testing::rng;
 use robodyn::Data;
+use robodyn_testing::rng;
 
 /// Example 10.1: theta3 = theta7 + pi/2 - theta2 and theta8 = theta2 - theta7, so link 3 keeps
 /// the orientation of link 7 (up to a quarter turn; link 7, one joint from the base, is the

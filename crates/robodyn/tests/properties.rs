@@ -7,8 +7,8 @@ use nalgebra::DVector;
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed};
 use robodyn::algorithms::energy::lagrangian_torques;
-use robodyn::testing::{random_state, random_tree, rng, TreeOptions};
 use robodyn::{direct_dynamics, inverse_dynamics, regressor, wrench_torques, Method, Robot};
+use robodyn_testing::{random_state, random_tree, rng, TreeOptions};
 
 fn config() -> Config {
     Config {

@@ -2,8 +2,8 @@
 
 use nalgebra::DVector;
 use robodyn::algorithms::regressor::PARAMS_PER_LINK;
-use robodyn::testing::{random_state, random_tree, rng, TreeOptions};
 use robodyn::{inverse_dynamics, regressor, wrench_torques};
+use robodyn_testing::{random_state, random_tree, rng, TreeOptions};
 
 #[test]
 fn regressor_times_standard_parameters_is_newton_euler() {

@@ -5,12 +5,12 @@
 
 use nalgebra::DMatrix;
 use robodyn::algorithms::inverse_dynamics::rnea;
-use robodyn::testing::{self, random_state, random_tree, TreeOptions};
 use robodyn::{
     closed_direct_dynamics_into, closed_inverse_dynamics_into, direct_dynamics_into, h_vector_into,
     inertia_matrix_into, inverse_dynamics_into, loop_closure_into, regressor_into, ClosedChain,
     ClosedData, Data, Method,
 };
+use robodyn_testing::{self as testing, random_state, random_tree, TreeOptions};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 use std::path::PathBuf;
@@ -61,7 +61,7 @@ fn counter_counts() {
 
 fn robots() -> Vec<robodyn::Robot> {
     let sr400 = robodyn::io::load(
-        &PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../robots/sr400.toml"),
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../robots/sr400.toml"),
     )
     .unwrap();
     let mut rng = testing::rng(5);
@@ -162,7 +162,7 @@ fn closed_chain_steady_state_allocates_nothing() {
         ("twoloops.toml", 1.0),
     ] {
         let robot = robodyn::io::load(
-            &PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+            PathBuf::from(env!("CARGO_MANIFEST_DIR"))
                 .join("../../robots")
                 .join(file),
         )
@@ -234,7 +234,7 @@ fn closed_chain_steady_state_allocates_nothing() {
 #[test]
 fn closed_chain_long_moves_allocate_nothing() {
     let robot = robodyn::io::load(
-        &PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../robots/fourbar.toml"),
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../robots/fourbar.toml"),
     )
     .unwrap();
     let chain = ClosedChain::new(&robot).unwrap();

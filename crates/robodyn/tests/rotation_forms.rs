@@ -6,7 +6,7 @@
 use nalgebra::{Matrix3, Vector3};
 use rand::Rng;
 use robodyn::model::{inertia_to_antecedent, RotationForm};
-use robodyn::testing::{random_tree, rng, TreeOptions};
+use robodyn_testing::{random_tree, rng, TreeOptions};
 
 fn rel(a: f64, b: f64) -> f64 {
     (a - b).abs() / (1.0 + b.abs())

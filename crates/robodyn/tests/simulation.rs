@@ -8,8 +8,8 @@ use robodyn::simulation::{
     plot_svg, simulate, CsvSink, Dynamics, Integrator, Ode, Recorder, SimOptions, Stepper,
     TimeSeries, TorqueInput, TreeDynamics,
 };
-use robodyn::testing::{random_state, random_tree_description, rng, TreeOptions};
 use robodyn::{Error, Expr, Robot};
+use robodyn_testing::{random_state, random_tree_description, rng, TreeOptions};
 use std::path::PathBuf;
 
 /// y0' = y1, y1' = -y0: y = [cos t, -sin t].

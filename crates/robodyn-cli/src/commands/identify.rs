@@ -295,6 +295,9 @@ pub fn run(a: Args) -> CliResult {
             eprintln!("robodyn: warning: {w}");
         }
     }
+    for h in id.warnings.iter().filter_map(crate::hint::warning_hint) {
+        eprintln!("robodyn: hint: {h}");
+    }
     if a.strict && !id.warnings.is_empty() {
         return Err(format!(
             "--strict: the identification has {} warning(s)",

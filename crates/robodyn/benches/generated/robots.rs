@@ -10,7 +10,7 @@ pub fn sr400_description() -> robodyn::RobotDescription {
     .expect("robots/sr400.toml loads")
 }
 
-/// Stäubli RX-90 geometry (conventions.md): alpha = {0, pi/2, 0, -pi/2, pi/2, -pi/2}, d3 = D3,
+/// Stäubli RX-90 geometry (as robots/rx90.toml): alpha = {0, pi/2, 0, -pi/2, pi/2, -pi/2}, d3 = D3,
 /// r4 = RL4; inertial parameters of a random physically consistent robot (fixed seed 90), rotor
 /// inertia and friction on every joint.
 #[allow(dead_code)]
@@ -27,9 +27,9 @@ pub fn rx90_description() -> robodyn::RobotDescription {
     d.symbols.insert("RL4".into(), 0.45);
     d.symbols.insert("G3".into(), 9.81);
     d.gravity = [Expr::zero(), Expr::zero(), Expr::parse("-G3").unwrap()];
-    let mut r = robodyn::testing::rng(90);
+    let mut r = robodyn_testing::rng(90);
     for j in 1..=6 {
-        let p = robodyn::testing::random_inertial(&mut r);
+        let p = robodyn_testing::random_inertial(&mut r);
         let l = d.link_mut(j);
         for (k, v) in p.iter().enumerate() {
             l.params[k] = Expr::num(*v);

@@ -806,7 +806,7 @@ pub fn loop_closure_into(
 /// use robodyn::{geometry::frame_transforms, loop_closure, ClosedChain};
 /// # fn main() -> robodyn::Result<()> {
 /// let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots/fourbar.toml");
-/// let robot = robodyn::io::load(path.as_ref())?;
+/// let robot = robodyn::io::load(path)?;
 /// let chain = ClosedChain::new(&robot)?;
 /// let mut branch = chain.assembly_branch()?; // closed at q = 0
 /// for q1 in [2.5, -2.0, 0.7] {
@@ -875,7 +875,7 @@ pub fn closed_state(
 /// use robodyn::{closed_inverse_dynamics_into, ClosedChain, ClosedData};
 /// # fn main() -> robodyn::Result<()> {
 /// let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots/sr400.toml");
-/// let sr400 = robodyn::io::load(path.as_ref())?;
+/// let sr400 = robodyn::io::load(path)?;
 /// let chain = ClosedChain::new(&sr400)?; // vectors over the actuated joints 1, 2, 4, 5, 6, 7
 /// let mut data = ClosedData::new(&chain);
 /// let mut branch = chain.assembly_branch()?; // the parallelogram assembly of the file

@@ -448,7 +448,7 @@ pub fn direct_dynamics_into(
 /// use robodyn::{direct_dynamics, h_vector, inertia_matrix, inverse_dynamics, Method};
 /// # fn main() -> robodyn::Result<()> {
 /// let urdf = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots/rx90.urdf");
-/// let robot = robodyn::io::load(urdf.as_ref())?;
+/// let robot = robodyn::io::load(urdf)?;
 /// let q = [0.1, -0.4, 1.2, 0.3, -0.7, 0.2];
 /// let qd = [0.5, 0.1, -0.3, 0.8, 0.2, -0.6];
 /// let tau = [1.0, 20.0, 5.0, 0.5, 0.3, 0.1]; // N m

@@ -3,7 +3,7 @@
 //! automatic differentiation (hyper-dual numbers, exact to rounding).
 //!
 //! Independent of the Newton–Euler recursion (it shares only the frame transforms iA_j, iP_j),
-//! so the two routes cross-check each other. Conventions (`conventions.md`):
+//! so the two routes cross-check each other. Conventions (chapter 10, §10.2.1):
 //! - link j's kinetic energy about O_j in R_j, `E_j = 1/2 (M V'V + 2 V'(w x MS) + w'J w)`
 //!   ([9.16]), plus the rotor's `1/2 Ia_j qd_j^2`;
 //! - potential energy `U_j = -g'(M_j 0P_j + 0A_j jMS_j)` ([9.25]);

@@ -172,7 +172,7 @@ impl LoopClosure {
             )));
         }
         // Generic rank at random configurations (fixed seed: the choice is reproducible).
-        let mut rng = <rand_chacha::ChaCha8Rng as rand::SeedableRng>::seed_from_u64(0x100b_c105);
+        let mut rng = crate::sampling::rng(0x100b_c105);
         let mut ws = lc.workspace();
         let mut random_jacobian = |lc: &LoopClosure, ws: &mut LoopWorkspace| {
             let q: Vec<f64> = (0..nl).map(|_| rng.random_range(-3.0..3.0)).collect();

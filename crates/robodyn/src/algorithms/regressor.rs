@@ -378,7 +378,7 @@ pub fn wrench_torques_into(
 /// use robodyn::{inverse_dynamics, regressor, wrench_torques};
 /// # fn main() -> robodyn::Result<()> {
 /// let urdf = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots/rx90.urdf");
-/// let robot = robodyn::io::load(urdf.as_ref())?;
+/// let robot = robodyn::io::load(urdf)?;
 /// let (q, qd, qdd) = ([0.3, -0.2, 0.9, 0.1, 0.4, -0.5], [0.2; 6], [-0.4; 6]);
 /// let phi = regressor(&robot, &q, &qd, &qdd)?; // 6 x 78
 /// let k = nalgebra::DVector::from_vec(robot.standard_parameters());

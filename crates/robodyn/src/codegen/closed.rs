@@ -96,7 +96,7 @@ pub fn constant_g(robot: &Robot) -> Result<DMatrix<f64>> {
     let act = robot.actuated_joints();
     let mut unk = robot.passive_joints();
     unk.extend(nl + 1..=nj);
-    let mut rng = crate::testing::rng(7);
+    let mut rng = crate::sampling::rng(7);
     let g_at = |q: &[f64]| -> Result<DMatrix<f64>> {
         let ja = jacobian(robot, q, &act);
         let jp = jacobian(robot, q, &unk);

@@ -168,7 +168,7 @@ fn symbolic_model(desc: &RobotDescription, opt: &GenOptions) -> Result<DynModel<
         e.eval(&env).map(Expr::num).map_err(|err| {
             Error::invalid(
                 item(),
-                format!("`{e}` has no numeric value for --numeric: {err}"),
+                format!("`{e}` has no numeric value (a numeric model needs every symbol's value): {err}"),
             )
         })
     };
@@ -298,7 +298,7 @@ pub(crate) fn pair_name(prefix: &str, i: usize, j: usize) -> String {
 /// use robodyn_symbolic::{emit, Lang};
 /// # fn main() -> robodyn::Result<()> {
 /// let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots/rx90.toml");
-/// let desc = robodyn::io::load_description(path.as_ref())?;
+/// let desc = robodyn::io::load_description(path)?;
 /// let opt = GenOptions { model: ModelKind::Idm, numeric: true, ..GenOptions::default() };
 /// let program = generate(&desc, &opt)?;
 /// let ops = program.count();
@@ -387,7 +387,7 @@ pub fn generate_with_progress(
     } else if desc.nj > desc.nl {
         description.push(
             "Closed robot: this is the model of the equivalent tree (loops cut); \
-             --model closed gives Gamma_cl"
+             the closed-chain model gives Gamma_cl"
                 .into(),
         );
     }
@@ -711,12 +711,15 @@ impl BaseParameters {
             .with_zero_parameters(desc, zeros);
         let sb = symbolic_base_parameters(desc, &sel)?;
         if !sb.unhandled_loops.is_empty() {
-            return Err(Error::Input(format!(
-                "the symbolic grouping rules do not cover the loops cut at joints {:?} (not \
-                 parallelograms): compute the base parameters with `robodyn base-params \
-                 --method numeric` and pass them with --base-file",
-                sb.unhandled_loops
-            )));
+            return Err(Error::Setting {
+                option: "codegen::GenOptions::base",
+                reason: format!(
+                    "the symbolic grouping rules do not cover the loops cut at joints {:?} (not \
+                     parallelograms): compute the base parameters with the numerical method and \
+                     give them as the model's base parameters",
+                    sb.unhandled_loops
+                ),
+            });
         }
         let selected: BTreeSet<usize> = sel.columns().into_iter().collect();
         let mut out = BaseParameters::default();

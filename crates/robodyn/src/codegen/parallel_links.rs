@@ -28,7 +28,7 @@ pub fn parallel_links(robot: &Robot) -> Result<Vec<Option<SharedOrientation<f64>
         return Ok(vec![None; nl]);
     }
     let mut sampler = ClosedChainSampler::new(robot)?;
-    let mut rng = crate::testing::rng(10_55);
+    let mut rng = crate::sampling::rng(10_55);
     let mut rotations = Vec::with_capacity(SAMPLES);
     for _ in 0..SAMPLES {
         let s = sampler.next_state(&mut rng)?;

@@ -21,10 +21,12 @@
 
 use super::conic;
 use super::estimators::LsSolution;
-use super::model_access::{ModelAccess, FS, FV, IA, PER_LINK};
+use super::model_access::ModelAccess;
 use super::parameters::{Kind, ParameterModel};
 use super::Consistent;
+use crate::algorithms::regressor::PARAMS_PER_LINK;
 use crate::error::{Error, Result};
+use crate::model::param::{FS, FV, IA};
 use faer::Mat;
 use nalgebra::{DMatrix, DVector, Matrix4};
 
@@ -54,9 +56,9 @@ struct Variables {
 
 impl Variables {
     fn new(model: &ParameterModel) -> Variables {
-        let nl = model.standard_count / PER_LINK;
+        let nl = model.standard_count / PARAMS_PER_LINK;
         let mut standard: Vec<usize> = (0..nl)
-            .flat_map(|j| (0..10).map(move |p| PER_LINK * j + p))
+            .flat_map(|j| (0..10).map(move |p| PARAMS_PER_LINK * j + p))
             .collect();
         let mut drives = Vec::new();
         let mut used: Vec<usize> = model
@@ -64,7 +66,7 @@ impl Variables {
             .iter()
             .flatten()
             .map(|(i, _)| *i)
-            .filter(|i| matches!(i % PER_LINK, IA | FS | FV))
+            .filter(|i| matches!(i % PARAMS_PER_LINK, IA | FS | FV))
             .collect();
         used.sort_unstable();
         used.dedup();
@@ -127,13 +129,13 @@ impl Variables {
 fn prior_weights(vars: &Variables, prior: &[f64]) -> Vec<f64> {
     let kind_max = |p: usize| -> f64 {
         (0..vars.nl)
-            .map(|j| prior[PER_LINK * j + p].abs())
+            .map(|j| prior[PARAMS_PER_LINK * j + p].abs())
             .fold(0.0, f64::max)
     };
     vars.standard
         .iter()
         .map(|&i| {
-            let m = kind_max(i % PER_LINK);
+            let m = kind_max(i % PARAMS_PER_LINK);
             if m > 0.0 {
                 let s = prior[i].abs().max(1e-3 * m);
                 1.0 / (s * s)
@@ -171,9 +173,9 @@ pub fn pseudo_inertia(k: &[f64]) -> Matrix4<f64> {
 
 /// Smallest eigenvalue of the pseudo-inertia matrices of all links.
 pub fn min_pseudo_inertia_eigenvalue(k: &[f64]) -> f64 {
-    (0..k.len() / PER_LINK)
+    (0..k.len() / PARAMS_PER_LINK)
         .map(|j| {
-            pseudo_inertia(&k[PER_LINK * j..PER_LINK * j + 10])
+            pseudo_inertia(&k[PARAMS_PER_LINK * j..PARAMS_PER_LINK * j + 10])
                 .symmetric_eigenvalues()
                 .min()
         })
@@ -338,88 +340,11 @@ pub fn from_pseudo_inertia(j: &Matrix4<f64>) -> [f64; 10] {
 
 #[cfg(feature = "sdp")]
 fn solve_sdp(vars: &Variables, p_dense: &Mat<f64>, q: &[f64]) -> Result<(Vec<f64>, String)> {
-    use clarabel::algebra::CscMatrix;
-    use clarabel::solver::{
-        DefaultSettingsBuilder, DefaultSolver, IPSolver, NonnegativeConeT, PSDTriangleConeT,
-        SolverStatus, SupportedConeT,
-    };
+    use clarabel::solver::{DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus};
     let nv = vars.count();
-    // P: upper triangle, CSC
-    let mut colptr = vec![0usize];
-    let mut rowval = Vec::new();
-    let mut nzval = Vec::new();
-    for c in 0..nv {
-        for r in 0..=c {
-            let v = 0.5 * (p_dense[(r, c)] + p_dense[(c, r)]);
-            if v != 0.0 {
-                rowval.push(r);
-                nzval.push(v);
-            }
-        }
-        colptr.push(rowval.len());
-    }
-    let p = CscMatrix::new(nv, nv, colptr, rowval, nzval);
-    // constraints s = b - A v: per link svec(J_j) in the PSD cone, drives >= 0
-    let sq2 = std::f64::consts::SQRT_2;
-    // svec of the 4x4 upper triangle, column-major: (0,0) (0,1) (1,1) (0,2) (1,2) (2,2) (0,3)...
-    // J as linear combinations of XX XY XZ YY YZ ZZ MX MY MZ M (local indices 0..10)
-    let entry = |r: usize, c: usize| -> Vec<(usize, f64)> {
-        match (r, c) {
-            (0, 0) => vec![(0, -0.5), (3, 0.5), (5, 0.5)],
-            (1, 1) => vec![(0, 0.5), (3, -0.5), (5, 0.5)],
-            (2, 2) => vec![(0, 0.5), (3, 0.5), (5, -0.5)],
-            (0, 1) => vec![(1, -1.0)],
-            (0, 2) => vec![(2, -1.0)],
-            (1, 2) => vec![(4, -1.0)],
-            (0, 3) => vec![(6, 1.0)],
-            (1, 3) => vec![(7, 1.0)],
-            (2, 3) => vec![(8, 1.0)],
-            (3, 3) => vec![(9, 1.0)],
-            _ => unreachable!(),
-        }
-    };
-    let mut rows: Vec<Vec<(usize, f64)>> = Vec::new();
-    let mut cones: Vec<SupportedConeT<f64>> = Vec::new();
-    for j in 0..vars.nl {
-        for c in 0..4 {
-            for r in 0..=c {
-                let scale = if r == c { 1.0 } else { sq2 };
-                // A = -dJ/dv (s = b - A v = J with b = 0)
-                rows.push(
-                    entry(r, c)
-                        .into_iter()
-                        .map(|(l, v)| (10 * j + l, -scale * v))
-                        .collect(),
-                );
-            }
-        }
-        cones.push(PSDTriangleConeT(4));
-    }
-    for &d in &vars.drives {
-        rows.push(vec![(d, -1.0)]);
-    }
-    if !vars.drives.is_empty() {
-        cones.push(NonnegativeConeT(vars.drives.len()));
-    }
-    let m = rows.len();
-    let mut cols: Vec<Vec<(usize, f64)>> = vec![Vec::new(); nv];
-    for (r, terms) in rows.iter().enumerate() {
-        for &(c, v) in terms {
-            cols[c].push((r, v));
-        }
-    }
-    let mut colptr = vec![0usize];
-    let mut rowval = Vec::new();
-    let mut nzval = Vec::new();
-    for col in &mut cols {
-        col.sort_by_key(|e| e.0);
-        for &(r, v) in col.iter() {
-            rowval.push(r);
-            nzval.push(v);
-        }
-        colptr.push(rowval.len());
-    }
-    let a = CscMatrix::new(m, nv, colptr, rowval, nzval);
+    let p = upper_csc(p_dense);
+    let (rows, cones) = sdp_constraints(vars);
+    let a = rows_csc(&rows, nv);
     // origin at the unconstrained minimizer v0 (as the interior-point solver): v = v0 + u,
     // q + P v0, s = J(v0) + J(u) = b - A u with b = -A v0
     let mut pr = DMatrix::from_fn(nv, nv, |r, c| 0.5 * (p_dense[(r, c)] + p_dense[(c, r)]));
@@ -464,6 +389,106 @@ fn solve_sdp(vars: &Variables, p_dense: &Mat<f64>, q: &[f64]) -> Result<(Vec<f64
             s.iterations
         ))),
     }
+}
+
+/// The upper triangle of the symmetric part of `p_dense`, in compressed sparse columns.
+#[cfg(feature = "sdp")]
+fn upper_csc(p_dense: &Mat<f64>) -> clarabel::algebra::CscMatrix<f64> {
+    let nv = p_dense.ncols();
+    // P: upper triangle, CSC
+    let mut colptr = vec![0usize];
+    let mut rowval = Vec::new();
+    let mut nzval = Vec::new();
+    for c in 0..nv {
+        for r in 0..=c {
+            let v = 0.5 * (p_dense[(r, c)] + p_dense[(c, r)]);
+            if v != 0.0 {
+                rowval.push(r);
+                nzval.push(v);
+            }
+        }
+        colptr.push(rowval.len());
+    }
+    clarabel::algebra::CscMatrix::new(nv, nv, colptr, rowval, nzval)
+}
+
+/// The rows of A (s = b - A v) and their cones: per link svec(J_j) in the PSD cone, the drive
+/// parameters >= 0.
+#[cfg(feature = "sdp")]
+#[allow(clippy::type_complexity)]
+fn sdp_constraints(
+    vars: &Variables,
+) -> (
+    Vec<Vec<(usize, f64)>>,
+    Vec<clarabel::solver::SupportedConeT<f64>>,
+) {
+    use clarabel::solver::{NonnegativeConeT, PSDTriangleConeT, SupportedConeT};
+    let sq2 = std::f64::consts::SQRT_2;
+    // svec of the 4x4 upper triangle, column-major: (0,0) (0,1) (1,1) (0,2) (1,2) (2,2) (0,3)...
+    // J as linear combinations of XX XY XZ YY YZ ZZ MX MY MZ M (local indices 0..10)
+    let entry = |r: usize, c: usize| -> Vec<(usize, f64)> {
+        match (r, c) {
+            (0, 0) => vec![(0, -0.5), (3, 0.5), (5, 0.5)],
+            (1, 1) => vec![(0, 0.5), (3, -0.5), (5, 0.5)],
+            (2, 2) => vec![(0, 0.5), (3, 0.5), (5, -0.5)],
+            (0, 1) => vec![(1, -1.0)],
+            (0, 2) => vec![(2, -1.0)],
+            (1, 2) => vec![(4, -1.0)],
+            (0, 3) => vec![(6, 1.0)],
+            (1, 3) => vec![(7, 1.0)],
+            (2, 3) => vec![(8, 1.0)],
+            (3, 3) => vec![(9, 1.0)],
+            _ => unreachable!(),
+        }
+    };
+    let mut rows: Vec<Vec<(usize, f64)>> = Vec::new();
+    let mut cones: Vec<SupportedConeT<f64>> = Vec::new();
+    for j in 0..vars.nl {
+        for c in 0..4 {
+            for r in 0..=c {
+                let scale = if r == c { 1.0 } else { sq2 };
+                // A = -dJ/dv (s = b - A v = J with b = 0)
+                rows.push(
+                    entry(r, c)
+                        .into_iter()
+                        .map(|(l, v)| (10 * j + l, -scale * v))
+                        .collect(),
+                );
+            }
+        }
+        cones.push(PSDTriangleConeT(4));
+    }
+    for &d in &vars.drives {
+        rows.push(vec![(d, -1.0)]);
+    }
+    if !vars.drives.is_empty() {
+        cones.push(NonnegativeConeT(vars.drives.len()));
+    }
+    (rows, cones)
+}
+
+/// The matrix of sparse `rows` (column, value) with `nv` columns, in compressed sparse columns.
+#[cfg(feature = "sdp")]
+fn rows_csc(rows: &[Vec<(usize, f64)>], nv: usize) -> clarabel::algebra::CscMatrix<f64> {
+    let m = rows.len();
+    let mut cols: Vec<Vec<(usize, f64)>> = vec![Vec::new(); nv];
+    for (r, terms) in rows.iter().enumerate() {
+        for &(c, v) in terms {
+            cols[c].push((r, v));
+        }
+    }
+    let mut colptr = vec![0usize];
+    let mut rowval = Vec::new();
+    let mut nzval = Vec::new();
+    for col in &mut cols {
+        col.sort_by_key(|e| e.0);
+        for &(r, v) in col.iter() {
+            rowval.push(r);
+            nzval.push(v);
+        }
+        colptr.push(rowval.len());
+    }
+    clarabel::algebra::CscMatrix::new(m, nv, colptr, rowval, nzval)
 }
 
 /// Add eps sum_i ((v_i - K0_i) / s_i)^2 to (P, q) (with 1/2 v^T P v + q^T v conventions).

@@ -462,7 +462,7 @@ mod tests {
     /// The streamed factor gives the same least squares as a QR of the whole matrix (nalgebra).
     #[test]
     fn streamed_factor_equals_whole_least_squares() {
-        let mut rng = crate::identification::model_access::seeded_rng(3);
+        let mut rng = crate::sampling::rng(3);
         use rand::Rng;
         let (m, p) = (1000, 7);
         let w = nalgebra::DMatrix::from_fn(m, p, |_, _| rng.random_range(-1.0..1.0));

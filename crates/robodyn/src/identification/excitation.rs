@@ -172,6 +172,54 @@ pub struct Limits {
     pub tau: Option<f64>,
 }
 
+/// The options of [`design`] checked against the robot: its `joints` (actuated, frame order)
+/// and `p` identified parameters.
+fn check_design_options(joints: &[usize], p: usize, opt: &DesignOptions) -> Result<()> {
+    let n = joints.len();
+    if opt.harmonics < 2 {
+        return Err(Error::Input(format!(
+            "{} harmonic(s): at least 2 are needed to start and end at rest",
+            opt.harmonics
+        )));
+    }
+    if !(opt.period.is_finite() && opt.period > 0.0) {
+        return Err(Error::Input(format!(
+            "period {} s must be positive",
+            opt.period
+        )));
+    }
+    if opt.start.len() != n || opt.limits.len() != n {
+        return Err(Error::Input(format!(
+            "{} start values and {} limits given, {n} actuated joints",
+            opt.start.len(),
+            opt.limits.len()
+        )));
+    }
+    for (j, l) in opt.limits.iter().enumerate() {
+        if !(l.qd > 0.0 && l.qdd > 0.0) {
+            return Err(Error::Input(format!(
+                "joint {}: velocity and acceleration limits must be positive",
+                joints[j]
+            )));
+        }
+        if l.q_min.is_some_and(|lo| lo >= opt.start[j])
+            || l.q_max.is_some_and(|hi| hi <= opt.start[j])
+        {
+            return Err(Error::Input(format!(
+                "joint {}: the start position {} is not inside the position limits",
+                joints[j], opt.start[j]
+            )));
+        }
+    }
+    if opt.samples * n <= p {
+        return Err(Error::Input(format!(
+            "{} samples x {n} joints give fewer equations than the {p} parameters",
+            opt.samples
+        )));
+    }
+    Ok(())
+}
+
 /// Options of [`design`].
 #[derive(Clone, Debug)]
 pub struct DesignOptions {
@@ -389,49 +437,7 @@ pub fn design(
 ) -> Result<Design> {
     use rand::Rng;
     let n = access.actuated_joints().len();
-    if opt.harmonics < 2 {
-        return Err(Error::Input(format!(
-            "{} harmonic(s): at least 2 are needed to start and end at rest",
-            opt.harmonics
-        )));
-    }
-    if !(opt.period.is_finite() && opt.period > 0.0) {
-        return Err(Error::Input(format!(
-            "period {} s must be positive",
-            opt.period
-        )));
-    }
-    if opt.start.len() != n || opt.limits.len() != n {
-        return Err(Error::Input(format!(
-            "{} start values and {} limits given, {n} actuated joints",
-            opt.start.len(),
-            opt.limits.len()
-        )));
-    }
-    for (j, l) in opt.limits.iter().enumerate() {
-        if !(l.qd > 0.0 && l.qdd > 0.0) {
-            return Err(Error::Input(format!(
-                "joint {}: velocity and acceleration limits must be positive",
-                access.actuated_joints()[j]
-            )));
-        }
-        if l.q_min.is_some_and(|lo| lo >= opt.start[j])
-            || l.q_max.is_some_and(|hi| hi <= opt.start[j])
-        {
-            return Err(Error::Input(format!(
-                "joint {}: the start position {} is not inside the position limits",
-                access.actuated_joints()[j],
-                opt.start[j]
-            )));
-        }
-    }
-    let p = params.count();
-    if opt.samples * n <= p {
-        return Err(Error::Input(format!(
-            "{} samples x {n} joints give fewer equations than the {p} parameters",
-            opt.samples
-        )));
-    }
+    check_design_options(access.actuated_joints(), params.count(), opt)?;
     let dim = n * FourierTrajectory::free_per_joint(opt.harmonics);
     let problem = Problem {
         inner: RefCell::new(Inner {
@@ -441,7 +447,7 @@ pub fn design(
         }),
         opt,
     };
-    let mut rng = crate::identification::model_access::seeded_rng(opt.seed);
+    let mut rng = crate::sampling::rng(opt.seed);
     let mut best: Option<(f64, Vec<f64>)> = None;
     for _ in 0..opt.restarts.max(1) {
         let x: Vec<f64> = (0..dim).map(|_| rng.random_range(-1.0..1.0)).collect();
@@ -453,7 +459,8 @@ pub fn design(
     let (c0, x0) = best.expect("one start");
     if c0 >= FAILED {
         return Err(Error::Numerical(
-            "no random starting trajectory could be evaluated (loop closure failed or a parameter              is not excited at all): check the start position and the limits"
+            "no random starting trajectory could be evaluated (loop closure failed or a parameter \
+             is not excited at all): check the start position and the limits"
                 .into(),
         ));
     }

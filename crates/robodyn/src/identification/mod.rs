@@ -56,6 +56,17 @@ pub enum Estimator {
     Iv,
 }
 
+impl Estimator {
+    /// Its name in the report: `OLS`, `WLS`, `IDIM-IV`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Estimator::Ols => "OLS",
+            Estimator::Wls => "WLS",
+            Estimator::Iv => "IDIM-IV",
+        }
+    }
+}
+
 /// Essential parameters: drop the least identifiable parameter (largest relative standard
 /// deviation) while that is above `max_relative_std` and the relative error grows by less than
 /// `tolerance` (relative).
@@ -684,11 +695,12 @@ fn joint_fits(
 ///
 /// ```
 /// use robodyn::identification::excitation::{simulated_log, FourierTrajectory};
-/// use robodyn::identification::model_access::{load_description, ModelAccess};
+/// use robodyn::identification::model_access::ModelAccess;
+/// use robodyn::io::load_description;
 /// use robodyn::identification::{identify, Estimator, Options};
 /// # fn main() -> robodyn::Result<()> {
 /// let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots/scara.toml");
-/// let mut access = ModelAccess::new(load_description(path.as_ref(), &Default::default())?)?;
+/// let mut access = ModelAccess::new(load_description(path)?)?;
 /// let start = access.reference_actuated()?;
 /// let harmonics = 5;
 /// let free: Vec<f64> = (0..start.len() * FourierTrajectory::free_per_joint(harmonics))
@@ -738,12 +750,7 @@ pub fn identify(
     preport.slow_rows = pass.slow_rows.clone();
     let ts: Vec<Mat<f64>> = pass.fit.iter_mut().map(|f| f.factor().clone()).collect();
     let (mut sol, sigma) = first_estimate(opt.estimator, &mut pass, &ts, rows, (&names, access))?;
-    let mut estimator = match opt.estimator {
-        Estimator::Ols => "OLS",
-        Estimator::Wls => "WLS",
-        Estimator::Iv => "IDIM-IV",
-    }
-    .to_string();
+    let mut estimator = opt.estimator.name().to_string();
     let mut iv_report = None;
     if opt.estimator == Estimator::Iv {
         let sig = sigma.as_deref().expect("weights");
@@ -764,35 +771,7 @@ pub fn identify(
     if opt.consistent || opt.standard {
         let c =
             consistency::consistent_parameters(access, &model, &tw, &sol, opt.consistency_solver)?;
-        let bound = p as f64 + 3.0 * (2.0 * p as f64).sqrt();
-        // changes at rounding level (a noise-free fit whose true values lie on the boundary,
-        // e.g. zero friction) are not reported
-        let scale = sol.x.iter().fold(0.0f64, |a, b| a.max(b.abs()));
-        let significant = c
-            .x_full
-            .iter()
-            .zip(&sol.x)
-            .any(|(a, b)| (a - b).abs() > 1e-6 * b.abs().max(1e-3 * scale));
-        if c.result.distance2 > bound && significant {
-            let worst = c
-                .result
-                .deviation
-                .iter()
-                .enumerate()
-                .max_by(|a, b| a.1.abs().partial_cmp(&b.1.abs()).unwrap())
-                .map_or(0, |(i, _)| i);
-            warnings.push(Warning::new(
-                WarningKind::Inconsistent,
-                vec![names[worst].clone()],
-                format!(
-                    "the unconstrained estimate is not physically consistent: the nearest \
-                     consistent set is at a squared Mahalanobis distance {:.1} (above \
-                     {bound:.1}, the 99.8 % quantile of chi-square with {p} degrees of \
-                     freedom); largest change {:.1} standard deviations ({})",
-                    c.result.distance2, c.result.max_deviation, names[worst]
-                ),
-            ));
-        }
+        warnings.extend(inconsistency_warning(&c, &sol, &names));
         if opt.consistent {
             sol.x = c.x_full.clone();
             estimator.push_str(" under physical-consistency constraints (SDP)");
@@ -812,13 +791,8 @@ pub fn identify(
     let relative_std = sol.relative_std();
     let (per_joint, relative_error) = joint_fits(access, &mut pass.fit, &sol.x, sigma.as_deref());
     let validation = validation(access, &mut pass, &sol.x, &preport);
-    warnings.extend(quality_warnings(
-        &sol,
-        &names,
-        &relative_std,
-        relative_error,
-        &validation,
-    ));
+    let quality = quality_warnings(&sol, &names, &relative_std, relative_error, &validation);
+    warnings.extend(quality);
     warnings.extend(signs::warnings(
         &model,
         &sol.x,
@@ -857,6 +831,47 @@ pub fn identify(
     })
 }
 
+/// The warning when the unconstrained estimate `sol` is not physically consistent: the nearest
+/// consistent set `c` lies beyond the 99.8 % quantile of chi-square with p degrees of freedom
+/// (p + 3 sqrt(2p)) in the metric of the estimate's covariance, and differs from it by more than
+/// rounding (a noise-free fit whose true values lie on the boundary, e.g. zero friction, is not
+/// reported).
+fn inconsistency_warning(
+    c: &consistency::ConsistentSolution,
+    sol: &LsSolution,
+    names: &[String],
+) -> Option<Warning> {
+    let p = sol.x.len();
+    let bound = p as f64 + 3.0 * (2.0 * p as f64).sqrt();
+    let scale = sol.x.iter().fold(0.0f64, |a, b| a.max(b.abs()));
+    let significant = c
+        .x_full
+        .iter()
+        .zip(&sol.x)
+        .any(|(a, b)| (a - b).abs() > 1e-6 * b.abs().max(1e-3 * scale));
+    if c.result.distance2 <= bound || !significant {
+        return None;
+    }
+    let worst = c
+        .result
+        .deviation
+        .iter()
+        .enumerate()
+        .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))
+        .map_or(0, |(i, _)| i);
+    Some(Warning::new(
+        WarningKind::Inconsistent,
+        vec![names[worst].clone()],
+        format!(
+            "the unconstrained estimate is not physically consistent: the nearest consistent \
+             set is at a squared Mahalanobis distance {:.1} (above {bound:.1}, the 99.8 % \
+             quantile of chi-square with {p} degrees of freedom); largest change {:.1} standard \
+             deviations ({})",
+            c.result.distance2, c.result.max_deviation, names[worst]
+        ),
+    ))
+}
+
 /// The triangular factor of the union of the joints' rows, joint k's weighted by 1 / sigma_k
 /// (unweighted without sigma).
 fn weighted(ts: &[Mat<f64>], sigma: Option<&[f64]>) -> Mat<f64> {
@@ -891,11 +906,14 @@ fn first_estimate(
         })
         .collect::<Result<Vec<f64>>>()?;
     if let Some(k) = sig.iter().position(|s| s.is_nan() || *s <= 0.0) {
-        return Err(Error::Numerical(format!(
-            "joint {}: its equations are fitted exactly (sigma = 0), so Gautier's weight \
-             1/sigma is infinite; use --estimator ols (noise-free data)",
-            access.actuated_joints()[k]
-        )));
+        return Err(Error::Setting {
+            option: "identification::Options::estimator",
+            reason: format!(
+                "joint {}: its equations are fitted exactly (sigma = 0), so Gautier's weight \
+                 1/sigma is infinite; use the OLS estimator (noise-free data)",
+                access.actuated_joints()[k]
+            ),
+        });
     }
     let sol = least_squares(&weighted(ts, Some(&sig)), rows, names)?;
     Ok((sol, Some(sig)))
@@ -916,7 +934,7 @@ fn processing_notes(preport: &ProcessingReport, opt: &Options, transmission: boo
     let total_slow: usize = preport.slow_rows.iter().sum();
     if total_slow > 0 {
         notes.push(format!(
-            "{total_slow} joint rows of the fit left out by --min-speed {} (per joint {:?})",
+            "{total_slow} joint rows of the fit left out as slower than the minimum speed {} (per joint {:?})",
             opt.min_speed, preport.slow_rows
         ));
     }
@@ -1035,8 +1053,8 @@ fn idim_iv(
             Vec::new(),
             format!(
                 "IDIM-IV did not converge in {it} iterations: the last iteration changed a \
-                 parameter by {last_change:.2} standard deviations (more iterations: \
-                 --iv-iterations; a slower tracking loop: --iv-bandwidth)"
+                 parameter by {last_change:.2} standard deviations (more iterations, or a slower \
+                 tracking loop: a lower IV bandwidth)"
             ),
         )
     });
@@ -1120,7 +1138,7 @@ fn quality_warnings(
             poor.into_iter().map(|(n, _)| n).collect(),
             format!(
                 "{} parameter(s) poorly identified (relative standard deviation above 50 %): {} \
-                 — their values are not significant (--essential drops them)",
+                 — their values are not significant (the essential parameters drop them)",
                 list.len(),
                 list.join(", ")
             ),

@@ -1,8 +1,9 @@
-//! The one place where identification calls the rest of the library (robot files, the
-//! regressor, the closed-chain Jacobian G, the base parameters, the inverse and direct dynamic
-//! models, the simulator). The other files of this module see only [`ModelAccess`],
-//! [`BaseSet`], [`TrackingModel`] and plain vectors, so that a change of the library's API
-//! changes this file only.
+//! The one place where identification calls the library's algorithms (the regressor, the
+//! closed-chain Jacobian G, the base parameters, the inverse and direct dynamic models, the
+//! simulator). The other files of this module see only [`ModelAccess`], [`BaseSet`],
+//! [`TrackingModel`] and plain vectors (with the model's parameter indices,
+//! [`crate::model::param`], and the library's number formats), so that a change of an
+//! algorithm's API changes this file only. Robot files are read by [`crate::io`].
 
 use crate::algorithms::base_parameters::{
     numeric_base_parameters, standard_values, ClosedChainSampler, NumericOptions, ParameterNames,
@@ -17,6 +18,7 @@ use crate::algorithms::regressor::{
 };
 use crate::data::Data;
 use crate::error::{Error, Result};
+use crate::model::param::FS;
 use crate::model::{DynModel, JointLimits, JointType, RobotDescription, Transmission};
 use crate::simulation::{
     simulate, ClosedChainDynamics, Dynamics, Integrator, Recorder, SimOptions, TimeSeries,
@@ -24,18 +26,6 @@ use crate::simulation::{
 };
 use crate::{Expr, Robot};
 use nalgebra::{DMatrix, DVector};
-use std::collections::BTreeMap;
-use std::path::Path;
-
-/// Standard parameters per link (XX XY XZ YY YZ ZZ MX MY MZ M IA FS FV).
-pub const PER_LINK: usize = PARAMS_PER_LINK;
-
-/// Index of IA (rotor inertia) within a link's 13 standard parameters.
-pub const IA: usize = 10;
-/// Index of FS (Coulomb friction).
-pub const FS: usize = 11;
-/// Index of FV (viscous friction).
-pub const FV: usize = 12;
 
 /// The sign of a velocity in the Coulomb friction Fs sign(v), with a dead band: 0 where
 /// |v| <= `band` (rad/s or m/s), so that rounding noise of an estimated velocity at rest does not
@@ -48,11 +38,6 @@ pub fn coulomb_sign(v: f64, band: f64) -> f64 {
     }
 }
 
-/// A coefficient for display, as `base-params` prints them (short rationals when they are).
-pub fn format_coefficient(x: f64) -> String {
-    crate::algorithms::base_parameters::numeric::format_coefficient(x)
-}
-
 /// Which drive parameters the base set includes (as `base-params --rotor/--no-friction`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Rotors {
@@ -62,22 +47,6 @@ pub enum Rotors {
     All,
     /// No rotor inertia.
     None,
-}
-
-/// A robot file read for identification: the description and its symbol overrides applied.
-pub fn load_description(
-    path: &Path,
-    overrides: &BTreeMap<String, f64>,
-) -> Result<RobotDescription> {
-    let mut desc = crate::io::load_description(path)?;
-    desc.symbols
-        .extend(overrides.iter().map(|(k, v)| (k.clone(), *v)));
-    Ok(desc)
-}
-
-/// Write a robot description (format by extension).
-pub fn save_description(desc: &RobotDescription, path: &Path) -> Result<()> {
-    crate::io::save_description(desc, path)
 }
 
 /// The base parameters of the selected standard parameters (numerical method of
@@ -157,7 +126,7 @@ impl ModelAccess {
         }
         Ok(ModelAccess {
             ws: Data::new(&robot),
-            phi: DMatrix::zeros(nl, PER_LINK * nl),
+            phi: DMatrix::zeros(nl, PARAMS_PER_LINK * nl),
             q: vec![0.0; nl],
             qd: vec![0.0; nl],
             qdd: vec![0.0; nl],
@@ -287,7 +256,7 @@ impl ModelAccess {
         seed: u64,
         cols: &[usize],
     ) -> Result<Vec<([Vec<f64>; 3], Vec<f64>)>> {
-        let mut rng = seeded_rng(seed);
+        let mut rng = crate::sampling::rng(seed);
         let mut sampler: Box<dyn Sampler> = if self.robot.is_tree() {
             Box::new(TreeSampler)
         } else {
@@ -410,7 +379,7 @@ impl ModelAccess {
         if coulomb_band > 0.0 {
             // the FS_j column is sign(qd_j) in row j alone (10.12)
             for (j, qd) in self.qd.iter().enumerate() {
-                self.phi[(j, PER_LINK * j + FS)] = coulomb_sign(*qd, coulomb_band);
+                self.phi[(j, PARAMS_PER_LINK * j + FS)] = coulomb_sign(*qd, coulomb_band);
             }
         }
         tree_wrench_torques(model, &mut self.ws, env, &self.q, &mut self.tau_e);
@@ -475,7 +444,7 @@ impl ModelAccess {
     /// configuration where it is smallest.
     pub fn min_inertia_eigenvalue(&self, k: &[f64], count: usize, seed: u64) -> Result<f64> {
         let robot = self.robot.with_standard_parameters(k)?;
-        let mut rng = seeded_rng(seed);
+        let mut rng = crate::sampling::rng(seed);
         let mut sampler: Box<dyn Sampler> = if robot.is_tree() {
             Box::new(TreeSampler)
         } else {
@@ -505,7 +474,7 @@ impl ModelAccess {
     pub fn tracking_model(&self, k: &[f64], smoothing: f64) -> Result<TrackingModel> {
         let mut k = k.to_vec();
         for (i, v) in k.iter_mut().enumerate() {
-            if matches!(i % PER_LINK, 9..=12) && *v < 0.0 {
+            if matches!(i % PARAMS_PER_LINK, 9..=12) && *v < 0.0 {
                 *v = 0.0;
             }
         }
@@ -515,8 +484,8 @@ impl ModelAccess {
                 desc,
                 |e: &Expr| self.robot.value(e).expect("validated"),
                 |j, p, e| {
-                    if p < PER_LINK {
-                        k[PER_LINK * (j - 1) + p]
+                    if p < PARAMS_PER_LINK {
+                        k[PARAMS_PER_LINK * (j - 1) + p]
                     } else {
                         self.robot.value(e).expect("validated")
                     }
@@ -684,10 +653,4 @@ impl TrackingModel {
             TrackingModel::Closed(d) => d.accel(0.0, qa, qda, taua, qdda),
         }
     }
-}
-
-/// The seeded random generator of the sampled states (ChaCha8, as the tests' generator).
-pub fn seeded_rng(seed: u64) -> rand_chacha::ChaCha8Rng {
-    use rand::SeedableRng;
-    rand_chacha::ChaCha8Rng::seed_from_u64(seed)
 }

@@ -11,10 +11,11 @@
 //! column in the span of the columns before it is grouped into them, e.g. the rotor of a first
 //! vertical axis into ZZR1 with the factor R_11^2).
 
-use super::model_access::{
-    coulomb_sign, format_coefficient, BaseSet, ModelAccess, Rotors, FS, FV, IA, PER_LINK,
-};
+use super::model_access::{coulomb_sign, BaseSet, ModelAccess, Rotors};
+use crate::algorithms::base_parameters::numeric::format_coefficient;
+use crate::algorithms::regressor::PARAMS_PER_LINK;
 use crate::error::{Error, Result};
+use crate::model::param::{FS, FV, IA};
 use faer::linalg::solvers::SolveLstsq;
 use faer::Mat;
 
@@ -146,7 +147,7 @@ impl ParameterModel {
             tau_e: vec![0.0; n],
             base,
             map: Vec::new(),
-            standard_count: PER_LINK * nl,
+            standard_count: PARAMS_PER_LINK * nl,
             transmission: transmission.clone(),
             motor_links: joints.clone(),
             joints: joints.clone(),
@@ -167,7 +168,7 @@ impl ParameterModel {
             let (kept, grouped) = model.reduce_motor_columns(access, &wanted, opt.seed)?;
             for &(k, which) in &kept {
                 let j = joints[k];
-                let index = PER_LINK * (j - 1) + which;
+                let index = PARAMS_PER_LINK * (j - 1) + which;
                 params.push(Parameter {
                     name: access.standard_name(index),
                     equation: access.standard_name(index),
@@ -177,7 +178,7 @@ impl ParameterModel {
             }
             // grouped motor parameters: x_r += coef K_motor in the parameters they join
             for ((k, which), coefs) in grouped {
-                let index = PER_LINK * (joints[k] - 1) + which;
+                let index = PARAMS_PER_LINK * (joints[k] - 1) + which;
                 for (r, c) in coefs {
                     map[r].push((index, c));
                     let mag = format_coefficient(c.abs());
@@ -240,7 +241,7 @@ impl ParameterModel {
             match p.kind {
                 Kind::Base(r) => k[self.base.base[r]] = *v,
                 Kind::Motor { motor, which } => {
-                    k[PER_LINK * (self.motor_links[motor] - 1) + which] = *v
+                    k[PARAMS_PER_LINK * (self.motor_links[motor] - 1) + which] = *v
                 }
                 Kind::Offset(_) => {}
             }
@@ -429,12 +430,12 @@ impl ParameterModel {
         for (c, &j) in self.joints.iter().enumerate() {
             let mut v = [0.0; 3];
             for (m, row) in r.iter().enumerate() {
-                let base = PER_LINK * (self.motor_links[m] - 1);
+                let base = PARAMS_PER_LINK * (self.motor_links[m] - 1);
                 v[0] += row[c] * row[c] * k[base + IA];
                 v[1] += row[c].abs() * k[base + FS];
                 v[2] += row[c] * row[c] * k[base + FV];
             }
-            let base = PER_LINK * (j - 1);
+            let base = PARAMS_PER_LINK * (j - 1);
             out[base + IA] = v[0];
             out[base + FS] = v[1];
             out[base + FV] = v[2];

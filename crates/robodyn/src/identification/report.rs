@@ -8,6 +8,7 @@
 
 use super::parameters::Kind;
 use super::Identification;
+#[cfg(feature = "plot")]
 use crate::error::Result;
 use crate::model::param;
 use crate::report::number::{format_number, Sig};
@@ -457,11 +458,13 @@ pub fn plot_fit(path: &Path, id: &Identification) -> Result<()> {
     use crate::report::figure::{write_svg, Curve, Figure, Panel, Style};
     let rows = &id.validation_rows;
     if rows.t.len() < 2 {
-        return Err(Error::Input(
-            "no validation rows to plot: give a validation segment (--validation FROM:TO) and \
-             --plot"
-                .into(),
-        ));
+        return Err(Error::Setting {
+            option: "identification::Options::validation",
+            reason:
+                "no validation rows to plot: the plot shows the validation segment of the log, \
+                     and none was given"
+                    .into(),
+        });
     }
     let pred = id.predicted_validation();
     let v = id.validation.as_ref();

@@ -25,9 +25,10 @@
 //! significant) and not at rounding level (its torques above 1e-9 of the measured ones).
 
 use super::estimators::output_sq;
-use super::model_access::{FS, FV, IA, PER_LINK};
 use super::parameters::{Kind, ParameterModel};
 use super::{Warning, WarningKind};
+use crate::algorithms::regressor::PARAMS_PER_LINK;
+use crate::model::param::{FS, FV, IA};
 use faer::Mat;
 use nalgebra::Matrix4;
 
@@ -81,14 +82,14 @@ fn sign_of(terms: &[(usize, f64)]) -> Option<Sign> {
         return None;
     }
     let tol = TOLERANCE * scale;
-    let mut links: Vec<usize> = terms.iter().map(|(i, _)| i / PER_LINK).collect();
+    let mut links: Vec<usize> = terms.iter().map(|(i, _)| i / PARAMS_PER_LINK).collect();
     links.sort_unstable();
     links.dedup();
     let (mut nonneg, mut nonpos) = (true, true);
     for l in links {
-        let mut b = [0.0; PER_LINK];
-        for (i, c) in terms.iter().filter(|(i, _)| i / PER_LINK == l) {
-            b[i % PER_LINK] += c;
+        let mut b = [0.0; PARAMS_PER_LINK];
+        for (i, c) in terms.iter().filter(|(i, _)| i / PARAMS_PER_LINK == l) {
+            b[i % PARAMS_PER_LINK] += c;
         }
         for d in [IA, FS, FV] {
             nonneg &= b[d] >= -tol;
@@ -106,7 +107,7 @@ fn sign_of(terms: &[(usize, f64)]) -> Option<Sign> {
 }
 
 /// C with tr(C J) = sum_k b_k K_k over a link's ten inertial parameters (module documentation).
-fn pseudo_inertia_functional(b: &[f64; PER_LINK]) -> Matrix4<f64> {
+fn pseudo_inertia_functional(b: &[f64; PARAMS_PER_LINK]) -> Matrix4<f64> {
     let [xx, xy, xz, yy, yz, zz, mx, my, mz, m, ..] = *b;
     Matrix4::new(
         yy + zz,
@@ -137,7 +138,7 @@ fn reason(terms: &[(usize, f64)], sign: Sign) -> String {
         .filter(|(_, c)| c.abs() > TOLERANCE * scale)
         .collect();
     let what = match terms.as_slice() {
-        [(i, _)] => match i % PER_LINK {
+        [(i, _)] => match i % PARAMS_PER_LINK {
             FS => Some("a Coulomb friction coefficient"),
             FV => Some("a viscous friction coefficient"),
             IA => Some("a rotor inertia"),
@@ -226,7 +227,7 @@ mod tests {
     const M: usize = 9;
 
     fn at(link: usize, k: usize) -> usize {
-        PER_LINK * (link - 1) + k
+        PARAMS_PER_LINK * (link - 1) + k
     }
 
     #[test]
@@ -300,14 +301,14 @@ mod tests {
     #[test]
     fn signs_agree_with_point_masses() {
         use rand::Rng;
-        let mut rng = crate::identification::model_access::seeded_rng(3);
+        let mut rng = crate::sampling::rng(3);
         let (mut psd, mut indefinite) = (0, 0);
         for trial in 0..400 {
             let a = Matrix4::from_fn(|_, _| rng.random_range(-1.0..1.0));
             let shift = if trial % 2 == 0 { 0.0 } else { 0.8 };
             let c = a * a.transpose() - Matrix4::identity() * shift;
             // b from C (the inverse of pseudo_inertia_functional)
-            let mut b = [0.0; PER_LINK];
+            let mut b = [0.0; PARAMS_PER_LINK];
             b[XX] = (c[(1, 1)] + c[(2, 2)] - c[(0, 0)]) / 2.0;
             b[YY] = (c[(0, 0)] + c[(2, 2)] - c[(1, 1)]) / 2.0;
             b[ZZ] = (c[(0, 0)] + c[(1, 1)] - c[(2, 2)]) / 2.0;

@@ -158,16 +158,17 @@ pub fn decode_text(bytes: Vec<u8>) -> String {
 /// [`SourceMap::warnings`] hold what the reader noticed and the physical-consistency check
 /// ([`physical_consistency`]) found, with their lines. The path `-` reads standard input, the
 /// format found by [`Format::sniff`].
-pub fn load_description_mapped(path: &Path) -> Result<(RobotDescription, SourceMap)> {
+pub fn load_description_mapped(path: impl AsRef<Path>) -> Result<(RobotDescription, SourceMap)> {
     load_description_with(path, &BTreeMap::new())
 }
 
 /// [`load_description_mapped`] with symbol values given or replaced (`overrides`, the CLI's
 /// `--set`) before the physical-consistency check, so that the check sees the values used.
 pub fn load_description_with(
-    path: &Path,
+    path: impl AsRef<Path>,
     overrides: &BTreeMap<String, f64>,
 ) -> Result<(RobotDescription, SourceMap)> {
+    let path = path.as_ref();
     let text = read(path)?;
     let (file, format) = if is_stdio(path) {
         ("<stdin>".to_string(), Format::sniff(&text))
@@ -212,7 +213,7 @@ pub fn set_values_mapped(
 /// Read and validate a robot, with the warnings of [`load_description_with`]; `overrides`
 /// give values by name as [`set_values`] does.
 pub fn load_with_warnings(
-    path: &Path,
+    path: impl AsRef<Path>,
     overrides: &BTreeMap<String, f64>,
 ) -> Result<(Robot, Vec<Warning>)> {
     let (desc, map) = load_description_with(path, overrides)?;
@@ -221,18 +222,18 @@ pub fn load_with_warnings(
 }
 
 /// Read a robot description from a file.
-pub fn load_description(path: &Path) -> Result<RobotDescription> {
+pub fn load_description(path: impl AsRef<Path>) -> Result<RobotDescription> {
     load_description_mapped(path).map(|(d, _)| d)
 }
 
 /// Read and validate a robot. `overrides` give values by name as [`set_values`] does (symbols,
 /// and standard parameters written as numbers); an unknown name is an error.
-pub fn load_with(path: &Path, overrides: &BTreeMap<String, f64>) -> Result<Robot> {
+pub fn load_with(path: impl AsRef<Path>, overrides: &BTreeMap<String, f64>) -> Result<Robot> {
     load_with_warnings(path, overrides).map(|(r, _)| r)
 }
 
 /// Read and validate a robot.
-pub fn load(path: &Path) -> Result<Robot> {
+pub fn load(path: impl AsRef<Path>) -> Result<Robot> {
     load_with(path, &BTreeMap::new())
 }
 
@@ -250,7 +251,8 @@ pub fn description_text(desc: &RobotDescription, format: Format) -> Result<Strin
 }
 
 /// Write a description in the format given by the file's extension.
-pub fn save_description(desc: &RobotDescription, path: &Path) -> Result<()> {
+pub fn save_description(desc: &RobotDescription, path: impl AsRef<Path>) -> Result<()> {
+    let path = path.as_ref();
     let text = description_text(desc, Format::from_path(path)?)?;
     std::fs::write(path, text).map_err(|e| Error::io(path.display().to_string(), e))
 }

@@ -427,17 +427,9 @@ fn parse_robodyn_comment(
         }
         _ => None,
     };
-    let text_of = |v: &str, v_at: usize, what: &str| -> Result<String> {
-        uncomment_text(v).ok_or_else(|| {
-            ctx.err(
-                v_at,
-                format!("robodyn {what}: `{v}` is not a well-formed quoted string"),
-            )
-        })
-    };
     match kind {
-        Some("note") => ex.notes.push(text_of(body.trim(), body_at, "note")?),
-        Some("name") => ex.robodyn_name = Some(text_of(body.trim(), body_at, "name")?),
+        Some("note") => ex.notes.push(quoted(ctx, body.trim(), body_at, "note")?),
+        Some("name") => ex.robodyn_name = Some(quoted(ctx, body.trim(), body_at, "name")?),
         Some(kind) => {
             for (item, off) in split_items(body) {
                 let item_at = body_at + off;
@@ -453,74 +445,114 @@ fn parse_robodyn_comment(
                         ),
                     ));
                 };
-                let k = item[..eq].trim();
                 let raw = &item[eq + 1..];
-                let v = raw.trim();
-                let v_at = item_at + eq + 1 + (raw.len() - raw.trim_start().len());
-                if let Some(lk) = limit_kind {
-                    let j: usize = k.parse().map_err(|_| {
-                        ctx.err(
-                            item_at,
-                            format!("robodyn limits {lk}: `{k}` is not a frame number"),
-                        )
-                    })?;
-                    let x = ctx
-                        .expr(&format!("{lk} limit of q{k}"), v, v_at)?
-                        .eval(&|_| None)
-                        .map_err(|e| ctx.err(v_at, format!("{lk} limit of q{k}: {e}")))?;
-                    if !x.is_finite() || (lk != "q_min" && lk != "q_max" && x <= 0.0) {
-                        return Err(ctx.err(
-                            v_at,
-                            format!("{lk} limit of q{k}: {x} is not a finite positive limit"),
-                        ));
-                    }
-                    ex.limits.insert((j, lk), (x, item_at));
-                } else if kind == "assembly" {
-                    let j: usize = k.parse().map_err(|_| {
-                        ctx.err(
-                            item_at,
-                            format!("robodyn assembly: `{k}` is not a joint number"),
-                        )
-                    })?;
-                    let x = ctx
-                        .expr(&format!("assembly value of q{k}"), v, v_at)?
-                        .eval(&|_| None)
-                        .map_err(|e| ctx.err(v_at, format!("assembly value of q{k}: {e}")))?;
-                    ex.assembly.insert(j, (x, item_at));
-                } else if kind == "values" {
-                    if !is_symbol_name(k) {
-                        return Err(ctx.err(
-                            item_at,
-                            format!("robodyn values: `{k}` is not a symbol name"),
-                        ));
-                    }
-                    let e = ctx.expr(&format!("value of {k}"), v, v_at)?;
-                    let x = e.eval(&|_| None).map_err(|e| {
-                        ctx.err(
-                            v_at,
-                            format!("value of {k}: {e} (values must be constants)"),
-                        )
-                    })?;
-                    map.set_symbol(k, ctx.line(item_at));
-                    ex.symbols.insert(k.to_string(), x);
-                } else {
-                    let j: usize = k.parse().map_err(|_| {
-                        ctx.err(
-                            item_at,
-                            format!("robodyn {kind}: `{k}` is not a frame/link number"),
-                        )
-                    })?;
-                    let name = text_of(v, v_at, kind)?;
-                    let dst = if kind == "frame names" {
-                        &mut ex.frame_names
-                    } else {
-                        &mut ex.link_names
-                    };
-                    dst.insert(j, name);
-                }
+                let entry = Entry {
+                    key: item[..eq].trim(),
+                    value: raw.trim(),
+                    at: item_at,
+                    value_at: item_at + eq + 1 + (raw.len() - raw.trim_start().len()),
+                };
+                robodyn_entry(ctx, (kind, limit_kind), entry, ex, map)?;
             }
         }
         None => {}
+    }
+    Ok(())
+}
+
+/// The quoted string `v` of a `robodyn` comment (a note, a name), unquoted.
+fn quoted(ctx: &Ctx, v: &str, v_at: usize, what: &str) -> Result<String> {
+    uncomment_text(v).ok_or_else(|| {
+        ctx.err(
+            v_at,
+            format!("robodyn {what}: `{v}` is not a well-formed quoted string"),
+        )
+    })
+}
+
+/// One `KEY = VALUE` entry of a `robodyn` comment, with the byte offsets of the entry and of its
+/// value in the file.
+struct Entry<'a> {
+    key: &'a str,
+    value: &'a str,
+    at: usize,
+    value_at: usize,
+}
+
+/// One entry of a `robodyn KIND:` comment (`limit_kind` for `robodyn limits KIND`) into `ex`.
+fn robodyn_entry(
+    ctx: &Ctx,
+    (kind, limit_kind): (&str, Option<&'static str>),
+    entry: Entry,
+    ex: &mut Extras,
+    map: &mut SourceMap,
+) -> Result<()> {
+    let Entry {
+        key: k,
+        value: v,
+        at: item_at,
+        value_at: v_at,
+    } = entry;
+    if let Some(lk) = limit_kind {
+        let j: usize = k.parse().map_err(|_| {
+            ctx.err(
+                item_at,
+                format!("robodyn limits {lk}: `{k}` is not a frame number"),
+            )
+        })?;
+        let x = ctx
+            .expr(&format!("{lk} limit of q{k}"), v, v_at)?
+            .eval(&|_| None)
+            .map_err(|e| ctx.err(v_at, format!("{lk} limit of q{k}: {e}")))?;
+        if !x.is_finite() || (lk != "q_min" && lk != "q_max" && x <= 0.0) {
+            return Err(ctx.err(
+                v_at,
+                format!("{lk} limit of q{k}: {x} is not a finite positive limit"),
+            ));
+        }
+        ex.limits.insert((j, lk), (x, item_at));
+    } else if kind == "assembly" {
+        let j: usize = k.parse().map_err(|_| {
+            ctx.err(
+                item_at,
+                format!("robodyn assembly: `{k}` is not a joint number"),
+            )
+        })?;
+        let x = ctx
+            .expr(&format!("assembly value of q{k}"), v, v_at)?
+            .eval(&|_| None)
+            .map_err(|e| ctx.err(v_at, format!("assembly value of q{k}: {e}")))?;
+        ex.assembly.insert(j, (x, item_at));
+    } else if kind == "values" {
+        if !is_symbol_name(k) {
+            return Err(ctx.err(
+                item_at,
+                format!("robodyn values: `{k}` is not a symbol name"),
+            ));
+        }
+        let e = ctx.expr(&format!("value of {k}"), v, v_at)?;
+        let x = e.eval(&|_| None).map_err(|e| {
+            ctx.err(
+                v_at,
+                format!("value of {k}: {e} (values must be constants)"),
+            )
+        })?;
+        map.set_symbol(k, ctx.line(item_at));
+        ex.symbols.insert(k.to_string(), x);
+    } else {
+        let j: usize = k.parse().map_err(|_| {
+            ctx.err(
+                item_at,
+                format!("robodyn {kind}: `{k}` is not a frame/link number"),
+            )
+        })?;
+        let name = quoted(ctx, v, v_at, kind)?;
+        let dst = if kind == "frame names" {
+            &mut ex.frame_names
+        } else {
+            &mut ex.link_names
+        };
+        dst.insert(j, name);
     }
     Ok(())
 }
@@ -1113,8 +1145,23 @@ fn symoro_name(s: &str) -> String {
 
 /// Write a description as a SYMORO `.par` file (plus our values/names in comments).
 pub fn write_description(desc: &RobotDescription) -> String {
-    let nf = desc.nf();
     let mut s = String::new();
+    write_header(&mut s, desc);
+    write_geometry(&mut s, desc);
+    write_dynamics(&mut s, desc);
+    write_extensions(&mut s, desc);
+    s.push_str("\n(* End of definition *)\n");
+    s
+}
+
+/// A SYMORO list: `{a,b,c}`.
+fn par_list(items: Vec<String>) -> String {
+    format!("{{{}}}", items.join(","))
+}
+
+/// The robot's name (and robodyn's own name and notes as comments) and its counts.
+fn write_header(s: &mut String, desc: &RobotDescription) {
+    let nf = desc.nf();
     let name = symoro_name(&desc.name);
     s.push_str(&format!("(* Robotname = '{name}' *)\n"));
     if name != desc.name || name.trim() != name || name.is_empty() {
@@ -1133,15 +1180,19 @@ pub fn write_description(desc: &RobotDescription) -> String {
         structure_type(desc),
         u8::from(desc.mobile_base)
     ));
-    let list = |items: Vec<String>| format!("{{{}}}", items.join(","));
+}
+
+/// The geometric parameters, the joint variables named after no symbol of the description.
+fn write_geometry(s: &mut String, desc: &RobotDescription) {
+    let nf = desc.nf();
     s.push_str("\n(* Geometric parameters *)\n");
     s.push_str(&format!(
         "ant = {}\n",
-        list(desc.frames.iter().map(|f| f.ant.to_string()).collect())
+        par_list(desc.frames.iter().map(|f| f.ant.to_string()).collect())
     ));
     s.push_str(&format!(
         "sigma = {}\n",
-        list(
+        par_list(
             desc.frames
                 .iter()
                 .map(|f| f.joint.sigma().to_string())
@@ -1197,8 +1248,12 @@ pub fn write_description(desc: &RobotDescription) -> String {
                 }
             })
             .collect();
-        s.push_str(&format!("{p} = {}\n", list(items)));
+        s.push_str(&format!("{p} = {}\n", par_list(items)));
     }
+}
+
+/// The dynamic parameters, external forces, joint and base motion, and gravity.
+fn write_dynamics(s: &mut String, desc: &RobotDescription) {
     s.push_str("\n(* Dynamic parameters and external forces *)\n");
     let order = [
         "XX", "XY", "XZ", "YY", "YZ", "ZZ", "MX", "MY", "MZ", "M", "IA", "FV", "FS", "FX", "FY",
@@ -1223,12 +1278,12 @@ pub fn write_description(desc: &RobotDescription) -> String {
                 }
             }))
             .collect();
-        s.push_str(&format!("{name} = {}\n", list(items)));
+        s.push_str(&format!("{name} = {}\n", par_list(items)));
     }
     s.push_str("\n(* Joint velocities and accelerations *)\n");
     for name in ["QP", "QDP", "GAM"] {
         let items: Vec<String> = (1..=desc.nj).map(|j| format!("{name}{j}")).collect();
-        s.push_str(&format!("{name} = {}\n", list(items)));
+        s.push_str(&format!("{name} = {}\n", par_list(items)));
     }
     s.push_str("\n(* Speed and acceleration of the base *)\n");
     for (name, v) in [
@@ -1239,20 +1294,25 @@ pub fn write_description(desc: &RobotDescription) -> String {
     ] {
         s.push_str(&format!(
             "{name} = {}\n",
-            list(v.iter().map(|e| e.decimal().to_string()).collect())
+            par_list(v.iter().map(|e| e.decimal().to_string()).collect())
         ));
     }
     s.push_str("\n(* Matrix Z *)\nZ = {1,0,0,0,0,1,0,0,0,0,1,0,0,0,0,1}\n");
     s.push_str("\n(* Acceleration of gravity *)\n");
     s.push_str(&format!(
         "G = {}\n",
-        list(
+        par_list(
             desc.gravity
                 .iter()
                 .map(|e| e.decimal().to_string())
                 .collect()
         )
     ));
+}
+
+/// What SYMORO has no field for, as robodyn comments: frame and link names, limits, the
+/// assembly, the symbols' values.
+fn write_extensions(s: &mut String, desc: &RobotDescription) {
     let default_frame = |j: usize, n: &str| n == format!("j{j}");
     if desc
         .frames
@@ -1329,6 +1389,4 @@ pub fn write_description(desc: &RobotDescription) -> String {
             items.join(";\n   ")
         ));
     }
-    s.push_str("\n(* End of definition *)\n");
-    s
 }

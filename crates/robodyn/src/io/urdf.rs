@@ -4,7 +4,8 @@
 //! node, so each error names the line of the offending `<joint>`/`<link>`, and it does not reject
 //! the extension tags real URDFs carry (`<gazebo>`, `<transmission>`, ...).
 //!
-//! Conversion (exact, derived from first principles; conventions.md, eq 10.18):
+//! Conversion (exact, derived from first principles; frames as in §10.1 of the chapter, iT_j by
+//! gamma, b, alpha, d, theta, r, its position iP_j by eq 10.18):
 //! - joints are numbered depth-first from the root link (children in file order), so a(j) < j;
 //!   frame j keeps the URDF joint's name, link j the child link's name;
 //! - frame R_j is placed at the joint origin with z_j along the axis (minimal rotation S_j taking
@@ -427,77 +428,10 @@ fn read_joints<'a>(
                 ),
             ));
         }
-        let axis = match child(n, "axis") {
-            None => Vector3::x(),
-            Some(a) => {
-                let v = ctx.numbers(a, "xyz", [1.0, 0.0, 0.0], &format!("{what}, <axis>"))?;
-                let v = Vector3::new(v[0], v[1], v[2]);
-                if v.norm() < 1e-12 && joint.is_movable() {
-                    return Err(ctx.err(a, format!("{what}: the axis is the zero vector")));
-                }
-                if v.norm() < 1e-12 {
-                    Vector3::z()
-                } else {
-                    v / v.norm()
-                }
-            }
-        };
-        let mimic = match child(n, "mimic") {
-            None => None,
-            Some(m) => {
-                let w = format!("{what}, <mimic>");
-                let number = |a: &str, default: f64| -> Result<f64> {
-                    m.attribute(a)
-                        .map_or(Ok(default), |t| ctx.number(m, t, &format!("{w}: {a}")))
-                };
-                Some(UMimic {
-                    joint: ctx.attr(m, "joint", &w)?.to_string(),
-                    node: m,
-                    multiplier: number("multiplier", 1.0)?,
-                    offset: number("offset", 0.0)?,
-                })
-            }
-        };
-        let (mut damping, mut friction) = (0.0, 0.0);
-        if let Some(dn) = child(n, "dynamics") {
-            if let Some(s) = dn.attribute("damping") {
-                damping = ctx.number(dn, s, &format!("{what}, damping"))?;
-            }
-            if let Some(s) = dn.attribute("friction") {
-                friction = ctx.number(dn, s, &format!("{what}, friction"))?;
-            }
-        }
-        // <limit lower upper velocity effort>: position limits of revolute and prismatic joints
-        // (not continuous), when lower < upper; speed and effort when positive (URDF writes 0
-        // for "not given")
-        let limits = match child(n, "limit") {
-            Some(ln) if joint != JointType::Fixed => {
-                let w = format!("{what}, <limit>");
-                let get = |a: &str| -> Result<Option<f64>> {
-                    ln.attribute(a)
-                        .map(|t| ctx.number(ln, t, &format!("{w}: {a}")))
-                        .transpose()
-                };
-                let (lo, hi) = (get("lower")?, get("upper")?);
-                let positional = kind != "continuous";
-                let (q_min, q_max) = match (lo, hi) {
-                    (Some(a), Some(b)) if positional && a < b => (Some(a), Some(b)),
-                    (None, Some(b)) if positional && b > 0.0 => (Some(0.0), Some(b)),
-                    (Some(a), None) if positional && a < 0.0 => (Some(a), Some(0.0)),
-                    _ => (None, None),
-                };
-                let positive = |v: Option<f64>| v.filter(|&x| x > 0.0);
-                let l = JointLimits {
-                    q_min,
-                    q_max,
-                    qd: positive(get("velocity")?),
-                    qdd: None,
-                    tau: positive(get("effort")?),
-                };
-                (l != JointLimits::default()).then_some(l)
-            }
-            _ => None,
-        };
+        let axis = joint_axis(ctx, n, &what, joint)?;
+        let mimic = joint_mimic(ctx, n, &what)?;
+        let (damping, friction) = joint_dynamics(ctx, n, &what)?;
+        let limits = joint_limits(ctx, n, &what, joint, kind != "continuous")?;
         joint_names.insert(name.clone(), joints.len());
         joints.push(UJoint {
             limits,
@@ -515,6 +449,147 @@ fn read_joints<'a>(
     }
 
     Ok(joints)
+}
+
+/// The unit axis of joint `n` (x when absent, as URDF says; a fixed joint's zero axis is z).
+fn joint_axis(ctx: &Ctx, n: roxmltree::Node, what: &str, joint: JointType) -> Result<Vector3<f64>> {
+    Ok(match child(n, "axis") {
+        None => Vector3::x(),
+        Some(a) => {
+            let v = ctx.numbers(a, "xyz", [1.0, 0.0, 0.0], &format!("{what}, <axis>"))?;
+            let v = Vector3::new(v[0], v[1], v[2]);
+            if v.norm() < 1e-12 && joint.is_movable() {
+                return Err(ctx.err(a, format!("{what}: the axis is the zero vector")));
+            }
+            if v.norm() < 1e-12 {
+                Vector3::z()
+            } else {
+                v / v.norm()
+            }
+        }
+    })
+}
+
+/// The `<mimic>` of joint `n`, if any.
+fn joint_mimic<'a>(
+    ctx: &Ctx,
+    n: roxmltree::Node<'a, 'a>,
+    what: &str,
+) -> Result<Option<UMimic<'a>>> {
+    Ok(match child(n, "mimic") {
+        None => None,
+        Some(m) => {
+            let w = format!("{what}, <mimic>");
+            let number = |a: &str, default: f64| -> Result<f64> {
+                m.attribute(a)
+                    .map_or(Ok(default), |t| ctx.number(m, t, &format!("{w}: {a}")))
+            };
+            Some(UMimic {
+                joint: ctx.attr(m, "joint", &w)?.to_string(),
+                node: m,
+                multiplier: number("multiplier", 1.0)?,
+                offset: number("offset", 0.0)?,
+            })
+        }
+    })
+}
+
+/// The `<dynamics damping friction>` of joint `n`: (viscous, Coulomb) friction, 0 when absent.
+fn joint_dynamics(ctx: &Ctx, n: roxmltree::Node, what: &str) -> Result<(f64, f64)> {
+    let (mut damping, mut friction) = (0.0, 0.0);
+    if let Some(dn) = child(n, "dynamics") {
+        if let Some(s) = dn.attribute("damping") {
+            damping = ctx.number(dn, s, &format!("{what}, damping"))?;
+        }
+        if let Some(s) = dn.attribute("friction") {
+            friction = ctx.number(dn, s, &format!("{what}, friction"))?;
+        }
+    }
+    Ok((damping, friction))
+}
+
+/// The `<limit lower upper velocity effort>` of joint `n`: position limits of revolute and
+/// prismatic joints (`positional`: not continuous) when lower < upper; speed and effort when
+/// positive (URDF writes 0 for "not given").
+fn joint_limits(
+    ctx: &Ctx,
+    n: roxmltree::Node,
+    what: &str,
+    joint: JointType,
+    positional: bool,
+) -> Result<Option<JointLimits>> {
+    Ok(match child(n, "limit") {
+        Some(ln) if joint != JointType::Fixed => {
+            let w = format!("{what}, <limit>");
+            let get = |a: &str| -> Result<Option<f64>> {
+                ln.attribute(a)
+                    .map(|t| ctx.number(ln, t, &format!("{w}: {a}")))
+                    .transpose()
+            };
+            let (lo, hi) = (get("lower")?, get("upper")?);
+            let (q_min, q_max) = match (lo, hi) {
+                (Some(a), Some(b)) if positional && a < b => (Some(a), Some(b)),
+                (None, Some(b)) if positional && b > 0.0 => (Some(0.0), Some(b)),
+                (Some(a), None) if positional && a < 0.0 => (Some(a), Some(0.0)),
+                _ => (None, None),
+            };
+            let positive = |v: Option<f64>| v.filter(|&x| x > 0.0);
+            let l = JointLimits {
+                q_min,
+                q_max,
+                qd: positive(get("velocity")?),
+                qdd: None,
+                tau: positive(get("effort")?),
+            };
+            (l != JointLimits::default()).then_some(l)
+        }
+        _ => None,
+    })
+}
+
+/// The standard inertial parameters about O_j in R_j (XX XY XZ YY YZ ZZ MX MY MZ M) of a URDF
+/// `<inertial>`: centre of mass `com` in the URDF link frame, whose orientation in R_j is `c_j`,
+/// mass `m`, inertia `jg` about the centre of mass in the `com` frame (Huygens-Steiner).
+fn inertial_about_origin(
+    c_j: &UnitQuaternion<f64>,
+    com: &Iso,
+    m: f64,
+    jg: &Matrix3<f64>,
+) -> [f64; 10] {
+    let cj = c_j.to_rotation_matrix();
+    let c = cj * com.translation.vector;
+    let rot: Rotation3<f64> = cj * com.rotation.to_rotation_matrix();
+    let jo = rot.matrix() * jg * rot.matrix().transpose()
+        + m * (c.dot(&c) * Matrix3::identity() - c * c.transpose());
+    [
+        jo[(0, 0)],
+        jo[(0, 1)],
+        jo[(0, 2)],
+        jo[(1, 1)],
+        jo[(1, 2)],
+        jo[(2, 2)],
+        m * c.x,
+        m * c.y,
+        m * c.z,
+        m,
+    ]
+}
+
+/// The warning for a `<mimic>` of joint `name` (frame `frame`) naming a joint the file does not
+/// define: the model does not change (mimic joints are imported as independent joints), but the
+/// file is wrong (example-robot-data's alex_psyonic_hands.urdf has such references, and
+/// Pinocchio loads it).
+fn unknown_mimic(ctx: &Ctx, name: &str, m: &UMimic, frame: usize) -> Warning {
+    let mut w = Warning::new(
+        Item::Frame(frame, None),
+        format!(
+            "joint `{name}`, <mimic>: joint `{}` is not defined (the joint is imported as an \
+             independent joint)",
+            m.joint
+        ),
+    );
+    w.location.line = Some(ctx.line(m.node));
+    w
 }
 
 /// The root link and the joints in depth-first order from it (children in file order), after
@@ -694,16 +769,7 @@ fn build(
             // as independent joints), but the file is wrong: example-robot-data's
             // alex_psyonic_hands.urdf has such references, and Pinocchio loads it
             if !joint_set.contains(m.joint.as_str()) {
-                let mut w = Warning::new(
-                    Item::Frame(frames.len(), None),
-                    format!(
-                        "joint `{}`, <mimic>: joint `{}` is not defined (the joint is imported \
-                         as an independent joint)",
-                        jt.name, m.joint
-                    ),
-                );
-                w.location.line = Some(ctx.line(m.node));
-                map.warn(w);
+                map.warn(unknown_mimic(ctx, &jt.name, m, frames.len()));
             }
             notes.push(format!(
                 "joint {} mimics {} (q = {:?} * q_{} + {:?}); imported as an independent joint",
@@ -716,23 +782,7 @@ fn build(
         map.set_link(j, None, ctx.line(ul.node));
         if let Some((com, m, jg, mass_node)) = &ul.inertial {
             map.set_link(j, Some("M"), ctx.line(*mass_node));
-            let cj = c_of[j].to_rotation_matrix();
-            let c = cj * com.translation.vector;
-            let rot: Rotation3<f64> = cj * com.rotation.to_rotation_matrix();
-            let jo = rot.matrix() * jg * rot.matrix().transpose()
-                + *m * (c.dot(&c) * Matrix3::identity() - c * c.transpose());
-            let vals = [
-                jo[(0, 0)],
-                jo[(0, 1)],
-                jo[(0, 2)],
-                jo[(1, 1)],
-                jo[(1, 2)],
-                jo[(2, 2)],
-                m * c.x,
-                m * c.y,
-                m * c.z,
-                *m,
-            ];
+            let vals = inertial_about_origin(&c_of[j], com, *m, jg);
             for (kk, v) in vals.iter().enumerate() {
                 ld.params[kk] = num_expr(*v, false);
             }

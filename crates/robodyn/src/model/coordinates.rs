@@ -12,13 +12,13 @@ use crate::error::{check_vector, Result};
 /// ```
 /// # fn main() -> robodyn::Result<()> {
 /// let robots = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots");
-/// let rx90 = robodyn::io::load(format!("{robots}/rx90.urdf").as_ref())?;
+/// let rx90 = robodyn::io::load(format!("{robots}/rx90.urdf"))?;
 /// let c = rx90.coordinates();
 /// let elbow = c.index_of("elbow").expect("a joint of the URDF");
 /// assert_eq!((elbow, c.frame(elbow), c.name(elbow)), (2, 3, "elbow"));
 ///
 /// // A closed chain's vectors hold its actuated joints; the passive ones have their own map.
-/// let sr400 = robodyn::io::load(format!("{robots}/sr400.toml").as_ref())?;
+/// let sr400 = robodyn::io::load(format!("{robots}/sr400.toml"))?;
 /// let chain = robodyn::ClosedChain::new(&sr400)?;
 /// assert_eq!(chain.coordinates().frames(), &[1, 2, 4, 5, 6, 7]);
 /// assert_eq!(chain.passive_coordinates().frames(), &[3, 8]);

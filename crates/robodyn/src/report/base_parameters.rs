@@ -1,6 +1,7 @@
 //! Text, LaTeX and JSON writers of a base-parameter [`Summary`].
 
 use crate::algorithms::base_parameters::summary::{Summary, LEGEND};
+use crate::report::number::{significant, Sig};
 use serde_json::json;
 
 /// Plain-text report: title, comparison block (when the methods differ), the table like
@@ -47,7 +48,11 @@ pub fn text(r: &Summary) -> String {
         s.push_str("\nValues (rounded to 12 significant digits):\n");
         for b in &r.base {
             match b.value {
-                Some(v) => s.push_str(&format!("  {:<width$} = {}\n", b.name, value_text(v))),
+                Some(v) => s.push_str(&format!(
+                    "  {:<width$} = {}\n",
+                    b.name,
+                    Sig(v, VALUE_DIGITS)
+                )),
                 None => s.push_str(&format!(
                     "  {:<width$} = (parameters without value)\n",
                     b.name
@@ -66,12 +71,10 @@ pub fn text(r: &Summary) -> String {
     s
 }
 
-/// A value for display: 12 significant digits (the rounding of the sums that make it,
-/// 10.899999999999999 -> 10.9), the report form of [`crate::report::number`]; integers without
-/// a point, -0 as 0. JSON keeps the full double.
-pub fn value_text(v: f64) -> String {
-    crate::report::number::significant(v, 12)
-}
+/// Significant digits of a value for display: 12, the rounding of the sums that make it
+/// (10.899999999999999 -> 10.9) in the report form of [`crate::report::number`]. JSON keeps the
+/// full double.
+const VALUE_DIGITS: usize = 12;
 
 /// LaTeX fragment (needs amsmath): the table (tabular, math cells), its legend, the grouping
 /// equations (align*, long sums broken between terms) and the values.
@@ -137,7 +140,7 @@ pub fn latex(r: &Summary) -> String {
                 format!(
                     "${}$ & ${}$",
                     latex_name(&b.name),
-                    latex_number(&value_text(v))
+                    latex_number(&significant(v, VALUE_DIGITS))
                 )
             })
         })

@@ -32,7 +32,7 @@
 //! # fn main() -> robodyn::Result<()> {
 //! use robodyn::view::{page, Pose, ViewOptions};
 //! let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots/sr400.toml");
-//! let sr400 = robodyn::io::load(path.as_ref())?;
+//! let sr400 = robodyn::io::load(path)?;
 //! let options = ViewOptions {
 //!     pose: Pose::Actuated(vec![0.1, 0.2, 0.3, 0.4, 0.5, 1.6]), // loop closure gives q_p
 //!     ..ViewOptions::default()

@@ -205,7 +205,7 @@ impl Probe<'_> {
     /// of that in m), each closed from the singular start's q_p: the first regular result on the
     /// parallelogram branch.
     fn search_start(&self, qa0: &[f64], guess: &[f64]) -> Option<Start> {
-        let mut rng = crate::testing::rng(0x57a7);
+        let mut rng = crate::sampling::rng(0x57a7);
         for attempt in 0..60 {
             let size = 0.05 * (1.0 + attempt as f64 / 4.0).min(16.0);
             let qa: Vec<f64> = qa0

@@ -22,7 +22,7 @@
 //! use robodyn::algorithms::regressor::{ParameterSelection, RotorMode};
 //! # fn main() -> robodyn::Result<()> {
 //! let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots/sr400.toml");
-//! let desc = robodyn::io::load_description(path.as_ref())?;
+//! let desc = robodyn::io::load_description(path)?;
 //! let sel = ParameterSelection::from_description(&desc, RotorMode::Actuated, false);
 //! let names = ParameterNames::of(&desc);
 //! let symbolic = symbolic_base_parameters(&desc, &sel)?;

@@ -61,7 +61,8 @@ impl ParameterNames {
     /// literal 0, an expression) takes its canonical name unless the file uses that name for
     /// something else.
     pub fn of(desc: &RobotDescription) -> ParameterNames {
-        let used = crate::io::known_symbols(desc);
+        let mut used: BTreeSet<String> = desc.symbols.keys().cloned().collect();
+        used.extend(desc.used_symbols());
         let n = PARAMS_PER_LINK * desc.nl;
         let own: Vec<Option<String>> = (0..n)
             .map(|k| {

@@ -516,18 +516,21 @@ pub fn numeric_base_parameters(
         .saturating_add(nl.saturating_mul(PARAMS_PER_LINK * nl))
         .saturating_mul(8);
     if bytes > MAX_OBSERVATION_BYTES {
-        return Err(Error::Input(format!(
-            "{}: the numerical method would need an observation matrix W of about {bound_rows} x \
-             {ncols} ({:.1} GiB, about {:.1} GiB in all); the limit is {:.1} GiB \
-             (MAX_OBSERVATION_BYTES, about 10,000 parameters). Use the symbolic method for this \
-             robot, or fewer drive parameters (--rotor none, --no-friction)",
-            robot.name(),
-            bytes as f64 / (1u64 << 30) as f64,
-            2.5 * bytes as f64 / (1u64 << 30) as f64,
-            MAX_OBSERVATION_BYTES as f64 / (1u64 << 30) as f64
-        )));
+        return Err(Error::Setting {
+            option: "base_parameters::NumericOptions::selection",
+            reason: format!(
+                "{}: the numerical method would need an observation matrix W of about \
+                 {bound_rows} x {ncols} ({:.1} GiB, about {:.1} GiB in all); the limit is {:.1} \
+                 GiB (MAX_OBSERVATION_BYTES, about 10,000 parameters). Use the symbolic method \
+                 for this robot, or fewer drive parameters (no rotor inertias, no friction)",
+                robot.name(),
+                bytes as f64 / (1u64 << 30) as f64,
+                2.5 * bytes as f64 / (1u64 << 30) as f64,
+                MAX_OBSERVATION_BYTES as f64 / (1u64 << 30) as f64
+            ),
+        });
     }
-    let mut rng = crate::testing::rng(opt.seed);
+    let mut rng = crate::sampling::rng(opt.seed);
     let model = robot.numeric();
     let mut ws = Data::new(robot);
     let mut phi = DMatrix::zeros(nl, PARAMS_PER_LINK * nl);

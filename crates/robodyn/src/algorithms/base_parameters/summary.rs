@@ -298,7 +298,7 @@ pub fn base_robot(
     d.name = format!("{} (base parameters)", desc.name);
     d.notes.push(
         "Base robot: every standard parameter is zero except the base parameters, which hold \
-         their grouped values (robodyn base-params --write-robot)."
+         their grouped values."
             .into(),
     );
     Ok(d)
@@ -392,8 +392,8 @@ impl MethodComparison {
             "METHODS DIFFER: the symbolic rules give {} base parameters, the numerical method {}. \
              The NUMERICAL method is the arbiter (its set is minimal){why}. Base by the rules \
              only (grouped or without effect numerically): {}. Base numerically only: {}. The \
-             symbolic equations above remain valid groupings but are not minimal; use \
-             `--method numeric` for the minimal set.",
+             symbolic equations above remain valid groupings but are not minimal; the numerical \
+             method gives the minimal set.",
             self.symbolic_count,
             self.numeric_count,
             list(&self.symbolic_only),
@@ -410,7 +410,7 @@ impl MethodComparison {
             "THE METHODS DIFFER; THE NUMERICAL METHOD IS THE ARBITER: it finds {} base parameters, \
              the symbolic rules {} ({}).\n  base by the rules only: {}\n  base numerically only: {}\n\
              The table and equations below are the symbolic ones (valid, not minimal); \
-             `--method numeric` gives the minimal set.\n\n",
+             the numerical method gives the minimal set.\n\n",
             self.numeric_count,
             self.symbolic_count,
             self.reason(),

@@ -280,7 +280,7 @@ impl Geo {
             ev(&desc.vp0[2])? - ev(&desc.gravity[2])?,
         );
         let g = if gv.norm() > 0.0 { gv.normalize() } else { gv };
-        let mut rng = crate::testing::rng(0x5eed);
+        let mut rng = crate::sampling::rng(0x5eed);
         let nf = frames.len();
         let mut configs = Vec::new();
         let mut poses = Vec::new();

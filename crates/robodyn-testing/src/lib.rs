@@ -1,13 +1,15 @@
-//! Random robots for tests and benchmarks (fixed seeds give reproducible robots).
+//! Random robots for robodyn's tests and benchmarks (fixed seeds give reproducible robots).
 //!
-//! Public so that the integration tests, the benches and property tests of every algorithm share
-//! one generator.
+//! One generator shared by the integration tests, the benches and the property tests of every
+//! algorithm. The library's own random samples (base parameters, customized models) come from
+//! `robodyn`'s internal `sampling` module, never from here.
 
-use crate::model::{JointType, LinkDesc, RobotDescription};
-use crate::Robot;
+#![deny(missing_docs)]
+
 use nalgebra::{Matrix3, Rotation3, Vector3};
 use rand::Rng;
-use robodyn_symbolic::Expr;
+use robodyn::model::{JointType, LinkDesc, RobotDescription};
+use robodyn::{Expr, Robot};
 
 /// Options of the random tree generator.
 #[derive(Clone, Debug)]
