@@ -197,6 +197,25 @@ pub fn is_broken_pipe(e: &(dyn std::error::Error + 'static)) -> bool {
     false
 }
 
+/// The value parser of an option whose values are a library enum's (`--lang`, `--rotor`): the
+/// enum's own list `all`, each value's `name` on the command line and its `help`, so that the
+/// command line has no second list of the values.
+pub fn choices<T: Copy + Send + Sync + 'static>(
+    all: &'static [T],
+    name: fn(T) -> &'static str,
+    help: fn(T) -> &'static str,
+) -> impl clap::builder::TypedValueParser<Value = T> {
+    let values = all
+        .iter()
+        .map(|&v| clap::builder::PossibleValue::new(name(v)).help(help(v)));
+    use clap::builder::TypedValueParser as _;
+    clap::builder::PossibleValuesParser::new(values).map(move |s| {
+        *all.iter()
+            .find(|&&v| name(v) == s)
+            .expect("clap accepts only the listed names")
+    })
+}
+
 /// How joint columns are named.
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum Names {

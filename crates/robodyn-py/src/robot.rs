@@ -133,14 +133,22 @@ pub fn parse_zeros(
     })
 }
 
+/// The library's rotor mode of its name (`"actuated"`, `"all"`, `"none"`).
 pub fn parse_rotor(rotor: &str) -> PyResult<RotorMode> {
-    match rotor {
-        "actuated" => Ok(RotorMode::Actuated),
-        "all" => Ok(RotorMode::All),
-        "none" => Ok(RotorMode::None),
-        _ => Err(InputError::new_err(format!(
-            "rotor = {rotor:?}: expected \"actuated\", \"all\" or \"none\""
-        ))),
+    RotorMode::from_name(rotor).ok_or_else(|| {
+        InputError::new_err(format!(
+            "rotor = {rotor:?}: expected {}",
+            quoted(RotorMode::ALL.map(RotorMode::name).as_slice())
+        ))
+    })
+}
+
+/// `"a", "b" or "c"`.
+pub fn quoted(names: &[&str]) -> String {
+    let q: Vec<String> = names.iter().map(|n| format!("{n:?}")).collect();
+    match q.split_last() {
+        Some((last, rest)) if !rest.is_empty() => format!("{} or {last}", rest.join(", ")),
+        _ => q.join(""),
     }
 }
 

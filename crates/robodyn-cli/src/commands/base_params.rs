@@ -2,7 +2,7 @@
 //! method or both (§10.2.4, §10.3.4–10.3.6), as a table like Table 10.2 with the grouping
 //! equations and the values for the robot's numbers.
 
-use crate::common::{CliResult, RobotArgs};
+use crate::common::{choices, CliResult, RobotArgs};
 use robodyn::algorithms::base_parameters::{
     base_robot, compare_methods, geometry_robot, numeric_base_parameters_auto, standard_values,
     symbolic_base_parameters, NumericOptions, ParameterNames, Summary,
@@ -32,16 +32,6 @@ pub enum Format {
 }
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Rotor {
-    /// Rotor inertia IA_j on the actuated joints.
-    Actuated,
-    /// On every movable joint.
-    All,
-    /// No rotor inertia.
-    None,
-}
-
-#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Zeros {
     /// A parameter written as a literal 0 does not exist (SYMORO's meaning).
     Absent,
@@ -64,8 +54,8 @@ pub struct Args {
     #[arg(long)]
     pub no_friction: bool,
     /// Which rotor inertias IA are parameters.
-    #[arg(long, value_enum, default_value = "actuated")]
-    pub rotor: Rotor,
+    #[arg(long, default_value = "actuated", value_parser = choices(&RotorMode::ALL, RotorMode::name, RotorMode::describe))]
+    pub rotor: RotorMode,
     /// Seed of the random samples of the numerical method.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -80,11 +70,7 @@ pub struct Args {
 
 pub fn run(a: Args) -> CliResult {
     let (desc, _) = a.robot.description()?;
-    let rotor = match a.rotor {
-        Rotor::Actuated => RotorMode::Actuated,
-        Rotor::All => RotorMode::All,
-        Rotor::None => RotorMode::None,
-    };
+    let rotor = a.rotor;
     let zeros = match a.zeros {
         Some(Zeros::Absent) => ZeroParameters::Absent,
         Some(Zeros::Value) => ZeroParameters::Value,

@@ -439,16 +439,25 @@ fn progress_bar() -> CliResult<ProgressBar> {
     Ok(bar)
 }
 
-pub fn run(a: Args) -> CliResult {
-    check_options(&a)?;
-    check_distinct(&[("--output", Some(&a.output)), ("--plot", a.plot.as_deref())])?;
-    let robot = a.robot.load()?;
-    let (dynamics, joints, what, q0_default) = model(&robot, &a)?;
-    let n = joints.len();
-    if n == 0 {
+/// The simulated system with its columns named as `--names` says (a closed chain's passive
+/// joints' `q<j>` too), its joints (frame numbers), what they are, the default q0, and the
+/// label of every movable joint by frame number.
+#[allow(clippy::type_complexity)]
+fn labelled_model<'r>(
+    robot: &'r robodyn::Robot,
+    a: &Args,
+) -> CliResult<(
+    Labelled<'r>,
+    Vec<usize>,
+    &'static str,
+    Option<Vec<f64>>,
+    HashMap<usize, String>,
+)> {
+    let (dynamics, joints, what, q0_default) = model(robot, a)?;
+    if joints.is_empty() {
         return Err("the robot has no movable joint: nothing to simulate".into());
     }
-    let label = joint_labels(&robot, &a.names);
+    let label = joint_labels(robot, &a.names);
     let labels: Vec<String> = joints.iter().map(|j| label[j].clone()).collect();
     // the passive joints' q<j> of a closed chain follow the same rule
     let extra = dynamics
@@ -461,11 +470,21 @@ pub fn run(a: Args) -> CliResult {
             },
         )
         .collect();
-    let mut dynamics = Labelled {
+    let dynamics = Labelled {
         inner: dynamics,
-        labels: labels.clone(),
+        labels,
         extra,
     };
+    Ok((dynamics, joints, what, q0_default, label))
+}
+
+pub fn run(a: Args) -> CliResult {
+    check_options(&a)?;
+    check_distinct(&[("--output", Some(&a.output)), ("--plot", a.plot.as_deref())])?;
+    let robot = a.robot.load()?;
+    let (mut dynamics, joints, what, q0_default, label) = labelled_model(&robot, &a)?;
+    let n = joints.len();
+    let labels = dynamics.labels.clone();
     // the initial state and the input (the columns of its files checked)
     let q0 = joint_values("q0", a.q0.as_deref(), &joints, what, q0_default.as_deref())?;
     let qd0 = joint_values("qd0", a.qd0.as_deref(), &joints, what, None)?;
