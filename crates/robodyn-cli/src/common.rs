@@ -3,6 +3,7 @@
 use crate::output::Output;
 pub use crate::output::{check_finite, write_table, write_text, TableFormat, TableWriter};
 use clap::Args;
+use robodyn::model::param;
 use robodyn::Robot;
 use std::collections::BTreeMap;
 use std::io::Write;
@@ -77,10 +78,13 @@ impl RobotArgs {
                     .enumerate()
                     .all(|(c, &x)| x == if r == c { 1.0 } else { 0.0 })
             });
+            // K: the standard parameters link after link, the drive ones IA, FS, FV
+            let per_link = robodyn::model::STANDARD_PARAMETERS.len();
+            let drive = [param::IA, param::FS, param::FV];
             let driven = t
                 .joints
                 .iter()
-                .any(|&j| (10..13).any(|p| k[13 * (j - 1) + p] != 0.0));
+                .any(|&j| drive.iter().any(|p| k[per_link * (j - 1) + p] != 0.0));
             if !identity && driven {
                 return Err(format!(
                     "{}: the robot has a motor-joint [transmission] and motor drive parameters \

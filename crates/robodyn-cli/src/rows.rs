@@ -39,7 +39,7 @@ pub fn evaluate(
     prefixes: [&str; 3],
     lists: [Option<&str>; 3],
     result: &str,
-    tree: &mut dyn FnMut(&robodyn::Robot, &Chunk, &mut [f64]) -> robodyn::Result<()>,
+    tree: &mut LoadedTreeModel,
     closed: &mut ClosedModel,
 ) -> CliResult {
     let mut t = Phases::start(args.timings);
@@ -79,6 +79,9 @@ pub struct Evaluation<'a> {
 
 /// A tree's evaluation of a chunk into its results.
 pub type TreeModel<'f> = dyn FnMut(&Chunk, &mut [f64]) -> robodyn::Result<()> + 'f;
+/// [`TreeModel`] on the robot [`evaluate`] loads.
+pub type LoadedTreeModel<'f> =
+    dyn FnMut(&robodyn::Robot, &Chunk, &mut [f64]) -> robodyn::Result<()> + 'f;
 /// A closed chain's evaluation of one state on the tracker into its results.
 pub type ClosedModel<'f> = dyn FnMut(
         &ClosedChain,

@@ -661,8 +661,10 @@ fn energy_balance(robot: &robodyn::Robot, input: &TorqueInput) -> EnergyBalance 
         _ => true,
     };
     let k = robot.standard_parameters();
-    let friction =
-        (0..robot.nl()).any(|j| k[13 * j + param::FS] != 0.0 || k[13 * j + param::FV] != 0.0);
+    let per_link = robodyn::model::STANDARD_PARAMETERS.len();
+    let friction = k
+        .chunks(per_link)
+        .any(|link| link[param::FS] != 0.0 || link[param::FV] != 0.0);
     match (driven, friction) {
         (true, _) => EnergyBalance::Work,
         (false, true) => EnergyBalance::Friction,
