@@ -31,14 +31,6 @@ pub enum Format {
     Json,
 }
 
-#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Zeros {
-    /// A parameter written as a literal 0 does not exist (SYMORO's meaning).
-    Absent,
-    /// A literal 0 is a value: the parameter exists.
-    Value,
-}
-
 #[derive(clap::Args, Debug)]
 pub struct Args {
     #[command(flatten)]
@@ -61,8 +53,8 @@ pub struct Args {
     pub seed: u64,
     /// What a parameter written as a literal 0 means (default: absent for a SYMORO .par, as in
     /// SYMORO; value for .toml and .urdf).
-    #[arg(long, value_enum)]
-    pub zeros: Option<Zeros>,
+    #[arg(long, value_parser = choices(&ZeroParameters::ALL, ZeroParameters::name, ZeroParameters::describe))]
+    pub zeros: Option<ZeroParameters>,
     /// Write a base robot (.toml) whose parameters are the grouped values.
     #[arg(long, value_name = "FILE.toml")]
     pub write_robot: Option<PathBuf>,
@@ -71,11 +63,9 @@ pub struct Args {
 pub fn run(a: Args) -> CliResult {
     let (desc, _) = a.robot.description()?;
     let rotor = a.rotor;
-    let zeros = match a.zeros {
-        Some(Zeros::Absent) => ZeroParameters::Absent,
-        Some(Zeros::Value) => ZeroParameters::Value,
-        None => ZeroParameters::for_path(&a.robot.robot),
-    };
+    let zeros = a
+        .zeros
+        .unwrap_or_else(|| ZeroParameters::for_path(&a.robot.robot));
     let sel = ParameterSelection::from_description(&desc, rotor, !a.no_friction)
         .with_zero_parameters(&desc, zeros);
     let names = ParameterNames::of(&desc);

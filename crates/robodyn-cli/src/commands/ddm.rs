@@ -6,28 +6,10 @@
 //! row on the assembly branch (the library's branch tracker, started at the robot's `assembly`
 //! or `--guess`); rows near a singularity are flagged on stderr and in JSON.
 
-use crate::common::{CliResult, RobotArgs};
+use crate::common::{choices, CliResult, RobotArgs};
 use crate::rows::{evaluate, EvaluationArgs};
 use robodyn::{closed_direct_dynamics_into, direct_dynamics_batch, Method};
 use std::path::PathBuf;
-
-/// Direct-dynamics algorithm.
-#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum MethodArg {
-    /// qdd = A^-1 (tau - H), A by composite links, tree L'DL factorization.
-    Composite,
-    /// O(n) recursive Newton-Euler direct model (articulated bodies).
-    Aba,
-}
-
-impl From<MethodArg> for Method {
-    fn from(m: MethodArg) -> Method {
-        match m {
-            MethodArg::Composite => Method::Composite,
-            MethodArg::Aba => Method::ArticulatedBody,
-        }
-    }
-}
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
@@ -48,14 +30,14 @@ pub struct Args {
     #[arg(long, allow_hyphen_values = true)]
     pub tau: Option<String>,
     /// Direct model of a tree robot (closed chains always use A_cl, H_cl of 10.46-10.48).
-    #[arg(long, value_enum, default_value = "composite")]
-    pub method: MethodArg,
+    #[arg(long, default_value = "composite", value_parser = choices(&Method::ALL, Method::name, Method::describe))]
+    pub method: Method,
     #[command(flatten)]
     pub eval: EvaluationArgs,
 }
 
 pub fn run(a: Args) -> CliResult {
-    let method: Method = a.method.into();
+    let method = a.method;
     evaluate(
         &a.robot,
         &a.eval,

@@ -9,8 +9,7 @@
 //! Joint columns follow `--names` as in `idm`, `ddm` and `regressor`: `q3` (frame number) or
 //! `q_shoulder` (joint name), in the CSV, the `--torque-csv` / `--track` input and the plot.
 
-use crate::commands::ddm::MethodArg;
-use crate::common::{format_number, parse_list, CliResult, NamesArg, RobotArgs};
+use crate::common::{choices, format_number, parse_list, CliResult, NamesArg, RobotArgs};
 use crate::output::{check_distinct, commit_all, Output};
 use crate::states::{classify, known_columns, ColumnSpec, Group};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -19,6 +18,7 @@ use robodyn::simulation::{
     plot_svg, simulate, ClosedChainDynamics, CsvSink, Dynamics, EnergyBalance, Integrator,
     PlotInfo, Recorder, SimOptions, Tee, TimeSeries, TorqueInput, TrajectorySink, TreeDynamics,
 };
+use robodyn::Method;
 use std::collections::HashMap;
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -66,8 +66,8 @@ pub struct Args {
     #[arg(long, allow_hyphen_values = true, requires = "track")]
     pub kd: Option<String>,
     /// Direct model of a tree robot (closed chains always use A_cl, H_cl of 10.46–10.48).
-    #[arg(long, value_enum, default_value = "aba")]
-    pub method: MethodArg,
+    #[arg(long, default_value = "aba", value_parser = choices(&Method::ALL, Method::name, Method::describe))]
+    pub method: Method,
     /// Simulate the Coulomb friction as Fs tanh(qd / V) instead of Fs sign(qd) (V in rad/s or
     /// m/s; 0 = exact sign, which makes sticking joints chatter and the steps collapse).
     #[arg(long, default_value_t = 0.01, value_name = "V")]
@@ -366,7 +366,7 @@ type Model<'r> = (
 fn model<'r>(robot: &'r robodyn::Robot, a: &Args) -> CliResult<Model<'r>> {
     let smoothing = Some(a.coulomb_smoothing);
     if robot.is_tree() {
-        let d = TreeDynamics::new(robot, a.method.into()).with_coulomb_smoothing(smoothing);
+        let d = TreeDynamics::new(robot, a.method).with_coulomb_smoothing(smoothing);
         let joints = d.joints().to_vec();
         return Ok((Box::new(d), joints, "movable tree joints", None));
     }

@@ -88,6 +88,32 @@ pub enum ZeroParameters {
 }
 
 impl ZeroParameters {
+    /// Both meanings (what a command line or a binding offers).
+    pub const ALL: [ZeroParameters; 2] = [ZeroParameters::Absent, ZeroParameters::Value];
+
+    /// The meaning's name: `absent`, `value` ([`ZeroParameters::from_name`] reads it back).
+    pub fn name(self) -> &'static str {
+        match self {
+            ZeroParameters::Absent => "absent",
+            ZeroParameters::Value => "value",
+        }
+    }
+
+    /// The meaning of a name of [`ZeroParameters::name`].
+    pub fn from_name(name: &str) -> Option<ZeroParameters> {
+        ZeroParameters::ALL.into_iter().find(|z| z.name() == name)
+    }
+
+    /// The meaning in a few words.
+    pub fn describe(self) -> &'static str {
+        match self {
+            ZeroParameters::Absent => {
+                "a parameter written as a literal 0 does not exist (SYMORO's meaning)"
+            }
+            ZeroParameters::Value => "a literal 0 is a value: the parameter exists",
+        }
+    }
+
     /// The meaning of the file format (by extension): `.par` -> [`ZeroParameters::Absent`],
     /// `.toml` and `.urdf` -> [`ZeroParameters::Value`] (see docs/robot-format.md).
     pub fn for_path(path: &std::path::Path) -> ZeroParameters {
