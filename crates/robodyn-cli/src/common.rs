@@ -3,6 +3,7 @@
 use crate::output::Output;
 pub use crate::output::{check_finite, write_table, write_text, TableFormat, TableWriter};
 use clap::Args;
+use robodyn::model::param;
 use robodyn::Robot;
 use std::collections::BTreeMap;
 use std::io::Write;
@@ -77,10 +78,13 @@ impl RobotArgs {
                     .enumerate()
                     .all(|(c, &x)| x == if r == c { 1.0 } else { 0.0 })
             });
+            // K: the standard parameters link after link, the drive ones IA, FS, FV
+            let per_link = robodyn::model::STANDARD_PARAMETERS.len();
+            let drive = [param::IA, param::FS, param::FV];
             let driven = t
                 .joints
                 .iter()
-                .any(|&j| (10..13).any(|p| k[13 * (j - 1) + p] != 0.0));
+                .any(|&j| drive.iter().any(|p| k[per_link * (j - 1) + p] != 0.0));
             if !identity && driven {
                 return Err(format!(
                     "{}: the robot has a motor-joint [transmission] and motor drive parameters \
@@ -195,6 +199,25 @@ pub fn is_broken_pipe(e: &(dyn std::error::Error + 'static)) -> bool {
         cur = e.source();
     }
     false
+}
+
+/// The value parser of an option whose values are a library enum's (`--lang`, `--rotor`): the
+/// enum's own list `all`, each value's `name` on the command line and its `help`, so that the
+/// command line has no second list of the values.
+pub fn choices<T: Copy + Send + Sync + 'static>(
+    all: &'static [T],
+    name: fn(T) -> &'static str,
+    help: fn(T) -> &'static str,
+) -> impl clap::builder::TypedValueParser<Value = T> {
+    let values = all
+        .iter()
+        .map(|&v| clap::builder::PossibleValue::new(name(v)).help(help(v)));
+    use clap::builder::TypedValueParser as _;
+    clap::builder::PossibleValuesParser::new(values).map(move |s| {
+        *all.iter()
+            .find(|&&v| name(v) == s)
+            .expect("clap accepts only the listed names")
+    })
 }
 
 /// How joint columns are named.

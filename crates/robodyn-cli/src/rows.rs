@@ -4,11 +4,59 @@
 
 use crate::common::{
     chunk_states, conditioning_json, in_table, start_branch, warn_conditioning, CliResult,
-    NamesArg, Phases, TableOutput, TableWriter,
+    NamesArg, Phases, RobotArgs, TableOutput, TableWriter, TimingsArg,
 };
-use crate::states::{Chunk, StateInput, StateRequest};
+use crate::states::{CarryArg, Chunk, StateInput, StateRequest};
 use robodyn::{Branch, ClosedChain, ClosedData, Conditioning};
 use std::path::Path;
+
+/// The options `idm` and `ddm` share after their inputs: the output table, the column names,
+/// the closed chains' start, the carried columns, the timings.
+#[derive(clap::Args, Debug)]
+pub struct EvaluationArgs {
+    #[command(flatten)]
+    pub out: TableOutput,
+    #[command(flatten)]
+    pub names: NamesArg,
+    /// Closed chains: start the assembly branch at the first state's q_a with this guess of q_p
+    /// (passive tree joints in order) instead of the robot's `assembly`.
+    #[arg(long, allow_hyphen_values = true)]
+    pub guess: Option<String>,
+    #[command(flatten)]
+    pub carry: CarryArg,
+    #[command(flatten)]
+    pub timings: TimingsArg,
+}
+
+/// Load the robot and evaluate `tree` or `closed` on every state of `input` or of the three
+/// command-line `lists` (quantities `prefixes`), writing one result per joint named `result`
+/// (`idm`, `ddm`).
+#[allow(clippy::too_many_arguments)]
+pub fn evaluate(
+    robot: &RobotArgs,
+    args: &EvaluationArgs,
+    input: Option<&Path>,
+    prefixes: [&str; 3],
+    lists: [Option<&str>; 3],
+    result: &str,
+    tree: &mut LoadedTreeModel,
+    closed: &mut ClosedModel,
+) -> CliResult {
+    let mut t = Phases::start(args.timings);
+    let robot = robot.load()?;
+    t.lap("robot");
+    let evaluation = Evaluation {
+        input,
+        prefixes,
+        lists,
+        names: args.names,
+        carry: &args.carry.carry,
+        guess: args.guess.as_deref(),
+        output: &args.out,
+        result,
+    };
+    evaluation.run(&robot, &mut t, &mut |c, x| tree(&robot, c, x), closed)
+}
 
 /// What `idm` and `ddm` share: states in (a table or the command line), one result per joint
 /// out, a tree's by chunks and a closed chain's on the branch tracker.
@@ -31,6 +79,9 @@ pub struct Evaluation<'a> {
 
 /// A tree's evaluation of a chunk into its results.
 pub type TreeModel<'f> = dyn FnMut(&Chunk, &mut [f64]) -> robodyn::Result<()> + 'f;
+/// [`TreeModel`] on the robot [`evaluate`] loads.
+pub type LoadedTreeModel<'f> =
+    dyn FnMut(&robodyn::Robot, &Chunk, &mut [f64]) -> robodyn::Result<()> + 'f;
 /// A closed chain's evaluation of one state on the tracker into its results.
 pub type ClosedModel<'f> = dyn FnMut(
         &ClosedChain,

@@ -126,6 +126,43 @@ impl ClosedChain {
     }
 }
 
+/// A closed-chain model over the actuated joints, three vectors in and one out
+/// (`closed_inverse_dynamics_into`, `closed_direct_dynamics_into`).
+type JointModel = fn(
+    &robodyn::ClosedChain,
+    &mut ClosedData,
+    &mut Branch,
+    &robodyn::Environment,
+    &[f64],
+    &[f64],
+    &[f64],
+    &mut [f64],
+) -> robodyn::Result<Conditioning>;
+
+impl ClosedChain {
+    /// `model` on one state or N states of the three named `inputs` (over the actuated
+    /// joints), its result named `result` in messages: what `idm` and `ddm` share.
+    fn dynamics<'py>(
+        &self,
+        py: Python<'py>,
+        result: &str,
+        inputs: [(&str, Option<&Bound<'py, PyAny>>); 3],
+        out: Option<&Bound<'py, PyAny>>,
+        model: JointModel,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let call = Call {
+            inputs: &inputs,
+            one: &[self.chain.dof()],
+            stacked: false,
+            out,
+        };
+        self.eval(py, result, call, |c, t, x, o| {
+            let env = c.robot().environment();
+            model(c, &mut t.data, &mut t.branch, env, x[0], x[1], x[2], o)
+        })
+    }
+}
+
 #[pymethods]
 impl ClosedChain {
     /// The closed-chain model of `robot`, its tracker on the branch of the robot's `assembly`
@@ -295,25 +332,8 @@ impl ClosedChain {
     ) -> PyResult<Bound<'py, PyAny>> {
         let qd_a = alias("qd_a", qd_a, "v", v)?;
         let qdd_a = alias("qdd_a", qdd_a, "a", a)?;
-        let n = self.chain.dof();
-        let call = Call {
-            inputs: &[("q_a", Some(q_a)), ("qd_a", qd_a), ("qdd_a", qdd_a)],
-            one: &[n],
-            stacked: false,
-            out,
-        };
-        self.eval(py, "tau_a", call, |c, t, x, o| {
-            closed_inverse_dynamics_into(
-                c,
-                &mut t.data,
-                &mut t.branch,
-                c.robot().environment(),
-                x[0],
-                x[1],
-                x[2],
-                o,
-            )
-        })
+        let inputs = [("q_a", Some(q_a)), ("qd_a", qd_a), ("qdd_a", qdd_a)];
+        self.dynamics(py, "tau_a", inputs, out, closed_inverse_dynamics_into)
     }
 
     /// Closed-chain direct dynamic model qdd_a = A_cl^-1 (Γ_cl - H_cl) (eqs 10.46–10.48): the
@@ -330,25 +350,8 @@ impl ClosedChain {
         out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let qd_a = alias("qd_a", qd_a, "v", v)?;
-        let n = self.chain.dof();
-        let call = Call {
-            inputs: &[("q_a", Some(q_a)), ("qd_a", qd_a), ("tau_a", tau_a)],
-            one: &[n],
-            stacked: false,
-            out,
-        };
-        self.eval(py, "qdd_a", call, |c, t, x, o| {
-            closed_direct_dynamics_into(
-                c,
-                &mut t.data,
-                &mut t.branch,
-                c.robot().environment(),
-                x[0],
-                x[1],
-                x[2],
-                o,
-            )
-        })
+        let inputs = [("q_a", Some(q_a)), ("qd_a", qd_a), ("tau_a", tau_a)];
+        self.dynamics(py, "qdd_a", inputs, out, closed_direct_dynamics_into)
     }
 
     /// Regressor of the closed chain, G^T Φ over all 13 NL standard parameters (K order,

@@ -9,7 +9,7 @@ use pyo3::types::{PyDict, PyTuple};
 use robodyn::algorithms::base_parameters::symbolic::standard_index;
 use robodyn::algorithms::base_parameters::{
     compare_methods, geometry_robot, numeric_base_parameters_auto, standard_values,
-    symbolic_base_parameters, NumericOptions, ParameterNames, Summary,
+    symbolic_base_parameters, NumericBase, NumericOptions, ParameterNames, Summary, SymbolicBase,
 };
 use robodyn::algorithms::regressor::{parameter_name, ParameterSelection, ZeroParameters};
 use robodyn::codegen::{generate as gen, BaseParameters as GenBase, GenOptions, ModelKind};
@@ -237,56 +237,75 @@ fn base_parameters_of(
                     s.add_comparison(&compare_methods(sb, nb, &names));
                 }
             }
-            let position: HashMap<usize, usize> =
-                s.columns.iter().enumerate().map(|(c, &i)| (i, c)).collect();
-            let coef = match (&sb, &nb) {
-                // K_base = K1 + beta K2, beta for the robot's geometry (not a generic one)
-                (None, Some((nb, _))) if generic.is_empty() => Some(
-                    (0..nb.count())
-                        .map(|r| {
-                            let mut row = vec![0.0; s.columns.len()];
-                            if let Some(&c) = position.get(&nb.base[r]) {
-                                row[c] = 1.0;
-                            }
-                            for (g, &i) in nb.grouped.iter().enumerate() {
-                                if let Some(&c) = position.get(&i) {
-                                    row[c] += nb.beta[(r, g)];
-                                }
-                            }
-                            row
-                        })
-                        .collect(),
-                ),
-                // the equations are linear in the standard parameters: the coefficient of
-                // column c is the equation at K = e_c
-                (Some(sb), _) => sb
-                    .equations
-                    .iter()
-                    .map(|eq| {
-                        s.columns
-                            .iter()
-                            .map(|&c| {
-                                let unit = parameter_name(c);
-                                eq.eval(&|name: &str| {
-                                    if name == unit {
-                                        Some(1.0)
-                                    } else if standard_index(name, desc.nl).is_some() {
-                                        Some(0.0)
-                                    } else {
-                                        desc.symbols.get(name).copied()
-                                    }
-                                })
-                                .ok()
-                            })
-                            .collect::<Option<Vec<f64>>>()
-                    })
-                    .collect::<Option<Vec<_>>>(),
-                _ => None,
-            };
+            let coef = coefficients(
+                desc,
+                &s,
+                sb.as_ref(),
+                nb.as_ref().map(|(nb, _)| nb),
+                &generic,
+            );
             Ok((s, coef))
         })
         .py()?;
     BaseParameters::from_summary(py, &summary, coef)
+}
+
+/// The coefficient table K_base = coefficients @ K[columns] of a summary: the symbolic
+/// method's equations at unit parameters, or the numerical method's K1 + beta K2 for the
+/// robot's geometry (None when that geometry took generic values, or a value is missing).
+fn coefficients(
+    desc: &robodyn::RobotDescription,
+    s: &Summary,
+    sb: Option<&SymbolicBase>,
+    nb: Option<&NumericBase>,
+    generic: &[(String, f64)],
+) -> Option<Vec<Vec<f64>>> {
+    let position: HashMap<usize, usize> =
+        s.columns.iter().enumerate().map(|(c, &i)| (i, c)).collect();
+    match (sb, nb) {
+        // K_base = K1 + beta K2, beta for the robot's geometry (not a generic one)
+        (None, Some(nb)) if generic.is_empty() => Some(
+            (0..nb.count())
+                .map(|r| {
+                    let mut row = vec![0.0; s.columns.len()];
+                    if let Some(&c) = position.get(&nb.base[r]) {
+                        row[c] = 1.0;
+                    }
+                    for (g, &i) in nb.grouped.iter().enumerate() {
+                        if let Some(&c) = position.get(&i) {
+                            row[c] += nb.beta[(r, g)];
+                        }
+                    }
+                    row
+                })
+                .collect(),
+        ),
+        // the equations are linear in the standard parameters: the coefficient of column c is
+        // the equation at K = e_c
+        (Some(sb), _) => sb
+            .equations
+            .iter()
+            .map(|eq| {
+                s.columns
+                    .iter()
+                    .map(|&c| {
+                        let unit = parameter_name(c);
+                        eq.eval(&|name: &str| {
+                            if name == unit {
+                                Some(1.0)
+                            } else if standard_index(name, desc.nl).is_some() {
+                                Some(0.0)
+                            } else {
+                                desc.symbols.get(name).copied()
+                            }
+                        })
+                        .ok()
+                    })
+                    .collect::<Option<Vec<f64>>>()
+            })
+            .collect::<Option<Vec<_>>>(),
+        _ => None,
+    }
 }
 
 /// A generated customized model.
@@ -349,20 +368,12 @@ pub fn generate(
             )))
         }
     };
-    let lang = match lang {
-        "text" => Lang::Text,
-        "latex" => Lang::Latex,
-        "rust" => Lang::Rust,
-        "c" => Lang::C,
-        "python" => Lang::Python,
-        "julia" => Lang::Julia,
-        "matlab" => Lang::Matlab,
-        _ => {
-            return Err(InputError::new_err(format!(
-                "lang = {lang:?}: expected text, latex, rust, c, python, julia or matlab"
-            )))
-        }
-    };
+    let lang = Lang::from_name(lang).ok_or_else(|| {
+        InputError::new_err(format!(
+            "lang = {lang:?}: expected {}",
+            crate::robot::quoted(Lang::ALL.map(Lang::name).as_slice())
+        ))
+    })?;
     let desc = robot.description();
     let base = match params {
         "standard" => None,

@@ -105,14 +105,15 @@ impl Models {
     }
 }
 
+/// The library's direct-dynamics method of its name (`"composite"`, `"aba"` or
+/// `"articulated"`).
 pub fn parse_method(method: &str) -> PyResult<Method> {
-    match method {
-        "composite" => Ok(Method::Composite),
-        "aba" | "articulated" => Ok(Method::ArticulatedBody),
-        _ => Err(InputError::new_err(format!(
-            "method = {method:?}: expected \"composite\" (tree L'DL of A) or \"aba\" (articulated bodies)"
-        ))),
-    }
+    Method::from_name(method).ok_or_else(|| {
+        InputError::new_err(format!(
+            "method = {method:?}: expected {}",
+            quoted(Method::ALL.map(Method::name).as_slice())
+        ))
+    })
 }
 
 /// What a literal 0 means: `zeros` ("absent" or "value"), else by the file it came from.
@@ -120,27 +121,33 @@ pub fn parse_zeros(
     zeros: Option<&str>,
     source: Option<&std::path::Path>,
 ) -> PyResult<ZeroParameters> {
-    Ok(match zeros {
-        Some("absent") => ZeroParameters::Absent,
-        Some("value") => ZeroParameters::Value,
-        None => source.map_or(ZeroParameters::Value, ZeroParameters::for_path),
-        Some(z) => {
-            return Err(InputError::new_err(format!(
-                "zeros = {z:?}: expected \"absent\" (a literal 0 is no parameter, SYMORO's \
-                 meaning) or \"value\""
-            )))
-        }
+    match zeros {
+        None => Ok(source.map_or(ZeroParameters::Value, ZeroParameters::for_path)),
+        Some(z) => ZeroParameters::from_name(z).ok_or_else(|| {
+            InputError::new_err(format!(
+                "zeros = {z:?}: expected {}",
+                quoted(ZeroParameters::ALL.map(ZeroParameters::name).as_slice())
+            ))
+        }),
+    }
+}
+
+/// The library's rotor mode of its name (`"actuated"`, `"all"`, `"none"`).
+pub fn parse_rotor(rotor: &str) -> PyResult<RotorMode> {
+    RotorMode::from_name(rotor).ok_or_else(|| {
+        InputError::new_err(format!(
+            "rotor = {rotor:?}: expected {}",
+            quoted(RotorMode::ALL.map(RotorMode::name).as_slice())
+        ))
     })
 }
 
-pub fn parse_rotor(rotor: &str) -> PyResult<RotorMode> {
-    match rotor {
-        "actuated" => Ok(RotorMode::Actuated),
-        "all" => Ok(RotorMode::All),
-        "none" => Ok(RotorMode::None),
-        _ => Err(InputError::new_err(format!(
-            "rotor = {rotor:?}: expected \"actuated\", \"all\" or \"none\""
-        ))),
+/// `"a", "b" or "c"`.
+pub fn quoted(names: &[&str]) -> String {
+    let q: Vec<String> = names.iter().map(|n| format!("{n:?}")).collect();
+    match q.split_last() {
+        Some((last, rest)) if !rest.is_empty() => format!("{} or {last}", rest.join(", ")),
+        _ => q.join(""),
     }
 }
 

@@ -31,6 +31,45 @@ pub enum Lang {
 }
 
 impl Lang {
+    /// Every language, in the order of the documentation (what a command line or a binding
+    /// offers; [`Lang::name`] is each one's name).
+    pub const ALL: [Lang; 7] = [
+        Lang::Text,
+        Lang::Latex,
+        Lang::Rust,
+        Lang::C,
+        Lang::Python,
+        Lang::Julia,
+        Lang::Matlab,
+    ];
+
+    /// The language's name: `text`, `latex`, `rust`, `c`, `python`, `julia`, `matlab`
+    /// ([`Lang::from_name`] reads it back).
+    pub fn name(self) -> &'static str {
+        match self {
+            Lang::Text => "text",
+            Lang::Latex => "latex",
+            Lang::Rust => "rust",
+            Lang::C => "c",
+            Lang::Python => "python",
+            Lang::Julia => "julia",
+            Lang::Matlab => "matlab",
+        }
+    }
+
+    /// What [`emit`] writes in this language, in a few words.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Lang::Text => "SYMORO-style equations, one `NAME = expression` per line",
+            Lang::Latex => "rows of a LaTeX align* environment (amsmath)",
+            Lang::Rust => "a Rust function over slices",
+            Lang::C => "a C99 function over double arrays",
+            Lang::Python => "a Python function over NumPy arrays",
+            Lang::Julia => "a Julia function `NAME!(out, ...)`, 1-based",
+            Lang::Matlab => "a MATLAB / GNU Octave function file `NAME.m`, 1-based",
+        }
+    }
+
     /// The language of a name or file extension (`c`, `rust`/`rs`, `python`/`py`, `m`...).
     pub fn from_name(s: &str) -> Option<Lang> {
         Some(match s {
@@ -889,4 +928,21 @@ fn emit_code(p: &Program, lang: Lang) -> String {
         _ => {}
     }
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Lang;
+
+    #[test]
+    fn every_language_is_read_back_from_its_name() {
+        for l in Lang::ALL {
+            assert_eq!(Lang::from_name(l.name()), Some(l), "{l:?}");
+            assert!(!l.describe().is_empty());
+        }
+        let mut names: Vec<&str> = Lang::ALL.iter().map(|l| l.name()).collect();
+        names.dedup();
+        assert_eq!(names.len(), 7);
+        assert_eq!(Lang::from_name("fortran"), None);
+    }
 }

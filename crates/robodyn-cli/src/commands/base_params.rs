@@ -2,7 +2,7 @@
 //! method or both (§10.2.4, §10.3.4–10.3.6), as a table like Table 10.2 with the grouping
 //! equations and the values for the robot's numbers.
 
-use crate::common::{CliResult, RobotArgs};
+use crate::common::{choices, CliResult, RobotArgs};
 use robodyn::algorithms::base_parameters::{
     base_robot, compare_methods, geometry_robot, numeric_base_parameters_auto, standard_values,
     symbolic_base_parameters, NumericOptions, ParameterNames, Summary,
@@ -31,24 +31,6 @@ pub enum Format {
     Json,
 }
 
-#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Rotor {
-    /// Rotor inertia IA_j on the actuated joints.
-    Actuated,
-    /// On every movable joint.
-    All,
-    /// No rotor inertia.
-    None,
-}
-
-#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Zeros {
-    /// A parameter written as a literal 0 does not exist (SYMORO's meaning).
-    Absent,
-    /// A literal 0 is a value: the parameter exists.
-    Value,
-}
-
 #[derive(clap::Args, Debug)]
 pub struct Args {
     #[command(flatten)]
@@ -64,15 +46,15 @@ pub struct Args {
     #[arg(long)]
     pub no_friction: bool,
     /// Which rotor inertias IA are parameters.
-    #[arg(long, value_enum, default_value = "actuated")]
-    pub rotor: Rotor,
+    #[arg(long, default_value = "actuated", value_parser = choices(&RotorMode::ALL, RotorMode::name, RotorMode::describe))]
+    pub rotor: RotorMode,
     /// Seed of the random samples of the numerical method.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// What a parameter written as a literal 0 means (default: absent for a SYMORO .par, as in
     /// SYMORO; value for .toml and .urdf).
-    #[arg(long, value_enum)]
-    pub zeros: Option<Zeros>,
+    #[arg(long, value_parser = choices(&ZeroParameters::ALL, ZeroParameters::name, ZeroParameters::describe))]
+    pub zeros: Option<ZeroParameters>,
     /// Write a base robot (.toml) whose parameters are the grouped values.
     #[arg(long, value_name = "FILE.toml")]
     pub write_robot: Option<PathBuf>,
@@ -80,16 +62,10 @@ pub struct Args {
 
 pub fn run(a: Args) -> CliResult {
     let (desc, _) = a.robot.description()?;
-    let rotor = match a.rotor {
-        Rotor::Actuated => RotorMode::Actuated,
-        Rotor::All => RotorMode::All,
-        Rotor::None => RotorMode::None,
-    };
-    let zeros = match a.zeros {
-        Some(Zeros::Absent) => ZeroParameters::Absent,
-        Some(Zeros::Value) => ZeroParameters::Value,
-        None => ZeroParameters::for_path(&a.robot.robot),
-    };
+    let rotor = a.rotor;
+    let zeros = a
+        .zeros
+        .unwrap_or_else(|| ZeroParameters::for_path(&a.robot.robot));
     let sel = ParameterSelection::from_description(&desc, rotor, !a.no_friction)
         .with_zero_parameters(&desc, zeros);
     let names = ParameterNames::of(&desc);

@@ -6,29 +6,10 @@
 //! row on the assembly branch (the library's branch tracker, started at the robot's `assembly`
 //! or `--guess`); rows near a singularity are flagged on stderr and in JSON.
 
-use crate::common::{CliResult, NamesArg, Phases, RobotArgs, TableOutput, TimingsArg};
-use crate::rows::Evaluation;
-use crate::states::CarryArg;
+use crate::common::{choices, CliResult, RobotArgs};
+use crate::rows::{evaluate, EvaluationArgs};
 use robodyn::{closed_direct_dynamics_into, direct_dynamics_batch, Method};
 use std::path::PathBuf;
-
-/// Direct-dynamics algorithm.
-#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum MethodArg {
-    /// qdd = A^-1 (tau - H), A by composite links, tree L'DL factorization.
-    Composite,
-    /// O(n) recursive Newton-Euler direct model (articulated bodies).
-    Aba,
-}
-
-impl From<MethodArg> for Method {
-    fn from(m: MethodArg) -> Method {
-        match m {
-            MethodArg::Composite => Method::Composite,
-            MethodArg::Aba => Method::ArticulatedBody,
-        }
-    }
-}
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
@@ -49,47 +30,38 @@ pub struct Args {
     #[arg(long, allow_hyphen_values = true)]
     pub tau: Option<String>,
     /// Direct model of a tree robot (closed chains always use A_cl, H_cl of 10.46-10.48).
-    #[arg(long, value_enum, default_value = "composite")]
-    pub method: MethodArg,
+    #[arg(long, default_value = "composite", value_parser = choices(&Method::ALL, Method::name, Method::describe))]
+    pub method: Method,
     #[command(flatten)]
-    pub out: TableOutput,
-    #[command(flatten)]
-    pub names: NamesArg,
-    /// Closed chains: start the assembly branch at the first state's q_a with this guess of q_p
-    /// (passive tree joints in order) instead of the robot's `assembly`.
-    #[arg(long, allow_hyphen_values = true)]
-    pub guess: Option<String>,
-    #[command(flatten)]
-    pub carry: CarryArg,
-    #[command(flatten)]
-    pub timings: TimingsArg,
+    pub eval: EvaluationArgs,
 }
 
 pub fn run(a: Args) -> CliResult {
-    let mut t = Phases::start(a.timings);
-    let robot = a.robot.load()?;
-    t.lap("robot");
-    let env = robot.environment();
-    let method: Method = a.method.into();
-    let evaluation = Evaluation {
-        input: a.input.as_deref(),
-        prefixes: ["q", "qd", "tau"],
-        lists: [a.q.as_deref(), a.qd.as_deref(), a.tau.as_deref()],
-        names: a.names,
-        carry: &a.carry.carry,
-        guess: a.guess.as_deref(),
-        output: &a.out,
-        result: "qdd",
-    };
-    evaluation.run(
-        &robot,
-        &mut t,
+    let method = a.method;
+    evaluate(
+        &a.robot,
+        &a.eval,
+        a.input.as_deref(),
+        ["q", "qd", "tau"],
+        [a.q.as_deref(), a.qd.as_deref(), a.tau.as_deref()],
+        "qdd",
         // chunks of the table at once over the cores (the library's batch; errors name their row)
-        &mut |c, qdd| direct_dynamics_batch(&robot, env, &c.x[0], &c.x[1], &c.x[2], method, qdd),
-        // closed chains: A_cl, H_cl of 10.46-10.48 (not --method), every row on the branch
-        // tracker
+        &mut |r, c, qdd| {
+            direct_dynamics_batch(r, r.environment(), &c.x[0], &c.x[1], &c.x[2], method, qdd)
+        },
+        // closed chains: every row on the branch tracker (continued from the previous row); A_cl,
+        // H_cl of 10.46-10.48, not --method
         &mut |chain, b, d, x, qdd| {
-            closed_direct_dynamics_into(chain, d, b, env, x[0], x[1], x[2], qdd)
+            closed_direct_dynamics_into(
+                chain,
+                d,
+                b,
+                chain.robot().environment(),
+                x[0],
+                x[1],
+                x[2],
+                qdd,
+            )
         },
     )
 }

@@ -5,11 +5,11 @@
 
 use crate::commands::identify::positive;
 use crate::common::format_number;
-use crate::common::{parse_list, CliResult, RobotArgs};
-use robodyn::identification::excitation::{design, DesignOptions, Limits};
+use crate::common::{choices, parse_list, CliResult, RobotArgs};
+use robodyn::algorithms::regressor::RotorMode;
+use robodyn::identification::excitation::{design, Design, DesignOptions, Limits};
 use robodyn::identification::model_access::ModelAccess;
 use robodyn::identification::parameters::{ParameterModel, ParameterOptions};
-use robodyn::identification::Rotors;
 use robodyn::report::figure::{write_svg, Curve, Figure, Panel, Style};
 use robodyn::report::Sig;
 use serde_json::json;
@@ -65,8 +65,8 @@ pub struct Args {
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// Which rotor inertias are parameters (as identify).
-    #[arg(long, value_enum, default_value = "actuated")]
-    pub rotor: crate::commands::identify::RotorArg,
+    #[arg(long, default_value = "actuated", value_parser = choices(&RotorMode::ALL, RotorMode::name, RotorMode::describe))]
+    pub rotor: RotorMode,
     /// Leave out the Coulomb and viscous friction parameters (as identify).
     #[arg(long)]
     pub no_friction: bool,
@@ -108,12 +108,51 @@ fn per_joint(name: &str, s: Option<&str>, n: usize) -> CliResult<Option<Vec<f64>
 const MAX_ROWS: f64 = 1e8;
 
 pub fn run(a: Args) -> CliResult {
+    let rows = output_rows(&a)?;
+    let desc = a.robot.description()?.0;
+    let mut access = ModelAccess::new(desc)?;
+    let joints = access.actuated_joints().to_vec();
+    let start = match per_joint("start", a.start.as_deref(), joints.len())? {
+        Some(v) => v,
+        None => access.reference_actuated()?,
+    };
+    let limits = joint_limits(&a, &access, &joints)?;
+    let mut params = ParameterModel::build(
+        &mut access,
+        &ParameterOptions {
+            rotors: crate::commands::identify::rotors(a.rotor),
+            friction: !a.no_friction,
+            offsets: a.offsets,
+            seed: a.seed,
+        },
+    )?;
+    let opt = DesignOptions {
+        period: a.period,
+        harmonics: a.harmonics,
+        start,
+        limits,
+        samples: a.samples,
+        iterations: a.iterations,
+        restarts: a.restarts,
+        seed: a.seed,
+    };
+    let d = design(&mut access, &mut params, &opt)?;
+    write_files(&a, &access, &joints, &d, rows)?;
+    let out = match a.format {
+        Format::Text => summary_text(&a, &access, &joints, params.count(), &d),
+        Format::Json => summary_json(&a, &access, &joints, &d)?,
+    };
+    crate::common::print_out(&out)
+}
+
+/// The output files checked and the number of CSV rows, before the design (which takes a
+/// while).
+fn output_rows(a: &Args) -> CliResult<usize> {
     let files = [
         ("--output", Some(a.output.as_path())),
         ("--plot", a.plot.as_deref()),
     ];
     crate::output::check_distinct(&files)?;
-    // the output's size before the design (which takes a while)
     if a.periods == 0 {
         return Err("--periods must be at least 1".into());
     }
@@ -125,14 +164,13 @@ pub fn run(a: Args) -> CliResult {
         )
         .into());
     }
-    let desc = a.robot.description()?.0;
-    let mut access = ModelAccess::new(desc)?;
-    let joints = access.actuated_joints().to_vec();
+    Ok(rows.round() as usize)
+}
+
+/// The limits of each actuated joint: the command line's, else the robot file's; velocity and
+/// acceleration limits are required.
+fn joint_limits(a: &Args, access: &ModelAccess, joints: &[usize]) -> CliResult<Vec<Limits>> {
     let n = joints.len();
-    let start = match per_joint("start", a.start.as_deref(), n)? {
-        Some(v) => v,
-        None => access.reference_actuated()?,
-    };
     let cli = |name: &str, s: &Option<String>| per_joint(name, s.as_deref(), n);
     let (qmin, qmax, qd, qdd, tau) = (
         cli("q-min", &a.q_min)?,
@@ -161,33 +199,19 @@ pub fn run(a: Args) -> CliResult {
             tau: pick(&tau, f.tau),
         });
     }
-    let mut params = ParameterModel::build(
-        &mut access,
-        &ParameterOptions {
-            rotors: match a.rotor {
-                crate::commands::identify::RotorArg::Actuated => Rotors::Actuated,
-                crate::commands::identify::RotorArg::All => Rotors::All,
-                crate::commands::identify::RotorArg::None => Rotors::None,
-            },
-            friction: !a.no_friction,
-            offsets: a.offsets,
-            seed: a.seed,
-        },
-    )?;
-    let opt = DesignOptions {
-        period: a.period,
-        harmonics: a.harmonics,
-        start,
-        limits,
-        samples: a.samples,
-        iterations: a.iterations,
-        restarts: a.restarts,
-        seed: a.seed,
-    };
-    let d = design(&mut access, &mut params, &opt)?;
-    // CSV
-    let rows = rows.round() as usize;
-    // all or nothing: both files put in place once both are written
+    Ok(limits)
+}
+
+/// The trajectory's CSV (`rows` + 1 rows at `--rate`) and its plot: all or nothing, both files
+/// put in place once both are written.
+fn write_files(
+    a: &Args,
+    access: &ModelAccess,
+    joints: &[usize],
+    d: &Design,
+    rows: usize,
+) -> CliResult {
+    let n = joints.len();
     let mut file = crate::output::Output::create(Some(&a.output))?;
     let mut plot_file = a
         .plot
@@ -225,83 +249,95 @@ pub fn run(a: Args) -> CliResult {
             format_number(a.period),
             Sig(d.condition, 4)
         );
-        plot_file.write_by_path(|p| {
-            excitation_figure(p, &title, &times, &series, &joints, &prismatic)
-        })?;
+        plot_file
+            .write_by_path(|p| excitation_figure(p, &title, &times, &series, joints, &prismatic))?;
     }
     crate::output::commit_all([Some(file), plot_file].into_iter().flatten().collect())?;
     eprintln!("wrote {}", a.output.display());
     if let Some(p) = &a.plot {
         eprintln!("wrote {}", p.display());
     }
+    Ok(())
+}
+
+/// The design in text: condition numbers, the binding limit, each joint's peaks.
+fn summary_text(
+    a: &Args,
+    access: &ModelAccess,
+    joints: &[usize],
+    parameters: usize,
+    d: &Design,
+) -> String {
     let mut out = String::new();
-    match a.format {
-        Format::Text => {
-            outln!(
-                out,
-                "{}: excitation trajectory, {} harmonics, period {} s, {} parameters",
-                access.name(),
-                a.harmonics,
-                a.period,
-                params.count()
-            );
-            outln!(
-                out,
-                "condition number of W (unit columns, {} samples): {} (best random start {}; {} \
-                 evaluations)",
-                a.samples,
-                Sig(d.condition, 4),
-                Sig(d.initial_condition, 4),
-                d.evaluations
-            );
-            outln!(
-                out,
-                "scaled to the {} limit of joint {}",
-                d.binding.what,
-                joints[d.binding.joint]
-            );
-            outln!(
-                out,
-                "  joint  max|q-start|       max|qd|      max|qdd|      max|tau|  (units: rad, \
-                 rad/s, rad/s^2, N m; m, m/s, m/s^2, N for a prismatic joint)"
-            );
-            for (k, j) in joints.iter().enumerate() {
-                let p = d.peaks[k].map(|x| Sig(x, 6).to_string());
-                let kind = if access.is_prismatic(*j) {
-                    " (prismatic)"
-                } else {
-                    ""
-                };
-                outln!(
-                    out,
-                    "  {j:<5} {:>13} {:>13} {:>13} {:>13}{kind}",
-                    p[0],
-                    p[1],
-                    p[2],
-                    p[3]
-                );
-            }
-        }
-        Format::Json => outln!(
+    outln!(
+        out,
+        "{}: excitation trajectory, {} harmonics, period {} s, {} parameters",
+        access.name(),
+        a.harmonics,
+        a.period,
+        parameters
+    );
+    outln!(
+        out,
+        "condition number of W (unit columns, {} samples): {} (best random start {}; {} \
+         evaluations)",
+        a.samples,
+        Sig(d.condition, 4),
+        Sig(d.initial_condition, 4),
+        d.evaluations
+    );
+    outln!(
+        out,
+        "scaled to the {} limit of joint {}",
+        d.binding.what,
+        joints[d.binding.joint]
+    );
+    outln!(
+        out,
+        "  joint  max|q-start|       max|qd|      max|qdd|      max|tau|  (units: rad, \
+         rad/s, rad/s^2, N m; m, m/s, m/s^2, N for a prismatic joint)"
+    );
+    for (k, j) in joints.iter().enumerate() {
+        let p = d.peaks[k].map(|x| Sig(x, 6).to_string());
+        let kind = if access.is_prismatic(*j) {
+            " (prismatic)"
+        } else {
+            ""
+        };
+        outln!(
             out,
-            "{}",
-            serde_json::to_string_pretty(&json!({
-                "robot": access.name(),
-                "period": a.period,
-                "harmonics": a.harmonics,
-                "condition_number": d.condition,
-                "initial_condition_number": d.initial_condition,
-                "evaluations": d.evaluations,
-                "binding": {"joint": joints[d.binding.joint], "limit": d.binding.what},
-                "start": d.trajectory.start,
-                "a": d.trajectory.a,
-                "b": d.trajectory.b,
-                "peaks": joints.iter().zip(&d.peaks).map(|(j, p)| json!({
-                    "joint": j, "q": p[0], "qd": p[1], "qdd": p[2], "tau": p[3]})).collect::<Vec<_>>(),
-            }))?
-        ),
+            "  {j:<5} {:>13} {:>13} {:>13} {:>13}{kind}",
+            p[0],
+            p[1],
+            p[2],
+            p[3]
+        );
     }
-    crate::common::print_out(&out)
+    out
+}
+
+/// The design in JSON (every number a full double).
+fn summary_json(a: &Args, access: &ModelAccess, joints: &[usize], d: &Design) -> CliResult<String> {
+    let mut out = String::new();
+    outln!(
+        out,
+        "{}",
+        serde_json::to_string_pretty(&json!({
+            "robot": access.name(),
+            "period": a.period,
+            "harmonics": a.harmonics,
+            "condition_number": d.condition,
+            "initial_condition_number": d.initial_condition,
+            "evaluations": d.evaluations,
+            "binding": {"joint": joints[d.binding.joint], "limit": d.binding.what},
+            "start": d.trajectory.start,
+            "a": d.trajectory.a,
+            "b": d.trajectory.b,
+            "peaks": joints.iter().zip(&d.peaks).map(|(j, p)| json!({
+                "joint": j, "q": p[0], "qd": p[1], "qdd": p[2], "tau": p[3]})).collect::<Vec<_>>(),
+        }))?
+    );
+    Ok(out)
 }
 
 /// The figure of an exciting trajectory: positions, velocities and accelerations of the

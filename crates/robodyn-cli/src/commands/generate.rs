@@ -1,7 +1,7 @@
 //! `robodyn generate ROBOT`: customized symbolic models (Table 10.3) as SYMORO-style text, LaTeX
 //! or code (Rust, C, Python, Julia, MATLAB/Octave), with operation counts in the header.
 
-use crate::common::CliResult;
+use crate::common::{choices, CliResult};
 use robodyn::algorithms::regressor::ZeroParameters;
 use robodyn::codegen::{generate_with_progress, BaseParameters, GenOptions, ModelKind};
 use robodyn_symbolic::{check_function_name, emit, Lang};
@@ -29,26 +29,6 @@ pub enum Params {
     Standard,
     /// Base parameters as symbols (the symbolic method's grouping, or --base-file).
     Base,
-}
-
-#[derive(clap::ValueEnum, Clone, Copy, Debug)]
-pub enum Language {
-    /// SYMORO-style equations, one `NAME = expression` per line.
-    Text,
-    /// Rows of a LaTeX align* environment (amsmath).
-    Latex,
-    /// A Rust function over slices (and a parameter struct unless --numeric).
-    Rust,
-    /// A C99 function over double arrays (and a parameter struct unless --numeric).
-    C,
-    /// A Python function over NumPy arrays (parameters by keyword unless --numeric).
-    Python,
-    /// A Julia function `NAME!(out, ...)`, 1-based (parameters as a named tuple unless
-    /// --numeric).
-    Julia,
-    /// A MATLAB / GNU Octave function file, named after --output's file stem (parameters as
-    /// a struct unless --numeric).
-    Matlab,
 }
 
 #[derive(clap::Args, Debug)]
@@ -80,9 +60,12 @@ pub struct Args {
     /// Substitute the robot's numeric values for all symbols.
     #[arg(long)]
     pub numeric: bool,
-    /// Output language (operation counts in the header of every one).
-    #[arg(long, value_enum, default_value = "text")]
-    pub lang: Language,
+    /// Output language (operation counts in the header of every one). The code takes its
+    /// parameters by name (a struct in Rust and C, keywords in Python, a named tuple in Julia,
+    /// a struct in MATLAB) unless --numeric; a MATLAB function file is named after --output's
+    /// file stem.
+    #[arg(long, default_value = "text", value_parser = choices(&Lang::ALL, Lang::name, Lang::describe))]
+    pub lang: Lang,
     /// Function name in the generated code (an identifier of the language that is not one of its
     /// reserved words; default `<robot>_<model>`).
     #[arg(long)]
@@ -176,7 +159,7 @@ pub fn run(a: Args) -> CliResult {
     });
     spinner.finish_and_clear();
     let prog = prog?;
-    let text = emit(&prog, lang(a.lang));
+    let text = emit(&prog, a.lang);
     crate::common::write_text(a.output.as_deref(), &text)?;
     let c = prog.count();
     eprintln!(
@@ -206,31 +189,18 @@ fn working(what: String) -> indicatif::ProgressBar {
     bar
 }
 
-/// The language of the generated code.
-fn lang(l: Language) -> Lang {
-    match l {
-        Language::Text => Lang::Text,
-        Language::Latex => Lang::Latex,
-        Language::Rust => Lang::Rust,
-        Language::C => Lang::C,
-        Language::Python => Lang::Python,
-        Language::Julia => Lang::Julia,
-        Language::Matlab => Lang::Matlab,
-    }
-}
-
 /// The function name: `--name`, or for MATLAB, which calls a function file by its file name, the
 /// stem of `--output` (`sr400_idm.m` -> `sr400_idm`). Checked for the language: an identifier
 /// that is no reserved word and no name the generated code uses itself.
 fn function_name(a: &Args) -> Result<Option<String>, String> {
-    let language = lang(a.lang);
+    let language = a.lang;
     let checked = |name: &str, what: &str| {
         check_function_name(name, language).map_err(|e| format!("{what}: {e}"))
     };
     if let Some(n) = &a.name {
         checked(n, &format!("--name {n}"))?;
     }
-    if !matches!(a.lang, Language::Matlab) {
+    if a.lang != Lang::Matlab {
         return Ok(a.name.clone());
     }
     let Some(stem) = a.output.as_ref().and_then(|p| p.file_stem()) else {

@@ -3,7 +3,8 @@
 //! deviations, the condition number and the per-joint errors; optionally a fit plot on a
 //! validation segment and a physically consistent robot file.
 
-use crate::common::{parse_list, parse_value, CliResult, RobotArgs};
+use crate::common::{choices, parse_list, parse_value, CliResult, RobotArgs};
+use robodyn::algorithms::regressor::RotorMode;
 use robodyn::identification::data::{CsvLog, Effort, JointLabels, LogSource};
 use robodyn::identification::model_access::ModelAccess;
 use robodyn::identification::parameters::ParameterOptions;
@@ -31,16 +32,6 @@ pub enum Format {
     Csv,
 }
 
-#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum RotorArg {
-    /// Rotor inertia IA_j of the actuated joints.
-    Actuated,
-    /// Of every movable joint.
-    All,
-    /// No rotor inertia.
-    None,
-}
-
 #[derive(clap::Args, Debug)]
 pub struct Args {
     #[command(flatten)]
@@ -57,8 +48,8 @@ pub struct Args {
     #[arg(long)]
     pub consistent: bool,
     /// Which rotor inertias are parameters (as base-params).
-    #[arg(long, value_enum, default_value = "actuated")]
-    pub rotor: RotorArg,
+    #[arg(long, default_value = "actuated", value_parser = choices(&RotorMode::ALL, RotorMode::name, RotorMode::describe))]
+    pub rotor: RotorMode,
     /// Leave out the Coulomb and viscous friction.
     #[arg(long)]
     pub no_friction: bool,
@@ -213,13 +204,44 @@ pub fn run(a: Args) -> CliResult {
         .map(|g| parse_list("gains", g))
         .transpose()?;
     check_gains(gains.as_deref(), &log, labels.numbers.len())?;
-    let opt = Options {
+    let opt = options(&a, gains)?;
+    let id = identify(&mut access, &log, &opt)?;
+    let text = match a.format {
+        Format::Text => report::to_text(&id),
+        Format::Json => format!("{}\n", serde_json::to_string_pretty(&report::to_json(&id))?),
+        Format::Csv => report::to_csv(&id),
+    };
+    write_files(&a, &access, &id, &text)?;
+    for p in [&a.plot, &a.write_robot].into_iter().flatten() {
+        eprintln!("wrote {}", p.display());
+    }
+    // the warnings once: in the report when it goes to standard output with them (text, JSON),
+    // else on standard error
+    let report_shows = a.output.as_deref().is_none_or(robodyn::io::is_stdio)
+        && matches!(a.format, Format::Text | Format::Json);
+    if !report_shows {
+        for w in &id.warnings {
+            eprintln!("robodyn: warning: {w}");
+        }
+    }
+    for h in id.warnings.iter().filter_map(crate::hint::warning_hint) {
+        eprintln!("robodyn: hint: {h}");
+    }
+    if a.strict && !id.warnings.is_empty() {
+        return Err(format!(
+            "--strict: the identification has {} warning(s)",
+            id.warnings.len()
+        )
+        .into());
+    }
+    Ok(())
+}
+
+/// The identification's options of the command line.
+fn options(a: &Args, gains: Option<Vec<f64>>) -> CliResult<Options> {
+    Ok(Options {
         parameters: ParameterOptions {
-            rotors: match a.rotor {
-                RotorArg::Actuated => Rotors::Actuated,
-                RotorArg::All => Rotors::All,
-                RotorArg::None => Rotors::None,
-            },
+            rotors: rotors(a.rotor),
             friction: !a.no_friction,
             offsets: a.offsets,
             seed: a.seed,
@@ -249,19 +271,22 @@ pub fn run(a: Args) -> CliResult {
         iv_iterations: a.iv_iterations,
         iv_bandwidth: a.iv_bandwidth,
         keep_validation_rows: a.plot.is_some(),
-    };
-    let id = identify(&mut access, &log, &opt)?;
-    let text = match a.format {
-        Format::Text => report::to_text(&id),
-        Format::Json => format!("{}\n", serde_json::to_string_pretty(&report::to_json(&id))?),
-        Format::Csv => report::to_csv(&id),
-    };
-    // all or nothing: the files are put in place once all are written
+    })
+}
+
+/// The report, the fit plot and the identified robot file: all or nothing, the files put in
+/// place once all are written.
+fn write_files(
+    a: &Args,
+    access: &ModelAccess,
+    id: &robodyn::identification::Identification,
+    text: &str,
+) -> CliResult {
     let mut files = vec![crate::output::Output::create(a.output.as_deref())?];
     files[0].write_all(text.as_bytes())?;
     if let Some(p) = &a.plot {
         let mut plot = crate::output::Output::create(Some(p))?;
-        plot.write_by_path(|tmp| report::plot_fit(tmp, &id))?;
+        plot.write_by_path(|tmp| report::plot_fit(tmp, id))?;
         files.push(plot);
     }
     if let Some(p) = &a.write_robot {
@@ -282,28 +307,15 @@ pub fn run(a: Args) -> CliResult {
         robot.write_all(text.as_bytes())?;
         files.push(robot);
     }
-    crate::output::commit_all(files)?;
-    for p in [&a.plot, &a.write_robot].into_iter().flatten() {
-        eprintln!("wrote {}", p.display());
+    crate::output::commit_all(files)
+}
+
+/// The identification's rotor option of the library's [`RotorMode`] (the two library enums have
+/// the same values; this goes when the library has one).
+pub fn rotors(mode: RotorMode) -> Rotors {
+    match mode {
+        RotorMode::Actuated => Rotors::Actuated,
+        RotorMode::All => Rotors::All,
+        RotorMode::None => Rotors::None,
     }
-    // the warnings once: in the report when it goes to standard output with them (text, JSON),
-    // else on standard error
-    let report_shows = a.output.as_deref().is_none_or(robodyn::io::is_stdio)
-        && matches!(a.format, Format::Text | Format::Json);
-    if !report_shows {
-        for w in &id.warnings {
-            eprintln!("robodyn: warning: {w}");
-        }
-    }
-    for h in id.warnings.iter().filter_map(crate::hint::warning_hint) {
-        eprintln!("robodyn: hint: {h}");
-    }
-    if a.strict && !id.warnings.is_empty() {
-        return Err(format!(
-            "--strict: the identification has {} warning(s)",
-            id.warnings.len()
-        )
-        .into());
-    }
-    Ok(())
 }

@@ -6,9 +6,8 @@
 //! (the library's branch tracker: each row continued from the previous one, the first from the
 //! robot's `assembly` or `--guess`); rows near a singularity are flagged on stderr and in JSON.
 
-use crate::common::{CliResult, NamesArg, Phases, RobotArgs, TableOutput, TimingsArg};
-use crate::rows::Evaluation;
-use crate::states::CarryArg;
+use crate::common::{CliResult, RobotArgs};
+use crate::rows::{evaluate, EvaluationArgs};
 use robodyn::{closed_inverse_dynamics_into, inverse_dynamics_batch};
 use std::path::PathBuf;
 
@@ -31,42 +30,31 @@ pub struct Args {
     #[arg(long, allow_hyphen_values = true)]
     pub qdd: Option<String>,
     #[command(flatten)]
-    pub out: TableOutput,
-    #[command(flatten)]
-    pub names: NamesArg,
-    /// Closed chains: start the assembly branch at the first state's q_a with this guess of q_p
-    /// (passive tree joints in order) instead of the robot's `assembly`.
-    #[arg(long, allow_hyphen_values = true)]
-    pub guess: Option<String>,
-    #[command(flatten)]
-    pub carry: CarryArg,
-    #[command(flatten)]
-    pub timings: TimingsArg,
+    pub eval: EvaluationArgs,
 }
 
 pub fn run(a: Args) -> CliResult {
-    let mut t = Phases::start(a.timings);
-    let robot = a.robot.load()?;
-    t.lap("robot");
-    let env = robot.environment();
-    let evaluation = Evaluation {
-        input: a.input.as_deref(),
-        prefixes: ["q", "qd", "qdd"],
-        lists: [a.q.as_deref(), a.qd.as_deref(), a.qdd.as_deref()],
-        names: a.names,
-        carry: &a.carry.carry,
-        guess: a.guess.as_deref(),
-        output: &a.out,
-        result: "tau",
-    };
-    evaluation.run(
-        &robot,
-        &mut t,
+    evaluate(
+        &a.robot,
+        &a.eval,
+        a.input.as_deref(),
+        ["q", "qd", "qdd"],
+        [a.q.as_deref(), a.qd.as_deref(), a.qdd.as_deref()],
+        "tau",
         // chunks of the table at once over the cores (the library's batch; errors name their row)
-        &mut |c, tau| inverse_dynamics_batch(&robot, env, &c.x[0], &c.x[1], &c.x[2], tau),
+        &mut |r, c, tau| inverse_dynamics_batch(r, r.environment(), &c.x[0], &c.x[1], &c.x[2], tau),
         // closed chains: every row on the branch tracker (continued from the previous row)
         &mut |chain, b, d, x, tau| {
-            closed_inverse_dynamics_into(chain, d, b, env, x[0], x[1], x[2], tau)
+            closed_inverse_dynamics_into(
+                chain,
+                d,
+                b,
+                chain.robot().environment(),
+                x[0],
+                x[1],
+                x[2],
+                tau,
+            )
         },
     )
 }

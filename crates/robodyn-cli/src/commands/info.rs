@@ -165,39 +165,7 @@ fn text(d: &RobotDescription, s: &robodyn::model::Structure) -> String {
     let g: Vec<String> = d.gravity.iter().map(expr).collect();
     outln!(out, "gravity: [{}]", g.join(", "));
     outln!(out);
-    let mut rows = vec![[
-        "j", "name", "a(j)", "sigma", "mu", "gamma", "b", "alpha", "d", "theta", "r", "role",
-    ]
-    .map(String::from)
-    .to_vec()];
-    for (i, f) in d.frames.iter().enumerate() {
-        let mut r = vec![
-            (i + 1).to_string(),
-            f.name.clone(),
-            f.ant.to_string(),
-            f.joint.sigma().to_string(),
-            u8::from(f.actuated).to_string(),
-        ];
-        for (k, e) in f.geometric().iter().enumerate() {
-            let var = match (k, f.joint.sigma(), i < d.nj) {
-                (4, 0, true) => Some(format!("th{}", i + 1)),
-                (5, 1, true) => Some(format!("r{}", i + 1)),
-                _ => None,
-            };
-            r.push(match var {
-                Some(v) if e.is_zero() => v,
-                Some(v) if expr(e) == e.decimal().to_string() => (robodyn::Expr::symbol(v)
-                    + (*e).clone())
-                .decimal()
-                .to_string(),
-                Some(v) => format!("{v} + {}", expr(e)).replace("+ -", "- "),
-                None => expr(e),
-            });
-        }
-        r.push(role(d, i + 1).into());
-        rows.push(r);
-    }
-    print_rows(&mut out, &rows);
+    print_rows(&mut out, &frame_rows(d));
     outln!(out);
     outln!(out, "main branches:");
     for b in &s.main_branches {
@@ -244,9 +212,53 @@ fn text(d: &RobotDescription, s: &robodyn::model::Structure) -> String {
             pas.join(", ")
         }
     );
+    limits_text(&mut out, d);
+    out
+}
+
+/// The frames table: one row per frame (its geometric parameters, the joint variable added
+/// to theta or r) under a header row.
+fn frame_rows(d: &RobotDescription) -> Vec<Vec<String>> {
+    let mut rows = vec![[
+        "j", "name", "a(j)", "sigma", "mu", "gamma", "b", "alpha", "d", "theta", "r", "role",
+    ]
+    .map(String::from)
+    .to_vec()];
+    for (i, f) in d.frames.iter().enumerate() {
+        let mut r = vec![
+            (i + 1).to_string(),
+            f.name.clone(),
+            f.ant.to_string(),
+            f.joint.sigma().to_string(),
+            u8::from(f.actuated).to_string(),
+        ];
+        for (k, e) in f.geometric().iter().enumerate() {
+            let var = match (k, f.joint.sigma(), i < d.nj) {
+                (4, 0, true) => Some(format!("th{}", i + 1)),
+                (5, 1, true) => Some(format!("r{}", i + 1)),
+                _ => None,
+            };
+            r.push(match var {
+                Some(v) if e.is_zero() => v,
+                Some(v) if expr(e) == e.decimal().to_string() => (robodyn::Expr::symbol(v)
+                    + (*e).clone())
+                .decimal()
+                .to_string(),
+                Some(v) => format!("{v} + {}", expr(e)).replace("+ -", "- "),
+                None => expr(e),
+            });
+        }
+        r.push(role(d, i + 1).into());
+        rows.push(r);
+    }
+    rows
+}
+
+/// The joint limits of the robot file, if any.
+fn limits_text(out: &mut String, d: &RobotDescription) {
     if !d.limits.is_empty() {
-        outln!(out);
-        outln!(out, "joint limits (rad, rad/s, rad/s^2, N m for revolute joints; m, m/s, m/s^2, N for prismatic):");
+        outln!(*out);
+        outln!(*out, "joint limits (rad, rad/s, rad/s^2, N m for revolute joints; m, m/s, m/s^2, N for prismatic):");
         for (j, l) in &d.limits {
             let mut parts = Vec::new();
             if let (Some(a), Some(b)) = (l.q_min, l.q_max) {
@@ -257,10 +269,9 @@ fn text(d: &RobotDescription, s: &robodyn::model::Structure) -> String {
                     parts.push(format!("{name} <= {}", short(v)));
                 }
             }
-            outln!(out, "  {j} ({}): {}", d.frame(*j).name, parts.join(", "));
+            outln!(*out, "  {j} ({}): {}", d.frame(*j).name, parts.join(", "));
         }
     }
-    out
 }
 
 /// A number for reading: 12 significant digits, so that float noise of an import

@@ -9,8 +9,7 @@
 //! Joint columns follow `--names` as in `idm`, `ddm` and `regressor`: `q3` (frame number) or
 //! `q_shoulder` (joint name), in the CSV, the `--torque-csv` / `--track` input and the plot.
 
-use crate::commands::ddm::MethodArg;
-use crate::common::{format_number, parse_list, CliResult, NamesArg, RobotArgs};
+use crate::common::{choices, format_number, parse_list, CliResult, NamesArg, RobotArgs};
 use crate::output::{check_distinct, commit_all, Output};
 use crate::states::{classify, known_columns, ColumnSpec, Group};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -19,6 +18,7 @@ use robodyn::simulation::{
     plot_svg, simulate, ClosedChainDynamics, CsvSink, Dynamics, EnergyBalance, Integrator,
     PlotInfo, Recorder, SimOptions, Tee, TimeSeries, TorqueInput, TrajectorySink, TreeDynamics,
 };
+use robodyn::Method;
 use std::collections::HashMap;
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -66,8 +66,8 @@ pub struct Args {
     #[arg(long, allow_hyphen_values = true, requires = "track")]
     pub kd: Option<String>,
     /// Direct model of a tree robot (closed chains always use A_cl, H_cl of 10.46–10.48).
-    #[arg(long, value_enum, default_value = "aba")]
-    pub method: MethodArg,
+    #[arg(long, default_value = "aba", value_parser = choices(&Method::ALL, Method::name, Method::describe))]
+    pub method: Method,
     /// Simulate the Coulomb friction as Fs tanh(qd / V) instead of Fs sign(qd) (V in rad/s or
     /// m/s; 0 = exact sign, which makes sticking joints chatter and the steps collapse).
     #[arg(long, default_value_t = 0.01, value_name = "V")]
@@ -366,7 +366,7 @@ type Model<'r> = (
 fn model<'r>(robot: &'r robodyn::Robot, a: &Args) -> CliResult<Model<'r>> {
     let smoothing = Some(a.coulomb_smoothing);
     if robot.is_tree() {
-        let d = TreeDynamics::new(robot, a.method.into()).with_coulomb_smoothing(smoothing);
+        let d = TreeDynamics::new(robot, a.method).with_coulomb_smoothing(smoothing);
         let joints = d.joints().to_vec();
         return Ok((Box::new(d), joints, "movable tree joints", None));
     }
@@ -439,16 +439,25 @@ fn progress_bar() -> CliResult<ProgressBar> {
     Ok(bar)
 }
 
-pub fn run(a: Args) -> CliResult {
-    check_options(&a)?;
-    check_distinct(&[("--output", Some(&a.output)), ("--plot", a.plot.as_deref())])?;
-    let robot = a.robot.load()?;
-    let (dynamics, joints, what, q0_default) = model(&robot, &a)?;
-    let n = joints.len();
-    if n == 0 {
+/// The simulated system with its columns named as `--names` says (a closed chain's passive
+/// joints' `q<j>` too), its joints (frame numbers), what they are, the default q0, and the
+/// label of every movable joint by frame number.
+#[allow(clippy::type_complexity)]
+fn labelled_model<'r>(
+    robot: &'r robodyn::Robot,
+    a: &Args,
+) -> CliResult<(
+    Labelled<'r>,
+    Vec<usize>,
+    &'static str,
+    Option<Vec<f64>>,
+    HashMap<usize, String>,
+)> {
+    let (dynamics, joints, what, q0_default) = model(robot, a)?;
+    if joints.is_empty() {
         return Err("the robot has no movable joint: nothing to simulate".into());
     }
-    let label = joint_labels(&robot, &a.names);
+    let label = joint_labels(robot, &a.names);
     let labels: Vec<String> = joints.iter().map(|j| label[j].clone()).collect();
     // the passive joints' q<j> of a closed chain follow the same rule
     let extra = dynamics
@@ -461,11 +470,21 @@ pub fn run(a: Args) -> CliResult {
             },
         )
         .collect();
-    let mut dynamics = Labelled {
+    let dynamics = Labelled {
         inner: dynamics,
-        labels: labels.clone(),
+        labels,
         extra,
     };
+    Ok((dynamics, joints, what, q0_default, label))
+}
+
+pub fn run(a: Args) -> CliResult {
+    check_options(&a)?;
+    check_distinct(&[("--output", Some(&a.output)), ("--plot", a.plot.as_deref())])?;
+    let robot = a.robot.load()?;
+    let (mut dynamics, joints, what, q0_default, label) = labelled_model(&robot, &a)?;
+    let n = joints.len();
+    let labels = dynamics.labels.clone();
     // the initial state and the input (the columns of its files checked)
     let q0 = joint_values("q0", a.q0.as_deref(), &joints, what, q0_default.as_deref())?;
     let qd0 = joint_values("qd0", a.qd0.as_deref(), &joints, what, None)?;
@@ -642,8 +661,10 @@ fn energy_balance(robot: &robodyn::Robot, input: &TorqueInput) -> EnergyBalance 
         _ => true,
     };
     let k = robot.standard_parameters();
-    let friction =
-        (0..robot.nl()).any(|j| k[13 * j + param::FS] != 0.0 || k[13 * j + param::FV] != 0.0);
+    let per_link = robodyn::model::STANDARD_PARAMETERS.len();
+    let friction = k
+        .chunks(per_link)
+        .any(|link| link[param::FS] != 0.0 || link[param::FV] != 0.0);
     match (driven, friction) {
         (true, _) => EnergyBalance::Work,
         (false, true) => EnergyBalance::Friction,

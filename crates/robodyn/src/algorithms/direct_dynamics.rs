@@ -34,6 +34,39 @@ pub enum Method {
     ArticulatedBody,
 }
 
+impl Method {
+    /// Every method (what a command line or a binding offers; [`Method::name`] names each).
+    pub const ALL: [Method; 2] = [Method::Composite, Method::ArticulatedBody];
+
+    /// The method's name: `composite`, `aba` ([`Method::from_name`] reads it back).
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Composite => "composite",
+            Method::ArticulatedBody => "aba",
+        }
+    }
+
+    /// The method of a name of [`Method::name`] (or `articulated` for `aba`).
+    pub fn from_name(name: &str) -> Option<Method> {
+        match name {
+            "articulated" => Some(Method::ArticulatedBody),
+            _ => Method::ALL.into_iter().find(|m| m.name() == name),
+        }
+    }
+
+    /// What the method computes, in a few words.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Method::Composite => {
+                "qdd = A^-1 (tau - H), A by composite links, tree L'DL factorization"
+            }
+            Method::ArticulatedBody => {
+                "O(n) recursive Newton-Euler direct model (articulated bodies)"
+            }
+        }
+    }
+}
+
 /// A usable pivot: finite and above the relative tolerance (false for NaN).
 #[inline]
 fn pivot_ok(d: f64, scale: f64) -> bool {

@@ -48,6 +48,34 @@ pub enum RotorMode {
     None,
 }
 
+impl RotorMode {
+    /// Every mode (what a command line or a binding offers; [`RotorMode::name`] names each).
+    pub const ALL: [RotorMode; 3] = [RotorMode::Actuated, RotorMode::All, RotorMode::None];
+
+    /// The mode's name: `actuated`, `all`, `none` ([`RotorMode::from_name`] reads it back).
+    pub fn name(self) -> &'static str {
+        match self {
+            RotorMode::Actuated => "actuated",
+            RotorMode::All => "all",
+            RotorMode::None => "none",
+        }
+    }
+
+    /// The mode of a name of [`RotorMode::name`].
+    pub fn from_name(name: &str) -> Option<RotorMode> {
+        RotorMode::ALL.into_iter().find(|m| m.name() == name)
+    }
+
+    /// What the mode makes parameters, in a few words.
+    pub fn describe(self) -> &'static str {
+        match self {
+            RotorMode::Actuated => "rotor inertia IA_j of the actuated joints",
+            RotorMode::All => "rotor inertia IA_j of every movable joint",
+            RotorMode::None => "no rotor inertia",
+        }
+    }
+}
+
 /// What a parameter written as a literal `0` in the robot file means.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ZeroParameters {
@@ -60,6 +88,32 @@ pub enum ZeroParameters {
 }
 
 impl ZeroParameters {
+    /// Both meanings (what a command line or a binding offers).
+    pub const ALL: [ZeroParameters; 2] = [ZeroParameters::Absent, ZeroParameters::Value];
+
+    /// The meaning's name: `absent`, `value` ([`ZeroParameters::from_name`] reads it back).
+    pub fn name(self) -> &'static str {
+        match self {
+            ZeroParameters::Absent => "absent",
+            ZeroParameters::Value => "value",
+        }
+    }
+
+    /// The meaning of a name of [`ZeroParameters::name`].
+    pub fn from_name(name: &str) -> Option<ZeroParameters> {
+        ZeroParameters::ALL.into_iter().find(|z| z.name() == name)
+    }
+
+    /// The meaning in a few words.
+    pub fn describe(self) -> &'static str {
+        match self {
+            ZeroParameters::Absent => {
+                "a parameter written as a literal 0 does not exist (SYMORO's meaning)"
+            }
+            ZeroParameters::Value => "a literal 0 is a value: the parameter exists",
+        }
+    }
+
     /// The meaning of the file format (by extension): `.par` -> [`ZeroParameters::Absent`],
     /// `.toml` and `.urdf` -> [`ZeroParameters::Value`] (see docs/robot-format.md).
     pub fn for_path(path: &std::path::Path) -> ZeroParameters {
