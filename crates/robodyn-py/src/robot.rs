@@ -19,12 +19,10 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::sync::{Arc, Mutex, OnceLock, RwLock};
 
-/// Per-thread buffers of a tree evaluation: the library's `Data`, a matrix output and a tree
-/// vector (NL entries).
+/// Per-thread buffers of a tree evaluation: the library's `Data` and a matrix output.
 pub struct Work {
     pub data: Data,
     pub m: DMatrix<f64>,
-    pub tree: Vec<f64>,
 }
 
 impl Work {
@@ -32,7 +30,6 @@ impl Work {
         Work {
             data: Data::new(robot),
             m: DMatrix::zeros(0, 0),
-            tree: vec![0.0; robot.nl()],
         }
     }
 
@@ -647,20 +644,8 @@ impl Robot {
             stacked: false,
             out,
         };
-        self.eval(py, &models, &models.full, call, |r, w, x, o| {
-            let tree = &mut w.tree;
-            tree.resize(r.nl(), 0.0);
-            for (k, &j) in r.coordinates().frames().iter().enumerate() {
-                tree[j - 1] = x[0][k];
-            }
-            if let Some(k) = x[0].iter().position(|v| !v.is_finite()) {
-                return Err(robodyn::Error::NotFinite {
-                    what: "q".into(),
-                    index: k,
-                    value: x[0][k],
-                });
-            }
-            for (j, t) in robodyn::geometry::frame_transforms(r, tree)
+        self.eval(py, &models, &models.full, call, |r, _w, x, o| {
+            for (j, t) in robodyn::geometry::frame_transforms(r, x[0])?
                 .iter()
                 .enumerate()
             {

@@ -803,7 +803,7 @@ pub fn loop_closure_into(
 /// its twin 5.
 ///
 /// ```
-/// use robodyn::{geometry::frame_transforms, loop_closure, ClosedChain};
+/// use robodyn::{geometry::frame_transforms_with_cuts, loop_closure, ClosedChain};
 /// # fn main() -> robodyn::Result<()> {
 /// let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots/fourbar.toml");
 /// let robot = robodyn::io::load(path.as_ref())?;
@@ -813,8 +813,7 @@ pub fn loop_closure_into(
 ///     let s = loop_closure(&chain, &mut branch, &[q1])?;
 ///     assert!(!s.conditioning.warning);
 ///     // an independent check: compose the frames of the tree (joints 1..3, cut joint 4)
-///     let q: Vec<f64> = s.q_tree.iter().chain(s.q_c.iter()).copied().collect();
-///     let t = frame_transforms(&robot, &q);
+///     let t = frame_transforms_with_cuts(&robot, s.q_tree.as_slice(), s.q_c.as_slice())?;
 ///     assert!((t[3].pos - t[4].pos).norm() < 1e-9); // O_4 = O_5
 ///     println!("q1 = {q1}: q_p = {}, W = {}", s.q_p, s.w);
 /// }
