@@ -7,9 +7,9 @@ use crate::errors::{InputError, IntoPy};
 use nalgebra::DMatrix;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
+use robodyn::algorithms::base_parameters::{base_columns, standard_columns};
 use robodyn::algorithms::regressor::{
-    base_columns, regressor_into, standard_columns, ParameterSelection, RotorMode, ZeroParameters,
-    PARAMS_PER_LINK,
+    regressor_into, ParameterSelection, RotorMode, ZeroParameters, PARAMS_PER_LINK,
 };
 use robodyn::batch::for_each_row;
 use robodyn::{

@@ -30,7 +30,7 @@ use crate::algorithms::inverse_dynamics::rnea_with_environment;
 use crate::algorithms::loop_closure::{fmt_vec, LoopClosure, LoopConstraint, LoopWorkspace};
 use crate::algorithms::regressor::{tree_regressor, tree_wrench_torques, PARAMS_PER_LINK};
 use crate::data::Data;
-use crate::error::{Error, Result};
+use crate::error::{Configuration, Error, Result};
 use crate::linalg::{norm1, rcond_cholesky, SmallLu};
 use crate::model::{Coordinates, Environment, JointType, Robot};
 use crate::scalar::DynScalar;
@@ -456,7 +456,10 @@ impl ClosedChain {
             ),
             rcond,
             limit: self.limits.wp_hard,
-            at: format!("q_tr = {}", fmt_vec(q_tr)),
+            at: Configuration::Joints {
+                name: "q_tr",
+                values: q_tr.to_vec(),
+            },
             hint: "the mechanism is at a singular configuration: q_p is not determined by q_a"
                 .into(),
         }
@@ -660,7 +663,10 @@ impl ClosedChain {
             what: "the closed-chain inertia matrix A_cl (10.46)".into(),
             rcond,
             limit: self.limits.a_cl_hard,
-            at: format!("q_tr = {}", fmt_vec(q_tr)),
+            at: Configuration::Joints {
+                name: "q_tr",
+                values: q_tr.to_vec(),
+            },
             hint: "check masses and inertias, or the configuration is singular".into(),
         }
     }

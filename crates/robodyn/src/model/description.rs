@@ -126,8 +126,24 @@ impl FrameDesc {
     }
 }
 
+/// Number of standard parameters per link (XX XY XZ YY YZ ZZ MX MY MZ M IA FS FV): the vector K
+/// of the regressor has `PARAMS_PER_LINK * NL` entries, link 1 first.
+pub const PARAMS_PER_LINK: usize = 13;
+
+/// Which rotor inertias IA_j are parameters of a model (the regressor's columns, the base
+/// parameters, identification).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RotorMode {
+    /// IA_j for the actuated joints (mu_j = 1).
+    Actuated,
+    /// IA_j for every movable joint.
+    All,
+    /// No rotor inertia.
+    None,
+}
+
 /// Names of the 13 standard parameters of a link, in SYMORO's order.
-pub const STANDARD_PARAMETERS: [&str; 13] = [
+pub const STANDARD_PARAMETERS: [&str; PARAMS_PER_LINK] = [
     "XX", "XY", "XZ", "YY", "YZ", "ZZ", "MX", "MY", "MZ", "M", "IA", "FS", "FV",
 ];
 
@@ -186,7 +202,7 @@ pub struct LinkDesc {
     /// Link name.
     pub name: String,
     /// XX XY XZ YY YZ ZZ MX MY MZ M IA FS FV, about O_j in R_j.
-    pub params: [Expr; 13],
+    pub params: [Expr; PARAMS_PER_LINK],
     /// FX FY FZ CX CY CZ: force and moment the link exerts on the environment, in R_j.
     pub wrench: [Expr; 6],
 }
