@@ -686,7 +686,7 @@ struct Observation {
     tree_rows: bool,
 }
 
-/// 1. W from `sampler`'s states (seeded by `opt.seed`): the regressor of each state (G^T Phi
+/// Step 1, W from `sampler`'s states (seeded by `opt.seed`): the regressor of each state (G^T Phi
 /// for a closed chain), columns `all`; `n_columns` (the existing parameters) sets the count.
 fn observation_matrix(
     robot: &Robot,
@@ -761,7 +761,7 @@ struct Grouping {
     residual_grouped: f64,
 }
 
-/// 5. QR of R's columns [kept, grouped]: the scaled grouping coefficients (R11^-1 R12), the
+/// Step 5, QR of R's columns [kept, grouped]: the scaled grouping coefficients (R11^-1 R12), the
 /// smallest singular value of the kept columns and the residual of the grouped ones; an error
 /// when the rank is not clear from these samples.
 fn grouping(
