@@ -3,7 +3,7 @@
 //! bundled robot (robots/*.toml, *.urdf, *.par): it loads with no console error and no network
 //! request, it draws (the screenshot is not blank and shows the red x and blue z axes), moving a
 //! slider changes the picture, and the frames it draws agree with robodyn's own forward
-//! kinematics (`robodyn::geometry::frame_transforms`) to 1e-9 on random joint values; closed
+//! kinematics (`robodyn::geometry::frame_transforms_with_cuts`) to 1e-9 on random joint values; closed
 //! robots are drawn assembled (R_k on its twin R_{k+B}) at their assembly and at random actuated
 //! values solved by `robodyn::loop_closure`; trajectories (a tree's, a closed robot's with and
 //! without its passive columns, `simulate`'s output) play. Talos (example-robot-data) with its
@@ -15,7 +15,7 @@
 mod common;
 
 use common::{robot, run, tmp};
-use robodyn::geometry::frame_transforms;
+use robodyn::geometry::frame_transforms_with_cuts;
 use robodyn::{loop_closure, ClosedChain, Robot};
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
@@ -88,7 +88,17 @@ impl Rng {
 
 /// 0T_j (j = 1..NF) as 4x4 row-major, from robodyn.
 fn expected(robot: &Robot, q_frames: &[f64]) -> Vec<[f64; 16]> {
-    frame_transforms(robot, q_frames)
+    let movable: Vec<f64> = robot
+        .coordinates()
+        .frames()
+        .iter()
+        .map(|&j| q_frames[j - 1])
+        .collect();
+    let cuts: Vec<f64> = (robot.nl() + 1..=robot.nj())
+        .map(|j| q_frames.get(j - 1).copied().unwrap_or(0.0))
+        .collect();
+    frame_transforms_with_cuts(robot, &movable, &cuts)
+        .expect("a finite state")
         .iter()
         .map(|t| {
             let m = t.matrix();

@@ -7,9 +7,9 @@ use crate::errors::{InputError, IntoPy};
 use nalgebra::DMatrix;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
+use robodyn::algorithms::base_parameters::{base_columns, standard_columns};
 use robodyn::algorithms::regressor::{
-    base_columns, regressor_into, standard_columns, ParameterSelection, RotorMode, ZeroParameters,
-    PARAMS_PER_LINK,
+    regressor_into, ParameterSelection, RotorMode, ZeroParameters, PARAMS_PER_LINK,
 };
 use robodyn::batch::for_each_row;
 use robodyn::{
@@ -19,12 +19,10 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::sync::{Arc, Mutex, OnceLock, RwLock};
 
-/// Per-thread buffers of a tree evaluation: the library's `Data`, a matrix output and a tree
-/// vector (NL entries).
+/// Per-thread buffers of a tree evaluation: the library's `Data` and a matrix output.
 pub struct Work {
     pub data: Data,
     pub m: DMatrix<f64>,
-    pub tree: Vec<f64>,
 }
 
 impl Work {
@@ -32,7 +30,6 @@ impl Work {
         Work {
             data: Data::new(robot),
             m: DMatrix::zeros(0, 0),
-            tree: vec![0.0; robot.nl()],
         }
     }
 
@@ -654,20 +651,8 @@ impl Robot {
             stacked: false,
             out,
         };
-        self.eval(py, &models, &models.full, call, |r, w, x, o| {
-            let tree = &mut w.tree;
-            tree.resize(r.nl(), 0.0);
-            for (k, &j) in r.coordinates().frames().iter().enumerate() {
-                tree[j - 1] = x[0][k];
-            }
-            if let Some(k) = x[0].iter().position(|v| !v.is_finite()) {
-                return Err(robodyn::Error::NotFinite {
-                    what: "q".into(),
-                    index: k,
-                    value: x[0][k],
-                });
-            }
-            for (j, t) in robodyn::geometry::frame_transforms(r, tree)
+        self.eval(py, &models, &models.full, call, |r, _w, x, o| {
+            for (j, t) in robodyn::geometry::frame_transforms(r, x[0])?
                 .iter()
                 .enumerate()
             {

@@ -4,10 +4,10 @@
 //!
 //! `cargo run --release --example third_party` (run by `cargo test` too: its test calls `main`).
 
-use nalgebra::{DMatrix, DVector}; // robodyn's own nalgebra version: `robodyn::nalgebra` once re-exported
 use robodyn::algorithms::base_parameters::ParameterNames;
 use robodyn::algorithms::base_parameters::{numeric_base_parameters_auto, NumericOptions};
-use robodyn::algorithms::regressor::{ParameterSelection, RotorMode};
+use robodyn::algorithms::regressor::{Friction, ParameterSelection, RotorMode};
+use robodyn::nalgebra::{DMatrix, DVector}; // robodyn's own nalgebra, re-exported
 use robodyn::{closed_inverse_dynamics, direct_dynamics_into, inertia_matrix_into};
 use robodyn::{inverse_dynamics, regressor, ClosedChain, Data, Method};
 use std::path::Path;
@@ -23,8 +23,8 @@ fn gap(a: &[f64], b: &[f64]) -> f64 {
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let robots = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../robots");
     // 1. robots from files: the Stäubli RX-90 as robodyn TOML and as URDF
-    let rx90 = robodyn::io::load(&robots.join("rx90.toml"))?;
-    let urdf = robodyn::io::load(&robots.join("rx90.urdf"))?;
+    let rx90 = robodyn::io::load(robots.join("rx90.toml"))?;
+    let urdf = robodyn::io::load(robots.join("rx90.urdf"))?;
     let n = rx90.dof();
     println!("{}: {n} joints, {} from URDF", rx90.name(), urdf.dof());
 
@@ -66,12 +66,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
     // 5. base parameters of the URDF robot (numerical method), checked on one state:
     //    Phi_base K_base = Phi K
-    let selection = ParameterSelection::new(&urdf, RotorMode::None, true);
-    let options = NumericOptions {
-        selection,
-        samples: None,
-        seed: 1,
-    };
+    let selection = ParameterSelection::new(&urdf, RotorMode::None, Friction::Actuated);
+    let options = NumericOptions::new(selection);
     let (base, _closed_start) = numeric_base_parameters_auto(&urdf, &options)?;
     let names = ParameterNames::of(urdf.description());
     println!("{} base parameters of {}:", base.count(), urdf.name());
@@ -88,7 +84,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
     // 6. a closed chain: the Acma SR400 (parallelogram loop), torques of the actuated joints on
     //    the file's assembly branch, (10.40) checked against the multiplier form (10.36)
-    let sr400 = robodyn::io::load(&robots.join("sr400.toml"))?;
+    let sr400 = robodyn::io::load(robots.join("sr400.toml"))?;
     let chain = ClosedChain::new(&sr400)?;
     let mut branch = chain.assembly_branch()?;
     let q_a = [0.1, 0.2, 0.3, 0.4, 0.5, 1.6];

@@ -171,4 +171,42 @@ impl<T: DynScalar> Data<T> {
     pub fn nl(&self) -> usize {
         self.nl
     }
+
+    // Read-only views of what the last Newton–Euler pass computed. After
+    // `inverse_dynamics_into` (and the other checked tree functions) the recursions ran on the
+    // model of the dynamic recursions (`Robot::dynamic`, fixed frames folded): index k = 1..=N
+    // is the link of joint-vector entry k-1 (frame `robot.coordinates().frame(k - 1)`), index 0
+    // the base; entries above N are left over. Vectors are in the link's own frame R_j.
+
+    /// jw_j, the angular velocity of each link (rad/s), index 0 the base.
+    pub fn angular_velocities(&self) -> &[Vector3<T>] {
+        &self.w
+    }
+
+    /// jwd_j, the angular acceleration of each link (rad/s²).
+    pub fn angular_accelerations(&self) -> &[Vector3<T>] {
+        &self.wd
+    }
+
+    /// jVd_j, the linear acceleration of each link's origin O_j (m/s²), gravity included as an
+    /// upward acceleration of the base (eq 10.6).
+    pub fn linear_accelerations(&self) -> &[Vector3<T>] {
+        &self.vd
+    }
+
+    /// jf_j, the force exerted on each link by its antecedent (N), eq 10.10.
+    pub fn forces(&self) -> &[Vector3<T>] {
+        &self.f
+    }
+
+    /// jm_j, the moment about O_j exerted on each link by its antecedent (N m), eq 10.11.
+    pub fn moments(&self) -> &[Vector3<T>] {
+        &self.m
+    }
+
+    /// iA_j and iP_j, the orientation and origin of each frame in its antecedent's frame
+    /// (placements relative to the antecedent, index 0 unused).
+    pub fn local_placements(&self) -> (&[Matrix3<T>], &[Vector3<T>]) {
+        (&self.rot, &self.pos)
+    }
 }

@@ -61,6 +61,41 @@ impl fmt::Display for Location {
     }
 }
 
+/// Where a matrix was found singular ([`Error::Singular`]): values, not text.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Configuration {
+    /// At the pivot of joint `joint` (frame number) of the tree's factorization (L'DL of A or
+    /// the articulated-body inertias).
+    Pivot {
+        /// The joint (frame number).
+        joint: usize,
+        /// The pivot found.
+        pivot: f64,
+    },
+    /// At the joint values `values` of the vector `name` (`q_tr`: the variables of a closed
+    /// chain's equivalent tree, joint j at index j-1, fixed frames 0).
+    Joints {
+        /// The vector's name.
+        name: &'static str,
+        /// Its values (rad, m).
+        values: Vec<f64>,
+    },
+}
+
+impl fmt::Display for Configuration {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Configuration::Pivot { joint, pivot } => write!(f, "joint {joint} (pivot {pivot:.3e})"),
+            Configuration::Joints { name, values } => write!(f, "{name} = {}", fmt_values(values)),
+        }
+    }
+}
+
+/// Joint values in messages: `[0.1, -0.25, 1.5]` (6 significant digits).
+pub(crate) fn fmt_values(v: &[f64]) -> String {
+    crate::report::number::vector(v, 6)
+}
+
 /// The error type of the library. Callers match on the variant; the message says where and why
 /// in words (no library message names a command-line flag).
 #[derive(Debug, Clone, thiserror::Error)]
@@ -127,8 +162,8 @@ pub enum Error {
         rcond: f64,
         /// The hard limit it fell below.
         limit: f64,
-        /// The configuration (joint values).
-        at: String,
+        /// The configuration: a joint's pivot or joint values.
+        at: Configuration,
         /// What it means for the mechanism.
         hint: String,
     },
@@ -147,19 +182,19 @@ pub enum Error {
         hint: String,
     },
     /// A configuration cannot be reached on the branch tracker's assembly branch.
-    #[error("q_a = {at} cannot be reached on the assembly branch: {reason}")]
+    #[error("q_a = {} cannot be reached on the assembly branch: {reason}", fmt_values(.at))]
     BranchLost {
-        /// The target actuated values.
-        at: String,
+        /// The target actuated values q_a (rad, m).
+        at: Vec<f64>,
         /// Why (a singularity or fold on the path, no convergence).
         reason: String,
     },
     /// A closed-chain configuration the branch tracker cannot reach within its step budget
     /// (`ClosedChain::step_budget`): the move is too long to follow and cannot be shortened.
-    #[error("q_a = {at} cannot be reached on the assembly branch within the continuation's budget of {budget} steps: {reason}")]
+    #[error("q_a = {} cannot be reached on the assembly branch within the continuation's budget of {budget} steps: {reason}", fmt_values(.at))]
     ContinuationBudget {
-        /// The target actuated values.
-        at: String,
+        /// The target actuated values q_a (rad, m).
+        at: Vec<f64>,
         /// The step budget.
         budget: usize,
         /// Why the move could not be followed or shortened.

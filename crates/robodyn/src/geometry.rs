@@ -1,5 +1,6 @@
 //! Geometric model: iT_j and 0T_j for given joint values.
 
+use crate::error::{check_vector, Result};
 use crate::model::Robot;
 use nalgebra::{Matrix3, Matrix4, Vector3};
 
@@ -53,9 +54,56 @@ pub fn local_transform(robot: &Robot, j: usize, q: f64) -> Transform {
     Transform { rot, pos }
 }
 
-/// 0T_j for every frame j = 1..NF (index j-1). `q` holds the joint values of frames 1..NL, or
-/// 1..NJ to include the cut-joint variables (missing cut-joint values are taken as 0).
-pub fn frame_transforms(robot: &Robot, q: &[f64]) -> Vec<Transform> {
+/// 0T_j for every frame j = 1..NF (index j-1) at joint values `q` over the movable joints in
+/// frame order ([`Robot::coordinates`], the vectors of every other function); fixed frames
+/// keep their constant placement and the cut-joint variables of a closed chain are 0 (use
+/// [`frame_transforms_with_cuts`] to give them).
+///
+/// Errors: [`crate::Error::Dimension`] when `q` does not have `robot.dof()` entries,
+/// [`crate::Error::NotFinite`] for a NaN or infinite entry.
+///
+/// # Example
+///
+/// ```
+/// # fn main() -> robodyn::Result<()> {
+/// let robots = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots");
+/// let rx90 = robodyn::io::load(format!("{robots}/rx90.urdf").as_ref())?;
+/// let t = robodyn::geometry::frame_transforms(&rx90, &[0.0; 6])?;
+/// assert_eq!(t.len(), rx90.nf());
+/// assert!(robodyn::geometry::frame_transforms(&rx90, &[0.0; 5]).is_err());
+/// # Ok(())
+/// # }
+/// ```
+pub fn frame_transforms(robot: &Robot, q: &[f64]) -> Result<Vec<Transform>> {
+    frame_transforms_with_cuts(robot, q, &vec![0.0; robot.n_loops()])
+}
+
+/// 0T_j for every frame j = 1..NF (index j-1) at joint values `q` over the movable joints
+/// (as [`frame_transforms`]) and the cut-joint variables `q_cut` of joints NL+1..NJ (one per
+/// loop, [`Robot::n_loops`] entries).
+///
+/// Errors: [`crate::Error::Dimension`], [`crate::Error::NotFinite`] for a bad `q` or `q_cut`.
+pub fn frame_transforms_with_cuts(
+    robot: &Robot,
+    q: &[f64],
+    q_cut: &[f64],
+) -> Result<Vec<Transform>> {
+    let c = robot.coordinates();
+    c.check("q", q, "movable joints")?;
+    check_vector("q_cut", q_cut, robot.n_loops(), || {
+        format!("cut joints {}..{}", robot.nl() + 1, robot.nj())
+    })?;
+    let mut frames = vec![0.0; robot.nj()];
+    c.scatter(q, &mut frames[..robot.nl()]);
+    frames[robot.nl()..].copy_from_slice(q_cut);
+    Ok(frame_transforms_per_frame(robot, &frames))
+}
+
+/// 0T_j for every frame j = 1..NF (index j-1) from per-frame values: `q` holds the values of
+/// frames 1..NL (fixed frames included, their entries ignored), or 1..NJ to include the
+/// cut-joint variables (missing values are taken as 0). Unchecked: the library's own layout,
+/// the public entry points are [`frame_transforms`] and [`frame_transforms_with_cuts`].
+pub(crate) fn frame_transforms_per_frame(robot: &Robot, q: &[f64]) -> Vec<Transform> {
     let nf = robot.nf();
     let mut out: Vec<Transform> = Vec::with_capacity(nf);
     for j in 1..=nf {

@@ -41,12 +41,8 @@
 //! use robodyn::algorithms::base_parameters::{
 //!     numeric_base_parameters, NumericOptions, ParameterNames, TreeSampler,
 //! };
-//! use robodyn::algorithms::regressor::{ParameterSelection, RotorMode};
-//! let opt = NumericOptions {
-//!     selection: ParameterSelection::new(&rx90, RotorMode::None, false),
-//!     samples: None,
-//!     seed: 1,
-//! };
+//! use robodyn::algorithms::regressor::{Friction, ParameterSelection, RotorMode};
+//! let opt = NumericOptions::new(ParameterSelection::new(&rx90, RotorMode::None, Friction::None));
 //! let base = numeric_base_parameters(&rx90, &mut TreeSampler, &opt)?;
 //! let names = ParameterNames::of(rx90.description());
 //! for r in 0..base.count() {
@@ -106,11 +102,16 @@ pub use algorithms::direct_dynamics::{direct_dynamics, direct_dynamics_into, Met
 pub use algorithms::inertia_matrix::{
     h_vector, h_vector_into, inertia_matrix, inertia_matrix_into,
 };
-pub use algorithms::inverse_dynamics::{inverse_dynamics, inverse_dynamics_into};
+pub use algorithms::inverse_dynamics::{
+    inverse_dynamics, inverse_dynamics_into, inverse_dynamics_state_into, State,
+};
 pub use algorithms::regressor::{regressor, regressor_into, wrench_torques, wrench_torques_into};
 pub use batch::{direct_dynamics_batch, inverse_dynamics_batch, regressor_batch};
 pub use data::Data;
 pub use error::{Error, Result};
 pub use model::{BaseMotion, Coordinates, DynModel, Environment, Robot, RobotDescription, Wrench};
+/// The nalgebra of robodyn's matrices and vectors (`DMatrix`, `DVector`, `Matrix3`, ...): use it
+/// to build the buffers of the `_into` functions without matching robodyn's nalgebra version.
+pub use nalgebra;
 pub use robodyn_symbolic::Expr;
 pub use scalar::DynScalar;

@@ -1,5 +1,7 @@
 //! Base inertial parameters: the numerical and symbolic methods on the SR400 (closed chain), the
 //! RX-90 (serial) and random trees.
+#[path = "common/frames.rs"]
+mod frames;
 
 use nalgebra::DMatrix;
 use rand::{Rng, RngCore};
@@ -95,7 +97,7 @@ fn sr400_sampler_closes_the_loop() {
     let mut r = rng(3);
     for _ in 0..20 {
         let s = Sr400Sampler.sample(&robot, &mut r).unwrap();
-        let t = robodyn::geometry::frame_transforms(&robot, &s.q);
+        let t = frames::per_frame(&robot, &s.q);
         let (t9, t10) = (&t[8], &t[9]);
         assert!((t9.pos - t10.pos).norm() < 1e-12, "loop not closed");
         assert!((t9.rot.column(2) - t10.rot.column(2)).norm() < 1e-12);

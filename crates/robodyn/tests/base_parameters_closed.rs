@@ -3,6 +3,8 @@
 //! the closed-chain inverse dynamic model Gamma_cl of `ClosedChain` (Newton–Euler on the
 //! equivalent tree projected by G, an independent route); the two methods against each other;
 //! counts against the bounds 10.24 / 10.57.
+#[path = "common/frames.rs"]
+mod frames;
 
 use nalgebra::{DMatrix, DVector};
 use rand::Rng;
@@ -247,7 +249,7 @@ fn sampler_states_close_the_loops_and_satisfy_the_velocity_constraints() {
         for _ in 0..15 {
             let st = s.sample(&robot, &mut r).unwrap();
             let gap = |q: &[f64]| -> Vec<f64> {
-                let t = robodyn::geometry::frame_transforms(&robot, q);
+                let t = frames::per_frame(&robot, q);
                 cuts.iter()
                     .flat_map(|&(c, w)| {
                         let d = t[c - 1].pos - t[w - 1].pos;
@@ -256,7 +258,7 @@ fn sampler_states_close_the_loops_and_satisfy_the_velocity_constraints() {
                     .collect()
             };
             for (l, &(c, w)) in cuts.iter().enumerate() {
-                let t = robodyn::geometry::frame_transforms(&robot, &st.q);
+                let t = frames::per_frame(&robot, &st.q);
                 let dp = (t[c - 1].pos - t[w - 1].pos).norm();
                 let dz = t[c - 1].rot.column(2).cross(&t[w - 1].rot.column(2)).norm();
                 assert!(

@@ -10,6 +10,8 @@
 //! `shared/` is found by walking up from this crate to a directory that contains
 //! `shared/cases/external`; when it is missing the test is skipped visibly, or fails where
 //! `ROBODYN_REQUIRE` requires the `shared` check (CI: `tests/common/harness.rs`).
+#[path = "common/frames.rs"]
+mod frames;
 
 use robodyn::algorithms::base_parameters::{
     compare_methods, geometry_robot, numeric_base_parameters_auto, symbolic_base_parameters,
@@ -550,7 +552,7 @@ fn twoloops_twin_frame_on_a_twin_frame_closes_on_its_link() {
             let s = loop_closure(&chain, &mut b0.clone(), &qa).unwrap();
             let mut q: Vec<f64> = s.q_tree.iter().copied().collect();
             q.extend(s.q_c.iter());
-            let t = robodyn::geometry::frame_transforms(&robot, &q);
+            let t = frames::per_frame(&robot, &q);
             for (k, tw) in [(9, 11), (10, 12)] {
                 assert!(
                     (t[k - 1].rot - t[tw - 1].rot).amax() < 1e-10,
@@ -564,7 +566,7 @@ fn twoloops_twin_frame_on_a_twin_frame_closes_on_its_link() {
             // not vacuous: the same q_a with q_p moved leaves loop 2 open
             let mut open = q.clone();
             open[5] += 0.1; // joint 6, passive, on loop 2 only
-            let t_open = robodyn::geometry::frame_transforms(&robot, &open);
+            let t_open = frames::per_frame(&robot, &open);
             assert!((t_open[9].pos - t_open[11].pos).norm() > 1e-3, "{file}");
             // the flattened description: the same solution
             let fs = loop_closure(&flat_chain, &mut fb0.clone(), &qa).unwrap();

@@ -3,9 +3,10 @@
 //! closure along the trajectory checked on the frame placements (independent of the closure
 //! solver's own residual), energy dissipation by viscous friction against the integrated
 //! friction power, and idm(ddm(tau)) = tau through the API the CLI uses.
+#[path = "common/frames.rs"]
+mod frames;
 
 use rand::Rng;
-use robodyn::geometry::frame_transforms;
 use robodyn::simulation::{
     simulate, ClosedChainDynamics, Dynamics, Integrator, Recorder, SimOptions, TorqueInput,
 };
@@ -98,7 +99,7 @@ fn tree_q(r: &Robot, rec: &Recorder, row: &[f64]) -> Vec<f64> {
 /// or prismatic cut frame does not depend on its own variable... for a prismatic cut it moves
 /// along z_k, so only the part normal to z_k is used), from `geometry::frame_transforms`.
 fn placement_gap(r: &Robot, q: &[f64]) -> f64 {
-    let t = frame_transforms(r, q);
+    let t = frames::per_frame(r, q);
     r.structure()
         .loops
         .iter()

@@ -3,6 +3,8 @@
 //! folded model) equals the kernel on the full frame list to 1e-12 relative, under random base
 //! motion, gravity and external wrenches on every link (those of folded links included); and
 //! the fold keeps the frame list, names and geometry.
+#[path = "common/frames.rs"]
+mod frames;
 
 #[path = "common/folding.rs"]
 mod folding;
@@ -52,7 +54,7 @@ fn folded_placements_compose_the_fixed_frames() {
     for _ in 0..20 {
         let robot = random_tree(&mut r, 9, &opt);
         let q: Vec<f64> = (0..robot.nl()).map(|_| r.random_range(-3.0..3.0)).collect();
-        let t0 = robodyn::geometry::frame_transforms(&robot, &q);
+        let t0 = frames::per_frame(&robot, &q);
         let dynamic = robot.dynamic();
         let c = robot.coordinates();
         for k in 1..=dynamic.nl {

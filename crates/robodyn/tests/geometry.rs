@@ -3,6 +3,8 @@
 //! `iT_j = Rot(z, gamma) Trans(z, b) Rot(x, alpha) Trans(x, d) Rot(z, theta) Trans(z, r)`
 //! written directly from the description, multiplied along the path from the base; iP_j against
 //! eq 10.18; and the SR400's loop closure of Example 10.1.
+#[path = "common/frames.rs"]
+mod frames;
 
 use nalgebra::{Matrix4, Vector3};
 use rand::Rng;
@@ -97,7 +99,10 @@ fn frame_transforms_match_elementary_products_on_random_trees() {
             };
             let robot = random_tree(&mut rng, n, &opt);
             let q: Vec<f64> = (0..n).map(|_| rng.random_range(-3.0..3.0)).collect();
-            let t = frame_transforms(&robot, &q);
+            // the public entry point takes the movable joints (fixed frames carry no value)
+            let c = robot.coordinates();
+            let movable: Vec<f64> = c.frames().iter().map(|&j| q[j - 1]).collect();
+            let t = frame_transforms(&robot, &movable).unwrap();
             assert_eq!(t.len(), n);
             for j in 1..=n {
                 let d = max_abs(&(t[j - 1].matrix() - path_product(&robot, j, &q)));
@@ -150,7 +155,7 @@ fn sr400_loop_closes_with_example_10_1() {
         let mut q: Vec<f64> = (0..8).map(|_| rng.random_range(-2.0..2.0)).collect();
         q[2] = q[6] + FRAC_PI_2 - q[1];
         q[7] = q[1] - q[6];
-        let t = frame_transforms(&robot, &q);
+        let t = frames::per_frame(&robot, &q);
         assert_eq!(t.len(), 10);
         let (t9, t10) = (&t[8], &t[9]);
         assert!(
@@ -163,7 +168,47 @@ fn sr400_loop_closes_with_example_10_1() {
         assert!((z9 - z10).norm() < 1e-12, "z9 {z9} vs z10 {z10}");
         // Off the closure manifold the loop is open.
         q[2] += 0.1;
-        let t = frame_transforms(&robot, &q);
+        let t = frames::per_frame(&robot, &q);
         assert!((t[8].pos - t[9].pos).norm() > 1e-3);
     }
+}
+
+/// Regression (issue 25, item 2): `frame_transforms` takes the movable-joint vector of every
+/// other function. On a URDF with a fixed joint between two revolute ones, q = [0, 1] is joint 1
+/// at 0 and joint 3 at 1 rad: 0T_3 must be the product of the elementary matrices with q3 = 1
+/// (it used to read q as per-frame values, giving the fixed frame the 1 and joint 3 a 0), and
+/// a vector over the frames (3 entries) is an error, not a silent placement.
+#[test]
+fn frame_transforms_take_the_movable_joints_of_a_urdf_with_a_fixed_joint() {
+    let urdf = r#"<robot name="fixed_between">
+      <link name="base"/><link name="l1"/><link name="l2"/><link name="l3"/>
+      <joint name="j1" type="revolute"><parent link="base"/><child link="l1"/>
+        <origin xyz="0 0 0.3"/><axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
+      <joint name="weld" type="fixed"><parent link="l1"/><child link="l2"/>
+        <origin xyz="0.4 0 0" rpy="1.5707963267948966 0 0"/></joint>
+      <joint name="j3" type="revolute"><parent link="l2"/><child link="l3"/>
+        <origin xyz="0.2 0.1 0"/><axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
+    </robot>"#;
+    let (desc, _) = robodyn::io::urdf::parse_description(urdf, None).unwrap();
+    let robot = Robot::new(desc).unwrap();
+    assert_eq!(robot.dof(), 2);
+    let c = robot.coordinates();
+    let (f1, f3) = (c.frame(0), c.frame(1));
+    assert!(f3 > f1 + 1, "a fixed frame between the two joints");
+    let t = frame_transforms(&robot, &[0.0, 1.0]).unwrap();
+    // independent: the elementary matrices with the per-frame values (joint 3 at 1 rad)
+    let mut per_frame = vec![0.0; robot.nl()];
+    per_frame[f3 - 1] = 1.0;
+    for j in 1..=robot.nf() {
+        let d = max_abs(&(t[j - 1].matrix() - path_product(&robot, j, &per_frame)));
+        assert!(d < 1e-12, "frame {j}: 0T_j differs by {d:e}");
+    }
+    // and the joint really turned: 0T_3(q3 = 1) = 0T_3(0) Rz(1)
+    let t0 = frame_transforms(&robot, &[0.0, 0.0]).unwrap();
+    let d = max_abs(&(t[f3 - 1].matrix() - t0[f3 - 1].matrix() * rot_z(1.0)));
+    assert!(d < 1e-12, "0T_3 is not turned by q3 = 1: {d:e}");
+    // a per-frame array, a short vector, a NaN: errors
+    assert!(frame_transforms(&robot, &[0.0, 0.0, 1.0]).is_err());
+    assert!(frame_transforms(&robot, &[0.0]).is_err());
+    assert!(frame_transforms(&robot, &[0.0, f64::NAN]).is_err());
 }

@@ -3,10 +3,11 @@
 //! joint origins xyz/rpy and axis motions, written here independently with explicit matrices),
 //! and the converted inertial parameters give the same mass, centre of mass and inertia in the
 //! world frame.
+#[path = "common/frames.rs"]
+mod frames;
 
 use nalgebra::{Matrix3, Vector3};
 use rand::Rng;
-use robodyn::geometry::frame_transforms;
 use robodyn::model::param;
 use robodyn::Robot;
 use robodyn_testing as testing;
@@ -196,7 +197,7 @@ fn frames_match_urdf_forward_kinematics() {
                 .collect();
             let q_of = |k: usize| qv[frame_of(k) - 1];
             let fk = urdf_fk(&joints, &q_of);
-            let ours = frame_transforms(&robot, &qv);
+            let ours = frames::per_frame(&robot, &qv);
             for (k, jt) in joints.iter().enumerate() {
                 let t = &ours[frame_of(k) - 1];
                 let (lr, lp) = fk[k + 1];
@@ -245,7 +246,7 @@ fn inertials_match_in_the_world_frame() {
                 .unwrap()
         };
         let fk = urdf_fk(&joints, &|k| qv[frame_of(k) - 1]);
-        let ours = frame_transforms(&robot, &qv);
+        let ours = frames::per_frame(&robot, &qv);
         let k13 = robot.standard_parameters();
         for k in 0..n {
             let j = frame_of(k);

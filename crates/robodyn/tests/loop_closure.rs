@@ -47,12 +47,6 @@ fn solve(
 }
 
 /// Joint values of every tree joint and cut joint (frames 1..NJ) of a closure solution.
-fn tree_and_cut(s: &robodyn::algorithms::closed_chain::ClosureSolution) -> Vec<f64> {
-    let mut q: Vec<f64> = s.q_tree.iter().copied().collect();
-    q.extend(s.q_c.iter());
-    q
-}
-
 #[test]
 fn sr400_example_10_1() {
     let r = robot("sr400.toml");
@@ -75,7 +69,12 @@ fn sr400_example_10_1() {
         assert!(d3.abs() < 1e-10, "theta3 off by {d3}");
         assert!(d8.abs() < 1e-10, "theta8 off by {d8}");
         // the closed frames coincide as frames: 0T_9(q9) = 0T_10
-        let t = robodyn::geometry::frame_transforms(&r, &tree_and_cut(&s));
+        let t = robodyn::geometry::frame_transforms_with_cuts(
+            &r,
+            s.q_tree.as_slice(),
+            s.q_c.as_slice(),
+        )
+        .unwrap();
         assert!((t[8].rot - t[9].rot).amax() < 1e-10);
         assert!((t[8].pos - t[9].pos).amax() < 1e-10);
     }
@@ -97,7 +96,12 @@ fn bundled_robots_close_at_reference_with_rank_chosen_rows() {
             assert!((a - b).abs() < 1e-10, "{name}: q_p {:?}", s.q_p);
         }
         // the cut frame and its twin coincide as frames (with the cut variable)
-        let t = robodyn::geometry::frame_transforms(&r, &tree_and_cut(&s));
+        let t = robodyn::geometry::frame_transforms_with_cuts(
+            &r,
+            s.q_tree.as_slice(),
+            s.q_c.as_slice(),
+        )
+        .unwrap();
         for l in lc.loops() {
             let (k, tw) = (l.topology.cut, l.topology.twin);
             assert!((t[k - 1].rot - t[tw - 1].rot).amax() < 1e-10, "{name}");
@@ -123,7 +127,12 @@ fn random_solutions_close_the_loops_as_frames() {
             for (a, b) in s.q_p.iter().zip(&qp) {
                 assert!((a - b).abs() < 1e-9, "{name}");
             }
-            let t = robodyn::geometry::frame_transforms(&r, &tree_and_cut(&s));
+            let t = robodyn::geometry::frame_transforms_with_cuts(
+                &r,
+                s.q_tree.as_slice(),
+                s.q_c.as_slice(),
+            )
+            .unwrap();
             for l in lc.loops() {
                 let (k, tw) = (l.topology.cut, l.topology.twin);
                 assert!((t[k - 1].rot - t[tw - 1].rot).amax() < 1e-10, "{name}");

@@ -5,12 +5,13 @@
 //! times, passive columns that do not close a loop, thinning), URDF visuals are found and placed
 //! (package://, relative, missing, other formats, the size cap), and `save` never replaces what
 //! is not a regular file.
+#[path = "common/frames.rs"]
+mod frames;
 
 mod common;
 
 use common::{robot, slider_crank};
 use nalgebra::{Isometry3, Rotation3, Translation3, Vector3};
-use robodyn::geometry::frame_transforms;
 use robodyn::io::table::Table;
 use robodyn::view::{
     page, save, urdf_visuals, JointColumns, MeshOptions, Pose, Trajectory, ViewOptions, MAX_SAMPLES,
@@ -103,7 +104,7 @@ fn the_scene_carries_the_geometry_of_every_bundled_robot() {
         assert_eq!(s["frames"].as_array().unwrap().len(), r.nf());
         let q = pose_q(&s);
         let drawn = compose(&s, &q);
-        let e = gap(&drawn, &frame_transforms(&r, &q));
+        let e = gap(&drawn, &frames::per_frame(&r, &q));
         assert!(
             e < 1e-12,
             "{}: the exported geometry differs by {e:e}",
@@ -308,7 +309,7 @@ fn closed_trajectories_close_their_loops() {
     // actuated joints only: solved by loop closure, the loops closed at every sample
     let tr = Trajectory::from_samples(&r, &t, &qa, JointColumns::Frame).unwrap();
     for i in 0..tr.len() {
-        let f = frame_transforms(&r, tr.values(i));
+        let f = frames::per_frame(&r, tr.values(i));
         assert!((f[8].pos - f[9].pos).norm() < 1e-9 && (f[8].rot - f[9].rot).abs().max() < 1e-9);
     }
     // with the passive columns (q3, q8): used as given, and checked
@@ -458,7 +459,7 @@ fn urdf_visuals_are_found_placed_and_capped() {
     assert_eq!(items[1]["scale"], serde_json::json!([2.0, 2.0, 2.0]));
     // a.stl's origin, placed in R_1 and composed with 0T_1: the URDF's placement of the visual,
     // joint origin (0, 0, 1) turned by pitch pi/2 (x_link = -z_0), then 0.1 along x_link
-    let t1 = frame_transforms(&r, &[0.0])[0].matrix();
+    let t1 = frames::per_frame(&r, &[0.0])[0].matrix();
     let o: Vec<f64> = (0..16)
         .map(|k| items[1]["origin"][k].as_f64().unwrap())
         .collect();

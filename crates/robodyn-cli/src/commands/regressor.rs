@@ -12,8 +12,9 @@ use crate::common::{
     TableWriter, TimingsArg,
 };
 use crate::states::{CarryArg, Chunk, StateInput, StateRequest};
+use robodyn::algorithms::base_parameters::{base_columns, standard_columns};
 use robodyn::algorithms::regressor::{
-    base_columns, standard_columns, ParameterSelection, RotorMode, ZeroParameters, PARAMS_PER_LINK,
+    ParameterSelection, RotorMode, ZeroParameters, PARAMS_PER_LINK,
 };
 use robodyn::{closed_regressor_into, regressor_batch, ClosedChain, ClosedData, Coordinates};
 use std::path::PathBuf;

@@ -30,7 +30,7 @@ use crate::algorithms::inverse_dynamics::rnea_with_environment;
 use crate::algorithms::loop_closure::{fmt_vec, LoopClosure, LoopConstraint, LoopWorkspace};
 use crate::algorithms::regressor::{tree_regressor, tree_wrench_torques, PARAMS_PER_LINK};
 use crate::data::Data;
-use crate::error::{Error, Result};
+use crate::error::{Configuration, Error, Result};
 use crate::linalg::{norm1, rcond_cholesky, SmallLu};
 use crate::model::{Coordinates, Environment, JointType, Robot};
 use crate::scalar::DynScalar;
@@ -456,7 +456,10 @@ impl ClosedChain {
             ),
             rcond,
             limit: self.limits.wp_hard,
-            at: format!("q_tr = {}", fmt_vec(q_tr)),
+            at: Configuration::Joints {
+                name: "q_tr",
+                values: q_tr.to_vec(),
+            },
             hint: "the mechanism is at a singular configuration: q_p is not determined by q_a"
                 .into(),
         }
@@ -660,7 +663,10 @@ impl ClosedChain {
             what: "the closed-chain inertia matrix A_cl (10.46)".into(),
             rcond,
             limit: self.limits.a_cl_hard,
-            at: format!("q_tr = {}", fmt_vec(q_tr)),
+            at: Configuration::Joints {
+                name: "q_tr",
+                values: q_tr.to_vec(),
+            },
             hint: "check masses and inertias, or the configuration is singular".into(),
         }
     }
@@ -803,7 +809,7 @@ pub fn loop_closure_into(
 /// its twin 5.
 ///
 /// ```
-/// use robodyn::{geometry::frame_transforms, loop_closure, ClosedChain};
+/// use robodyn::{geometry::frame_transforms_with_cuts, loop_closure, ClosedChain};
 /// # fn main() -> robodyn::Result<()> {
 /// let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots/fourbar.toml");
 /// let robot = robodyn::io::load(path)?;
@@ -813,8 +819,7 @@ pub fn loop_closure_into(
 ///     let s = loop_closure(&chain, &mut branch, &[q1])?;
 ///     assert!(!s.conditioning.warning);
 ///     // an independent check: compose the frames of the tree (joints 1..3, cut joint 4)
-///     let q: Vec<f64> = s.q_tree.iter().chain(s.q_c.iter()).copied().collect();
-///     let t = frame_transforms(&robot, &q);
+///     let t = frame_transforms_with_cuts(&robot, s.q_tree.as_slice(), s.q_c.as_slice())?;
 ///     assert!((t[3].pos - t[4].pos).norm() < 1e-9); // O_4 = O_5
 ///     println!("q1 = {q1}: q_p = {}, W = {}", s.q_p, s.w);
 /// }

@@ -16,7 +16,7 @@
 use crate::algorithms::inertia_matrix::composite_inertia_matrix;
 use crate::algorithms::inverse_dynamics::{folded_wrench, rnea_with_environment, tree_vector_map};
 use crate::data::{with_data, Data};
-use crate::error::{Error, Result};
+use crate::error::{Configuration, Error, Result};
 use crate::model::{DynModel, Environment, JointType, Robot};
 use crate::scalar::DynScalar;
 use nalgebra::{DMatrix, DVector, Matrix3, Matrix6, Vector3, Vector6};
@@ -78,7 +78,10 @@ fn singular(j: usize, what: &str, value: f64, scale: f64) -> Error {
         what: format!("{what} of joint {j}"),
         rcond: if scale > 0.0 { value / scale } else { 0.0 },
         limit: PIVOT_TOL,
-        at: format!("joint {j} (pivot {value:.3e})"),
+        at: Configuration::Pivot {
+            joint: j,
+            pivot: value,
+        },
         hint: format!(
             "the direct dynamic model is singular: the links carried by joint {j} have no mass \
              or inertia along its axis (e.g. a massless chain end) or the inertial parameters \

@@ -569,6 +569,49 @@ pub fn inverse_dynamics_into(
     )
 }
 
+/// A state of a tree robot over its movable joints (frame order): positions `q` (rad, m),
+/// velocities `qd` and accelerations `qdd`. Named fields, so that a swap of the three vectors
+/// reads as one (`State { q: &qd, .. }`) where three positional `&[f64]` would compile silently.
+#[derive(Clone, Copy, Debug)]
+pub struct State<'a> {
+    /// Joint positions (rad, m).
+    pub q: &'a [f64],
+    /// Joint velocities (rad/s, m/s).
+    pub qd: &'a [f64],
+    /// Joint accelerations (rad/s², m/s²).
+    pub qdd: &'a [f64],
+}
+
+/// [`inverse_dynamics_into`] with the state as named fields: Gamma (N m, N) of the movable
+/// joints into `tau`. Allocation-free; the same checks and errors.
+///
+/// # Example
+///
+/// ```
+/// use robodyn::{inverse_dynamics_state_into, Data, State};
+/// # fn main() -> robodyn::Result<()> {
+/// let urdf = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots/rx90.urdf");
+/// let robot = robodyn::io::load(urdf.as_ref())?;
+/// let mut data = Data::new(&robot);
+/// let (q, qd, qdd) = ([0.1; 6], [0.2; 6], [0.3; 6]);
+/// let mut tau = [0.0; 6];
+/// let state = State { q: &q, qd: &qd, qdd: &qdd };
+/// inverse_dynamics_state_into(&robot, &mut data, robot.environment(), state, &mut tau)?;
+/// let w = data.angular_velocities()[6]; // jw_j of the last link (R_6), after Newton–Euler
+/// assert!(w.norm() > 0.0);
+/// # Ok(())
+/// # }
+/// ```
+pub fn inverse_dynamics_state_into(
+    robot: &Robot,
+    data: &mut Data,
+    env: &Environment,
+    state: State<'_>,
+    tau: &mut [f64],
+) -> Result<()> {
+    inverse_dynamics_into(robot, data, env, state.q, state.qd, state.qdd, tau)
+}
+
 /// Inverse dynamic model with the robot's own environment: Gamma (N m, N) of the movable joints
 /// (frame order) for q, qd, qdd over the movable joints. Allocates; use
 /// [`inverse_dynamics_into`] in loops (this form allocates only its result: its buffers are

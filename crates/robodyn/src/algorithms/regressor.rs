@@ -25,8 +25,7 @@ use super::inverse_dynamics::{
     add_folded_wrenches, check_state, forward_pass, on_tree_arrays, tree_vector_map,
 };
 
-/// Number of standard parameters per link.
-pub const PARAMS_PER_LINK: usize = 13;
+pub use crate::model::{RotorMode, PARAMS_PER_LINK};
 
 /// Name of standard parameter `index` of the vector K (0-based, 13 per link): `XX1`, ..., `FV<NL>`.
 pub fn parameter_name(index: usize) -> String {
@@ -35,45 +34,6 @@ pub fn parameter_name(index: usize) -> String {
         STANDARD_PARAMETERS[index % PARAMS_PER_LINK],
         index / PARAMS_PER_LINK + 1
     )
-}
-
-/// Which rotor inertias are parameters of the model.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum RotorMode {
-    /// IA_j for the actuated joints (mu_j = 1).
-    Actuated,
-    /// IA_j for every movable joint.
-    All,
-    /// No rotor inertia.
-    None,
-}
-
-impl RotorMode {
-    /// Every mode (what a command line or a binding offers; [`RotorMode::name`] names each).
-    pub const ALL: [RotorMode; 3] = [RotorMode::Actuated, RotorMode::All, RotorMode::None];
-
-    /// The mode's name: `actuated`, `all`, `none` ([`RotorMode::from_name`] reads it back).
-    pub fn name(self) -> &'static str {
-        match self {
-            RotorMode::Actuated => "actuated",
-            RotorMode::All => "all",
-            RotorMode::None => "none",
-        }
-    }
-
-    /// The mode of a name of [`RotorMode::name`].
-    pub fn from_name(name: &str) -> Option<RotorMode> {
-        RotorMode::ALL.into_iter().find(|m| m.name() == name)
-    }
-
-    /// What the mode makes parameters, in a few words.
-    pub fn describe(self) -> &'static str {
-        match self {
-            RotorMode::Actuated => "rotor inertia IA_j of the actuated joints",
-            RotorMode::All => "rotor inertia IA_j of every movable joint",
-            RotorMode::None => "no rotor inertia",
-        }
-    }
 }
 
 /// What a parameter written as a literal `0` in the robot file means.
@@ -124,6 +84,28 @@ impl ZeroParameters {
     }
 }
 
+/// Whether the Coulomb and viscous friction FS_j, FV_j are parameters of a model (passive joints
+/// of closed loops are assumed frictionless).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Friction {
+    /// FS_j and FV_j for the actuated joints.
+    Actuated,
+    /// No friction parameter.
+    None,
+}
+
+/// `true` is [`Friction::Actuated`], `false` [`Friction::None`] (the former bare flag of
+/// [`ParameterSelection::new`]; write the variant instead).
+impl From<bool> for Friction {
+    fn from(on: bool) -> Friction {
+        if on {
+            Friction::Actuated
+        } else {
+            Friction::None
+        }
+    }
+}
+
 /// Which of the drive parameters IA, FS, FV are kept, joint by joint (index j-1), and which
 /// standard parameters do not exist (`absent`, K indices: written as a literal 0 in a SYMORO
 /// file). The ten inertial parameters of every link are in K unless absent.
@@ -138,14 +120,19 @@ pub struct ParameterSelection {
 }
 
 impl ParameterSelection {
-    /// Rotor inertias by `rotor`; Coulomb and viscous friction on the actuated joints when
-    /// `friction` (passive joints of closed loops are assumed frictionless).
-    pub fn new(robot: &Robot, rotor: RotorMode, friction: bool) -> Self {
+    /// Rotor inertias by `rotor`, Coulomb and viscous friction by `friction`
+    /// ([`Friction::Actuated`]: on the actuated joints).
+    pub fn new(robot: &Robot, rotor: RotorMode, friction: impl Into<Friction>) -> Self {
         Self::from_description(robot.description(), rotor, friction)
     }
 
     /// As [`ParameterSelection::new`], from a description (symbols may lack values).
-    pub fn from_description(desc: &RobotDescription, rotor: RotorMode, friction: bool) -> Self {
+    pub fn from_description(
+        desc: &RobotDescription,
+        rotor: RotorMode,
+        friction: impl Into<Friction>,
+    ) -> Self {
+        let friction = friction.into() == Friction::Actuated;
         let nl = desc.nl;
         let f = |j: usize| desc.frame(j);
         ParameterSelection {
@@ -455,81 +442,4 @@ pub fn wrench_torques(robot: &Robot, q: &[f64]) -> Result<nalgebra::DVector<f64>
     let mut t = nalgebra::DVector::zeros(robot.dof());
     wrench_torques_into(robot, &mut data, robot.environment(), q, t.as_mut_slice())?;
     Ok(t)
-}
-
-/// Columns of the regressor kept for a model: indices in K and their names.
-#[derive(Clone, Debug, PartialEq)]
-pub struct RegressorColumns {
-    /// Indices in K (13 per link), in K order.
-    pub indices: Vec<usize>,
-    /// Names: `XX1`..., base parameters that group others get an `R` (`XX2R`).
-    pub names: Vec<String>,
-    /// How the set was chosen when it is not the symbolic rules' (for the user).
-    pub note: Option<String>,
-}
-
-/// The regressor columns of the standard parameters selected by `selection` (absent ones left
-/// out), named with the robot file's own parameter names.
-pub fn standard_columns(robot: &Robot, selection: &ParameterSelection) -> RegressorColumns {
-    let names = crate::algorithms::base_parameters::ParameterNames::of(robot.description());
-    let indices = selection.columns();
-    RegressorColumns {
-        names: indices.iter().map(|&i| names.name(i).to_string()).collect(),
-        indices,
-        note: None,
-    }
-}
-
-/// The regressor columns of the base parameters (Phi_b with Gamma = Phi_b K_b + Gamma_e): the
-/// symbolic rules' set (§10.3.6); for a closed chain whose loops the rules do not all handle, the
-/// numerical method's set (§10.3.4, samples seeded by `seed`), said in `note`. Names are the
-/// robot file's own (grouped ones with their `R` name).
-pub fn base_columns(
-    robot: &Robot,
-    selection: &ParameterSelection,
-    seed: u64,
-) -> Result<RegressorColumns> {
-    use crate::algorithms::base_parameters::{
-        numeric_base_parameters, symbolic_base_parameters, ClosedChainSampler, NumericOptions,
-        ParameterNames,
-    };
-    let names = ParameterNames::of(robot.description());
-    let name = |i: usize, regrouped: bool| {
-        if regrouped {
-            names.grouped(i).to_string()
-        } else {
-            names.name(i).to_string()
-        }
-    };
-    let sb = symbolic_base_parameters(robot.description(), selection)?;
-    if !robot.is_tree() && !sb.unhandled_loops.is_empty() {
-        let opt = NumericOptions {
-            selection: selection.clone(),
-            samples: None,
-            seed,
-        };
-        let mut sampler = ClosedChainSampler::new(robot)?;
-        let nb = numeric_base_parameters(robot, &mut sampler, &opt)?;
-        let (indices, names) = (0..nb.count())
-            .map(|r| (nb.base[r], name(nb.base[r], nb.is_regrouped(r))))
-            .unzip();
-        return Ok(RegressorColumns {
-            indices,
-            names,
-            note: Some(format!(
-                "{}: the symbolic rules do not handle the loop(s) cut at joint(s) {:?}; the \
-                 columns are the numerical method's base parameters (the arbiter)",
-                robot.name(),
-                sb.unhandled_loops
-            )),
-        });
-    }
-    let (indices, names) = (0..sb.count())
-        .map(|r| (sb.base[r], name(sb.base[r], sb.is_regrouped(r))))
-        .unzip();
-    Ok(RegressorColumns {
-        indices,
-        names,
-        note: None,
-    })
 }

@@ -15,7 +15,7 @@ use super::GenOptions;
 use crate::algorithms::closed_chain::ClosedChain;
 use crate::algorithms::loop_closure::LoopClosure;
 use crate::error::{Error, Item, Result};
-use crate::geometry::frame_transforms;
+use crate::geometry::frame_transforms_per_frame;
 use crate::model::{DynModel, JointType, RobotDescription};
 use crate::Robot;
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
@@ -27,7 +27,7 @@ use std::collections::BTreeMap;
 /// Loop-closure residual: for each cut joint k, position and orientation difference between
 /// R_k and R_{k+B} (12 entries per loop).
 fn residual(robot: &Robot, q: &[f64]) -> DVector<f64> {
-    let t = frame_transforms(robot, q);
+    let t = frame_transforms_per_frame(robot, q);
     let (nl, nj) = (robot.nl(), robot.nj());
     let b = nj - nl;
     let mut r = Vec::with_capacity(12 * b);

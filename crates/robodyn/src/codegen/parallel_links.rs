@@ -11,7 +11,7 @@
 use crate::algorithms::base_parameters::closed::ClosedChainSampler;
 use crate::algorithms::inverse_dynamics::SharedOrientation;
 use crate::error::Result;
-use crate::geometry::frame_transforms;
+use crate::geometry::frame_transforms_per_frame;
 use crate::model::path_from_base;
 use crate::Robot;
 use nalgebra::Matrix3;
@@ -32,7 +32,7 @@ pub fn parallel_links(robot: &Robot) -> Result<Vec<Option<SharedOrientation<f64>
     let mut rotations = Vec::with_capacity(SAMPLES);
     for _ in 0..SAMPLES {
         let s = sampler.next_state(&mut rng)?;
-        let t = frame_transforms(robot, s.q.as_slice());
+        let t = frame_transforms_per_frame(robot, s.q.as_slice());
         rotations.push(t[..nl].iter().map(|t| t.rot).collect::<Vec<_>>());
     }
     let signed_permutation = |c: &Matrix3<f64>| -> Option<Matrix3<f64>> {

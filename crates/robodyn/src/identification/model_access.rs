@@ -14,7 +14,7 @@ use crate::algorithms::direct_dynamics::{ddm, Method};
 use crate::algorithms::inertia_matrix::inertia_matrix;
 use crate::algorithms::inverse_dynamics::rnea;
 use crate::algorithms::regressor::{
-    tree_regressor, tree_wrench_torques, ParameterSelection, RotorMode, PARAMS_PER_LINK,
+    tree_regressor, tree_wrench_torques, ParameterSelection, PARAMS_PER_LINK,
 };
 use crate::data::Data;
 use crate::error::{Error, Result};
@@ -38,16 +38,8 @@ pub fn coulomb_sign(v: f64, band: f64) -> f64 {
     }
 }
 
-/// Which drive parameters the base set includes (as `base-params --rotor/--no-friction`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Rotors {
-    /// IA_j of the actuated joints.
-    Actuated,
-    /// IA_j of every movable joint.
-    All,
-    /// No rotor inertia.
-    None,
-}
+/// Which rotor inertias the base set includes: the library's one rotor enum.
+pub use crate::model::RotorMode as Rotors;
 
 /// The base parameters of the selected standard parameters (numerical method of
 /// `base-params`, the arbiter): K_base = K1 + beta K2.
@@ -217,13 +209,8 @@ impl ModelAccess {
     /// Base parameters by the numerical method (the set `base-params --method numeric` prints,
     /// with the same names and equations).
     pub fn base_parameters(&self, rotors: Rotors, friction: bool, seed: u64) -> Result<BaseSet> {
-        let mode = match rotors {
-            Rotors::Actuated => RotorMode::Actuated,
-            Rotors::All => RotorMode::All,
-            Rotors::None => RotorMode::None,
-        };
         let opt = NumericOptions {
-            selection: ParameterSelection::new(&self.robot, mode, friction),
+            selection: ParameterSelection::new(&self.robot, rotors, friction),
             samples: None,
             seed,
         };

@@ -238,7 +238,7 @@ pub struct LinkConstants<T: DynScalar> {
 
 impl<T: DynScalar> LinkConstants<T> {
     /// From the 13 standard parameters (XX XY XZ YY YZ ZZ MX MY MZ M IA FS FV).
-    pub fn new(p: [T; 13]) -> Self {
+    pub fn new(p: [T; super::PARAMS_PER_LINK]) -> Self {
         let [xx, xy, xz, yy, yz, zz, mx, my, mz, m, ia, fs, fv] = p;
         LinkConstants {
             inertia_diff: Vector3::new(
@@ -510,7 +510,7 @@ impl<T: DynScalar> DynModel<T> {
             .iter()
             .enumerate()
             .map(|(i, l)| {
-                let mut c = |k: usize| link(i + 1, 13 + k, &l.wrench[k]);
+                let mut c = |k: usize| link(i + 1, super::PARAMS_PER_LINK + k, &l.wrench[k]);
                 Wrench {
                     force: Vector3::new(c(0), c(1), c(2)),
                     moment: Vector3::new(c(3), c(4), c(5)),

@@ -126,8 +126,52 @@ impl FrameDesc {
     }
 }
 
+/// Number of standard parameters per link (XX XY XZ YY YZ ZZ MX MY MZ M IA FS FV): the vector K
+/// of the regressor has `PARAMS_PER_LINK * NL` entries, link 1 first.
+pub const PARAMS_PER_LINK: usize = 13;
+
+/// Which rotor inertias IA_j are parameters of a model (the regressor's columns, the base
+/// parameters, identification).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RotorMode {
+    /// IA_j for the actuated joints (mu_j = 1).
+    Actuated,
+    /// IA_j for every movable joint.
+    All,
+    /// No rotor inertia.
+    None,
+}
+
+impl RotorMode {
+    /// Every mode (what a command line or a binding offers; [`RotorMode::name`] names each).
+    pub const ALL: [RotorMode; 3] = [RotorMode::Actuated, RotorMode::All, RotorMode::None];
+
+    /// The mode's name: `actuated`, `all`, `none` ([`RotorMode::from_name`] reads it back).
+    pub fn name(self) -> &'static str {
+        match self {
+            RotorMode::Actuated => "actuated",
+            RotorMode::All => "all",
+            RotorMode::None => "none",
+        }
+    }
+
+    /// The mode of a name of [`RotorMode::name`].
+    pub fn from_name(name: &str) -> Option<RotorMode> {
+        RotorMode::ALL.into_iter().find(|m| m.name() == name)
+    }
+
+    /// What the mode makes parameters, in a few words.
+    pub fn describe(self) -> &'static str {
+        match self {
+            RotorMode::Actuated => "rotor inertia IA_j of the actuated joints",
+            RotorMode::All => "rotor inertia IA_j of every movable joint",
+            RotorMode::None => "no rotor inertia",
+        }
+    }
+}
+
 /// Names of the 13 standard parameters of a link, in SYMORO's order.
-pub const STANDARD_PARAMETERS: [&str; 13] = [
+pub const STANDARD_PARAMETERS: [&str; PARAMS_PER_LINK] = [
     "XX", "XY", "XZ", "YY", "YZ", "ZZ", "MX", "MY", "MZ", "M", "IA", "FS", "FV",
 ];
 
@@ -186,7 +230,7 @@ pub struct LinkDesc {
     /// Link name.
     pub name: String,
     /// XX XY XZ YY YZ ZZ MX MY MZ M IA FS FV, about O_j in R_j.
-    pub params: [Expr; 13],
+    pub params: [Expr; PARAMS_PER_LINK],
     /// FX FY FZ CX CY CZ: force and moment the link exerts on the environment, in R_j.
     pub wrench: [Expr; 6],
 }

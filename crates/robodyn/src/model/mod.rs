@@ -16,8 +16,8 @@ pub use constants::{
 };
 pub use coordinates::Coordinates;
 pub use description::{
-    param, FrameDesc, JointLimits, JointType, LinkDesc, RobotDescription, Transmission,
-    GEOMETRIC_PARAMETERS, STANDARD_PARAMETERS, WRENCH_COMPONENTS,
+    param, FrameDesc, JointLimits, JointType, LinkDesc, RobotDescription, RotorMode, Transmission,
+    GEOMETRIC_PARAMETERS, PARAMS_PER_LINK, STANDARD_PARAMETERS, WRENCH_COMPONENTS,
 };
 pub use environment::{BaseMotion, Environment, Wrench};
 pub use structure::{path_from_base, ClosedLoop, Structure, StructureType};
@@ -391,13 +391,16 @@ impl Robot {
 
     /// The same robot with the given numeric standard parameters (13 per link, link 1 first).
     pub fn with_standard_parameters(&self, k: &[f64]) -> Result<Robot> {
-        crate::error::check_vector("standard parameters", k, 13 * self.nl(), || {
-            "13 per link: XX XY XZ YY YZ ZZ MX MY MZ M IA FS FV".into()
-        })?;
+        crate::error::check_vector(
+            "standard parameters",
+            k,
+            PARAMS_PER_LINK * self.nl(),
+            || "13 per link: XX XY XZ YY YZ ZZ MX MY MZ M IA FS FV".into(),
+        )?;
         let mut desc = self.desc.clone();
         for (j, l) in desc.links.iter_mut().enumerate() {
             for (p, e) in l.params.iter_mut().enumerate() {
-                *e = Expr::num(k[13 * j + p]);
+                *e = Expr::num(k[PARAMS_PER_LINK * j + p]);
             }
         }
         Robot::new(desc)

@@ -71,7 +71,7 @@ pub use output::{format_number, CsvSink, Recorder, Tee, TrajectorySink};
 #[cfg(feature = "plot")]
 pub use plot::{plot_svg, EnergyBalance, PlotInfo};
 
-use crate::algorithms::direct_dynamics::{ddm, Method};
+use crate::algorithms::direct_dynamics::{direct_dynamics_into, Method};
 use crate::data::Data;
 use crate::error::{Error, Result};
 use crate::model::{Environment, Robot};
@@ -98,17 +98,19 @@ pub trait Dynamics {
     }
 }
 
-/// A tree robot: the coordinates are its movable joints (fixed frames carry no state).
+/// A tree robot: the coordinates are its movable joints (fixed frames carry no state). The
+/// accelerations come from the checked direct model on the movable-joint vectors
+/// ([`direct_dynamics_into`]), the path of every other consumer.
 pub struct TreeDynamics<'a> {
     robot: &'a Robot,
     method: Method,
-    joints: Vec<usize>,
     ws: Data,
     env: Environment,
-    q: Vec<f64>,
-    qd: Vec<f64>,
+    /// The torque given to the direct model (smoothed Coulomb friction added), movable joints.
     tau: Vec<f64>,
-    qdd: Vec<f64>,
+    /// Tree arrays (NL entries) of the energy.
+    q_tree: Vec<f64>,
+    qd_tree: Vec<f64>,
     coulomb_smoothing: Option<f64>,
 }
 
@@ -120,13 +122,11 @@ impl<'a> TreeDynamics<'a> {
         TreeDynamics {
             robot,
             method,
-            joints: robot.coordinates().frames().to_vec(),
             ws: Data::new(robot),
             env: robot.environment().clone(),
-            q: vec![0.0; nl],
-            qd: vec![0.0; nl],
-            tau: vec![0.0; nl],
-            qdd: vec![0.0; nl],
+            tau: vec![0.0; robot.dof()],
+            q_tree: vec![0.0; nl],
+            qd_tree: vec![0.0; nl],
             coulomb_smoothing: None,
         }
     }
@@ -142,23 +142,16 @@ impl<'a> TreeDynamics<'a> {
 
     /// The movable joints, in frame order: coordinate k is joint `joints()[k]`.
     pub fn joints(&self) -> &[usize] {
-        &self.joints
-    }
-
-    fn scatter(&mut self, q: &[f64], qd: &[f64]) {
-        for (k, &j) in self.joints.iter().enumerate() {
-            self.q[j - 1] = q[k];
-            self.qd[j - 1] = qd[k];
-        }
+        self.robot.coordinates().frames()
     }
 }
 
 impl Dynamics for TreeDynamics<'_> {
     fn dof(&self) -> usize {
-        self.joints.len()
+        self.robot.dof()
     }
     fn labels(&self) -> Vec<String> {
-        self.joints.iter().map(|j| j.to_string()).collect()
+        self.joints().iter().map(|j| j.to_string()).collect()
     }
     fn accel(
         &mut self,
@@ -168,37 +161,42 @@ impl Dynamics for TreeDynamics<'_> {
         tau: &[f64],
         qdd: &mut [f64],
     ) -> Result<()> {
-        self.scatter(q, qd);
-        let model = self.robot.numeric();
-        for (k, &j) in self.joints.iter().enumerate() {
-            self.tau[j - 1] = tau[k];
-            if let Some(v) = self.coulomb_smoothing {
-                let (fs, s) = (model.link(j).fs, qd[k]);
-                self.tau[j - 1] += fs * (s.sign() - (s / v).tanh());
+        let tau = match self.coulomb_smoothing {
+            None => tau,
+            Some(v) => {
+                let c = self.robot.coordinates();
+                c.check("qd", qd, "movable joints")?;
+                c.check("tau", tau, "movable joints")?;
+                let model = self.robot.numeric();
+                for (k, &j) in c.frames().iter().enumerate() {
+                    let (fs, s) = (model.link(j).fs, qd[k]);
+                    self.tau[k] = tau[k] + fs * (s.sign() - (s / v).tanh());
+                }
+                &self.tau
             }
-        }
-        ddm(
-            model,
+        };
+        direct_dynamics_into(
+            self.robot,
             &mut self.ws,
             &self.env,
+            q,
+            qd,
+            tau,
             self.method,
-            &self.q,
-            &self.qd,
-            &self.tau,
-            &mut self.qdd,
-        )?;
-        for (k, &j) in self.joints.iter().enumerate() {
-            qdd[k] = self.qdd[j - 1];
-        }
-        Ok(())
+            qdd,
+        )
     }
     fn energy(&mut self, q: &[f64], qd: &[f64]) -> Result<f64> {
-        self.scatter(q, qd);
+        let c = self.robot.coordinates();
+        c.check("q", q, "movable joints")?;
+        c.check("qd", qd, "movable joints")?;
+        c.scatter(q, &mut self.q_tree);
+        c.scatter(qd, &mut self.qd_tree);
         Ok(mechanical_energy(
             self.robot,
             &mut self.ws,
-            &self.q,
-            &self.qd,
+            &self.q_tree,
+            &self.qd_tree,
         ))
     }
 }

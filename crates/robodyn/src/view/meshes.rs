@@ -4,11 +4,11 @@
 //! The URDF importer puts frame R_j at the joint with z_j along its axis and keeps link j's name
 //! (`io::urdf`); the URDF link frame is R_j C_j with a constant C_j. C_j is found here without
 //! the importer's internals: at q = 0 the URDF link frame is the product of the joint origins
-//! from the root, and R_j is 0T_j(0) ([`frame_transforms`]), so C_j = 0T_j(0)^-1 (URDF link
+//! from the root, and R_j is 0T_j(0) ([`frame_transforms_per_frame`]), so C_j = 0T_j(0)^-1 (URDF link
 //! pose at 0). A visual at `<origin>` O_v of the link is drawn at R_j C_j O_v.
 
 use crate::error::{Error, Result};
-use crate::geometry::{frame_transforms, Transform};
+use crate::geometry::{frame_transforms_per_frame, Transform};
 use crate::Robot;
 use base64::Engine as _;
 use nalgebra::{Matrix3, Translation3, UnitQuaternion, Vector3};
@@ -217,7 +217,7 @@ fn link_placements(robot: &Robot, root: roxmltree::Node) -> HashMap<String, (usi
         }
         t
     };
-    let t0 = frame_transforms(robot, &vec![0.0; robot.nj()]);
+    let t0 = frame_transforms_per_frame(robot, &vec![0.0; robot.nj()]);
     let mut out: HashMap<String, (usize, Transform)> = HashMap::new();
     for l in elements(root, "link").filter_map(|l| l.attribute("name")) {
         let frame = if parent.contains_key(l) {

@@ -5,7 +5,7 @@
 use super::{Pose, ViewOptions};
 use crate::algorithms::closed_chain::ClosureSolution;
 use crate::error::{Error, Result};
-use crate::geometry::{frame_transforms, Transform};
+use crate::geometry::{frame_transforms_per_frame, Transform};
 use crate::model::{param, ClosedLoop, JointType, Robot, GEOMETRIC_PARAMETERS};
 use crate::{loop_closure, ClosedChain};
 use serde_json::{json, Value};
@@ -224,7 +224,7 @@ pub(crate) fn tree_pose(robot: &Robot, joints: &[usize], values: &[f64]) -> Vec<
 pub(crate) fn with_cut_variables(robot: &Robot, q: &mut [f64]) {
     let (nl, nj) = (robot.nl(), robot.nj());
     q[nl..nj].iter_mut().for_each(|x| *x = 0.0);
-    let t = frame_transforms(robot, q);
+    let t = frame_transforms_per_frame(robot, q);
     for k in nl + 1..=nj {
         let (tk, tt) = (&t[k - 1], &t[k + nj - nl - 1]);
         let rel = tk.rot.transpose();
@@ -241,7 +241,7 @@ pub(crate) fn with_cut_variables(robot: &Robot, q: &mut [f64]) {
 /// The gap of each loop at `q` (frames 1..NJ): the distance of the origins of R_k and
 /// R_{k+B} (m) and the angle of their relative rotation (rad), both 0 when the loop is closed.
 pub(crate) fn loop_gaps<'r>(robot: &'r Robot, q: &[f64]) -> Vec<(&'r ClosedLoop, f64, f64)> {
-    let t: Vec<Transform> = frame_transforms(robot, q);
+    let t: Vec<Transform> = frame_transforms_per_frame(robot, q);
     robot
         .structure()
         .loops

@@ -13,9 +13,8 @@ pub fn closure_gap(
     cc: &robodyn::ClosedChain,
     s: &robodyn::algorithms::closed_chain::ClosureSolution,
 ) -> f64 {
-    let mut q: Vec<f64> = s.q_tree.iter().copied().collect();
-    q.extend(s.q_c.iter());
-    let t = robodyn::geometry::frame_transforms(r, &q);
+    let t = robodyn::geometry::frame_transforms_with_cuts(r, s.q_tree.as_slice(), s.q_c.as_slice())
+        .expect("a solution's state");
     cc.loops()
         .iter()
         .map(|l| {

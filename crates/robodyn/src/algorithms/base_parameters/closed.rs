@@ -31,7 +31,7 @@ use crate::algorithms::closed_chain::{
     closed_state, refine_closure, Branch, ClosedChain, ClosedState, ConditioningLimits,
 };
 use crate::error::{Error, Result};
-use crate::geometry::frame_transforms;
+use crate::geometry::frame_transforms_per_frame;
 use crate::model::{JointType, Robot};
 use nalgebra::Matrix3;
 use rand::{Rng, RngCore};
@@ -234,7 +234,7 @@ impl Probe<'_> {
         if self.pairs.is_empty() {
             return true;
         }
-        let t = frame_transforms(self.chain.robot(), q);
+        let t = frame_transforms_per_frame(self.chain.robot(), q);
         let rot = |j: usize| {
             if j == 0 {
                 Matrix3::identity()

@@ -19,11 +19,11 @@
 //!     compare_methods, geometry_robot, numeric_base_parameters_auto, symbolic_base_parameters,
 //!     NumericOptions, ParameterNames,
 //! };
-//! use robodyn::algorithms::regressor::{ParameterSelection, RotorMode};
+//! use robodyn::algorithms::regressor::{Friction, ParameterSelection, RotorMode};
 //! # fn main() -> robodyn::Result<()> {
 //! let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots/sr400.toml");
 //! let desc = robodyn::io::load_description(path)?;
-//! let sel = ParameterSelection::from_description(&desc, RotorMode::Actuated, false);
+//! let sel = ParameterSelection::from_description(&desc, RotorMode::Actuated, Friction::None);
 //! let names = ParameterNames::of(&desc);
 //! let symbolic = symbolic_base_parameters(&desc, &sel)?;
 //! for (r, e) in symbolic.equations.iter().enumerate().filter(|(r, _)| symbolic.is_regrouped(*r)) {
@@ -39,12 +39,14 @@
 //! ```
 
 pub mod closed;
+pub mod columns;
 pub mod names;
 pub mod numeric;
 pub mod summary;
 pub mod symbolic;
 
 pub use closed::{ClosedChainSampler, StartReport};
+pub use columns::{base_columns, standard_columns, RegressorColumns};
 pub use names::ParameterNames;
 pub use numeric::{
     numeric_base_parameters, ConsistentSample, NumericBase, NumericOptions, Sampler, TreeSampler,

@@ -6,7 +6,7 @@
 //! names robodyn makes up (for a parameter the file gives as a number or a literal 0, and the
 //! grouped `R` names) never clash with a symbol of the file (a clash gets `_` appended).
 
-use super::super::regressor::PARAMS_PER_LINK;
+use crate::model::PARAMS_PER_LINK;
 use crate::model::{RobotDescription, STANDARD_PARAMETERS};
 use robodyn_symbolic::Expr;
 use std::collections::{BTreeSet, HashMap};

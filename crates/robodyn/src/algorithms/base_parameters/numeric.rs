@@ -119,6 +119,18 @@ pub struct NumericOptions {
     pub seed: u64,
 }
 
+impl NumericOptions {
+    /// The options for `selection` with the default number of samples and seed 1. (There is no
+    /// `Default`: the selection is a robot's.)
+    pub fn new(selection: ParameterSelection) -> NumericOptions {
+        NumericOptions {
+            selection,
+            samples: None,
+            seed: 1,
+        }
+    }
+}
+
 /// Result of the numerical method. Parameter indices are indices in K (13 per link).
 #[derive(Clone, Debug)]
 pub struct NumericBase {
@@ -500,85 +512,13 @@ pub fn numeric_base_parameters(
         .filter(|i| sel.absent.contains(i))
         .collect();
     let ncols = all.len();
-    // size check before any allocation: N <= NL rows per sample, so rows <= max(target + NL,
-    // 20 NL); phi (NL x 13 NL) is allocated too
-    let bound_rows = opt
-        .samples
-        .map(|s| s.saturating_mul(nl))
-        .unwrap_or_else(|| {
-            (3 * ncols)
-                .min(3000.max(ncols + ncols / 4))
-                .saturating_add(nl)
-                .max(20 * nl)
-        });
-    let bytes = bound_rows
-        .saturating_mul(ncols.max(1))
-        .saturating_add(nl.saturating_mul(PARAMS_PER_LINK * nl))
-        .saturating_mul(8);
-    if bytes > MAX_OBSERVATION_BYTES {
-        return Err(Error::Setting {
-            option: "base_parameters::NumericOptions::selection",
-            reason: format!(
-                "{}: the numerical method would need an observation matrix W of about \
-                 {bound_rows} x {ncols} ({:.1} GiB, about {:.1} GiB in all); the limit is {:.1} \
-                 GiB (MAX_OBSERVATION_BYTES, about 10,000 parameters). Use the symbolic method \
-                 for this robot, or fewer drive parameters (no rotor inertias, no friction)",
-                robot.name(),
-                bytes as f64 / (1u64 << 30) as f64,
-                2.5 * bytes as f64 / (1u64 << 30) as f64,
-                MAX_OBSERVATION_BYTES as f64 / (1u64 << 30) as f64
-            ),
-        });
-    }
-    let mut rng = crate::sampling::rng(opt.seed);
-    let model = robot.numeric();
-    let mut ws = Data::new(robot);
-    let mut phi = DMatrix::zeros(nl, PARAMS_PER_LINK * nl);
-    // the first sample fixes N (rows per sample)
-    let first = sampler.sample(robot, &mut rng)?;
-    let n_rows_per = first.g.as_ref().map_or(nl, |g| g.ncols()).max(1);
-    let samples = sample_count(opt, columns.len(), n_rows_per);
-    let rows = samples * n_rows_per;
-    let tree_rows = first.g.is_none();
-    let mut w = Mat::<f64>::zeros(rows, ncols);
-    let mut s = first;
-    for k in 0..samples {
-        if k > 0 {
-            s = sampler.sample(robot, &mut rng)?;
-        }
-        if s.q.len() != nl || s.qd.len() != nl || s.qdd.len() != nl {
-            return Err(Error::Input(format!(
-                "the sampler returned a state of the wrong size (NL = {nl} expected)"
-            )));
-        }
-        tree_regressor(model, &mut ws, &model.env, &s.q, &s.qd, &s.qdd, &mut phi);
-        let block = match &s.g {
-            Some(g) => closed_chain_regressor(g, &phi)?,
-            None => phi.clone(),
-        };
-        if block.nrows() != n_rows_per {
-            return Err(Error::Input(
-                "the sampler's G changed its number of columns".into(),
-            ));
-        }
-        if block.iter().any(|x| !x.is_finite()) {
-            return Err(Error::Numerical(
-                "the regressor of a sampled state is not finite".into(),
-            ));
-        }
-        for (c, &col) in all.iter().enumerate() {
-            for r in 0..n_rows_per {
-                // a tree's rows by joint, then sample: the column of link j is zero in the rows
-                // of joints after j (only its ancestors a(j) < j and j itself carry it)
-                let row = if tree_rows {
-                    r * samples + k
-                } else {
-                    k * n_rows_per + r
-                };
-                w[(row, c)] = block[(r, col)];
-            }
-        }
-    }
+    check_observation_size(robot, opt, ncols)?;
+    let Observation {
+        mut w,
+        rows,
+        samples,
+        tree_rows,
+    } = observation_matrix(robot, sampler, opt, &all, columns.len())?;
     // 2. no-effect columns (existing parameters); absent columns of no effect are dropped
     let norms: Vec<f64> = (0..ncols).map(|c| w.col(c).norm_l2()).collect();
     let is_absent = |c: usize| sel.absent.contains(&all[c]);
@@ -680,10 +620,162 @@ pub fn numeric_base_parameters(
     }
     drop(r_k);
 
-    // 5. beta and the rank certificate: QR of R's columns [kept, grouped]
-    let order: Vec<usize> = kept.iter().chain(&dep).copied().collect();
-    let r2 = refactor(&r_all, &order);
+    // 5. beta and the rank certificate
+    let g = grouping(robot, &r_all, &kept, &dep, tol)?;
     drop(r_all);
+    let col = |k: usize| all[live[k]];
+    let mut beta = DMatrix::zeros(kept.len(), dep.len());
+    for (x, &kc) in kept.iter().enumerate() {
+        for (y, &dc) in dep.iter().enumerate() {
+            beta[(x, y)] = g.beta_s[(x, y)] * norms[live[dc]] / norms[live[kc]];
+        }
+    }
+    Ok(NumericBase {
+        base: kept.iter().map(|&k| col(k)).collect(),
+        grouped: dep.iter().map(|&k| col(k)).collect(),
+        no_effect,
+        absent,
+        columns,
+        beta,
+        tolerance: tol,
+        singular_values,
+        sigma_min_kept: g.sigma_min_kept,
+        residual_grouped: g.residual_grouped,
+        rows,
+    })
+}
+
+/// Refuse, before any allocation, an observation matrix W beyond [`MAX_OBSERVATION_BYTES`]:
+/// N <= NL rows per sample, so rows <= max(target + NL, 20 NL); phi (NL x 13 NL) counts too.
+fn check_observation_size(robot: &Robot, opt: &NumericOptions, ncols: usize) -> Result<()> {
+    let nl = robot.nl();
+    let bound_rows = opt
+        .samples
+        .map(|s| s.saturating_mul(nl))
+        .unwrap_or_else(|| {
+            (3 * ncols)
+                .min(3000.max(ncols + ncols / 4))
+                .saturating_add(nl)
+                .max(20 * nl)
+        });
+    let bytes = bound_rows
+        .saturating_mul(ncols.max(1))
+        .saturating_add(nl.saturating_mul(PARAMS_PER_LINK * nl))
+        .saturating_mul(8);
+    if bytes > MAX_OBSERVATION_BYTES {
+        return Err(Error::Setting {
+            option: "base_parameters::NumericOptions::selection",
+            reason: format!(
+                "{}: the numerical method would need an observation matrix W of about \
+                 {bound_rows} x {ncols} ({:.1} GiB, about {:.1} GiB in all); the limit is {:.1} \
+                 GiB (MAX_OBSERVATION_BYTES, about 10,000 parameters). Use the symbolic method \
+                 for this robot, or fewer drive parameters (no rotor inertias, no friction)",
+                robot.name(),
+                bytes as f64 / (1u64 << 30) as f64,
+                2.5 * bytes as f64 / (1u64 << 30) as f64,
+                MAX_OBSERVATION_BYTES as f64 / (1u64 << 30) as f64
+            ),
+        });
+    }
+    Ok(())
+}
+
+/// The sampled observation matrix W (rows: the regressor rows of the sampled states, a tree's
+/// by joint then sample; columns: the standard parameters `all`).
+struct Observation {
+    w: Mat<f64>,
+    rows: usize,
+    samples: usize,
+    tree_rows: bool,
+}
+
+/// Step 1, W from `sampler`'s states (seeded by `opt.seed`): the regressor of each state (G^T Phi
+/// for a closed chain), columns `all`; `n_columns` (the existing parameters) sets the count.
+fn observation_matrix(
+    robot: &Robot,
+    sampler: &mut dyn Sampler,
+    opt: &NumericOptions,
+    all: &[usize],
+    n_columns: usize,
+) -> Result<Observation> {
+    let nl = robot.nl();
+    let mut rng = crate::sampling::rng(opt.seed);
+    let model = robot.numeric();
+    let mut ws = Data::new(robot);
+    let mut phi = DMatrix::zeros(nl, PARAMS_PER_LINK * nl);
+    // the first sample fixes N (rows per sample)
+    let first = sampler.sample(robot, &mut rng)?;
+    let n_rows_per = first.g.as_ref().map_or(nl, |g| g.ncols()).max(1);
+    let samples = sample_count(opt, n_columns, n_rows_per);
+    let rows = samples * n_rows_per;
+    let tree_rows = first.g.is_none();
+    let ncols = all.len();
+    let mut w = Mat::<f64>::zeros(rows, ncols);
+    let mut s = first;
+    for k in 0..samples {
+        if k > 0 {
+            s = sampler.sample(robot, &mut rng)?;
+        }
+        if s.q.len() != nl || s.qd.len() != nl || s.qdd.len() != nl {
+            return Err(Error::Input(format!(
+                "the sampler returned a state of the wrong size (NL = {nl} expected)"
+            )));
+        }
+        tree_regressor(model, &mut ws, &model.env, &s.q, &s.qd, &s.qdd, &mut phi);
+        let block = match &s.g {
+            Some(g) => closed_chain_regressor(g, &phi)?,
+            None => phi.clone(),
+        };
+        if block.nrows() != n_rows_per {
+            return Err(Error::Input(
+                "the sampler's G changed its number of columns".into(),
+            ));
+        }
+        if block.iter().any(|x| !x.is_finite()) {
+            return Err(Error::Numerical(
+                "the regressor of a sampled state is not finite".into(),
+            ));
+        }
+        for (c, &col) in all.iter().enumerate() {
+            for r in 0..n_rows_per {
+                // a tree's rows by joint, then sample: the column of link j is zero in the rows
+                // of joints after j (only its ancestors a(j) < j and j itself carry it)
+                let row = if tree_rows {
+                    r * samples + k
+                } else {
+                    k * n_rows_per + r
+                };
+                w[(row, c)] = block[(r, col)];
+            }
+        }
+    }
+    Ok(Observation {
+        w,
+        rows,
+        samples,
+        tree_rows,
+    })
+}
+
+/// beta and the rank certificate of step 5.
+struct Grouping {
+    beta_s: Mat<f64>,
+    sigma_min_kept: f64,
+    residual_grouped: f64,
+}
+
+/// Step 5, QR of R's columns [kept, grouped]: the scaled grouping coefficients (R11^-1 R12), the
+/// smallest singular value of the kept columns and the residual of the grouped ones; an error
+/// when the rank is not clear from these samples.
+fn grouping(
+    robot: &Robot,
+    r_all: &Mat<f64>,
+    kept: &[usize],
+    dep: &[usize],
+    tol: f64,
+) -> Result<Grouping> {
+    let order: Vec<usize> = kept.iter().chain(dep).copied().collect();
+    let r2 = refactor(r_all, &order);
     let nk = kept.len();
     let r11 = r2.as_ref().submatrix(0, 0, nk, nk);
     let sigma_min_kept = sigma_min_upper(r11);
@@ -713,24 +805,9 @@ pub fn numeric_base_parameters(
             par(),
         );
     }
-    let col = |k: usize| all[live[k]];
-    let mut beta = DMatrix::zeros(nk, dep.len());
-    for (x, &kc) in kept.iter().enumerate() {
-        for (y, &dc) in dep.iter().enumerate() {
-            beta[(x, y)] = beta_s[(x, y)] * norms[live[dc]] / norms[live[kc]];
-        }
-    }
-    Ok(NumericBase {
-        base: kept.iter().map(|&k| col(k)).collect(),
-        grouped: dep.iter().map(|&k| col(k)).collect(),
-        no_effect,
-        absent,
-        columns,
-        beta,
-        tolerance: tol,
-        singular_values,
+    Ok(Grouping {
+        beta_s,
         sigma_min_kept,
         residual_grouped,
-        rows,
     })
 }

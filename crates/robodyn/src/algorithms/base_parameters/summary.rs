@@ -8,8 +8,8 @@
 use super::names::ParameterNames;
 use super::numeric::NumericBase;
 use super::symbolic::{collect_by_coefficient, SymbolicBase};
-use crate::algorithms::regressor::PARAMS_PER_LINK;
 use crate::error::{Error, Item, Result};
+use crate::model::PARAMS_PER_LINK;
 use crate::model::{param, RobotDescription, STANDARD_PARAMETERS};
 use crate::report::number::{format_number, significant};
 use robodyn_symbolic::Expr;

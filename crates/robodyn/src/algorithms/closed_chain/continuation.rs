@@ -145,7 +145,7 @@ impl ClosedChain {
         turning: &[(usize, f64)],
     ) -> Result<()> {
         let refused = |reason: String| Error::ContinuationBudget {
-            at: fmt_vec(q_a),
+            at: q_a.to_vec(),
             budget: self.budget,
             reason,
         };
@@ -256,7 +256,7 @@ impl ClosedChain {
                 let near = fmt_vec(&d.qa);
                 self.restore(d, b);
                 return Err(Error::ContinuationBudget {
-                    at: fmt_vec(q_a),
+                    at: q_a.to_vec(),
                     budget: self.budget,
                     reason: format!(
                         "the continuation tried {tried} steps and stopped near q_a = {near} \
@@ -300,7 +300,7 @@ impl ClosedChain {
         let near = fmt_vec(&d.qa);
         self.restore(d, b);
         Err(Error::BranchLost {
-            at: fmt_vec(q_a),
+            at: q_a.to_vec(),
             reason: self.lost_reason(failure, &near),
         })
     }
