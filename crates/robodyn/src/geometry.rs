@@ -67,7 +67,7 @@ pub fn local_transform(robot: &Robot, j: usize, q: f64) -> Transform {
 /// ```
 /// # fn main() -> robodyn::Result<()> {
 /// let robots = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots");
-/// let rx90 = robodyn::io::load(format!("{robots}/rx90.urdf").as_ref())?;
+/// let rx90 = robodyn::io::load(format!("{robots}/rx90.urdf"))?;
 /// let t = robodyn::geometry::frame_transforms(&rx90, &[0.0; 6])?;
 /// assert_eq!(t.len(), rx90.nf());
 /// assert!(robodyn::geometry::frame_transforms(&rx90, &[0.0; 5]).is_err());

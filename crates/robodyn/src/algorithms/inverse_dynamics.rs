@@ -591,7 +591,7 @@ pub struct State<'a> {
 /// use robodyn::{inverse_dynamics_state_into, Data, State};
 /// # fn main() -> robodyn::Result<()> {
 /// let urdf = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots/rx90.urdf");
-/// let robot = robodyn::io::load(urdf.as_ref())?;
+/// let robot = robodyn::io::load(urdf)?;
 /// let mut data = Data::new(&robot);
 /// let (q, qd, qdd) = ([0.1; 6], [0.2; 6], [0.3; 6]);
 /// let mut tau = [0.0; 6];
