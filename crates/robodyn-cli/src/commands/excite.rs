@@ -120,7 +120,7 @@ pub fn run(a: Args) -> CliResult {
     let mut params = ParameterModel::build(
         &mut access,
         &ParameterOptions {
-            rotors: crate::commands::identify::rotors(a.rotor),
+            rotors: a.rotor,
             friction: !a.no_friction,
             offsets: a.offsets,
             seed: a.seed,

@@ -8,7 +8,7 @@ use robodyn::algorithms::regressor::RotorMode;
 use robodyn::identification::data::{CsvLog, Effort, JointLabels, LogSource};
 use robodyn::identification::model_access::ModelAccess;
 use robodyn::identification::parameters::ParameterOptions;
-use robodyn::identification::{identify, report, EssentialOptions, Estimator, Options, Rotors};
+use robodyn::identification::{identify, report, EssentialOptions, Estimator, Options};
 use std::path::PathBuf;
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
@@ -241,7 +241,7 @@ pub fn run(a: Args) -> CliResult {
 fn options(a: &Args, gains: Option<Vec<f64>>) -> CliResult<Options> {
     Ok(Options {
         parameters: ParameterOptions {
-            rotors: rotors(a.rotor),
+            rotors: a.rotor,
             friction: !a.no_friction,
             offsets: a.offsets,
             seed: a.seed,
@@ -308,14 +308,4 @@ fn write_files(
         files.push(robot);
     }
     crate::output::commit_all(files)
-}
-
-/// The identification's rotor option of the library's [`RotorMode`] (the two library enums have
-/// the same values; this goes when the library has one).
-pub fn rotors(mode: RotorMode) -> Rotors {
-    match mode {
-        RotorMode::Actuated => Rotors::Actuated,
-        RotorMode::All => Rotors::All,
-        RotorMode::None => Rotors::None,
-    }
 }
