@@ -65,20 +65,7 @@ pub fn random_inertial<R: Rng>(rng: &mut R) -> [f64; 10] {
         rng.random_range(0.01..0.3),
     );
     let jg = rot.matrix() * Matrix3::from_diagonal(&pr) * rot.matrix().transpose();
-    let jo = jg + (Matrix3::identity() * c.dot(&c) - c * c.transpose()) * m;
-    let ms = c * m;
-    [
-        jo[(0, 0)],
-        jo[(0, 1)],
-        jo[(0, 2)],
-        jo[(1, 1)],
-        jo[(1, 2)],
-        jo[(2, 2)],
-        ms.x,
-        ms.y,
-        ms.z,
-        m,
-    ]
+    robodyn::model::inertial_parameters(m, &c, &jg)
 }
 
 /// A random tree of `n` links with random geometry and parameters.

@@ -218,13 +218,7 @@ pub fn warnings(
 mod tests {
     use super::*;
 
-    const XX: usize = 0;
-    const XY: usize = 1;
-    const YY: usize = 3;
-    const ZZ: usize = 5;
-    const MX: usize = 6;
-    const MZ: usize = 8;
-    const M: usize = 9;
+    use crate::model::param::{M, MX, MZ, XX, XY, YY, ZZ};
 
     fn at(link: usize, k: usize) -> usize {
         PARAMS_PER_LINK * (link - 1) + k

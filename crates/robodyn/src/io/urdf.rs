@@ -559,20 +559,7 @@ fn inertial_about_origin(
     let cj = c_j.to_rotation_matrix();
     let c = cj * com.translation.vector;
     let rot: Rotation3<f64> = cj * com.rotation.to_rotation_matrix();
-    let jo = rot.matrix() * jg * rot.matrix().transpose()
-        + m * (c.dot(&c) * Matrix3::identity() - c * c.transpose());
-    [
-        jo[(0, 0)],
-        jo[(0, 1)],
-        jo[(0, 2)],
-        jo[(1, 1)],
-        jo[(1, 2)],
-        jo[(2, 2)],
-        m * c.x,
-        m * c.y,
-        m * c.z,
-        m,
-    ]
+    crate::model::inertial_parameters(m, &c, &(rot.matrix() * jg * rot.matrix().transpose()))
 }
 
 /// The warning for a `<mimic>` of joint `name` (frame `frame`) naming a joint the file does not

@@ -126,6 +126,29 @@ impl FrameDesc {
     }
 }
 
+/// The ten inertial standard parameters (XX XY XZ YY YZ ZZ MX MY MZ M) of a body of mass `m`
+/// whose centre of mass is at `c` and whose inertia about the centre of mass is `j_com`, both in
+/// the link frame: the inertia about the frame origin by Huygens-Steiner, and MS = m c.
+pub fn inertial_parameters(
+    m: f64,
+    c: &nalgebra::Vector3<f64>,
+    j_com: &nalgebra::Matrix3<f64>,
+) -> [f64; 10] {
+    let jo = j_com + m * (c.dot(c) * nalgebra::Matrix3::identity() - c * c.transpose());
+    [
+        jo[(0, 0)],
+        jo[(0, 1)],
+        jo[(0, 2)],
+        jo[(1, 1)],
+        jo[(1, 2)],
+        jo[(2, 2)],
+        m * c.x,
+        m * c.y,
+        m * c.z,
+        m,
+    ]
+}
+
 /// Number of standard parameters per link (XX XY XZ YY YZ ZZ MX MY MZ M IA FS FV): the vector K
 /// of the regressor has `PARAMS_PER_LINK * NL` entries, link 1 first.
 pub const PARAMS_PER_LINK: usize = 13;

@@ -16,8 +16,9 @@ pub use constants::{
 };
 pub use coordinates::Coordinates;
 pub use description::{
-    param, FrameDesc, JointLimits, JointType, LinkDesc, RobotDescription, RotorMode, Transmission,
-    GEOMETRIC_PARAMETERS, PARAMS_PER_LINK, STANDARD_PARAMETERS, WRENCH_COMPONENTS,
+    inertial_parameters, param, FrameDesc, JointLimits, JointType, LinkDesc, RobotDescription,
+    RotorMode, Transmission, GEOMETRIC_PARAMETERS, PARAMS_PER_LINK, STANDARD_PARAMETERS,
+    WRENCH_COMPONENTS,
 };
 pub use environment::{BaseMotion, Environment, Wrench};
 pub use structure::{path_from_base, ClosedLoop, Structure, StructureType};
