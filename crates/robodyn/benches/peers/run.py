@@ -163,7 +163,7 @@ def build_pinocchio(prefix):
         return exe
     print("building pinocchio_peer (header-only Pinocchio, -O3 -march=native; a few minutes)...", flush=True)
     inc = os.path.join(prefix, "include")
-    run(["nice", "-n", "19", "g++", "-std=c++17", "-O3", "-march=native", "-DNDEBUG", *PIN_DEFINES,
+    run(["nice", "-n", "19", "g++", "-std=c++17", "-O3", "-march=native", "-DNDEBUG", "-w", *PIN_DEFINES,
          "-I", inc, "-I", os.path.join(inc, "eigen3"), src, "-o", exe])
     return exe
 
