@@ -8,8 +8,9 @@ use robodyn::algorithms::base_parameters::ParameterNames;
 use robodyn::algorithms::base_parameters::{numeric_base_parameters_auto, NumericOptions};
 use robodyn::algorithms::regressor::{Friction, ParameterSelection, RotorMode};
 use robodyn::nalgebra::{DMatrix, DVector}; // robodyn's own nalgebra, re-exported
-use robodyn::{closed_inverse_dynamics, direct_dynamics_into, inertia_matrix_into};
-use robodyn::{inverse_dynamics, regressor, ClosedChain, Data, Method};
+use robodyn::State;
+use robodyn::{closed_inverse_dynamics, direct_dynamics_state_into, inertia_matrix_into};
+use robodyn::{inverse_dynamics, regressor_state_into, ClosedChain, Data, DirectState, Method};
 use std::path::Path;
 
 /// Largest absolute difference of two vectors.
@@ -50,17 +51,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     // 4. direct dynamics, both methods, back to qdd from the torques of step 2
     let env = rx90.environment();
     let mut back = [0.0; 6];
+    let inputs = DirectState {
+        q: &q,
+        qd: &qd,
+        tau: tau.as_slice(),
+    };
     for method in [Method::Composite, Method::ArticulatedBody] {
-        direct_dynamics_into(
-            &rx90,
-            &mut data,
-            env,
-            &q,
-            &qd,
-            tau.as_slice(),
-            method,
-            &mut back,
-        )?;
+        direct_dynamics_state_into(&rx90, &mut data, env, inputs, method, &mut back)?;
         assert!(gap(&back, &qdd) < 1e-9, "{method:?}");
     }
 
@@ -75,7 +72,19 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         println!("  {}", base.equation(r, &names));
     }
     let k = urdf.standard_parameters();
-    let phi = regressor(&urdf, &q, &qd, &qdd)?;
+    let mut phi = DMatrix::zeros(urdf.dof(), 13 * urdf.nl());
+    let state = State {
+        q: &q,
+        qd: &qd,
+        qdd: &qdd,
+    };
+    regressor_state_into(
+        &urdf,
+        &mut Data::new(&urdf),
+        urdf.environment(),
+        state,
+        &mut phi,
+    )?;
     let k_base = base.base_values(&k);
     let phi_base = phi.select_columns(&base.base);
     let by_base = &phi_base * DVector::from_vec(k_base);

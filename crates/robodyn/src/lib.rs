@@ -98,14 +98,18 @@ pub use algorithms::closed_chain::{
     loop_closure, loop_closure_into, Branch, ClosedChain, ClosedData, Conditioning,
     ConditioningLimits,
 };
-pub use algorithms::direct_dynamics::{direct_dynamics, direct_dynamics_into, Method};
+pub use algorithms::direct_dynamics::{
+    direct_dynamics, direct_dynamics_into, direct_dynamics_state_into, DirectState, Method,
+};
 pub use algorithms::inertia_matrix::{
     h_vector, h_vector_into, inertia_matrix, inertia_matrix_into,
 };
 pub use algorithms::inverse_dynamics::{
     inverse_dynamics, inverse_dynamics_into, inverse_dynamics_state_into, State,
 };
-pub use algorithms::regressor::{regressor, regressor_into, wrench_torques, wrench_torques_into};
+pub use algorithms::regressor::{
+    regressor, regressor_into, regressor_state_into, wrench_torques, wrench_torques_into,
+};
 pub use batch::{direct_dynamics_batch, inverse_dynamics_batch, regressor_batch};
 pub use data::Data;
 pub use error::{Error, Result};

@@ -473,6 +473,53 @@ pub fn direct_dynamics_into(
     )
 }
 
+/// The inputs of the direct model over the movable joints (frame order): positions `q` (rad,
+/// m), velocities `qd` and joint torques/forces `tau` (N m, N). Named fields, like
+/// [`crate::State`], so that a swap of the three vectors reads as one.
+#[derive(Clone, Copy, Debug)]
+pub struct DirectState<'a> {
+    /// Joint positions (rad, m).
+    pub q: &'a [f64],
+    /// Joint velocities (rad/s, m/s).
+    pub qd: &'a [f64],
+    /// Joint torques/forces (N m, N).
+    pub tau: &'a [f64],
+}
+
+/// [`direct_dynamics_into`] with the inputs as named fields: the accelerations (rad/s², m/s²)
+/// of the movable joints into `qdd`. Allocation-free; the same checks and errors.
+///
+/// # Example
+///
+/// Back to the accelerations from the torques of the inverse model:
+///
+/// ```
+/// use robodyn::{direct_dynamics_state_into, inverse_dynamics, Data, DirectState, Method};
+/// # fn main() -> robodyn::Result<()> {
+/// let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots/rx90.toml");
+/// let robot = robodyn::io::load(path)?;
+/// let mut data = Data::new(&robot);
+/// let (q, qd, qdd) = ([0.1; 6], [0.2; 6], [0.3; 6]);
+/// let tau = inverse_dynamics(&robot, &q, &qd, &qdd)?;
+/// let mut back = [0.0; 6];
+/// let state = DirectState { q: &q, qd: &qd, tau: tau.as_slice() };
+/// let env = robot.environment();
+/// direct_dynamics_state_into(&robot, &mut data, env, state, Method::Composite, &mut back)?;
+/// assert!(back.iter().zip(&qdd).all(|(a, b)| (a - b).abs() < 1e-9));
+/// # Ok(())
+/// # }
+/// ```
+pub fn direct_dynamics_state_into(
+    robot: &Robot,
+    data: &mut Data,
+    env: &Environment,
+    state: DirectState<'_>,
+    method: Method,
+    qdd: &mut [f64],
+) -> Result<()> {
+    direct_dynamics_into(robot, data, env, state.q, state.qd, state.tau, method, qdd)
+}
+
 /// Direct dynamic model with the robot's environment: qdd over the movable joints. Allocates;
 /// use [`direct_dynamics_into`] in loops.
 ///

@@ -126,6 +126,15 @@ pub(crate) fn fmt_vec(v: &[f64]) -> String {
     crate::report::number::vector(v, 6)
 }
 
+/// What [`LoopClosure::solve_from_guess`]'s damped Newton reached.
+struct NewtonResult {
+    q_p: Vec<f64>,
+    /// Largest kept closure equation at `q_p`.
+    residual: f64,
+    iterations: usize,
+    converged: bool,
+}
+
 /// Rank of a matrix by SVD (singular values above `tol` times the largest, or above `tol`).
 fn rank(m: &DMatrix<f64>, tol: f64) -> usize {
     if m.nrows() == 0 || m.ncols() == 0 {
@@ -522,15 +531,65 @@ impl LoopClosure {
             p,
             &format!("passive joints {:?}", self.passive),
         )?;
-        let mut qp: Vec<f64> = guess.to_vec();
-        let initial = qp.clone();
-        let nl = self.robot.nl();
         let mut q = std::mem::take(&mut ws.q);
-        let mut r = DVector::zeros(p);
-        let mut jac = DMatrix::zeros(p, nl);
-        let mut lambda = 1e-6;
-        self.assemble(q_a, &qp, &mut q);
+        let newton = self.damped_newton(ws, &mut q, q_a, guess);
+        // restore placements of the current qp
+        self.assemble(q_a, &newton.q_p, &mut q);
         self.kinematics(ws, &q, None, None);
+        let (worst, worst_loop) = self.worst_candidate(ws);
+        ws.q = q;
+        if !newton.converged || worst > 1e3 * self.tolerance.max(1e-12) {
+            return Err(Error::LoopNotClosed {
+                loop_label: self.loops[worst_loop].label(),
+                residual: worst.max(newton.residual),
+                tolerance: self.tolerance,
+                at: q_a.to_vec(),
+                actuated: self.actuated.clone(),
+                guess: guess.to_vec(),
+                passive: self.passive.clone(),
+                iterations: newton.iterations,
+                hint: "the configuration is unreachable or the guess is too far".into(),
+            });
+        }
+        // A revolute cut also vanishes with z_{k+B} = -z_k: reject that flipped assembly.
+        for lp in &self.loops {
+            if lp.cut_joint == JointType::Revolute {
+                let (k, t) = (lp.topology.cut, lp.topology.twin);
+                if ws.rot[k].column(2).dot(&ws.rot[t].column(2)) < 0.0 {
+                    return Err(Error::Numerical(format!(
+                        "{} converged to a flipped assembly (z_{k} = -z_{t}) at q_a = {}: give a \
+                         better guess",
+                        lp.label(),
+                        fmt_vec(q_a)
+                    )));
+                }
+            }
+        }
+        Ok(GuessSolution {
+            q_c: self.cut_variables(ws),
+            q_tr: ws.q.clone(),
+            q_p: newton.q_p,
+            iterations: newton.iterations,
+            residual: worst,
+        })
+    }
+
+    /// Damped Newton (Levenberg–Marquardt) on the kept closure equations from `guess`, at most
+    /// `max_iterations` steps; `q` is the tree configuration buffer.
+    fn damped_newton(
+        &self,
+        ws: &mut LoopWorkspace,
+        q: &mut [f64],
+        q_a: &[f64],
+        guess: &[f64],
+    ) -> NewtonResult {
+        let p = self.p;
+        let mut qp: Vec<f64> = guess.to_vec();
+        let mut r = DVector::zeros(p);
+        let mut jac = DMatrix::zeros(p, self.robot.nl());
+        let mut lambda = 1e-6;
+        self.assemble(q_a, &qp, q);
+        self.kinematics(ws, q, None, None);
         self.residual(ws, &mut r);
         let mut norm = r.norm();
         let mut it = 0;
@@ -553,8 +612,8 @@ impl LoopClosure {
                     continue;
                 };
                 let trial: Vec<f64> = qp.iter().zip(step.iter()).map(|(a, b)| a + b).collect();
-                self.assemble(q_a, &trial, &mut q);
-                self.kinematics(ws, &q, None, None);
+                self.assemble(q_a, &trial, q);
+                self.kinematics(ws, q, None, None);
                 let mut rt = DVector::zeros(p);
                 self.residual(ws, &mut rt);
                 let nt = rt.norm();
@@ -573,9 +632,17 @@ impl LoopClosure {
                 break;
             }
         }
-        // restore placements of the current qp
-        self.assemble(q_a, &qp, &mut q);
-        self.kinematics(ws, &q, None, None);
+        NewtonResult {
+            q_p: qp,
+            residual: r.amax(),
+            iterations: it,
+            converged,
+        }
+    }
+
+    /// The largest candidate closure equation over all loops at the placements in `ws`, and its
+    /// loop.
+    fn worst_candidate(&self, ws: &LoopWorkspace) -> (f64, usize) {
         let mut worst = (0.0_f64, 0usize);
         for l in 0..self.loops.len() {
             let c = self.candidates(ws, l);
@@ -584,47 +651,7 @@ impl LoopClosure {
                 worst = (m, l);
             }
         }
-        ws.q = q;
-        if !converged || worst.0 > 1e3 * self.tolerance.max(1e-12) {
-            let lp = &self.loops[worst.1];
-            return Err(Error::LoopNotClosed {
-                loop_label: lp.label(),
-                residual: worst.0.max(r.amax()),
-                tolerance: self.tolerance,
-                at: format!(
-                    "q_a = {} (joints {:?}), after {it} damped Newton iterations from the guess \
-                     q_p = {} (joints {:?})",
-                    fmt_vec(q_a),
-                    self.actuated,
-                    fmt_vec(&initial),
-                    self.passive
-                ),
-                hint: "the configuration is unreachable or the guess is too far".into(),
-            });
-        }
-        // A revolute cut also vanishes with z_{k+B} = -z_k: reject that flipped assembly.
-        for lp in &self.loops {
-            if lp.cut_joint == JointType::Revolute {
-                let (k, t) = (lp.topology.cut, lp.topology.twin);
-                if ws.rot[k].column(2).dot(&ws.rot[t].column(2)) < 0.0 {
-                    return Err(Error::Numerical(format!(
-                        "{} converged to a flipped assembly (z_{k} = -z_{t}) at q_a = {}: give a \
-                         better guess",
-                        lp.label(),
-                        fmt_vec(q_a)
-                    )));
-                }
-            }
-        }
-        let q_c = self.cut_variables(ws);
-        let q_tr = ws.q.clone();
-        Ok(GuessSolution {
-            q_tr,
-            q_p: qp,
-            q_c,
-            iterations: it,
-            residual: worst.0,
-        })
+        worst
     }
 
     /// A revolute cut's equations also vanish with z_{k+B} = -z_k: the loop label of a loop

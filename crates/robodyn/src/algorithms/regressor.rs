@@ -22,7 +22,7 @@ use crate::model::{
 use nalgebra::{DMatrix, Matrix3, SMatrix, Vector3};
 
 use super::inverse_dynamics::{
-    add_folded_wrenches, check_state, forward_pass, on_tree_arrays, tree_vector_map,
+    add_folded_wrenches, check_state, forward_pass, on_tree_arrays, tree_vector_map, State,
 };
 
 pub use crate::model::{RotorMode, PARAMS_PER_LINK};
@@ -382,6 +382,40 @@ pub fn regressor_into(
         data.phi = full;
     });
     crate::error::check_finite_matrix("Phi", phi)
+}
+
+/// [`regressor_into`] with the state as named fields ([`State`]): Phi (N x 13 NL) into `phi`.
+/// Allocation-free; the same checks and errors.
+///
+/// # Example
+///
+/// Phi K is the inverse model's torque (with the environment's wrenches, Gamma_e):
+///
+/// ```
+/// use robodyn::nalgebra::{DMatrix, DVector};
+/// use robodyn::{inverse_dynamics, regressor_state_into, Data, State};
+/// # fn main() -> robodyn::Result<()> {
+/// let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots/rx90.toml");
+/// let robot = robodyn::io::load(path)?;
+/// let mut data = Data::new(&robot);
+/// let (q, qd, qdd) = ([0.1; 6], [0.2; 6], [0.3; 6]);
+/// let mut phi = DMatrix::zeros(robot.dof(), 13 * robot.nl());
+/// let state = State { q: &q, qd: &qd, qdd: &qdd };
+/// regressor_state_into(&robot, &mut data, robot.environment(), state, &mut phi)?;
+/// let by_phi = &phi * DVector::from_vec(robot.standard_parameters());
+/// let tau = inverse_dynamics(&robot, &q, &qd, &qdd)?;
+/// assert!((by_phi - tau).amax() < 1e-9); // no external wrench: Gamma_e = 0
+/// # Ok(())
+/// # }
+/// ```
+pub fn regressor_state_into(
+    robot: &Robot,
+    data: &mut Data,
+    env: &Environment,
+    state: State<'_>,
+    phi: &mut DMatrix<f64>,
+) -> Result<()> {
+    regressor_into(robot, data, env, state.q, state.qd, state.qdd, phi)
 }
 
 /// Gamma_e into `tau_e` (movable joints): the torques the external wrenches of `env` alone

@@ -43,6 +43,34 @@ pub struct Robot {
 /// serves purely symbolic descriptions.
 pub fn validate_structure(desc: &RobotDescription) -> Result<Structure> {
     let (nl, nj) = (desc.nl, desc.nj);
+    check_counts(desc)?;
+    let mut ant = vec![0; desc.nf() + 1];
+    for (idx, f) in desc.frames.iter().enumerate() {
+        let j = idx + 1;
+        check_antecedent(f, j, nl, nj)?;
+        check_joint_kind(f, j, nl, nj)?;
+        ant[j] = f.ant;
+    }
+    check_assembly(desc)?;
+    let b = nj - nl;
+    for k in nl + 1..=nj {
+        if ant[k] == structure::carrying_link(&ant, nl, k + b) {
+            return Err(Error::invalid(
+                Item::Frame(k, Some("ant".into())),
+                format!(
+                    "cut joint {k} and its twin frame {} are on the same link {}: not a loop",
+                    k + b,
+                    ant[k]
+                ),
+            ));
+        }
+    }
+    Ok(Structure::new(ant, nl, nj))
+}
+
+/// NL > 0, NJ >= NL, NF = 2 NJ - NL frames and NL links.
+fn check_counts(desc: &RobotDescription) -> Result<()> {
+    let (nl, nj) = (desc.nl, desc.nj);
     if nl == 0 {
         return Err(Error::invalid(
             Item::Robot,
@@ -71,103 +99,103 @@ pub fn validate_structure(desc: &RobotDescription) -> Result<Structure> {
             format!("{} links given, NL = {nl} expected", desc.links.len()),
         ));
     }
-    let mut ant = vec![0; nf + 1];
-    for (idx, f) in desc.frames.iter().enumerate() {
-        let j = idx + 1;
-        let item = || Item::Frame(j, Some("ant".into()));
-        if j <= nl {
-            if f.ant >= j {
-                return Err(Error::invalid(
-                    item(),
-                    format!(
-                        "antecedent a({j}) = {} must be smaller than {j} (frames are numbered \
-                         from the base; a(j) >= j makes a cycle or a forward reference)",
-                        f.ant
-                    ),
-                ));
-            }
-        } else if j <= nj && f.ant > nl {
+    Ok(())
+}
+
+/// The antecedent of frame `j`: a link frame's is an earlier frame, a cut joint's a link, a twin
+/// frame's a link or an earlier twin frame.
+fn check_antecedent(f: &FrameDesc, j: usize, nl: usize, nj: usize) -> Result<()> {
+    let item = || Item::Frame(j, Some("ant".into()));
+    if j <= nl {
+        if f.ant >= j {
             return Err(Error::invalid(
                 item(),
                 format!(
-                    "antecedent a({j}) = {} of a cut-joint frame must be a link (0..{nl})",
+                    "antecedent a({j}) = {} must be smaller than {j} (frames are numbered \
+                     from the base; a(j) >= j makes a cycle or a forward reference)",
                     f.ant
                 ),
             ));
-        } else if j > nj && f.ant > nl && (f.ant <= nj || f.ant >= j) {
-            // A twin frame may sit on an earlier twin frame (OpenSYMORO's TwoLoops: frame 12 on
-            // frame 11): the chain of fixed frames then ends on a link. A cut joint's frame
-            // moves with its own variable, so nothing may be fixed on it.
-            return Err(Error::invalid(
-                item(),
-                format!(
-                    "antecedent a({j}) = {} of a twin frame must be a link (0..{nl}) or an \
-                     earlier twin frame ({}..{})",
-                    f.ant,
-                    nj + 1,
-                    j - 1
-                ),
-            ));
         }
-        if j > nl && j <= nj {
-            if f.joint == JointType::Fixed {
-                return Err(Error::invalid(
-                    Item::Frame(j, Some("sigma".into())),
-                    "a cut joint must be revolute or prismatic (sigma 0 or 1)",
-                ));
-            }
-            if f.actuated {
-                return Err(Error::invalid(
-                    Item::Frame(j, Some("mu".into())),
-                    "a cut joint must be passive (mu = 0)",
-                ));
-            }
-        }
-        if j > nj && f.joint != JointType::Fixed {
+    } else if j <= nj && f.ant > nl {
+        return Err(Error::invalid(
+            item(),
+            format!(
+                "antecedent a({j}) = {} of a cut-joint frame must be a link (0..{nl})",
+                f.ant
+            ),
+        ));
+    } else if j > nj && f.ant > nl && (f.ant <= nj || f.ant >= j) {
+        // A twin frame may sit on an earlier twin frame (OpenSYMORO's TwoLoops: frame 12 on
+        // frame 11): the chain of fixed frames then ends on a link. A cut joint's frame
+        // moves with its own variable, so nothing may be fixed on it.
+        return Err(Error::invalid(
+            item(),
+            format!(
+                "antecedent a({j}) = {} of a twin frame must be a link (0..{nl}) or an \
+                 earlier twin frame ({}..{})",
+                f.ant,
+                nj + 1,
+                j - 1
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// The joint of frame `j`: a cut joint is movable and passive, a twin frame fixed, a fixed link
+/// frame not actuated.
+fn check_joint_kind(f: &FrameDesc, j: usize, nl: usize, nj: usize) -> Result<()> {
+    if j > nl && j <= nj {
+        if f.joint == JointType::Fixed {
             return Err(Error::invalid(
                 Item::Frame(j, Some("sigma".into())),
-                format!(
-                    "frame {j} is the twin of cut joint {} and must be fixed (sigma = 2)",
-                    j - (nj - nl)
-                ),
+                "a cut joint must be revolute or prismatic (sigma 0 or 1)",
             ));
         }
-        if j <= nl && f.joint == JointType::Fixed && f.actuated {
+        if f.actuated {
             return Err(Error::invalid(
                 Item::Frame(j, Some("mu".into())),
-                "a fixed frame (sigma = 2) cannot be actuated",
-            ));
-        }
-        ant[j] = f.ant;
-    }
-    if let Some(a) = &desc.assembly {
-        if a.len() != nl {
-            return Err(Error::invalid(
-                Item::Base("assembly".into()),
-                format!("{} joint values given, NL = {nl} expected", a.len()),
-            ));
-        }
-        if let Some(k) = a.iter().position(|x| !x.is_finite()) {
-            return Err(Error::invalid(
-                Item::Base("assembly".into()),
-                format!("q{} = {} is not a finite number", k + 1, a[k]),
+                "a cut joint must be passive (mu = 0)",
             ));
         }
     }
-    let b = nj - nl;
-    for k in nl + 1..=nj {
-        if ant[k] == structure::carrying_link(&ant, nl, k + b) {
-            return Err(Error::invalid(
-                Item::Frame(k, Some("ant".into())),
-                format!(
-                    "cut joint {k} and its twin frame {} are on the same link {}: not a loop",
-                    k + b,
-                    ant[k]
-                ),
-            ));
-        }
+    if j > nj && f.joint != JointType::Fixed {
+        return Err(Error::invalid(
+            Item::Frame(j, Some("sigma".into())),
+            format!(
+                "frame {j} is the twin of cut joint {} and must be fixed (sigma = 2)",
+                j - (nj - nl)
+            ),
+        ));
     }
-    Ok(Structure::new(ant, nl, nj))
+    if j <= nl && f.joint == JointType::Fixed && f.actuated {
+        return Err(Error::invalid(
+            Item::Frame(j, Some("mu".into())),
+            "a fixed frame (sigma = 2) cannot be actuated",
+        ));
+    }
+    Ok(())
+}
+
+/// The assembly configuration, when given: NL finite values.
+fn check_assembly(desc: &RobotDescription) -> Result<()> {
+    let Some(a) = &desc.assembly else {
+        return Ok(());
+    };
+    if a.len() != desc.nl {
+        return Err(Error::invalid(
+            Item::Base("assembly".into()),
+            format!("{} joint values given, NL = {} expected", a.len(), desc.nl),
+        ));
+    }
+    if let Some(k) = a.iter().position(|x| !x.is_finite()) {
+        return Err(Error::invalid(
+            Item::Base("assembly".into()),
+            format!("q{} = {} is not a finite number", k + 1, a[k]),
+        ));
+    }
+    Ok(())
 }
 
 impl Robot {

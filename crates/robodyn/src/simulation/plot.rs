@@ -55,110 +55,27 @@ pub fn plot_svg(path: &Path, rec: &Recorder, info: &PlotInfo) -> Result<()> {
     }
     // a single row still gets an axis
     let t = if t.len() == 1 { vec![t[0], t[0]] } else { t };
-    let column = |name: &str| -> Vec<f64> {
-        let mut v = rec.series(name).unwrap_or_default();
-        if v.len() == 1 {
-            v.push(v[0]);
-        }
-        v
-    };
     let joints = joint_labels(rec);
     let reference = reference_values(rec, info, &t);
+    let t_end = *t.last().unwrap();
     let mut fig = Figure {
         title: info.title.clone(),
-        note: info.stopped.as_ref().map(|why| {
-            let mut why = stop_reason(why);
-            if why.chars().count() > 140 {
-                why = why.chars().take(137).collect::<String>() + "...";
-            }
-            format!(
-                "stopped early at t = {} s: {why}",
-                format_number(*t.last().unwrap())
-            )
-        }),
+        note: info.stopped.as_ref().map(|why| stop_note(why, t_end)),
         x_label: "t [s]".into(),
         panels: Vec::new(),
-        mark: info.stopped.as_ref().map(|_| *t.last().unwrap()),
+        mark: info.stopped.as_ref().map(|_| t_end),
         colors: joints.len(),
     };
-    for (prismatic, unit) in [(false, "rad"), (true, "m")] {
-        let of_kind: Vec<(usize, &String)> = joints
-            .iter()
-            .enumerate()
-            .filter(|(_, l)| info.prismatic.contains(l) == prismatic)
-            .collect();
-        if of_kind.is_empty() {
-            continue;
-        }
-        let kind = if prismatic { "prismatic" } else { "revolute" };
-        let mut positions = Panel {
-            title: format!("joint positions, {kind} joints"),
-            y_label: format!("q [{unit}]"),
-            ..Panel::default()
-        };
-        let mut errors = Panel {
-            title: format!("tracking error q_ref - q, {kind} joints"),
-            y_label: format!("q_ref - q [{unit}]"),
-            ..Panel::default()
-        };
-        for &(k, l) in &of_kind {
-            let q = column(&format!("q{l}"));
-            let passive = info.passive.contains(l);
-            let (label, style) = if passive {
-                (format!("q{l} (passive)"), Style::Dotted)
-            } else {
-                (format!("q{l}"), Style::Solid)
-            };
-            positions
-                .curves
-                .push(Curve::new(label, q.clone(), k, style));
-            if let Some(r) = reference.iter().find(|(rl, _)| rl == l).map(|(_, r)| r) {
-                positions
-                    .curves
-                    .push(Curve::new(format!("q{l} ref"), r.clone(), k, Style::Dashed).unlisted());
-                let e = r.iter().zip(&q).map(|(r, q)| r - q).collect();
-                errors
-                    .curves
-                    .push(Curve::new(format!("q{l}"), e, k, Style::Solid));
-            }
-        }
-        if !errors.curves.is_empty() {
-            positions.keys = vec![
-                ("simulated".into(), Style::Solid),
-                ("reference".into(), Style::Dashed),
-            ];
-        }
-        fig.panels.push(positions);
-        if !errors.curves.is_empty() {
-            fig.panels.push(errors);
-        }
+    for prismatic in [false, true] {
+        fig.panels
+            .extend(joint_panels(rec, info, &joints, &reference, prismatic));
     }
     if rec.column("energy").is_some() {
-        let e = column("energy");
-        let e0 = e[0];
-        let what = match info.energy {
-            EnergyBalance::Drift => {
-                "energy drift E - E(0): no torque and no friction conserve E, this is the \
-                 integration error"
-            }
-            EnergyBalance::Friction => "energy change E - E(0): the work of friction",
-            EnergyBalance::Work => {
-                "energy change E - E(0): the work of the joint torques and of friction"
-            }
-        };
-        fig.panels.push(Panel {
-            title: format!("{what} (E(0) = {} J)", Sig(e0, 4)),
-            y_label: "E - E(0) [J]".into(),
-            // near-black: no joint's colour
-            curves: vec![Curve::new(
-                "E - E(0)",
-                e.iter().map(|x| x - e0).collect(),
-                joints.len(),
-                Style::Solid,
-            )
-            .unlisted()],
-            ..Panel::default()
-        });
+        fig.panels.push(energy_panel(
+            &column(rec, "energy"),
+            info.energy,
+            joints.len(),
+        ));
     }
     if fig.panels.is_empty() {
         return Err(err(
@@ -166,6 +83,115 @@ pub fn plot_svg(path: &Path, rec: &Recorder, info: &PlotInfo) -> Result<()> {
         ));
     }
     write_svg(path, &t, &fig)
+}
+
+/// Column `name` of `rec` (empty when absent), a single row doubled to match the time axis.
+fn column(rec: &Recorder, name: &str) -> Vec<f64> {
+    let mut v = rec.series(name).unwrap_or_default();
+    if v.len() == 1 {
+        v.push(v[0]);
+    }
+    v
+}
+
+/// "stopped early at t = 1.2 s: why" (the reason cut at 140 characters).
+fn stop_note(why: &str, t_end: f64) -> String {
+    let mut why = stop_reason(why);
+    if why.chars().count() > 140 {
+        why = why.chars().take(137).collect::<String>() + "...";
+    }
+    format!("stopped early at t = {} s: {why}", format_number(t_end))
+}
+
+/// The panels of the revolute (`prismatic` false, rad) or prismatic (m) joints: their positions
+/// (the passive joints dotted, a tracked reference dashed) and, when a reference was tracked,
+/// the tracking errors. None when the robot has no joint of that kind.
+fn joint_panels(
+    rec: &Recorder,
+    info: &PlotInfo,
+    joints: &[String],
+    reference: &[(String, Vec<f64>)],
+    prismatic: bool,
+) -> Vec<Panel> {
+    let of_kind: Vec<(usize, &String)> = joints
+        .iter()
+        .enumerate()
+        .filter(|(_, l)| info.prismatic.contains(l) == prismatic)
+        .collect();
+    if of_kind.is_empty() {
+        return Vec::new();
+    }
+    let (kind, unit) = if prismatic {
+        ("prismatic", "m")
+    } else {
+        ("revolute", "rad")
+    };
+    let mut positions = Panel {
+        title: format!("joint positions, {kind} joints"),
+        y_label: format!("q [{unit}]"),
+        ..Panel::default()
+    };
+    let mut errors = Panel {
+        title: format!("tracking error q_ref - q, {kind} joints"),
+        y_label: format!("q_ref - q [{unit}]"),
+        ..Panel::default()
+    };
+    for &(k, l) in &of_kind {
+        let q = column(rec, &format!("q{l}"));
+        let (label, style) = if info.passive.contains(l) {
+            (format!("q{l} (passive)"), Style::Dotted)
+        } else {
+            (format!("q{l}"), Style::Solid)
+        };
+        positions
+            .curves
+            .push(Curve::new(label, q.clone(), k, style));
+        if let Some(r) = reference.iter().find(|(rl, _)| rl == l).map(|(_, r)| r) {
+            positions
+                .curves
+                .push(Curve::new(format!("q{l} ref"), r.clone(), k, Style::Dashed).unlisted());
+            let e = r.iter().zip(&q).map(|(r, q)| r - q).collect();
+            errors
+                .curves
+                .push(Curve::new(format!("q{l}"), e, k, Style::Solid));
+        }
+    }
+    if errors.curves.is_empty() {
+        return vec![positions];
+    }
+    positions.keys = vec![
+        ("simulated".into(), Style::Solid),
+        ("reference".into(), Style::Dashed),
+    ];
+    vec![positions, errors]
+}
+
+/// The panel of E - E(0), captioned by what it measures in this run, in colour `color` (past the
+/// joints' colours: near-black).
+fn energy_panel(e: &[f64], balance: EnergyBalance, color: usize) -> Panel {
+    let e0 = e[0];
+    let what = match balance {
+        EnergyBalance::Drift => {
+            "energy drift E - E(0): no torque and no friction conserve E, this is the \
+             integration error"
+        }
+        EnergyBalance::Friction => "energy change E - E(0): the work of friction",
+        EnergyBalance::Work => {
+            "energy change E - E(0): the work of the joint torques and of friction"
+        }
+    };
+    Panel {
+        title: format!("{what} (E(0) = {} J)", Sig(e0, 4)),
+        y_label: "E - E(0) [J]".into(),
+        curves: vec![Curve::new(
+            "E - E(0)",
+            e.iter().map(|x| x - e0).collect(),
+            color,
+            Style::Solid,
+        )
+        .unlisted()],
+        ..Panel::default()
+    }
 }
 
 /// The `<l>` of every `q<l>` column (q<frame> or q_<joint name>, not qd.. / qdd..), in order.

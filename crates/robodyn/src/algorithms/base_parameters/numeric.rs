@@ -492,8 +492,8 @@ pub fn numeric_base_parameters(
     sampler: &mut dyn Sampler,
     opt: &NumericOptions,
 ) -> Result<NumericBase> {
-    let nl = robot.nl();
     let sel = &opt.selection;
+    let nl = robot.nl();
     if sel.rotor.len() != nl || sel.friction.len() != nl {
         return Err(Error::Input(format!(
             "the parameter selection has {} entries, the robot has NL = {nl} links",
@@ -501,25 +501,79 @@ pub fn numeric_base_parameters(
         )));
     }
     let columns = sel.columns();
-    // W's columns: the existing parameters (K order), then the absent ones of the selection
-    let all: Vec<usize> = (0..PARAMS_PER_LINK * nl)
-        .filter(|&i| sel.slot(i) && !sel.absent.contains(&i))
-        .chain((0..PARAMS_PER_LINK * nl).filter(|&i| sel.slot(i) && sel.absent.contains(&i)))
-        .collect();
-    let absent: Vec<usize> = all
-        .iter()
-        .copied()
-        .filter(|i| sel.absent.contains(i))
-        .collect();
-    let ncols = all.len();
-    check_observation_size(robot, opt, ncols)?;
+    let all = observed_columns(sel, nl);
+    check_observation_size(robot, opt, all.len())?;
+    // 1. W
     let Observation {
         mut w,
         rows,
         samples,
         tree_rows,
     } = observation_matrix(robot, sampler, opt, &all, columns.len())?;
-    // 2. no-effect columns (existing parameters); absent columns of no effect are dropped
+    // 2.-3. no-effect columns, the others scaled to unit norm
+    let scaled = scale_columns(&mut w, &all, sel);
+    let r_all = staircase_r(w, &scaled.live, &all, rows, samples, tree_rows);
+    let (singular_values, tol) = rank_tolerance(&r_all, scaled.n_present)?;
+    // 4. ordered selection among the existing columns and the absent ones in their span
+    let candidates = span_candidates(&r_all, &scaled, &all, rows, tol);
+    let (kept, dep) = ordered_selection(&r_all, &candidates, scaled.n_present, tol);
+    // 5. beta and the rank certificate
+    let g = grouping(robot, &r_all, &kept, &dep, tol)?;
+    drop(r_all);
+    let (norms, live) = (&scaled.norms, &scaled.live);
+    let col = |k: usize| all[live[k]];
+    let mut beta = DMatrix::zeros(kept.len(), dep.len());
+    for (x, &kc) in kept.iter().enumerate() {
+        for (y, &dc) in dep.iter().enumerate() {
+            beta[(x, y)] = g.beta_s[(x, y)] * norms[live[dc]] / norms[live[kc]];
+        }
+    }
+    Ok(NumericBase {
+        base: kept.iter().map(|&k| col(k)).collect(),
+        grouped: dep.iter().map(|&k| col(k)).collect(),
+        no_effect: scaled.no_effect,
+        absent: all
+            .iter()
+            .copied()
+            .filter(|i| sel.absent.contains(i))
+            .collect(),
+        columns,
+        beta,
+        tolerance: tol,
+        singular_values,
+        sigma_min_kept: g.sigma_min_kept,
+        residual_grouped: g.residual_grouped,
+        rows,
+    })
+}
+
+/// W's columns (K indices): the existing parameters of the selection (K order), then its absent
+/// ones.
+fn observed_columns(sel: &ParameterSelection, nl: usize) -> Vec<usize> {
+    (0..PARAMS_PER_LINK * nl)
+        .filter(|&i| sel.slot(i) && !sel.absent.contains(&i))
+        .chain((0..PARAMS_PER_LINK * nl).filter(|&i| sel.slot(i) && sel.absent.contains(&i)))
+        .collect()
+}
+
+/// The columns of W after steps 2 and 3.
+struct ScaledColumns {
+    /// ||W_c|| of every column of W.
+    norms: Vec<f64>,
+    /// The columns with an effect (indices into W's columns, increasing), now packed to the left
+    /// of W and scaled to unit norm: the existing ones first, then the absent candidates.
+    live: Vec<usize>,
+    /// How many of `live` are existing parameters.
+    n_present: usize,
+    /// K indices of the existing parameters of no effect.
+    no_effect: Vec<usize>,
+}
+
+/// Steps 2 and 3: the existing parameters of no effect (absent columns of no effect are
+/// dropped), the other columns scaled to unit norm and packed to the left of W in place (no
+/// second copy of W).
+fn scale_columns(w: &mut Mat<f64>, all: &[usize], sel: &ParameterSelection) -> ScaledColumns {
+    let ncols = all.len();
     let norms: Vec<f64> = (0..ncols).map(|c| w.col(c).norm_l2()).collect();
     let is_absent = |c: usize| sel.absent.contains(&all[c]);
     let max_norm = (0..ncols)
@@ -531,10 +585,8 @@ pub fn numeric_base_parameters(
         .filter(|&c| !is_absent(c) && zero(c))
         .map(|c| all[c])
         .collect();
-    // 3. unit columns: existing ones first (K order), then the absent candidates
     let live: Vec<usize> = (0..ncols).filter(|&c| !zero(c)).collect();
     let n_present = live.iter().filter(|&&c| !is_absent(c)).count();
-    // scaled and packed to the left in place (live is increasing): no second copy of W
     for (j, &c) in live.iter().enumerate() {
         let f = 1.0 / norms[c];
         if c == j {
@@ -549,11 +601,28 @@ pub fn numeric_base_parameters(
                 .for_each(|(d, x)| *d = x * f);
         }
     }
+    ScaledColumns {
+        norms,
+        live,
+        n_present,
+        no_effect,
+    }
+}
+
+/// R of the unpivoted QR of the scaled live columns of W (W consumed): a tree's W is a staircase
+/// (rows by joint), its column c zero below the rows of its link.
+fn staircase_r(
+    mut w: Mat<f64>,
+    live: &[usize],
+    all: &[usize],
+    rows: usize,
+    samples: usize,
+    tree_rows: bool,
+) -> Mat<f64> {
     let mut a = w.as_mut().subcols_mut(0, live.len());
-    // a tree's W is a staircase (rows by joint): column c is zero below the rows of its link
     let mut last = Vec::with_capacity(live.len());
     let mut running = 0;
-    for &c in &live {
+    for &c in live {
         let lr = if tree_rows {
             (all[c] / PARAMS_PER_LINK + 1) * samples - 1
         } else {
@@ -563,9 +632,12 @@ pub fn numeric_base_parameters(
         last.push(running);
     }
     qr_in_place_staircase(a.rb_mut(), &|j| last[j]);
-    let r_all = upper(a.rb());
-    drop(w);
-    // R of the existing columns alone (the leading block): sigma_max and tolerance
+    upper(a.rb())
+}
+
+/// The singular values of R's leading block (the existing columns; empty beyond
+/// [`SVD_COLUMNS`]) and the rank tolerance [`RANK_TOLERANCE`] sigma_max.
+fn rank_tolerance(r_all: &Mat<f64>, n_present: usize) -> Result<(Vec<f64>, f64)> {
     let r_present = r_all.as_ref().submatrix(0, 0, n_present, n_present);
     let singular_values: Vec<f64> = if n_present <= SVD_COLUMNS {
         let mut sv = r_present
@@ -581,35 +653,53 @@ pub fn numeric_base_parameters(
         .first()
         .copied()
         .unwrap_or_else(|| sigma_max(r_present));
-    let tol = RANK_TOLERANCE * smax;
-    // absent columns in the span of the existing ones: distance below tol
-    let candidates: Vec<usize> = {
-        let mut c: Vec<usize> = (0..live.len())
-            .filter(|&k| {
-                k < n_present || {
-                    let d = (n_present..live.len().min(rows))
-                        .map(|i| r_all[(i, k)] * r_all[(i, k)])
-                        .sum::<f64>()
-                        .sqrt();
-                    d <= tol
-                }
-            })
-            .collect();
-        c.sort_by_key(|&k| all[live[k]]);
-        c
-    };
-    // 4. ordered selection: unpivoted QR in K order (the first QR already is, without absent
-    // candidates)
+    Ok((singular_values, RANK_TOLERANCE * smax))
+}
+
+/// The candidates of step 4 (indices into `live`, in K order): the existing columns, and the
+/// absent ones in the span of the existing ones (distance below `tol`).
+fn span_candidates(
+    r_all: &Mat<f64>,
+    scaled: &ScaledColumns,
+    all: &[usize],
+    rows: usize,
+    tol: f64,
+) -> Vec<usize> {
+    let (live, n_present) = (&scaled.live, scaled.n_present);
+    let mut c: Vec<usize> = (0..live.len())
+        .filter(|&k| {
+            k < n_present || {
+                let d = (n_present..live.len().min(rows))
+                    .map(|i| r_all[(i, k)] * r_all[(i, k)])
+                    .sum::<f64>()
+                    .sqrt();
+                d <= tol
+            }
+        })
+        .collect();
+    c.sort_by_key(|&k| all[live[k]]);
+    c
+}
+
+/// Step 4, the ordered selection: an unpivoted QR of the candidates in K order (the first QR
+/// already is, without absent candidates); |R_ii| > tol keeps candidate i, else an existing one
+/// is grouped. Returns (kept, grouped), indices into `live`.
+fn ordered_selection(
+    r_all: &Mat<f64>,
+    candidates: &[usize],
+    n_present: usize,
+    tol: f64,
+) -> (Vec<usize>, Vec<usize>) {
     let r_k = if candidates.len() == n_present {
         None
     } else {
-        Some(refactor(&r_all, &candidates))
+        Some(refactor(r_all, candidates))
     };
     let diag = |i: usize| match &r_k {
         Some(r) => r[(i, i)],
         None => r_all[(i, i)],
     };
-    let mut kept = Vec::new(); // indices into `live`
+    let mut kept = Vec::new();
     let mut dep = Vec::new();
     for (i, &k) in candidates.iter().enumerate() {
         if diag(i).abs() > tol {
@@ -618,31 +708,7 @@ pub fn numeric_base_parameters(
             dep.push(k);
         }
     }
-    drop(r_k);
-
-    // 5. beta and the rank certificate
-    let g = grouping(robot, &r_all, &kept, &dep, tol)?;
-    drop(r_all);
-    let col = |k: usize| all[live[k]];
-    let mut beta = DMatrix::zeros(kept.len(), dep.len());
-    for (x, &kc) in kept.iter().enumerate() {
-        for (y, &dc) in dep.iter().enumerate() {
-            beta[(x, y)] = g.beta_s[(x, y)] * norms[live[dc]] / norms[live[kc]];
-        }
-    }
-    Ok(NumericBase {
-        base: kept.iter().map(|&k| col(k)).collect(),
-        grouped: dep.iter().map(|&k| col(k)).collect(),
-        no_effect,
-        absent,
-        columns,
-        beta,
-        tolerance: tol,
-        singular_values,
-        sigma_min_kept: g.sigma_min_kept,
-        residual_grouped: g.residual_grouped,
-        rows,
-    })
+    (kept, dep)
 }
 
 /// Refuse, before any allocation, an observation matrix W beyond [`MAX_OBSERVATION_BYTES`]:
