@@ -77,7 +77,7 @@ fn dual_placement(
             None => HyperDual64::from_re(0.0),
         };
         let (r, p) = f.transform(&qk);
-        pos += &rot * p;
+        pos += rot * p;
         rot *= r;
     }
     (rot, pos)

@@ -58,7 +58,7 @@ impl Frames {
             }
         };
         let j = match self.frame {
-            Some(j) if j == 0 => {
+            Some(0) => {
                 return Err(Error::Setting {
                     option: "codegen::Frames::frame",
                     reason: "frame 0 is the base: choose a frame 1..NL".into(),
