@@ -697,14 +697,21 @@ impl Program {
     }
 
     /// An output that is a copy of an intermediate (`W3_1 = X2_1`, `QDP2 = X2`) gives that
-    /// intermediate its own name, so that the equations read `W3_1 = ...` once. Inputs, and
-    /// intermediates copied by several outputs beyond the first, keep theirs. No operation changes.
+    /// intermediate its own name, so that the equations read `W3_1 = ...` once. Inputs,
+    /// intermediates copied by several outputs beyond the first, and elementary function calls
+    /// (`S1 = sin(q1)` stays `S1`, as SYMORO writes it, when a Jacobian entry is S1) keep theirs.
+    /// No operation changes.
     pub fn name_outputs(&mut self) {
-        let assigned: HashSet<&str> = self.assignments.iter().map(|a| a.name.as_str()).collect();
+        let assigned: HashSet<&str> = self
+            .assignments
+            .iter()
+            .filter(|a| !matches!(a.expr.node(), Node::Func(..)))
+            .map(|a| a.name.as_str())
+            .collect();
         let taken: HashSet<String> = self
             .input_symbols()
             .into_iter()
-            .chain(assigned.iter().map(|s| s.to_string()))
+            .chain(self.assignments.iter().map(|a| a.name.clone()))
             .collect();
         let mut map: HashMap<String, Expr> = HashMap::new();
         for o in &self.outputs {

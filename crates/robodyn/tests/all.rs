@@ -39,6 +39,8 @@ mod codegen_compile;
 mod codegen_counts;
 #[path = "codegen_errors.rs"]
 mod codegen_errors;
+#[path = "codegen_kinematics.rs"]
+mod codegen_kinematics;
 #[path = "codegen_latex.rs"]
 mod codegen_latex;
 #[path = "codegen_opcount.rs"]

@@ -13,7 +13,9 @@
 //!
 //! Robots: the SR400 (symbolic and numeric), the RX-90, every other bundled robot (the closed
 //! ones as their equivalent trees, and as closed chains), a slider-crank with a prismatic cut
-//! joint, three random trees, and the SCARA with symbols named `end`, `p`, `in`, `out`.
+//! joint, three random trees, and the SCARA with symbols named `end`, `p`, `in`, `out`; and the
+//! DGM and Jacobian programs of `codegen_kinematics.rs` (against `frame_transforms` and the
+//! derivative of the numeric DGM, to 1e-12).
 //!
 //! Every program is compiled (rustc, cc) into a harness that reads inputs on stdin and prints the
 //! outputs; tolerance 1e-10 relative (norm-wise over each output vector).
@@ -377,6 +379,17 @@ fn all_cases() -> Vec<Case> {
         cases.extend(tree_cases(&d, false, seed, &format!("tree{seed}")));
     }
     cases.extend(fixed_frame_cases());
+    // the geometric and kinematic models (DGM iT_j, Jacobian iJ_j): see codegen_kinematics.rs
+    cases.extend(
+        crate::codegen_kinematics::kinematic_cases()
+            .into_iter()
+            .map(|c| Case {
+                prog: c.prog,
+                inputs: c.inputs,
+                expected: c.expected,
+                what: c.what,
+            }),
+    );
     finish_cases(cases)
 }
 
@@ -498,9 +511,12 @@ fn check(cases: &[Case], outputs: &[Vec<Vec<f64>>], lang: &str) -> f64 {
         if c.what.ends_with(" h") {
             continue;
         }
+        // the geometric models (a few products per entry) to 1e-12
+        let kinematic = c.what.contains(" dgm ") || c.what.contains(" jacobian ");
+        let tolerance = if kinematic { 1e-12 } else { 1e-10 };
         for (got, exp) in outputs[i].iter().zip(&c.expected) {
             let e = rel_err(got, exp);
-            assert!(e < 1e-10, "{lang} {}: off by {e:e}", c.what);
+            assert!(e < tolerance, "{lang} {}: off by {e:e}", c.what);
             if e > worst {
                 worst_case = c.what.clone();
             }

@@ -103,6 +103,10 @@ fn counts_equal_operators_of_the_printed_code() {
             check(&generate(&desc, &opt).unwrap());
         }
     }
+    // the geometric and kinematic models, every frame choice of codegen_kinematics.rs
+    for c in crate::codegen_kinematics::kinematic_cases() {
+        check(&c.prog);
+    }
     let mut r = rng(8);
     for n in [3, 6] {
         let d = random_tree_description(&mut r, n, &TreeOptions::default());

@@ -3,7 +3,7 @@
 
 use crate::common::{choices, CliResult};
 use robodyn::algorithms::regressor::ZeroParameters;
-use robodyn::codegen::{generate_with_progress, BaseParameters, GenOptions, ModelKind};
+use robodyn::codegen::{generate_with_progress, BaseParameters, Frames, GenOptions, ModelKind};
 use robodyn_symbolic::{check_function_name, emit, Lang};
 use std::path::PathBuf;
 
@@ -21,6 +21,11 @@ pub enum Model {
     Closed,
     /// Closed chain: W = d q_p / d q_a (10.30), inputs the closed tree positions.
     W,
+    /// Direct geometric model iT_j (see --frame, --reference), inputs the joint positions.
+    Dgm,
+    /// Jacobian iJ_j of frame j expressed in frame i, rows [linear; angular] (see --frame,
+    /// --reference), inputs the joint positions.
+    Jacobian,
 }
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug)]
@@ -41,6 +46,13 @@ pub struct Args {
     /// The model to generate.
     #[arg(long, value_enum, default_value = "idm")]
     pub model: Model,
+    /// --model dgm, jacobian: frame j, 1..NL (default: the terminal link's frame).
+    #[arg(long, value_name = "J")]
+    pub frame: Option<usize>,
+    /// --model dgm, jacobian: reference frame i: the DGM is iT_j, the Jacobian is expressed in
+    /// frame i; 0 the base (world axes at O_j), `local` frame j itself.
+    #[arg(long, value_name = "I|local", value_parser = reference)]
+    pub reference: Option<Reference>,
     /// Which inertial parameters are the model's symbols.
     #[arg(long, value_enum, default_value = "standard")]
     pub params: Params,
@@ -75,7 +87,35 @@ pub struct Args {
     pub output: Option<PathBuf>,
 }
 
+/// `--reference`: a frame number, or `local` (frame j itself).
+#[derive(Clone, Copy, Debug)]
+pub struct Reference(Option<usize>);
+
+fn reference(s: &str) -> Result<Reference, String> {
+    if s == "local" {
+        return Ok(Reference(None));
+    }
+    s.parse()
+        .map(|i| Reference(Some(i)))
+        .map_err(|_| format!("`{s}`: expected a frame number (0: the base) or `local`"))
+}
+
+/// The frames of --model dgm and jacobian; --frame and --reference belong to those models only.
+fn frames(a: &Args) -> Frames {
+    let mut f = Frames::TERMINAL;
+    f.frame = a.frame;
+    if let Some(Reference(i)) = a.reference {
+        f.reference = i;
+    }
+    f
+}
+
 pub fn run(a: Args) -> CliResult {
+    if !matches!(a.model, Model::Dgm | Model::Jacobian)
+        && (a.frame.is_some() || a.reference.is_some())
+    {
+        return Err("--frame and --reference choose the frames of --model dgm and jacobian".into());
+    }
     let rargs = crate::common::RobotArgs {
         robot: a.robot.clone(),
         set: a.set.clone(),
@@ -119,6 +159,8 @@ pub fn run(a: Args) -> CliResult {
             Model::Ddm => ModelKind::Ddm,
             Model::Closed => ModelKind::Closed,
             Model::W => ModelKind::W,
+            Model::Dgm => ModelKind::Dgm(frames(&a)),
+            Model::Jacobian => ModelKind::Jacobian(frames(&a)),
         },
         numeric: a.numeric,
         symmetric: a.symmetric,

@@ -15,11 +15,13 @@
 //! the frame numbers (`q<j>`, `GAM<j>`, `W<c><j>`).
 
 mod closed;
+mod geometric;
 mod linear;
 mod parallel_links;
 
 pub use closed::constant_g;
 use closed::{closed_form, closed_torques, closed_w, ClosedForm};
+pub use geometric::{Frames, DGM_OUTPUTS};
 pub use parallel_links::parallel_links;
 
 use crate::algorithms::inertia_matrix::composite_inertia_matrix;
@@ -39,6 +41,13 @@ use std::collections::{BTreeSet, HashMap};
 /// Which model to generate.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ModelKind {
+    /// Direct geometric model iT_j (SYMORO's DGM): the 12 entries of [s n a P] column by
+    /// column ([`DGM_OUTPUTS`]) from the positions of the movable joints.
+    Dgm(Frames),
+    /// Jacobian iJ_j of frame j expressed in frame i: the velocity of the origin O_j and the
+    /// angular velocity of frame j, rows [linear; angular], one column per movable joint, from
+    /// the positions (`J<row><joint>`, row by row).
+    Jacobian(Frames),
     /// Inverse dynamic model of the (equivalent) tree: Gamma(q, qd, qdd).
     Idm,
     /// Inertia matrix A(q) (lower triangle).
@@ -56,10 +65,12 @@ pub enum ModelKind {
 }
 
 impl ModelKind {
-    /// Short name (`idm`, `inertia`, `h`, `ddm`, `closed`, `w`): the default function name's
-    /// suffix.
+    /// Short name (`dgm`, `jacobian`, `idm`, `inertia`, `h`, `ddm`, `closed`, `w`): the default
+    /// function name's suffix.
     pub fn name(self) -> &'static str {
         match self {
+            ModelKind::Dgm(_) => "dgm",
+            ModelKind::Jacobian(_) => "jacobian",
             ModelKind::Idm => "idm",
             ModelKind::Inertia => "inertia",
             ModelKind::H => "h",
@@ -342,11 +353,21 @@ pub fn generate_with_progress(
     let nl = desc.nl;
     let joints = desc.movable_joints();
     let closed = matches!(opt.model, ModelKind::Closed | ModelKind::W);
+    // geometric and kinematic models: the frames resolved and checked first (errors as values)
+    let kinematic = match opt.model {
+        ModelKind::Dgm(f) | ModelKind::Jacobian(f) => Some(f.resolve(desc)?),
+        _ => None,
+    };
     // Tree models run on the model of the dynamic recursions (`Robot::dynamic`): fixed frames
     // folded into their movable ancestor, so link k is the movable joint joints[k - 1] and the
     // tree arrays are the joint vectors of the library. Closed models need the cut-joint frames
     // and keep every frame (q of a fixed frame is never read).
-    let model = if closed { model } else { model.fold_fixed() };
+    // The geometric models keep every frame too: frame j may be a fixed frame (a tool).
+    let model = if closed || kinematic.is_some() {
+        model
+    } else {
+        model.fold_fixed()
+    };
     // the numeric robot of the closed models (loop closure, constant G, parallel links)
     let robot = closed.then(|| crate::Robot::new(desc.clone()));
     let form = match &robot {
@@ -378,10 +399,10 @@ pub fn generate_with_progress(
         joints.len()
     ));
     let (outputs, assignments) = record(&reserved_names(desc, opt), || {
-        record_model(&model, opt, &form, &shared)
+        record_model(desc, &model, opt, &form, &shared)
     });
     let outputs = outputs?;
-    let mut description = describe(desc, opt);
+    let mut description = describe(desc, opt, kinematic);
     if closed {
         description.extend(form.describe(nl));
     } else if desc.nj > desc.nl {
@@ -459,7 +480,7 @@ fn joint_inputs(joints: &[usize], model: ModelKind) -> Vec<InputGroup> {
             inputs.push(group("qdd", "QDP", "joint accelerations"));
         }
         ModelKind::H => inputs.push(group("qd", "QP", "joint velocities")),
-        ModelKind::Inertia | ModelKind::W => {}
+        ModelKind::Inertia | ModelKind::W | ModelKind::Dgm(_) | ModelKind::Jacobian(_) => {}
         ModelKind::Ddm => {
             inputs.push(group("qd", "QP", "joint velocities"));
             inputs.push(group("gam", "GAM", "joint torques"));
@@ -472,6 +493,7 @@ fn joint_inputs(joints: &[usize], model: ModelKind) -> Vec<InputGroup> {
 /// `model` is folded (link k is the k-th movable joint); for the closed ones it has every frame
 /// (tree arrays indexed by frame number). Either way `wrench_link` gives the frame number.
 fn record_model(
+    desc: &RobotDescription,
     model: &DynModel<Expr>,
     opt: &GenOptions,
     form: &ClosedForm,
@@ -496,6 +518,14 @@ fn record_model(
     let mut ws = Data::from_model(model);
     let mut tau = vec![Expr::zero(); nl];
     match opt.model {
+        ModelKind::Dgm(f) => {
+            let (i, j) = f.resolve(desc)?;
+            Ok(geometric::dgm(model, i, j))
+        }
+        ModelKind::Jacobian(f) => {
+            let (i, j) = f.resolve(desc)?;
+            Ok(geometric::jacobian(model, i, j, &desc.movable_joints()))
+        }
         ModelKind::Idm | ModelKind::Closed => {
             forward_recursion_sharing(model, &mut ws, &q, &qd, &qdd, shared);
             // the closed model only needs G^T Gamma_tr: moments of shared links move too
@@ -642,8 +672,16 @@ impl NamedGam for Expr {
     }
 }
 
-fn describe(desc: &RobotDescription, opt: &GenOptions) -> Vec<String> {
+fn describe(
+    desc: &RobotDescription,
+    opt: &GenOptions,
+    kinematic: Option<(usize, usize)>,
+) -> Vec<String> {
+    if let Some((i, j)) = kinematic {
+        return geometric::describe(desc, opt.model, i, j, opt.numeric);
+    }
     let model = match opt.model {
+        ModelKind::Dgm(_) | ModelKind::Jacobian(_) => "geometric model",
         ModelKind::Idm => "customized inverse dynamic model Gamma = f(q, qd, qdd) (Newton-Euler, eqs 10.3-10.12)",
         ModelKind::Inertia => "inertia matrix A(q), lower triangle (Newton-Euler columns)",
         ModelKind::H => "vector H(q, qd) = Gamma(q, qd, 0)",
