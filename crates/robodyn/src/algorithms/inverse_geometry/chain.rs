@@ -152,9 +152,16 @@ impl Chain {
     /// turn into the joint's limits when a turn does; whether it lies within them.
     pub fn joint_value(&self, k: usize, theta: f64) -> (f64, bool) {
         use std::f64::consts::{PI, TAU};
-        let mut q = (theta - self.theta0[k]).rem_euclid(TAU);
-        if q > PI {
+        let mut q = theta - self.theta0[k];
+        // the angles come from atan2 and acos sums: a few turns at most (rem_euclid otherwise)
+        if q.abs() > 4.0 * TAU {
+            q = q.rem_euclid(TAU);
+        }
+        while q > PI {
             q -= TAU;
+        }
+        while q <= -PI {
+            q += TAU;
         }
         let (lo, hi) = self.limits[k];
         let inside = |x: f64| lo <= x && x <= hi;

@@ -427,12 +427,15 @@ impl ClosedFormIgm {
                     continue;
                 };
                 for th5 in t5 {
-                    let m5 = c4.rot * (rot_z(th5) * p6);
+                    let c4r5 = c4.rot * rot_z(th5);
+                    let m5 = c4r5 * p6;
                     let th4 = angle_between(&m5, &b, CLOSED_FORM_TOLERANCE);
                     th[3] = th4.unwrap_or(self.chain.theta0[3]);
                     th[4] = th5;
-                    let n = (rot_z(th[3]) * c4.rot * rot_z(th5) * c5.rot).tr_mul(&r);
-                    th[5] = n[(1, 0)].atan2(n[(0, 0)]);
+                    // Rz(theta6) = Q^T R, Q = Rz(theta4) C4 Rz(theta5) C5: its first column
+                    let q = rot_z(th[3]) * c4r5 * c5.rot;
+                    let r0 = r.column(0);
+                    th[5] = q.column(1).dot(&r0).atan2(q.column(0).dot(&r0));
                     let singular = Singularity {
                         shoulder: shoulder || s.shoulder,
                         elbow: s.elbow,
