@@ -73,6 +73,8 @@ mod identification_tx40;
 mod inertia_matrix;
 #[path = "inverse_dynamics.rs"]
 mod inverse_dynamics;
+#[path = "inverse_geometry.rs"]
+mod inverse_geometry;
 #[path = "io_consistency.rs"]
 mod io_consistency;
 #[path = "io_external.rs"]

@@ -1,0 +1,505 @@
+//! Closed-form inverse geometric model by Paul's method (Khalil & Dombre, ch. 7; SYMORO's
+//! IGM) for the two classes of 6R chains it solves, detected from the axes of the chain:
+//!
+//! - [`IgmClass::SphericalWrist`]: axes 2 and 3 parallel, axis 1 not parallel to them, axes 4,
+//!   5 and 6 through one point (RX-90, TX40, PUMA): the wrist centre gives theta1 (type 2),
+//!   theta3 (type 2 on its distance to axis 2) and theta2 (atan2); the orientation then gives
+//!   theta5 (type 2), theta4 and theta6 (atan2).
+//! - [`IgmClass::OffsetWrist`]: axes 2, 3 and 4 parallel, axis 1 not parallel to them, axes 5
+//!   and 6 through one point W (the UR family): W gives theta1, the direction of axis 6 theta5,
+//!   the direction of axis 2 seen from frame 6 theta6, and the planar 2R arm theta3, theta2,
+//!   theta4.
+//!
+//! Each level has at most two roots: up to 8 solutions. The equations are those of the
+//! canonical chain T = C0 Rz(theta1) C1 ... Rz(theta6) C6 (`chain.rs`); the page
+//! docs/models/inverse_geometry.md derives them.
+
+use super::chain::{rot_z, then_rot_z, Chain};
+use super::transform_of;
+use crate::error::{Error, Result};
+use crate::geometry::Transform;
+use crate::model::Robot;
+use nalgebra::{Matrix4, Vector3};
+
+/// Relative tolerance of the class detection (parallel axes, concurrent axes) and of the
+/// singularity markers (a root whose equation's discriminant is within it of zero).
+pub const CLOSED_FORM_TOLERANCE: f64 = 1e-9;
+
+/// The class of 6R chain the closed form solves, found from its axes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum IgmClass {
+    /// Axes 2 and 3 parallel, axes 4, 5 and 6 concurrent (a spherical wrist).
+    SphericalWrist,
+    /// Axes 2, 3 and 4 parallel, axes 5 and 6 concurrent (the UR family's offset wrist).
+    OffsetWrist,
+}
+
+impl IgmClass {
+    /// The class's name as the docs use it.
+    pub fn name(self) -> &'static str {
+        match self {
+            IgmClass::SphericalWrist => "6R with a spherical wrist",
+            IgmClass::OffsetWrist => "6R with axes 2, 3, 4 parallel (offset wrist)",
+        }
+    }
+}
+
+/// The singular cases a solution lies in (or within [`CLOSED_FORM_TOLERANCE`] of). A joint of
+/// an infinite family of solutions is given one representative value (0 for the joint itself).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Singularity {
+    /// The point that fixes theta1 (wrist centre, W) on axis 1 (theta1 free), or the point
+    /// that fixes theta2 on axis 2 (theta2 free).
+    pub shoulder: bool,
+    /// The arm fully stretched or folded: the two elbow roots coincide.
+    pub elbow: bool,
+    /// The wrist's first and last axes aligned (axes 4 and 6; for the offset wrist axis 6
+    /// parallel to axis 2): only their sum (difference) is fixed.
+    pub wrist: bool,
+}
+
+impl Singularity {
+    /// Whether any singular case applies.
+    pub fn any(&self) -> bool {
+        self.shoulder || self.elbow || self.wrist
+    }
+}
+
+/// One solution of the closed-form inverse geometric model.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct IgmSolution {
+    /// The chain's six joint values in the robot's movable-joint order ([`ClosedFormIgm::joints`]),
+    /// each wrapped to (-pi, pi] or moved by a turn into its limits.
+    pub q: [f64; 6],
+    /// Whether every joint value lies within the description's `limits` (absent: no limit).
+    pub within_limits: bool,
+    /// The singular cases of this solution.
+    pub singular: Singularity,
+}
+
+/// The solutions of one target (at most 8), without allocation.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct IgmSolutions {
+    items: [IgmSolution; 8],
+    len: usize,
+}
+
+impl IgmSolutions {
+    /// The solutions found (empty when the target is out of reach).
+    pub fn as_slice(&self) -> &[IgmSolution] {
+        &self.items[..self.len]
+    }
+
+    /// Their number.
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    /// Whether the target is out of reach.
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    fn push(&mut self, s: IgmSolution) {
+        self.items[self.len] = s;
+        self.len += 1;
+    }
+}
+
+/// Roots of the type-2 equation X sin(theta) + Y cos(theta) = Z.
+#[derive(Clone, Copy, Debug)]
+enum Roots {
+    /// Two roots (equal when `singular`: a double root, within the tolerance).
+    Two(f64, f64, bool),
+    /// X = Y = Z = 0: any theta.
+    Any,
+    /// |Z| > sqrt(X^2 + Y^2): no root.
+    None,
+}
+
+/// theta with a . Rz(theta) b = k (a type-2 equation of Paul's method): X = a_y b_x - a_x b_y,
+/// Y = a_x b_x + a_y b_y, Z = k - a_z b_z; `tol` is the tolerance on Z (units of k) for
+/// X = Y = 0 and for |Z| beyond sqrt(X^2 + Y^2).
+fn solve_dot(a: &Vector3<f64>, b: &Vector3<f64>, k: f64, tol: f64) -> Roots {
+    let x = a.y * b.x - a.x * b.y;
+    let y = a.x * b.x + a.y * b.y;
+    let z = k - a.z * b.z;
+    let rho = x.hypot(y);
+    if rho <= tol {
+        return if z.abs() <= tol {
+            Roots::Any
+        } else {
+            Roots::None
+        };
+    }
+    if z.abs() > rho + tol {
+        return Roots::None;
+    }
+    let cos = (z / rho).clamp(-1.0, 1.0);
+    let phi = x.atan2(y);
+    let delta = cos.acos();
+    // rounding in Z / rho moves a double root by ~sqrt(eps): the roots count as one when
+    // they are within sqrt(CLOSED_FORM_TOLERANCE) of each other (or of a half turn apart)
+    let singular = delta.min(std::f64::consts::PI - delta) <= CLOSED_FORM_TOLERANCE.sqrt();
+    Roots::Two(phi + delta, phi - delta, singular)
+}
+
+/// The angle theta of Rz(theta) u = v in the xy plane; None when u or v lies on the z axis.
+fn angle_between(u: &Vector3<f64>, v: &Vector3<f64>, tol: f64) -> Option<f64> {
+    (u.xy().norm() > tol && v.xy().norm() > tol).then(|| v.y.atan2(v.x) - u.y.atan2(u.x))
+}
+
+/// A root pair, a free angle given as `free` (twice), or none.
+fn roots_or(r: Roots, free: f64) -> Option<([f64; 2], bool)> {
+    match r {
+        Roots::Two(a, b, s) => Some(([a, b], s)),
+        Roots::Any => Some(([free; 2], true)),
+        Roots::None => None,
+    }
+}
+
+/// The closed-form inverse geometric model of one 6R chain: constants found once from the
+/// robot, then [`Self::solve`] per target (no allocation).
+#[derive(Clone, Debug)]
+pub struct ClosedFormIgm {
+    chain: Chain,
+    class: IgmClass,
+    /// The terminal frame.
+    frame: usize,
+    /// tool^-1 (identity without a tool).
+    tool_inv: Transform,
+    /// C0^-1.
+    c0_inv: Transform,
+    /// C6^-1.
+    c6_inv: Transform,
+    /// Axis 2's direction in frame A1 (C1 e_z).
+    u2: Vector3<f64>,
+    /// The class's point (wrist centre, W) in A1 at theta = 0, in A6, and in the link where
+    /// the planar arm ends (A3: the wrist centre; A3 for O4 of the offset wrist).
+    point0: Vector3<f64>,
+    point6: Vector3<f64>,
+    point3: Vector3<f64>,
+    /// Axis 2's direction in frame A4 (offset wrist).
+    e4: Vector3<f64>,
+}
+
+/// A geometric line: a point and a unit direction.
+#[derive(Clone, Copy)]
+struct Axis {
+    p: Vector3<f64>,
+    u: Vector3<f64>,
+}
+
+impl Axis {
+    fn parallel(&self, o: &Axis) -> bool {
+        self.u.cross(&o.u).norm() <= CLOSED_FORM_TOLERANCE
+    }
+
+    fn distance_to(&self, x: &Vector3<f64>) -> f64 {
+        (x - self.p).cross(&self.u).norm()
+    }
+
+    /// The common point of two non-parallel axes, if they meet (within `tol`).
+    fn meet(&self, o: &Axis, tol: f64) -> Option<Vector3<f64>> {
+        // closest points p + s u, o.p + t o.u
+        let w = self.p - o.p;
+        let b = self.u.dot(&o.u);
+        let (d, e) = (self.u.dot(&w), o.u.dot(&w));
+        let den = 1.0 - b * b;
+        if den <= CLOSED_FORM_TOLERANCE {
+            return None;
+        }
+        let s = (b * e - d) / den;
+        let t = (e - b * d) / den;
+        let (x, y) = (self.p + self.u * s, o.p + o.u * t);
+        ((x - y).norm() <= tol).then_some((x + y) / 2.0)
+    }
+}
+
+impl ClosedFormIgm {
+    /// The closed form for the placement of the robot's last frame (a serial robot).
+    ///
+    /// Errors: [`Error::Input`] when the robot is not a serial chain, or its chain is of no
+    /// class handled (the message names the numeric inverse geometric model).
+    pub fn new(robot: &Robot) -> Result<Self> {
+        Self::for_frame(robot, super::chain::terminal_frame(robot)?)
+    }
+
+    /// The closed form for the placement of frame `frame` (the chain from the base to it must
+    /// hold six revolute joints of one of the classes of [`IgmClass`]).
+    pub fn for_frame(robot: &Robot, frame: usize) -> Result<Self> {
+        let chain = Chain::new(robot, frame)?;
+        if chain.n() != 6 {
+            return Err(no_class(
+                robot,
+                &format!(
+                    "{} joints on the path to frame {frame}, 6 needed",
+                    chain.n()
+                ),
+            ));
+        }
+        // the axes at theta = 0, in the frame of C0 (P_1 = I, P_{k+1} = P_k C_k)
+        let mut p = Transform::identity();
+        let mut frames = [Transform::identity(); 6];
+        let mut axes = [Axis {
+            p: Vector3::zeros(),
+            u: Vector3::z(),
+        }; 6];
+        for k in 0..6 {
+            if k > 0 {
+                p = p.compose(&chain.c[k]);
+            }
+            frames[k] = p;
+            axes[k] = Axis {
+                p: p.pos,
+                u: p.rot.column(2).into(),
+            };
+        }
+        let tol = CLOSED_FORM_TOLERANCE * chain.scale;
+        let [a1, a2, a3, a4, a5, a6] = axes;
+        let arm = a2.parallel(&a3) && !a1.parallel(&a2);
+        let wrist = a4.meet(&a5, tol).filter(|c| a6.distance_to(c) <= tol);
+        let (class, point0) =
+            match wrist {
+                Some(c) if arm && !a5.parallel(&a6) => (IgmClass::SphericalWrist, c),
+                _ => match a5.meet(&a6, tol) {
+                    Some(w) if arm && a3.parallel(&a4) && !a4.parallel(&a5) => {
+                        (IgmClass::OffsetWrist, w)
+                    }
+                    _ => return Err(no_class(
+                        robot,
+                        "neither axes 2, 3 parallel with axes 4, 5, 6 concurrent nor axes 2, 3, 4 \
+                         parallel with axes 5, 6 concurrent",
+                    )),
+                },
+            };
+        let inv = |t: &Transform, x: &Vector3<f64>| t.rot.tr_mul(&(x - t.pos));
+        let u2: Vector3<f64> = chain.c[1].rot.column(2).into();
+        let point3 = match class {
+            IgmClass::SphericalWrist => inv(&frames[2], &point0),
+            IgmClass::OffsetWrist => chain.c[3].pos,
+        };
+        Ok(ClosedFormIgm {
+            class,
+            frame,
+            tool_inv: Transform::identity(),
+            c0_inv: chain.c[0].inverse(),
+            c6_inv: chain.c[6].inverse(),
+            u2,
+            point6: inv(&frames[5], &point0),
+            point3,
+            point0,
+            e4: frames[3].rot.tr_mul(&u2),
+            chain,
+        })
+    }
+
+    /// The same model for a tool frame fixed on the terminal frame at `tool` (its 4x4 placement
+    /// in the terminal frame): targets are then placements of the tool frame.
+    ///
+    /// Errors: as a target ([`Self::solve`]).
+    pub fn with_tool(mut self, tool: &Matrix4<f64>) -> Result<Self> {
+        self.tool_inv = transform_of("tool", tool)?.inverse();
+        Ok(self)
+    }
+
+    /// The class found.
+    pub fn class(&self) -> IgmClass {
+        self.class
+    }
+
+    /// The terminal frame (without the tool).
+    pub fn frame(&self) -> usize {
+        self.frame
+    }
+
+    /// The index of each solution entry in the robot's movable-joint vector.
+    pub fn joints(&self) -> [usize; 6] {
+        let mut j = [0; 6];
+        j.copy_from_slice(&self.chain.coord);
+        j
+    }
+
+    /// Every solution for the 4x4 placement `target` of the terminal (or tool) frame in the
+    /// base frame; empty when it is out of reach.
+    ///
+    /// Errors: [`Error::NotFinite`] for a NaN or infinite entry, [`Error::Input`] when the
+    /// rotation part is not orthonormal with determinant 1 or the last row is not (0, 0, 0, 1)
+    /// (within 1e-9).
+    pub fn solve(&self, target: &Matrix4<f64>) -> Result<IgmSolutions> {
+        let t = transform_of("target", target)?;
+        let m = self
+            .c0_inv
+            .compose(&t.compose(&self.tool_inv))
+            .compose(&self.c6_inv);
+        let mut out = IgmSolutions::default();
+        match self.class {
+            IgmClass::SphericalWrist => self.spherical(&m, &mut out),
+            IgmClass::OffsetWrist => self.offset(&m, &mut out),
+        }
+        Ok(out)
+    }
+
+    fn tol(&self) -> f64 {
+        CLOSED_FORM_TOLERANCE * self.chain.scale
+    }
+
+    /// theta1 from the point's component along axis 2, invariant under joints 2, 3 (and 4):
+    /// u2 . Rz(theta1)^T x_M = u2 . x(0).
+    fn theta1(&self, x_m: &Vector3<f64>) -> Option<([f64; 2], bool)> {
+        let r = solve_dot(x_m, &self.u2, self.u2.dot(&self.point0), self.tol());
+        roots_or(r, self.chain.theta0[0])
+    }
+
+    /// theta2, theta3 of the planar arm placing the point `point3` (fixed in A3) at `x_m`:
+    /// theta3 from its distance to O2 (type 2), theta2 from atan2.
+    fn planar(&self, theta1: f64, x_m: &Vector3<f64>) -> Option<[(f64, f64, Singularity); 2]> {
+        let (c1, c2) = (&self.chain.c[1], &self.chain.c[2]);
+        let x2 = c1.rot.tr_mul(&(rot_z(theta1).tr_mul(x_m) - c1.pos));
+        let a = c2.rot.tr_mul(&c2.pos);
+        let b = &self.point3;
+        let k = (x2.norm_squared() - c2.pos.norm_squared() - b.norm_squared()) / 2.0;
+        let tol2 = self.tol() * self.chain.scale;
+        let (t3, elbow) = roots_or(solve_dot(&a, b, k, tol2), self.chain.theta0[2])?;
+        Some(t3.map(|th3| {
+            let v = c2.compose(&Transform {
+                rot: rot_z(th3),
+                pos: Vector3::zeros(),
+            });
+            let v = v.rot * b + v.pos;
+            let th2 = angle_between(&v, &x2, self.tol());
+            let singular = Singularity {
+                shoulder: th2.is_none(),
+                elbow,
+                wrist: false,
+            };
+            (th2.unwrap_or(self.chain.theta0[1]), th3, singular)
+        }))
+    }
+
+    /// A3 = Rz(theta1) C1 Rz(theta2) C2 Rz(theta3) (the frame of C0 removed).
+    fn a3(&self, th: &[f64; 6]) -> Transform {
+        let c = &self.chain.c;
+        let a1 = Transform {
+            rot: rot_z(th[0]),
+            pos: Vector3::zeros(),
+        };
+        then_rot_z(&then_rot_z(&a1.compose(&c[1]), th[1]).compose(&c[2]), th[2])
+    }
+
+    fn push(&self, th: &[f64; 6], singular: Singularity, out: &mut IgmSolutions) {
+        let mut q = [0.0; 6];
+        let mut within = true;
+        for k in 0..6 {
+            let (v, inside) = self.chain.joint_value(k, th[k]);
+            q[k] = v;
+            within &= inside;
+        }
+        out.push(IgmSolution {
+            q,
+            within_limits: within,
+            singular,
+        });
+    }
+
+    fn spherical(&self, m: &Transform, out: &mut IgmSolutions) {
+        let c_m = m.rot * self.point6 + m.pos;
+        let Some((t1, shoulder)) = self.theta1(&c_m) else {
+            return;
+        };
+        let (c3, c4, c5) = (&self.chain.c[3], &self.chain.c[4], &self.chain.c[5]);
+        for th1 in t1 {
+            let Some(arm) = self.planar(th1, &c_m) else {
+                continue;
+            };
+            for (th2, th3, s) in arm {
+                let mut th = [th1, th2, th3, 0.0, 0.0, 0.0];
+                // R = 3A4'^T A3^T M: Rz(theta4) C4 Rz(theta5) C5 Rz(theta6)
+                let r = c3.rot.tr_mul(&self.a3(&th).rot.tr_mul(&m.rot));
+                let b: Vector3<f64> = r.column(2).into();
+                let z = Vector3::z();
+                let g = c4.rot.tr_mul(&z);
+                let p6 = c5.rot * z;
+                let Some((t5, _)) = roots_or(
+                    solve_dot(&g, &p6, b.z, CLOSED_FORM_TOLERANCE),
+                    self.chain.theta0[4],
+                ) else {
+                    continue;
+                };
+                for th5 in t5 {
+                    let c4r5 = c4.rot * rot_z(th5);
+                    let m5 = c4r5 * p6;
+                    let th4 = angle_between(&m5, &b, CLOSED_FORM_TOLERANCE);
+                    th[3] = th4.unwrap_or(self.chain.theta0[3]);
+                    th[4] = th5;
+                    // Rz(theta6) = Q^T R, Q = Rz(theta4) C4 Rz(theta5) C5: its first column
+                    let q = rot_z(th[3]) * c4r5 * c5.rot;
+                    let r0 = r.column(0);
+                    th[5] = q.column(1).dot(&r0).atan2(q.column(0).dot(&r0));
+                    let singular = Singularity {
+                        shoulder: shoulder || s.shoulder,
+                        elbow: s.elbow,
+                        wrist: th4.is_none(),
+                    };
+                    self.push(&th, singular, out);
+                }
+            }
+        }
+    }
+
+    fn offset(&self, m: &Transform, out: &mut IgmSolutions) {
+        let w_m = m.rot * self.point6 + m.pos;
+        let Some((t1, shoulder)) = self.theta1(&w_m) else {
+            return;
+        };
+        let (c3, c4, c5) = (&self.chain.c[3], &self.chain.c[4], &self.chain.c[5]);
+        let z6: Vector3<f64> = m.rot.column(2).into();
+        let z = Vector3::z();
+        for th1 in t1 {
+            let z2 = rot_z(th1) * self.u2;
+            // axis 6 against axis 2: e4 . C4 Rz(theta5) C5 e_z = z2 . z6
+            let g = c4.rot.tr_mul(&self.e4);
+            let p6 = c5.rot * z;
+            let Some((t5, _)) = roots_or(
+                solve_dot(&g, &p6, z2.dot(&z6), CLOSED_FORM_TOLERANCE),
+                self.chain.theta0[4],
+            ) else {
+                continue;
+            };
+            for th5 in t5 {
+                // axis 2 seen from frame 6: Rz(theta6) n = m6
+                let n = m.rot.tr_mul(&z2);
+                let m6 = c5.rot.tr_mul(&rot_z(th5).tr_mul(&g));
+                let th6 = angle_between(&n, &m6, CLOSED_FORM_TOLERANCE);
+                let wrist = th6.is_none();
+                let th6 = th6.unwrap_or(self.chain.theta0[5]);
+                // A4 = M (C4 Rz5 C5 Rz6)^-1
+                let tail = then_rot_z(&then_rot_z(c4, th5).compose(c5), th6);
+                let a4 = m.compose(&tail.inverse());
+                let Some(arm) = self.planar(th1, &a4.pos) else {
+                    continue;
+                };
+                for (th2, th3, s) in arm {
+                    let mut th = [th1, th2, th3, 0.0, th5, th6];
+                    let n4 = (self.a3(&th).rot * c3.rot).tr_mul(&a4.rot);
+                    th[3] = n4[(1, 0)].atan2(n4[(0, 0)]);
+                    let singular = Singularity {
+                        shoulder: shoulder || s.shoulder,
+                        elbow: s.elbow,
+                        wrist,
+                    };
+                    self.push(&th, singular, out);
+                }
+            }
+        }
+    }
+}
+
+fn no_class(robot: &Robot, why: &str) -> Error {
+    Error::Input(format!(
+        "{}: no closed-form inverse geometric model ({why}); the closed form handles 6R chains \
+         with a spherical wrist or with axes 2, 3, 4 parallel: use the numeric inverse geometric \
+         model (inverse_geometry::NumericIgm)",
+        robot.name()
+    ))
+}

@@ -1,0 +1,70 @@
+//! Inverse geometric model (IGM: joint values for a placement of a frame) and inverse kinematic
+//! model (IKM: joint velocities for a twist of a frame), Khalil & Dombre ch. 7 and 6.
+//!
+//! - [`closed_form`]: every solution by Paul's method for the 6R classes it handles
+//!   ([`IgmClass`]), found from the robot's axes;
+//!
+//! The equations and the methods' parameters: docs/models/inverse_geometry.md.
+
+mod chain;
+pub mod closed_form;
+
+pub use closed_form::{
+    ClosedFormIgm, IgmClass, IgmSolution, IgmSolutions, Singularity, CLOSED_FORM_TOLERANCE,
+};
+
+use crate::error::{Error, Result};
+use crate::geometry::Transform;
+use nalgebra::{Matrix3, Matrix4, Vector3};
+
+/// Tolerance of the checks of a placement: |R^T R - I|, |det R - 1| and the last row.
+pub const PLACEMENT_TOLERANCE: f64 = 1e-9;
+
+/// A 4x4 placement as a [`Transform`], checked: finite, rotation part orthonormal with
+/// determinant 1, last row (0, 0, 0, 1), each within [`PLACEMENT_TOLERANCE`].
+pub(crate) fn transform_of(what: &str, m: &Matrix4<f64>) -> Result<Transform> {
+    check_target(what, m)?;
+    Ok(Transform {
+        rot: m.fixed_view::<3, 3>(0, 0).into_owned(),
+        pos: m.fixed_view::<3, 1>(0, 3).into_owned(),
+    })
+}
+
+/// The checks of [`transform_of`].
+pub(crate) fn check_target(what: &str, m: &Matrix4<f64>) -> Result<()> {
+    // column-major index k = row + 4 column, reported as [row, column]
+    if let Some(k) = m.iter().position(|x| !x.is_finite()) {
+        return Err(Error::NotFinite {
+            what: format!("{what}[{}, {}]", k % 4, k / 4),
+            index: k,
+            value: m[k],
+        });
+    }
+    let row = m.fixed_view::<1, 4>(3, 0);
+    let last = (row - nalgebra::RowVector4::new(0.0, 0.0, 0.0, 1.0)).amax();
+    if last > PLACEMENT_TOLERANCE {
+        return Err(Error::Input(format!(
+            "{what}: the last row of a 4x4 placement must be (0, 0, 0, 1), it is ({}, {}, {}, {})",
+            row[0], row[1], row[2], row[3]
+        )));
+    }
+    let r: Matrix3<f64> = m.fixed_view::<3, 3>(0, 0).into_owned();
+    let ortho = (r.tr_mul(&r) - Matrix3::identity()).amax();
+    let det = r.determinant();
+    if ortho > PLACEMENT_TOLERANCE || (det - 1.0).abs() > PLACEMENT_TOLERANCE {
+        return Err(Error::Input(format!(
+            "{what}: the rotation part of a placement must be orthonormal with determinant 1 \
+             (largest entry of R'R - I: {ortho:.3e}, det R = {det}, tolerance {PLACEMENT_TOLERANCE:.0e})"
+        )));
+    }
+    Ok(())
+}
+
+/// The 4x4 matrix of a rotation and a position.
+pub fn placement(rot: &Matrix3<f64>, pos: &Vector3<f64>) -> Matrix4<f64> {
+    Transform {
+        rot: *rot,
+        pos: *pos,
+    }
+    .matrix()
+}
