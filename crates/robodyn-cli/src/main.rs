@@ -16,6 +16,7 @@ macro_rules! outln {
 mod commands;
 mod common;
 mod hint;
+mod kinematic_state;
 mod output;
 mod rows;
 mod states;
@@ -48,6 +49,14 @@ enum Command {
     Regressor(commands::regressor::Args),
     /// Convert a robot file: TOML, SYMORO .par or URDF -> TOML or .par (by extension).
     Convert(commands::convert::Args),
+    /// Direct geometric model: placements (and velocities, accelerations) of frames.
+    Fk(commands::fk::Args),
+    /// Jacobian of a frame in the world, local or local-world-aligned reference.
+    Jacobian(commands::jacobian::Args),
+    /// Centre of mass, its velocity, acceleration and Jacobian.
+    Com(commands::com::Args),
+    /// Inverse geometric model in closed form: every joint solution for a frame's placement.
+    Ik(commands::ik::Args),
     /// Inertia matrix A(q) by the composite-link method (csv or json).
     Inertia(commands::inertia::Args),
     /// Direct dynamic model: joint accelerations for given states and torques.
@@ -92,6 +101,10 @@ fn main() {
         Command::Regressor(a) => commands::regressor::run(a),
         Command::Convert(a) => commands::convert::run(a),
         Command::Inertia(a) => commands::inertia::run(a),
+        Command::Fk(a) => commands::fk::run(a),
+        Command::Jacobian(a) => commands::jacobian::run(a),
+        Command::Com(a) => commands::com::run(a),
+        Command::Ik(a) => commands::ik::run(a),
         Command::Ddm(a) => commands::ddm::run(a),
         Command::Simulate(a) => commands::simulate::run(a),
         Command::Generate(a) => commands::generate::run(a),

@@ -35,6 +35,8 @@ mod cli_identify_hostile;
 mod cli_info;
 #[path = "cli_info_assembly.rs"]
 mod cli_info_assembly;
+#[path = "cli_kinematics.rs"]
+mod cli_kinematics;
 #[path = "cli_long_inputs.rs"]
 mod cli_long_inputs;
 #[path = "cli_outputs.rs"]

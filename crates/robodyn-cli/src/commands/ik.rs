@@ -1,0 +1,117 @@
+//! `robodyn ik ROBOT --frame NAME --pose ...`: the inverse geometric model in closed form
+//! (Paul's method, docs/models/inverse_geometry.md): every joint solution placing the frame at
+//! the target, each flagged within/outside the joint limits and with its singular cases.
+
+use crate::common::{format_number, parse_list, write_text, CliResult, TableFormat};
+use nalgebra::{Matrix4, Rotation3, Vector3};
+use robodyn::algorithms::inverse_geometry::{ClosedFormIgm, IgmSolution};
+use std::path::PathBuf;
+
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    #[command(flatten)]
+    pub robot: crate::common::RobotArgs,
+    /// The frame to place, by name as the robot file gives it (a link or joint frame of the
+    /// chain, or a `[[tool]]` fixed on it; default: the last frame).
+    #[arg(long)]
+    pub frame: Option<String>,
+    /// The target placement of the frame in R_0: `x,y,z,roll,pitch,yaw` (m, rad; URDF's rpy)
+    /// or the 16 entries of the 4x4 matrix row by row.
+    #[arg(long, allow_hyphen_values = true)]
+    pub pose: String,
+    /// Output file (default: standard output).
+    #[arg(long)]
+    pub output: Option<PathBuf>,
+    /// csv: one row per solution (a column per joint of the chain, then within_limits and
+    /// singular); json: a list of {"q", "within_limits", "singular"}.
+    #[arg(long, value_enum, default_value = "csv")]
+    pub format: TableFormat,
+}
+
+pub fn run(a: Args) -> CliResult {
+    let robot = a.robot.load()?;
+    let igm = match &a.frame {
+        None => ClosedFormIgm::new(&robot)?,
+        Some(name) => {
+            let f = robot.frame_id(name)?;
+            let igm = ClosedFormIgm::for_frame(&robot, f.parent())?;
+            igm.with_tool(&f.offset().matrix())?
+        }
+    };
+    let target = pose(&a.pose)?;
+    let solutions = igm.solve(&target)?;
+    if solutions.is_empty() {
+        eprintln!(
+            "robodyn: the target is out of reach of the {}: no solution",
+            igm.class().name()
+        );
+    }
+    let names = robot.coordinates().names();
+    let joints: Vec<&str> = igm.joints().iter().map(|&k| names[k].as_str()).collect();
+    let text = match a.format {
+        TableFormat::Csv => {
+            let h: Vec<String> = joints
+                .iter()
+                .map(|n| crate::commands::fk::csv_field(n))
+                .collect();
+            let mut s = format!("{},within_limits,singular\n", h.join(","));
+            for sol in solutions.as_slice() {
+                let v: Vec<String> = sol.q.iter().map(|x| format_number(*x)).collect();
+                s += &format!("{},{},{}\n", v.join(","), sol.within_limits, singular(sol));
+            }
+            s
+        }
+        TableFormat::Json => {
+            let items: Vec<_> = solutions
+                .as_slice()
+                .iter()
+                .map(|sol| {
+                    serde_json::json!({"q": sol.q, "within_limits": sol.within_limits,
+                                       "singular": singular(sol)})
+                })
+                .collect();
+            let v = serde_json::json!({"class": igm.class().name(), "joints": joints,
+                                       "solutions": items});
+            serde_json::to_string_pretty(&v)? + "\n"
+        }
+    };
+    write_text(a.output.as_deref(), &text)
+}
+
+/// The singular cases of a solution, `-` when none (`shoulder+wrist`, ...).
+fn singular(s: &IgmSolution) -> String {
+    let c = s.singular;
+    let names: Vec<&str> = [
+        (c.shoulder, "shoulder"),
+        (c.elbow, "elbow"),
+        (c.wrist, "wrist"),
+    ]
+    .iter()
+    .filter(|(on, _)| *on)
+    .map(|(_, n)| *n)
+    .collect();
+    if names.is_empty() {
+        "-".into()
+    } else {
+        names.join("+")
+    }
+}
+
+/// `--pose`: six numbers (position, URDF rpy) or sixteen (the matrix row by row).
+fn pose(s: &str) -> CliResult<Matrix4<f64>> {
+    let v = parse_list("pose", s)?;
+    match v.len() {
+        6 => {
+            let rot = Rotation3::from_euler_angles(v[3], v[4], v[5]);
+            let mut m = Matrix4::identity();
+            m.fixed_view_mut::<3, 3>(0, 0).copy_from(rot.matrix());
+            m.fixed_view_mut::<3, 1>(0, 3).copy_from(&Vector3::new(v[0], v[1], v[2]));
+            Ok(m)
+        }
+        16 => Ok(Matrix4::from_row_slice(&v)),
+        n => Err(format!(
+            "--pose has {n} numbers: give x,y,z,roll,pitch,yaw (6) or the 4x4 matrix row by row (16)"
+        )
+        .into()),
+    }
+}
