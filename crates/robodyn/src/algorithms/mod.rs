@@ -7,5 +7,6 @@ pub mod energy;
 pub mod inertia_matrix;
 pub mod inverse_dynamics;
 pub mod inverse_geometry;
+pub mod kinematics;
 pub mod loop_closure;
 pub mod regressor;
