@@ -3,15 +3,23 @@
 //!
 //! - [`closed_form`]: every solution by Paul's method for the 6R classes it handles
 //!   ([`IgmClass`]), found from the robot's axes;
+//! - [`numeric`]: one solution for any robot and frame, by damped least squares from several
+//!   starts ([`NumericIgm`], [`numeric_igm_batch`]);
+//! - [`ikm`]: joint velocities for a twist, damped near singularities ([`inverse_kinematics`]).
 //!
 //! The equations and the methods' parameters: docs/models/inverse_geometry.md.
 
 mod chain;
 pub mod closed_form;
+pub mod ikm;
+pub mod numeric;
 
 pub use closed_form::{
     ClosedFormIgm, IgmClass, IgmSolution, IgmSolutions, Singularity, CLOSED_FORM_TOLERANCE,
 };
+
+pub use ikm::{inverse_kinematics, IkmOptions, IkmSolution};
+pub use numeric::{numeric_igm_batch, NumericIgm, NumericOptions, NumericSolution};
 
 use crate::error::{Error, Result};
 use crate::geometry::Transform;
