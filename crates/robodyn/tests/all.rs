@@ -75,6 +75,8 @@ mod inertia_matrix;
 mod inverse_dynamics;
 #[path = "inverse_geometry.rs"]
 mod inverse_geometry;
+#[path = "inverse_kinematics.rs"]
+mod inverse_kinematics;
 #[path = "io_consistency.rs"]
 mod io_consistency;
 #[path = "io_external.rs"]

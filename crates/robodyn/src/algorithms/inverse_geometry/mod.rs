@@ -3,19 +3,47 @@
 //!
 //! - [`closed_form`]: every solution by Paul's method for the 6R classes it handles
 //!   ([`IgmClass`]), found from the robot's axes;
+//! - [`numeric`]: one solution for any robot and frame, by damped least squares from several
+//!   starts ([`NumericIgm`], [`numeric_igm_batch`]);
+//! - [`ikm`]: joint velocities for a twist, damped near singularities ([`inverse_kinematics`]).
 //!
 //! The equations and the methods' parameters: docs/models/inverse_geometry.md.
+//!
+//! # Example
+//!
+//! ```
+//! use robodyn::algorithms::inverse_geometry::{ClosedFormIgm, IgmClass};
+//! # fn main() -> robodyn::Result<()> {
+//! let robots = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots");
+//! let rx90 = robodyn::io::load(format!("{robots}/rx90.toml"))?;
+//! let igm = ClosedFormIgm::new(&rx90)?;
+//! assert_eq!(igm.class(), IgmClass::SphericalWrist);
+//! let q = [0.1, -0.5, 1.0, 0.3, 0.7, -0.2];
+//! let target = robodyn::geometry::frame_transforms(&rx90, &q)?[igm.frame() - 1].matrix();
+//! let solutions = igm.solve(&target)?;
+//! assert_eq!(solutions.len(), 8);
+//! assert!(solutions.as_slice().iter().any(|s| {
+//!     s.q.iter().zip(&q).all(|(a, b)| (a - b).abs() < 1e-9)
+//! }));
+//! # Ok(())
+//! # }
+//! ```
 
 mod chain;
 pub mod closed_form;
+pub mod ikm;
+pub mod numeric;
 
 pub use closed_form::{
     ClosedFormIgm, IgmClass, IgmSolution, IgmSolutions, Singularity, CLOSED_FORM_TOLERANCE,
 };
 
+pub use ikm::{inverse_kinematics, IkmOptions, IkmSolution};
+pub use numeric::{numeric_igm_batch, NumericIgm, NumericOptions, NumericSolution};
+
 use crate::error::{Error, Result};
 use crate::geometry::Transform;
-use nalgebra::{Matrix3, Matrix4, Vector3};
+use nalgebra::{Matrix3, Matrix4};
 
 /// Tolerance of the checks of a placement: |R^T R - I|, |det R - 1| and the last row.
 pub const PLACEMENT_TOLERANCE: f64 = 1e-9;
@@ -58,13 +86,4 @@ pub(crate) fn check_target(what: &str, m: &Matrix4<f64>) -> Result<()> {
         )));
     }
     Ok(())
-}
-
-/// The 4x4 matrix of a rotation and a position.
-pub fn placement(rot: &Matrix3<f64>, pos: &Vector3<f64>) -> Matrix4<f64> {
-    Transform {
-        rot: *rot,
-        pos: *pos,
-    }
-    .matrix()
 }
