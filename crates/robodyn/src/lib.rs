@@ -61,7 +61,9 @@
 //! - `codegen` (feature `codegen`): customized symbolic models;
 //! - `view` (feature `view`): a 3D view of the frames, links and trajectories in one HTML page;
 //! - `identification` (feature `identification`): dynamic parameters from measured logs;
-//! - [`geometry`]: iT_j and 0T_j.
+//! - [`geometry`]: iT_j and 0T_j;
+//! - [`algorithms::kinematics`]: named frames, placements, velocities, accelerations, frame
+//!   Jacobians (World, Local, LocalWorldAligned), J̇, centre of mass.
 //!
 //! Cargo features (default `io`, `plot`, `codegen`, `view`, `identification`):
 //! `--no-default-features` builds the numeric dynamics alone, and each feature builds alone. The
@@ -108,10 +110,10 @@ pub use algorithms::inverse_dynamics::{
     inverse_dynamics, inverse_dynamics_into, inverse_dynamics_state_into, State,
 };
 pub use algorithms::kinematics::{
-    forward_kinematics_into, frame_acceleration, frame_classical_acceleration,
-    frame_classical_drift, frame_jacobian, frame_jacobian_into, frame_jacobian_time_variation_into,
-    frame_placement, frame_velocity, placements_into, relative_placement, FrameId, KinematicsData,
-    Motion, Reference,
+    center_of_mass, center_of_mass_jacobian_into, forward_kinematics_into, frame_acceleration,
+    frame_classical_acceleration, frame_classical_drift, frame_jacobian, frame_jacobian_into,
+    frame_jacobian_time_variation_into, frame_placement, frame_velocity, placements_into,
+    relative_placement, FrameId, KinematicsData, Motion, Reference,
 };
 pub use algorithms::regressor::{
     regressor, regressor_into, regressor_state_into, wrench_torques, wrench_torques_into,

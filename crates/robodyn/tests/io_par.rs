@@ -99,10 +99,13 @@ fn bundled_robots_convert_to_par_and_back() {
         let back = Robot::new(d).unwrap();
         let e = torque_difference(&r, &back, 4);
         assert!(e == 0.0, "{name}: {e:e}");
-        // TOML -> .par -> TOML is the identity on the description
+        // TOML -> .par -> TOML is the identity on the description, but for the named frames
+        // ([[tool]], the URDF root link's), which a .par has no place for
+        let mut without_tools = r.description().clone();
+        without_tools.tools.clear();
         assert_eq!(
             toml_format::write_description(back.description()),
-            toml_format::write_description(r.description()),
+            toml_format::write_description(&without_tools),
             "{name}"
         );
     }

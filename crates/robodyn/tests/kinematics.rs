@@ -496,3 +496,50 @@ fn bad_tools_are_errors_at_their_line() {
         );
     }
 }
+
+#[test]
+fn frame_motion_read_after_newton_euler_equals_the_forward_pass() {
+    use robodyn::algorithms::kinematics::frame_motion_from_newton_euler;
+    use robodyn::{inverse_dynamics_into, Data};
+    let mut rng = testing::rng(1126);
+    let opt = testing::TreeOptions {
+        gravity: None, // a random gravity: the read must take it off
+        ..Default::default()
+    };
+    for case in 0..8 {
+        let robot = testing::random_tree(&mut rng, 3 + case, &opt);
+        let s = testing::random_state(&mut rng, robot.dof());
+        let mut data = Data::new(&robot);
+        let env = robot.environment().clone();
+        let mut tau = vec![0.0; robot.dof()];
+        inverse_dynamics_into(&robot, &mut data, &env, &s[0], &s[1], &s[2], &mut tau).unwrap();
+        let kd = fk(&robot, &s);
+        for f in frames(&robot, &mut rng) {
+            let ne = frame_motion_from_newton_euler(&robot, &data, &env, &f).unwrap();
+            let t = frame_placement(&robot, &kd, &f).unwrap();
+            let a = frame_classical_acceleration(&robot, &kd, &f, Reference::LocalWorldAligned)
+                .unwrap();
+            let v = frame_velocity(&robot, &kd, &f, Reference::LocalWorldAligned).unwrap();
+            let ctx = format!("tree {case}, frame on {}", f.parent());
+            let tol = |x: f64| 1e-12 * x.max(1.0);
+            assert!(
+                (ne.placement.matrix() - t.matrix()).amax() < 1e-12,
+                "{ctx}: placement"
+            );
+            assert!(
+                (ne.angular_velocity - v.angular).amax() < tol(v.angular.amax()),
+                "{ctx}: w"
+            );
+            assert!(
+                (ne.angular_acceleration - a.angular).amax() < tol(a.angular.amax()),
+                "{ctx}: wd"
+            );
+            assert!(
+                (ne.linear_acceleration - a.linear).amax() < tol(a.linear.amax()),
+                "{ctx}: a {} vs {}",
+                ne.linear_acceleration,
+                a.linear
+            );
+        }
+    }
+}
