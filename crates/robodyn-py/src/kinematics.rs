@@ -4,7 +4,7 @@
 
 use crate::arrays::values;
 use crate::errors::{DimensionError, IntoPy};
-use crate::robot::{quoted, Call, Robot};
+use crate::robot::{quoted, Call, Robot, Work};
 use nalgebra::{DMatrix, Matrix4};
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::exceptions::PyValueError;
@@ -53,6 +53,33 @@ fn matrix4(what: &str, obj: &Bound<'_, PyAny>) -> PyResult<Matrix4<f64>> {
     Ok(Matrix4::from_row_slice(&v))
 }
 
+impl Robot {
+    /// `f` on the model over one state or N states of `inputs` (up to three), `one` the
+    /// result's shape for one state: the call every kinematic function makes.
+    fn kinematics<'py, F>(
+        &self,
+        py: Python<'py>,
+        inputs: &[(&str, Option<&Bound<'py, PyAny>>)],
+        one: &[usize],
+        out: Option<&Bound<'py, PyAny>>,
+        f: F,
+    ) -> PyResult<Bound<'py, PyAny>>
+    where
+        F: Fn(&robodyn::Robot, &mut Work, [&[f64]; 3], &mut [f64]) -> robodyn::Result<()>
+            + Sync
+            + Send,
+    {
+        let models = self.models();
+        let call = Call {
+            inputs,
+            one,
+            stacked: false,
+            out,
+        };
+        self.eval(py, &models, &models.full, call, f)
+    }
+}
+
 #[pymethods]
 impl Robot {
     /// Total mass (kg) of the links a joint moves (what `com` weighs; Pinocchio's
@@ -75,15 +102,8 @@ impl Robot {
         frame: &str,
         out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let models = self.models();
-        let f = models.full.frame_id(frame).py()?;
-        let call = Call {
-            inputs: &[("q", Some(q))],
-            one: &[4, 4],
-            stacked: false,
-            out,
-        };
-        self.eval(py, &models, &models.full, call, move |r, w, x, o| {
+        let f = self.model().frame_id(frame).py()?;
+        self.kinematics(py, &[("q", Some(q))], &[4, 4], out, move |r, w, x, o| {
             placements_into(r, &mut w.kin, x[0])?;
             let m = frame_placement(r, &w.kin, &f)?.matrix();
             for a in 0..4 {
@@ -111,16 +131,9 @@ impl Robot {
         out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let rf = parse_reference(reference)?;
-        let models = self.models();
-        let f = models.full.frame_id(frame).py()?;
-        let n = models.full.dof();
-        let call = Call {
-            inputs: &[("q", Some(q))],
-            one: &[6, n],
-            stacked: false,
-            out,
-        };
-        self.eval(py, &models, &models.full, call, move |r, w, x, o| {
+        let f = self.model().frame_id(frame).py()?;
+        let n = self.model().dof();
+        self.kinematics(py, &[("q", Some(q))], &[6, n], out, move |r, w, x, o| {
             let (kin, j) = w.kin_split(6, n);
             placements_into(r, kin, x[0])?;
             frame_jacobian_into(r, kin, &f, rf, j)?;
@@ -144,19 +157,18 @@ impl Robot {
         out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let rf = parse_reference(reference)?;
-        let models = self.models();
-        let f = models.full.frame_id(frame).py()?;
-        let call = Call {
-            inputs: &[("q", Some(q)), ("qd", Some(qd)), ("qdd", None)],
-            one: &[6],
-            stacked: false,
+        let f = self.model().frame_id(frame).py()?;
+        self.kinematics(
+            py,
+            &[("q", Some(q)), ("qd", Some(qd)), ("qdd", None)],
+            &[6],
             out,
-        };
-        self.eval(py, &models, &models.full, call, move |r, w, x, o| {
-            forward_kinematics_into(r, &mut w.kin, x[0], x[1], x[2])?;
-            write_motion(&frame_velocity(r, &w.kin, &f, rf)?, o);
-            check_finite_result("frame velocity", o)
-        })
+            move |r, w, x, o| {
+                forward_kinematics_into(r, &mut w.kin, x[0], x[1], x[2])?;
+                write_motion(&frame_velocity(r, &w.kin, &f, rf)?, o);
+                check_finite_result("frame velocity", o)
+            },
+        )
     }
 
     /// Classical acceleration of the frame named `frame` in `reference` (as `jacobian`):
@@ -177,19 +189,18 @@ impl Robot {
         out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let rf = parse_reference(reference)?;
-        let models = self.models();
-        let f = models.full.frame_id(frame).py()?;
-        let call = Call {
-            inputs: &[("q", Some(q)), ("qd", Some(qd)), ("qdd", Some(qdd))],
-            one: &[6],
-            stacked: false,
+        let f = self.model().frame_id(frame).py()?;
+        self.kinematics(
+            py,
+            &[("q", Some(q)), ("qd", Some(qd)), ("qdd", Some(qdd))],
+            &[6],
             out,
-        };
-        self.eval(py, &models, &models.full, call, move |r, w, x, o| {
-            forward_kinematics_into(r, &mut w.kin, x[0], x[1], x[2])?;
-            write_motion(&frame_classical_acceleration(r, &w.kin, &f, rf)?, o);
-            check_finite_result("frame acceleration", o)
-        })
+            move |r, w, x, o| {
+                forward_kinematics_into(r, &mut w.kin, x[0], x[1], x[2])?;
+                write_motion(&frame_classical_acceleration(r, &w.kin, &f, rf)?, o);
+                check_finite_result("frame acceleration", o)
+            },
+        )
     }
 
     /// Centre of mass 0P_G (m, in the base frame) of the links a joint moves, for q (rad, m):
@@ -202,19 +213,18 @@ impl Robot {
         q: &Bound<'py, PyAny>,
         out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let models = self.models();
-        let call = Call {
-            inputs: &[("q", Some(q)), ("qd", None), ("qdd", None)],
-            one: &[3],
-            stacked: false,
+        self.kinematics(
+            py,
+            &[("q", Some(q)), ("qd", None), ("qdd", None)],
+            &[3],
             out,
-        };
-        self.eval(py, &models, &models.full, call, |r, w, x, o| {
-            forward_kinematics_into(r, &mut w.kin, x[0], x[1], x[2])?;
-            let g = center_of_mass(r, &mut w.kin, None)?;
-            o.copy_from_slice(g.position.as_slice());
-            check_finite_result("com", o)
-        })
+            |r, w, x, o| {
+                forward_kinematics_into(r, &mut w.kin, x[0], x[1], x[2])?;
+                let g = center_of_mass(r, &mut w.kin, None)?;
+                o.copy_from_slice(g.position.as_slice());
+                check_finite_result("com", o)
+            },
+        )
     }
 
     /// Jacobian of the centre of mass (m per unit of qd): its velocity is com_jacobian(q) qd;
@@ -227,15 +237,8 @@ impl Robot {
         q: &Bound<'py, PyAny>,
         out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let models = self.models();
-        let n = models.full.dof();
-        let call = Call {
-            inputs: &[("q", Some(q))],
-            one: &[3, n],
-            stacked: false,
-            out,
-        };
-        self.eval(py, &models, &models.full, call, move |r, w, x, o| {
+        let n = self.model().dof();
+        self.kinematics(py, &[("q", Some(q))], &[3, n], out, move |r, w, x, o| {
             let (kin, j) = w.kin_split(3, n);
             placements_into(r, kin, x[0])?;
             center_of_mass_jacobian_into(r, kin, None, j)?;

@@ -7,71 +7,19 @@ placed at the target); and a closed chain's J_a against finite differences of it
 The Pinocchio checks need `pip install pin example-robot-data`; they skip visibly without them
 unless ROBODYN_REQUIRE_PINOCCHIO is set (as test_pinocchio.py)."""
 
-import os
-import pathlib
-
 import numpy as np
 import pytest
 
 import robodyn
 from conftest import robot_path
 
-try:
-    import cmeel
-    import pinocchio as pin
-
-    ERD = pathlib.Path(os.path.dirname(os.path.dirname(cmeel.__file__))) / "cmeel.prefix" / "share" / "example-robot-data" / "robots"
-    if not ERD.is_dir():
-        raise ImportError(f"{ERD} not found")
-    SKIP = None
-except ImportError as e:  # pragma: no cover - depends on the machine
-    if os.environ.get("ROBODYN_REQUIRE_PINOCCHIO"):
-        raise
-    SKIP = f"pinocchio / example-robot-data not found ({e}): pip install pin example-robot-data"
+from pinocchio_ref import SKIP, Pin, find, pin
 
 needs_pinocchio = pytest.mark.skipif(SKIP is not None, reason=SKIP or "")
 
 URDFS = ["ur5_robot.urdf", "panda.urdf"]
 REFERENCES = ["world", "local", "local_world_aligned"]
 TOL = 1e-12
-
-
-def find(name):
-    hits = sorted(ERD.rglob(name))
-    assert hits, f"{name} not in {ERD}"
-    return hits[0]
-
-
-class Pin:
-    """Pinocchio's model, with robodyn's joint vector mapped to Pinocchio's q and v."""
-
-    def __init__(self, path, robot):
-        self.model = pin.buildModelFromUrdf(str(path))
-        self.data = self.model.createData()
-        m = self.model
-        names = robot.joint_names
-        assert m.nv == len(names), (m.nv, len(names))
-        self.iv = np.array([m.joints[m.getJointId(n)].idx_v for n in names])
-        self.iq = np.array([m.joints[m.getJointId(n)].idx_q for n in names])
-        self.nqs = np.array([m.joints[m.getJointId(n)].nq for n in names])
-
-    def q(self, q):
-        out = np.zeros(self.model.nq)
-        for k, (i, nq) in enumerate(zip(self.iq, self.nqs)):
-            if nq == 2:  # continuous joint: (cos, sin)
-                out[i], out[i + 1] = np.cos(q[k]), np.sin(q[k])
-            else:
-                out[i] = q[k]
-        return out
-
-    def v(self, x):
-        out = np.zeros(self.model.nv)
-        out[self.iv] = x
-        return out
-
-    def body_frames(self):
-        """The names of the URDF links (Pinocchio's BODY frames), the base link left out."""
-        return [f.name for f in self.model.frames if f.type == pin.FrameType.BODY and f.parentJoint > 0]
 
 
 def pin_ref(name):
@@ -90,7 +38,7 @@ def assert_close(ours, theirs, what):
 def test_placements_jacobians_com_match_pinocchio(name):
     path = find(name)
     robot = robodyn.load(path)
-    p = Pin(path, robot)
+    p = Pin(path, robot.joint_names)
     frames = p.body_frames()
     assert len(frames) >= 6
     assert set(frames) <= set(robot.frame_names), set(frames) - set(robot.frame_names)
