@@ -1,6 +1,7 @@
 """Pinocchio and example-robot-data as the reference of the URDF cross-checks (test_pinocchio.py,
 test_kinematics.py): `SKIP` is None when both are installed, else the reason to skip; with
-ROBODYN_REQUIRE_PINOCCHIO set (CI) their absence is an error. `Pin` is Pinocchio's model with
+ROBODYN_REQUIRE=all or a list naming `pinocchio` (README; CI sets `all`), or the older
+ROBODYN_REQUIRE_PINOCCHIO, their absence is an error. `Pin` is Pinocchio's model with
 robodyn's joint order."""
 
 import os
@@ -17,7 +18,8 @@ try:
         raise ImportError(f"{ERD} not found")
     SKIP = None
 except ImportError as e:  # pragma: no cover - depends on the machine
-    if os.environ.get("ROBODYN_REQUIRE_PINOCCHIO"):
+    keys = [k.strip() for k in os.environ.get("ROBODYN_REQUIRE", "").split(",")]
+    if "all" in keys or "pinocchio" in keys or os.environ.get("ROBODYN_REQUIRE_PINOCCHIO"):
         raise
     pin, ERD = None, None
     SKIP = f"pinocchio / example-robot-data not found ({e}): pip install pin example-robot-data"

@@ -5,7 +5,7 @@ Fortran-ordered input; the errors; the closed-form inverse geometric model (ever
 placed at the target); and a closed chain's J_a against finite differences of its placements.
 
 The Pinocchio checks need `pip install pin example-robot-data`; they skip visibly without them
-unless ROBODYN_REQUIRE_PINOCCHIO is set (as test_pinocchio.py)."""
+unless ROBODYN_REQUIRE names them (tests/pinocchio_ref.py)."""
 
 import numpy as np
 import pytest

@@ -3,7 +3,7 @@ inertia (crba) and ddm (aba) agree to 1e-10 (relative to the largest entry). Pin
 URDF damping and friction; robodyn applies them as Fv qd + Fs sign(qd), added here.
 
 Needs `pip install pin example-robot-data`; skipped without them unless
-ROBODYN_REQUIRE_PINOCCHIO is set (CI sets it)."""
+ROBODYN_REQUIRE names them (tests/pinocchio_ref.py; CI sets it)."""
 
 import numpy as np
 import pytest
