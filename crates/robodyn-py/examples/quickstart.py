@@ -24,7 +24,15 @@ print("batch:", TAU.shape)
 
 # %% Where the frames are: 0T_j of every frame
 T = robot.forward_kinematics(q)
-print("last frame origin:", T[-1, :3, 3], robot.frame_names[-1])
+print("last frame origin:", T[-1, :3, 3], robot.description_frame_names[-1])
+
+# %% Kinematics by frame name (robot.frame_names): placement, Jacobian, centre of mass, IK
+tool = robot.description_frame_names[-1]
+print("0T_tool =", robot.placement(q, tool))
+print("J (local_world_aligned) =", robot.jacobian(q, tool, "local_world_aligned"))
+print("com =", robot.com(q), "mass =", robot.mass)
+sols = robot.ik(tool, robot.placement(q, tool))
+print("IK:", len(sols["q"]), "solutions,", sols["within_limits"].sum(), "within the limits")
 
 # %% Symbols: change a value, save the robot
 sr400 = robodyn.load("robots/sr400.toml")

@@ -11,6 +11,7 @@ use pyo3::create_exception;
 use pyo3::exceptions::PyUserWarning;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use robodyn::algorithms::kinematics::closed_frame_jacobian;
 use robodyn::algorithms::regressor::PARAMS_PER_LINK;
 use robodyn::{
     closed_direct_dynamics_into, closed_inverse_dynamics_into, closed_regressor_into, loop_closure,
@@ -311,6 +312,37 @@ impl ClosedChain {
         d.set_item("rcond_wp", s.conditioning.wp)?;
         d.set_item("warning", s.conditioning.warning)?;
         Ok(d)
+    }
+
+    /// Jacobian J_a = J_tr G of the frame named `frame` (as `Robot.placement`) in the actuated
+    /// coordinates, in `reference` ("world", "local", "local_world_aligned", as
+    /// `Robot.jacobian`): the frame's velocity is J_a qd_a on the closure manifold, the
+    /// passive joints solved by loop closure on the tracker's branch. Rows [linear; angular]:
+    /// shape (6, nq) for q_a of shape (nq,), (N, 6, nq) for (N, nq) (rows followed in order on
+    /// one branch). out: as for idm.
+    #[pyo3(signature = (q_a, frame, reference="world", *, out=None))]
+    fn jacobian<'py>(
+        &self,
+        py: Python<'py>,
+        q_a: &Bound<'py, PyAny>,
+        frame: &str,
+        reference: &str,
+        out: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let rf = crate::kinematics::parse_reference(reference)?;
+        let f = self.chain.robot().frame_id(frame).py()?;
+        let n = self.chain.dof();
+        let call = Call {
+            inputs: &[("q_a", Some(q_a))],
+            one: &[6, n],
+            stacked: false,
+            out,
+        };
+        self.eval(py, "J_a", call, move |c, t, x, o| {
+            let j = closed_frame_jacobian(c, &mut t.branch, x[0], &f, rf)?;
+            crate::kinematics::write_matrix(&j.j_a, o);
+            Ok(j.state.conditioning)
+        })
     }
 
     /// Closed-chain inverse dynamic model Γ_cl = G^T Γ_tr (eq 10.40): the torques (N m) /

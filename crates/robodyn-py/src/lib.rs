@@ -6,6 +6,7 @@
 mod arrays;
 mod closed;
 mod errors;
+mod kinematics;
 mod models;
 mod robot;
 mod view;

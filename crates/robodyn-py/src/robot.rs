@@ -12,6 +12,7 @@ use robodyn::algorithms::regressor::{
     regressor_into, ParameterSelection, RotorMode, ZeroParameters, PARAMS_PER_LINK,
 };
 use robodyn::batch::for_each_row;
+use robodyn::KinematicsData;
 use robodyn::{
     direct_dynamics_into, h_vector_into, inertia_matrix_into, inverse_dynamics_into, Data, Method,
 };
@@ -19,9 +20,11 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::sync::{Arc, Mutex, OnceLock, RwLock};
 
-/// Per-thread buffers of a tree evaluation: the library's `Data` and a matrix output.
+/// Per-thread buffers of a tree evaluation: the library's `Data`, its `KinematicsData` and a
+/// matrix output.
 pub struct Work {
     pub data: Data,
+    pub kin: KinematicsData,
     pub m: DMatrix<f64>,
 }
 
@@ -29,6 +32,7 @@ impl Work {
     pub fn new(robot: &robodyn::Robot) -> Work {
         Work {
             data: Data::new(robot),
+            kin: KinematicsData::new(robot),
             m: DMatrix::zeros(0, 0),
         }
     }
@@ -39,6 +43,14 @@ impl Work {
             self.m = DMatrix::zeros(r, c);
         }
         (&mut self.data, &mut self.m)
+    }
+
+    /// The kinematics data and the matrix buffer with shape (r, c), borrowed together.
+    pub fn kin_split(&mut self, r: usize, c: usize) -> (&mut KinematicsData, &mut DMatrix<f64>) {
+        if self.m.shape() != (r, c) {
+            self.m = DMatrix::zeros(r, c);
+        }
+        (&mut self.kin, &mut self.m)
     }
 }
 
@@ -378,9 +390,20 @@ impl Robot {
         self.model().coordinates().frames().to_vec()
     }
 
-    /// Names of the frames 1..NF (joint names; fixed frames and cut-joint twins included).
+    /// Every frame name `placement`, `jacobian`, `frame_velocity`, ... accept, each once:
+    /// tools (the body frames of URDF links), links, then the description's frames (joint
+    /// names; cut-joint frames left out). The numbers "0".."NF" are accepted too.
     #[getter]
     fn frame_names(&self) -> Vec<String> {
+        let r = self.model();
+        r.frame_names().into_iter().map(str::to_string).collect()
+    }
+
+    /// Names of the description's frames 1..NF, in frame order (joint names; fixed frames,
+    /// cut joints and their twins included): the frames of `forward_kinematics` and
+    /// `antecedents`.
+    #[getter]
+    fn description_frame_names(&self) -> Vec<String> {
         let r = self.model();
         (1..=r.nf()).map(|j| r.frame(j).name.clone()).collect()
     }
@@ -634,7 +657,7 @@ impl Robot {
     }
 
     /// Geometric model: 0T_j (4 x 4 homogeneous matrices, metres) of the frames 1..NF
-    /// (frame_names) for the movable joints' values q (rad, m; cut-joint variables taken as
+    /// (description_frame_names) for the movable joints' values q (rad, m; cut-joint variables taken as
     /// 0): shape (NF, 4, 4) for q of shape (nq,), (N, NF, 4, 4) for (N, nq). out: as for idm.
     #[pyo3(signature = (q, *, out=None))]
     fn forward_kinematics<'py>(

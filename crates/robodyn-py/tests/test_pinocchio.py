@@ -3,67 +3,19 @@ inertia (crba) and ddm (aba) agree to 1e-10 (relative to the largest entry). Pin
 URDF damping and friction; robodyn applies them as Fv qd + Fs sign(qd), added here.
 
 Needs `pip install pin example-robot-data`; skipped without them unless
-ROBODYN_REQUIRE_PINOCCHIO is set (CI sets it)."""
-
-import os
-import pathlib
+ROBODYN_REQUIRE names them (tests/pinocchio_ref.py; CI sets it)."""
 
 import numpy as np
 import pytest
 
 import robodyn
 
-try:
-    import cmeel
-    import pinocchio as pin
+from pinocchio_ref import SKIP, Pin, find, pin
 
-    ERD = pathlib.Path(os.path.dirname(os.path.dirname(cmeel.__file__))) / "cmeel.prefix" / "share" / "example-robot-data" / "robots"
-    if not ERD.is_dir():
-        raise ImportError(f"{ERD} not found")
-except ImportError as e:  # pragma: no cover - depends on the machine
-    if os.environ.get("ROBODYN_REQUIRE_PINOCCHIO"):
-        raise
-    pytest.skip(f"pinocchio / example-robot-data not found ({e}): pip install pin example-robot-data", allow_module_level=True)
+if SKIP is not None:  # pragma: no cover - depends on the machine
+    pytest.skip(SKIP, allow_module_level=True)
 
 URDFS = ["ur5_robot.urdf", "panda.urdf", "baxter.urdf", "talos_reduced.urdf", "hyq_no_sensors.urdf", "double_pendulum_continuous.urdf"]
-
-
-def find(name):
-    hits = sorted(ERD.rglob(name))
-    assert hits, f"{name} not in {ERD}"
-    return hits[0]
-
-
-class Pin:
-    """Pinocchio's model with robodyn's joint order: idx maps our vector to Pinocchio's v."""
-
-    def __init__(self, path, names):
-        self.model = pin.buildModelFromUrdf(str(path))
-        self.data = self.model.createData()
-        m = self.model
-        assert m.nv == len(names), (m.nv, len(names))
-        self.iv = np.array([m.joints[m.getJointId(n)].idx_v for n in names])
-        self.iq = np.array([m.joints[m.getJointId(n)].idx_q for n in names])
-        self.nqs = np.array([m.joints[m.getJointId(n)].nq for n in names])
-
-    def q(self, q):
-        out = np.zeros(self.model.nq)
-        for k, (i, nq) in enumerate(zip(self.iq, self.nqs)):
-            if nq == 2:  # continuous joint: (cos, sin)
-                out[i], out[i + 1] = np.cos(q[k]), np.sin(q[k])
-            else:
-                out[i] = q[k]
-        return out
-
-    def v(self, x):
-        out = np.zeros(self.model.nv)
-        out[self.iv] = x
-        return out
-
-    def drive(self, qd):
-        """Damping and friction Pinocchio's rnea/aba leave out (robodyn's Fv, Fs)."""
-        v = self.v(qd)
-        return self.model.damping * v + self.model.friction * np.sign(v)
 
 
 @pytest.mark.parametrize("name", URDFS)

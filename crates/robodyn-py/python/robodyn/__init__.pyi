@@ -111,7 +111,14 @@ class Robot:
     joint_frames: List[int]
     """Frame numbers (1-based) of the movable joints, in vector order."""
     frame_names: List[str]
-    """Names of the frames 1..NF (fixed frames and cut-joint twins included)."""
+    """Every frame name placement, jacobian, frame_velocity, ... accept, each once: tools (the
+    body frames of URDF links), links, then the description's frames (joint names; cut-joint
+    frames left out). The numbers "0".."NF" are accepted too."""
+    description_frame_names: List[str]
+    """Names of the description's frames 1..NF in frame order (fixed frames, cut joints and
+    their twins included): the frames of forward_kinematics and antecedents."""
+    mass: float
+    """Total mass (kg) of the links a joint moves (what com weighs)."""
     link_names: List[str]
     """Names of the links 1..NL."""
     antecedents: List[int]
@@ -180,8 +187,38 @@ class Robot:
         a singular A. out: as for idm."""
     def forward_kinematics(self, q: ArrayLike, *, out: Optional[Array] = None) -> Array:
         """Geometric model: 0T_j (4 x 4 homogeneous matrices, metres) of the frames 1..NF
-        (frame_names) for the movable joints' values q (rad, m; cut-joint variables taken as
+        (description_frame_names) for the movable joints' values q (rad, m; cut-joint variables taken as
         0): shape (NF, 4, 4) for q of shape (nq,), (N, NF, 4, 4) for (N, nq). out: as for idm."""
+    def placement(self, q: ArrayLike, frame: str, *, out: Optional[Array] = None) -> Array:
+        """Placement 0T_f of the frame named ``frame`` (a name of ``frame_names``: URDF link or
+        joint, tool, link, or a frame number "0".."NF"): a 4 x 4 homogeneous matrix (metres) for
+        q (rad, m) of shape (nq,), (N, 4, 4) for (N, nq) (Pinocchio's data.oMf). Raises
+        InputError for an unknown frame (with the near names). out: as for idm."""
+    def jacobian(self, q: ArrayLike, frame: str, reference: str = "world", *, out: Optional[Array] = None) -> Array:
+        """Jacobian of the frame named ``frame`` in ``reference``: "world", "local" or
+        "local_world_aligned" (Pinocchio's WORLD, LOCAL, LOCAL_WORLD_ALIGNED). Rows [linear;
+        angular]: shape (6, nq) for q of shape (nq,), (N, 6, nq) for (N, nq). An unknown
+        reference raises ValueError. out: as for idm."""
+    def frame_velocity(self, q: ArrayLike, qd: ArrayLike, frame: str, reference: str = "world", *, out: Optional[Array] = None) -> Array:
+        """Velocity [linear; angular] (m/s, rad/s) of the frame named ``frame`` in ``reference``
+        (as jacobian), J(q) qd: shape (6,) for one state, (N, 6) for N states (N, nq). out: as
+        for idm."""
+    def frame_acceleration(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, frame: str, reference: str = "world", *, out: Optional[Array] = None) -> Array:
+        """Classical acceleration [linear; angular] (m/s^2, rad/s^2) of the frame named ``frame``
+        in ``reference`` (Pinocchio's getFrameClassicalAcceleration): shape (6,) for one state,
+        (N, 6) for N states (N, nq). out: as for idm."""
+    def com(self, q: ArrayLike, *, out: Optional[Array] = None) -> Array:
+        """Centre of mass (m, base frame) of the links a joint moves: shape (3,) for q of shape
+        (nq,), (N, 3) for (N, nq). out: as for idm."""
+    def com_jacobian(self, q: ArrayLike, *, out: Optional[Array] = None) -> Array:
+        """Jacobian of the centre of mass: shape (3, nq) for q of shape (nq,), (N, 3, nq) for
+        (N, nq). out: as for idm."""
+    def ik(self, frame: str, target: ArrayLike) -> Dict[str, Any]:
+        """Closed-form inverse geometric model (6R, spherical wrist or axes 2, 3, 4 parallel):
+        every q placing the frame named ``frame`` at ``target`` (4 x 4). A dict: "q" (S, nq)
+        (joints off the chain are 0), "within_limits", "singular", "shoulder", "elbow", "wrist"
+        (S,) bool, "joints" (the chain's 6 indices in q), "class". Raises InputError when the
+        chain has no closed form."""
     def regressor_columns(self, columns: str = "standard", friction: bool = True, rotor: str = "actuated", seed: int = 1) -> List[str]:
         """Names of the regressor's columns for ``columns`` ("standard" or "base")."""
     def regressor(self, q: ArrayLike, qd: Optional[ArrayLike] = None, qdd: Optional[ArrayLike] = None, columns: str = "standard", friction: bool = True, rotor: str = "actuated", seed: int = 1, *, v: Optional[ArrayLike] = None, a: Optional[ArrayLike] = None, out: Optional[Array] = None) -> Array:
@@ -243,6 +280,11 @@ class ClosedChain:
         """Loop closure at one q_a (nq,): q_p, cut-joint variables q_c, the tree's movable-joint
         vector q_tree (rad, m), W = d q_p / d q_a (eq 10.30, (p, nq)), residual, rcond_wp,
         warning."""
+    def jacobian(self, q_a: ArrayLike, frame: str, reference: str = "world", *, out: Optional[Array] = None) -> Array:
+        """Jacobian J_a = J_tr G of the frame named ``frame`` in the actuated coordinates, in
+        ``reference`` (as Robot.jacobian): the frame's velocity is J_a qd_a on the closure
+        manifold. Shape (6, nq) for q_a of shape (nq,), (N, 6, nq) for (N, nq) (rows followed in
+        order on one branch). out: as for idm."""
     def idm(self, q_a: ArrayLike, qd_a: Optional[ArrayLike] = None, qdd_a: Optional[ArrayLike] = None, *, v: Optional[ArrayLike] = None, a: Optional[ArrayLike] = None, out: Optional[Array] = None) -> Array:
         """Closed-chain inverse dynamic model Gamma_cl = G^T Gamma_tr (eq 10.40): the torques
         (N m) / forces (N) of the actuated joints for their positions q_a (rad, m), velocities
