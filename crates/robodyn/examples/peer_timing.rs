@@ -16,9 +16,11 @@
 //! pool of 1 and of 2 threads, 15 pairs run back to back, and prints the median ratio.
 
 use nalgebra::DMatrix;
+use robodyn::algorithms::kinematics::center_of_mass_jacobian_into;
 use robodyn::model::param;
 use robodyn::{
-    direct_dynamics_into, inertia_matrix_into, inverse_dynamics_into, Data, Method, Robot,
+    direct_dynamics_into, frame_jacobian_into, inertia_matrix_into, inverse_dynamics_into,
+    placements_into, Data, FrameId, KinematicsData, Method, Reference, Robot,
 };
 use std::fmt::Write as _;
 use std::hint::black_box;
@@ -61,6 +63,14 @@ fn joint_indices(robot: &Robot, names: &[&str]) -> Result<Vec<usize>, Error> {
             })
         })
         .collect()
+}
+
+/// The frame of each joint named in the states file (Pinocchio's joint frames), in its order.
+fn joint_frames(robot: &Robot, path: &Path) -> Result<Vec<FrameId>, Error> {
+    let text = std::fs::read_to_string(path)?;
+    let header = text.lines().next().ok_or("empty states file")?;
+    let frames = header.split_whitespace().skip(1).map(|n| robot.frame_id(n));
+    Ok(frames.collect::<robodyn::Result<_>>()?)
 }
 
 /// States file: a line `names <joint>...`, then one line per state: q, v, a, tau (nv each).
@@ -176,6 +186,10 @@ fn main() -> Result<(), Error> {
     let mut a = DMatrix::zeros(n, n);
     let mut out = vec![0.0; n];
     let (cmp, aba) = (Method::Composite, Method::ArticulatedBody);
+    let frames = joint_frames(&robot, Path::new(&args[2]))?;
+    let tip = *frames.last().ok_or("no joint")?;
+    let mut kin = KinematicsData::new(&robot);
+    let (mut jac, mut jcom) = (DMatrix::zeros(6, n), DMatrix::zeros(3, n));
 
     let mut text = String::new();
     let put = |text: &mut String, tag: &str, v: &[f64]| {
@@ -200,6 +214,16 @@ fn main() -> Result<(), Error> {
         put(&mut text, "aba", &out);
         direct_dynamics_into(&robot, &mut data, &env, &s.q, &s.qd, &s.tau, cmp, &mut out)?;
         put(&mut text, "composite", &out);
+        placements_into(&robot, &mut kin, &s.q)?;
+        frame_jacobian_into(&robot, &kin, &tip, Reference::Local, &mut jac)?;
+        put_matrix(&mut text, "jac", &jac, &idx, &[]);
+        let g = robodyn::algorithms::kinematics::center_of_mass(
+            &robot,
+            &mut kin_motion(&robot, s)?,
+            None,
+        )?;
+        center_of_mass_jacobian_into(&robot, &mut kin, None, &mut jcom)?;
+        put_matrix(&mut text, "com", &jcom, &idx, g.position.as_slice());
     }
     std::fs::write(&args[3], text)?;
 
@@ -230,5 +254,47 @@ fn main() -> Result<(), Error> {
         direct_dynamics_into(&robot, &mut data, &env, q, &s.qd, &s.tau, cmp, &mut out).unwrap();
         black_box(&out);
     });
+    time("joint_jacobians", &states, samples, target_us, |s| {
+        placements_into(&robot, &mut kin, black_box(&s.q)).unwrap();
+        black_box(&kin);
+    });
+    time("all_frame_jacobians", &states, samples, target_us, |s| {
+        placements_into(&robot, &mut kin, black_box(&s.q)).unwrap();
+        for f in &frames {
+            frame_jacobian_into(&robot, &kin, f, Reference::World, &mut jac).unwrap();
+            black_box(&jac);
+        }
+    });
+    time("frame_jacobian", &states, samples, target_us, |s| {
+        placements_into(&robot, &mut kin, black_box(&s.q)).unwrap();
+        frame_jacobian_into(&robot, &kin, &tip, Reference::Local, &mut jac).unwrap();
+        black_box(&jac);
+    });
+    time("com_jacobian", &states, samples, target_us, |s| {
+        placements_into(&robot, &mut kin, black_box(&s.q)).unwrap();
+        center_of_mass_jacobian_into(&robot, &mut kin, None, &mut jcom).unwrap();
+        black_box(&jcom);
+    });
     Ok(())
+}
+
+/// The kinematics at a state with velocities (the centre of mass's position is read there).
+fn kin_motion(robot: &Robot, s: &State) -> Result<KinematicsData, Error> {
+    let mut k = KinematicsData::new(robot);
+    robodyn::forward_kinematics_into(robot, &mut k, &s.q, &s.qd, &s.qdd)?;
+    Ok(k)
+}
+
+/// `tag`, the leading values, then the matrix row by row with its columns in the states' order.
+fn put_matrix(text: &mut String, tag: &str, m: &DMatrix<f64>, idx: &[usize], lead: &[f64]) {
+    text.push_str(tag);
+    for x in lead {
+        write!(text, " {x:e}").unwrap();
+    }
+    for r in 0..m.nrows() {
+        for &c in idx {
+            write!(text, " {:e}", m[(r, c)]).unwrap();
+        }
+    }
+    text.push('\n');
 }

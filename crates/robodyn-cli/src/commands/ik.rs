@@ -19,6 +19,15 @@ pub struct Args {
     /// or the 16 entries of the 4x4 matrix row by row.
     #[arg(long, allow_hyphen_values = true)]
     pub pose: String,
+    /// The numeric inverse geometric model (Levenberg-Marquardt on the placement error, joint
+    /// limits kept, seeded restarts) instead of the closed form: any robot and frame; one row
+    /// with the joint values, whether it converged and the residual.
+    #[arg(long)]
+    pub numeric: bool,
+    /// --numeric: the first start, all movable joints (default zeros; then random starts
+    /// within the limits until one converges).
+    #[arg(long, allow_hyphen_values = true, requires = "numeric")]
+    pub q0: Option<String>,
     /// Output file (default: standard output).
     #[arg(long)]
     pub output: Option<PathBuf>,
@@ -30,6 +39,9 @@ pub struct Args {
 
 pub fn run(a: Args) -> CliResult {
     let robot = a.robot.load()?;
+    if a.numeric {
+        return numeric(&a, &robot);
+    }
     let igm = match &a.frame {
         None => ClosedFormIgm::new(&robot)?,
         Some(name) => {
@@ -72,6 +84,56 @@ pub fn run(a: Args) -> CliResult {
                 .collect();
             let v = serde_json::json!({"class": igm.class().name(), "joints": joints,
                                        "solutions": items});
+            serde_json::to_string_pretty(&v)? + "\n"
+        }
+    };
+    write_text(a.output.as_deref(), &text)
+}
+
+/// `--numeric`: one row, the movable joints, `converged`, the position (m) and rotation (rad)
+/// errors, the steps and the starts used.
+fn numeric(a: &Args, robot: &robodyn::Robot) -> CliResult {
+    use robodyn::algorithms::inverse_geometry::{NumericIgm, NumericOptions};
+    let frame = match &a.frame {
+        Some(name) => robot.frame_id(name)?,
+        None => robot.frame_id_of(robot.nf())?,
+    };
+    let start = match &a.q0 {
+        Some(s) => parse_list("q0", s)?,
+        None => vec![0.0; robot.dof()],
+    };
+    let igm = NumericIgm::new(robot, frame, NumericOptions::default())?;
+    let s = igm.solve(robot, &pose(&a.pose)?, &start)?;
+    if !s.converged {
+        eprintln!(
+            "robodyn: warning: no start converged ({} starts): the closest joint values are \
+             written, {:e} m and {:e} rad from the target",
+            s.starts, s.position_error, s.rotation_error
+        );
+    }
+    let names = robot.coordinates().names();
+    let text = match a.format {
+        TableFormat::Csv => {
+            let h: Vec<String> = names
+                .iter()
+                .map(|n| crate::commands::fk::csv_field(n))
+                .collect();
+            let v: Vec<String> = s.q.iter().map(|x| format_number(*x)).collect();
+            format!(
+                "{},converged,position_error,rotation_error,iterations,starts\n{},{},{},{},{},{}\n",
+                h.join(","),
+                v.join(","),
+                s.converged,
+                format_number(s.position_error),
+                format_number(s.rotation_error),
+                s.iterations,
+                s.starts
+            )
+        }
+        TableFormat::Json => {
+            let v = serde_json::json!({"joints": names, "q": s.q, "converged": s.converged,
+                "position_error": s.position_error, "rotation_error": s.rotation_error,
+                "iterations": s.iterations, "starts": s.starts});
             serde_json::to_string_pretty(&v)? + "\n"
         }
     };

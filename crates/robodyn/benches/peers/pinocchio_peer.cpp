@@ -16,6 +16,9 @@
 #include "peer_model.hpp"
 
 #include <pinocchio/algorithm/aba.hpp>
+#include <pinocchio/algorithm/center-of-mass.hpp>
+#include <pinocchio/algorithm/frames.hpp>
+#include <pinocchio/algorithm/jacobian.hpp>
 #include <pinocchio/algorithm/cholesky.hpp>
 #include <pinocchio/algorithm/crba.hpp>
 #include <pinocchio/algorithm/rnea.hpp>
@@ -86,8 +89,13 @@ int main(int argc, char** argv) {
     if (o == "--samples") samples = std::atoi(argv[k + 1]);
     else if (o == "--target-us") target_us = std::atof(argv[k + 1]);
   }
-  const Model model = read_model(argv[1]);
+  Model built = read_model(argv[1]);
+  // the kinematics' frame: the last joint's own frame (robodyn's frame of that URDF joint)
+  const pinocchio::JointIndex last = built.njoints - 1;
+  const pinocchio::FrameIndex tip = built.addJointFrame(last, -1);
+  const Model model = built;
   Data data(model);
+  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(6, model.nv);
   const int nv = model.nv;
   const std::vector<State> states = read_states(argv[2], nv);
   VectorXd x(nv);
@@ -111,6 +119,16 @@ int main(int argc, char** argv) {
       out << "\ncomposite";
       composite(model, data, s, Convention::LOCAL, x);
       for (int k = 0; k < nv; ++k) out << ' ' << x[k];
+      out << "\njac";
+      J.setZero();
+      pinocchio::computeFrameJacobian(model, data, s.q, tip, pinocchio::LOCAL, J);
+      for (int r = 0; r < 6; ++r)
+        for (int c = 0; c < nv; ++c) out << ' ' << J(r, c);
+      out << "\ncom";
+      pinocchio::jacobianCenterOfMass(model, data, s.q);
+      for (int r = 0; r < 3; ++r) out << ' ' << data.com[0][r];
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < nv; ++c) out << ' ' << data.Jcom(r, c);
       out << '\n';
     }
   }
@@ -158,6 +176,26 @@ int main(int argc, char** argv) {
       sink += x[0];
     });
   }
+  // kinematics (issue 26): from q each time, as a controller calls them
+  time("joint_jacobians", [&](const State& s) {
+    sink += pinocchio::computeJointJacobians(model, data, s.q)(0, nv - 1);
+  });
+  time("all_frame_jacobians", [&](const State& s) {
+    pinocchio::computeJointJacobians(model, data, s.q);
+    for (pinocchio::JointIndex j = 1; j < (pinocchio::JointIndex)model.njoints; ++j) {
+      J.setZero();
+      pinocchio::getJointJacobian(model, data, j, pinocchio::WORLD, J);
+      sink += J(0, 0);
+    }
+  });
+  time("frame_jacobian", [&](const State& s) {
+    J.setZero();
+    pinocchio::computeFrameJacobian(model, data, s.q, tip, pinocchio::LOCAL, J);
+    sink += J(0, 0);
+  });
+  time("com_jacobian", [&](const State& s) {
+    sink += pinocchio::jacobianCenterOfMass(model, data, s.q)(0, 0) + data.com[0][0];
+  });
   std::fprintf(stderr, "sink %g\n", sink);
   return 0;
 }

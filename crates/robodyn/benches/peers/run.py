@@ -189,7 +189,7 @@ def read_results(path):
 def agreement(pin_res, rd_res):
     """Max abs and relative differences per algorithm."""
     rows = {}
-    for alg in ("rnea", "crba", "aba", "composite"):
+    for alg in ("rnea", "crba", "aba", "composite", "jac", "com"):
         p, r = pin_res[alg], rd_res[alg]
         diff = np.abs(p - r).max()
         rel = diff / max(1.0, np.abs(p).max())
@@ -302,11 +302,17 @@ def main():
             ("inertia matrix vs crba upper only", "crba_full", ["crba_upper_local", "crba_upper_world"]),
             ("direct dynamics O(n) (aba)", "aba", ["aba_local", "aba_world"]),
             ("direct dynamics A^-1(tau - H)", "composite", ["composite_local", "composite_world"]),
+            ("all joints' Jacobians (robodyn: placements; Pinocchio: computeJointJacobians)",
+             "joint_jacobians", ["joint_jacobians"]),
+            ("every joint's Jacobian read, WORLD (the above + one read per joint)",
+             "all_frame_jacobians", ["all_frame_jacobians"]),
+            ("a frame Jacobian, LOCAL, from q (computeFrameJacobian)", "frame_jacobian", ["frame_jacobian"]),
+            ("centre of mass + its Jacobian from q (jacobianCenterOfMass)", "com_jacobian", ["com_jacobian"]),
         ]:
             rm, rs = stat(rd, rname)
             best = min(pnames, key=lambda n: stat(pn, n)[0])
             pm, ps = stat(pn, best)
-            variant = best.rsplit("_", 1)[1] if best != "rnea" else "local"
+            variant = best.rsplit("_", 1)[1] if best.endswith(("_local", "_world")) else "-"
             # the ratio of each round (the two programs ran back to back): its median and range
             # are robust to the VM's speed changing between rounds
             ratios = [a[rname] / b[best] for a, b in zip(rd, pn)]

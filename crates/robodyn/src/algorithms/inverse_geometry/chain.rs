@@ -40,14 +40,19 @@ pub(crate) fn check_frame(robot: &Robot, frame: usize) -> Result<()> {
     if in_tree {
         Ok(())
     } else {
+        let fixed = if robot.nf() > robot.nj() {
+            format!(" and the fixed frames {}..{}", robot.nj() + 1, robot.nf())
+        } else {
+            String::new()
+        };
+        let what = if frame == 0 {
+            "the base frame does not move: it is no placement target".to_string()
+        } else {
+            "no such frame for a placement target".to_string()
+        };
         Err(Error::invalid(
             Item::Frame(frame, None),
-            format!(
-                "no such frame for a placement target: frames 1..{} and fixed frames {}..{} are",
-                robot.nl(),
-                robot.nj() + 1,
-                robot.nf()
-            ),
+            format!("{what}: the link frames 1..{}{fixed} are", robot.nl()),
         ))
     }
 }
