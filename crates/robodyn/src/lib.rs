@@ -105,6 +105,12 @@ pub use algorithms::inertia_matrix::{
 pub use algorithms::inverse_dynamics::{
     inverse_dynamics, inverse_dynamics_into, inverse_dynamics_state_into, State,
 };
+pub use algorithms::kinematics::{
+    forward_kinematics_into, frame_acceleration, frame_classical_acceleration,
+    frame_classical_drift, frame_jacobian, frame_jacobian_into, frame_jacobian_time_variation_into,
+    frame_placement, frame_velocity, placements_into, relative_placement, FrameId, KinematicsData,
+    Motion, Reference,
+};
 pub use algorithms::regressor::{regressor, regressor_into, wrench_torques, wrench_torques_into};
 pub use batch::{direct_dynamics_batch, inverse_dynamics_batch, regressor_batch};
 pub use data::Data;

@@ -87,6 +87,12 @@ mod io_par;
 mod io_urdf;
 #[path = "io_urdf_pinocchio.rs"]
 mod io_urdf_pinocchio;
+#[path = "kinematics.rs"]
+mod kinematics;
+#[path = "kinematics_closed.rs"]
+mod kinematics_closed;
+#[path = "kinematics_pinocchio.rs"]
+mod kinematics_pinocchio;
 #[path = "loop_closure.rs"]
 mod loop_closure;
 #[path = "named_values.rs"]

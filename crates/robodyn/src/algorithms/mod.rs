@@ -6,5 +6,6 @@ pub mod direct_dynamics;
 pub mod energy;
 pub mod inertia_matrix;
 pub mod inverse_dynamics;
+pub mod kinematics;
 pub mod loop_closure;
 pub mod regressor;

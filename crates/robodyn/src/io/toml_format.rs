@@ -11,7 +11,7 @@ use crate::error::{Error, Location, Result};
 use crate::io::source::LineIndex;
 pub use crate::io::SourceMap;
 use crate::model::{
-    validate_structure, JointLimits, JointType, LinkDesc, RobotDescription, Transmission,
+    validate_structure, JointLimits, JointType, LinkDesc, RobotDescription, Tool, Transmission,
     GEOMETRIC_PARAMETERS, STANDARD_PARAMETERS, WRENCH_COMPONENTS,
 };
 use crate::Robot;
@@ -52,6 +52,26 @@ struct FileTop {
     #[serde(default)]
     link: Vec<Spanned<LinkTable>>,
     transmission: Option<Spanned<TransmissionTable>>,
+    #[serde(default)]
+    tool: Vec<Spanned<ToolTable>>,
+}
+
+/// `[[tool]]`: a named frame fixed on a frame (see `docs/robot-format.md`).
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+struct ToolTable {
+    name: Spanned<String>,
+    frame: Spanned<FrameRef>,
+    xyz: Option<Spanned<Vec<SV>>>,
+    rpy: Option<Spanned<Vec<SV>>>,
+}
+
+/// The frame a tool is fixed on: its number or the name of a frame or link.
+#[derive(Deserialize, Debug)]
+#[serde(untagged)]
+enum FrameRef {
+    Number(i64),
+    Name(String),
 }
 
 /// `[transmission]`: m = R q over the actuated joints (see `docs/robot-format.md`).
@@ -522,6 +542,7 @@ pub fn parse_description(text: &str, file: Option<&str>) -> Result<(RobotDescrip
     if let Some(t) = &top.transmission {
         desc.transmission = Some(r.transmission(&desc, t)?);
     }
+    r.tools(&top, &mut desc)?;
     validate_structure(&desc).map_err(|e| r.map.locate(e))?;
     Ok((desc, r.map))
 }
@@ -642,6 +663,66 @@ impl Reader<'_> {
             );
         }
         Ok(Transmission { joints, matrix })
+    }
+}
+
+impl Reader<'_> {
+    /// `[[tool]]` tables: name, the frame (number, frame name or link name), xyz and rpy
+    /// constants; each line recorded for the structure's checks ([`crate::model::tool_item`]).
+    fn tools(&mut self, top: &FileTop, desc: &mut RobotDescription) -> Result<()> {
+        for tt in &top.tool {
+            let t = tt.get_ref();
+            let name = t.name.get_ref().clone();
+            let key = format!("tool `{name}`");
+            self.map.set_base(&key, self.line(tt.span()));
+            let frame = self.tool_frame(&key, desc, &t.frame)?;
+            let three = |v: &Option<Spanned<Vec<SV>>>, what: &str| -> Result<[f64; 3]> {
+                let Some(v) = v else { return Ok([0.0; 3]) };
+                if v.get_ref().len() != 3 {
+                    return Err(self.err(
+                        v.span(),
+                        format!(
+                            "{key}: {what} has {} entries, 3 expected",
+                            v.get_ref().len()
+                        ),
+                    ));
+                }
+                let mut out = [0.0; 3];
+                for (k, e) in v.get_ref().iter().enumerate() {
+                    out[k] = self.constant(&format!("{key}, {what}"), &desc.symbols, e)?;
+                }
+                Ok(out)
+            };
+            let tool = Tool {
+                name,
+                frame,
+                xyz: three(&t.xyz, "xyz")?,
+                rpy: three(&t.rpy, "rpy")?,
+            };
+            desc.tools.push(tool);
+        }
+        Ok(())
+    }
+
+    /// The frame number of a tool's `frame`: a number, or the name of a frame or of a link
+    /// (link j is on frame j).
+    fn tool_frame(
+        &self,
+        key: &str,
+        desc: &RobotDescription,
+        f: &Spanned<FrameRef>,
+    ) -> Result<usize> {
+        match f.get_ref() {
+            FrameRef::Number(n) => usize::try_from(*n)
+                .map_err(|_| self.err(f.span(), format!("{key}: frame {n} is not a frame number"))),
+            FrameRef::Name(n) => {
+                let by_frame = desc.frames.iter().position(|fr| &fr.name == n);
+                let by_link = desc.links.iter().position(|l| &l.name == n);
+                by_frame.or(by_link).map(|i| i + 1).ok_or_else(|| {
+                    self.err(f.span(), format!("{key}: no frame or link is named `{n}`"))
+                })
+            }
+        }
     }
 }
 
@@ -778,6 +859,15 @@ pub fn write_description(desc: &RobotDescription) -> String {
             "\n[transmission]\njoints = {:?}\nmatrix = [\n{}\n]\n",
             t.joints,
             rows.join("\n")
+        ));
+    }
+    for t in &desc.tools {
+        let [x, y, z] = t.xyz;
+        let [r, p, w] = t.rpy;
+        s.push_str(&format!(
+            "\n[[tool]]\nname = {}\nframe = {}\nxyz = [{x:?}, {y:?}, {z:?}]\nrpy = [{r:?}, {p:?}, {w:?}]\n",
+            toml_string(&t.name),
+            t.frame
         ));
     }
     s

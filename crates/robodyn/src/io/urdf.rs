@@ -11,7 +11,10 @@
 //! - frame R_j is placed at the joint origin with z_j along the axis (minimal rotation S_j taking
 //!   z to the axis); the URDF child link frame is then R_j(q) C_j with the constant C_j = S_j^-1,
 //!   because a rotation (translation) about (along) the axis in the joint frame is the rotation
-//!   (translation) about (along) z_j in R_j, with the same q;
+//!   (translation) about (along) z_j in R_j, with the same q; each link whose C_j is not the
+//!   identity becomes a named frame (a [`Tool`]) with the link's name fixed on R_j with
+//!   orientation C_j, and the root link one on R_0, so that every URDF link frame can be named
+//!   (`Robot::frame_id`);
 //! - the placement of R_j in R_i (i = a(j)) is T = C_i O_j S_j (O_j = joint origin xyz/rpy), and
 //!   T is decomposed into Rz(gamma) Tz(b) Rx(alpha) Tx(d) Rz(theta) Tz(r) via the common normal of
 //!   z_i and z_j ([`decompose`]); parallel or coincident axes take the normal through R_j's
@@ -27,7 +30,7 @@
 use crate::error::{Error, Item, Location, Result};
 use crate::io::source::LineIndex;
 use crate::io::{SourceMap, Warning};
-use crate::model::{param, FrameDesc, JointLimits, JointType, LinkDesc, RobotDescription};
+use crate::model::{param, FrameDesc, JointLimits, JointType, LinkDesc, RobotDescription, Tool};
 use nalgebra::{Matrix3, Rotation3, Translation3, UnitQuaternion, Vector3};
 use robodyn_symbolic::Expr;
 use std::collections::HashMap;
@@ -681,6 +684,17 @@ fn tree_order(
 }
 
 /// The description: frame j carries link j (auxiliary fixed frames carry massless links).
+/// The body frame of URDF link `name` as a named frame fixed on frame `j` with orientation
+/// `c` (C_j, a rotation: the link frame and R_j share their origin).
+fn link_frame(name: &str, j: usize, c: &UnitQuaternion<f64>) -> Tool {
+    Tool {
+        name: name.to_string(),
+        frame: j,
+        xyz: [0.0; 3],
+        rpy: crate::algorithms::kinematics::rpy(c.to_rotation_matrix().matrix()),
+    }
+}
+
 fn build(
     ctx: &Ctx,
     robot_name: String,
@@ -698,6 +712,12 @@ fn build(
     let mut number_of_link: Vec<usize> = vec![0; links.len()]; // URDF link -> our link number
                                                                // c_of[j]: orientation of the URDF link frame in R_j (index 0: the base)
     let mut c_of: Vec<UnitQuaternion<f64>> = vec![UnitQuaternion::identity()];
+    // the root link is the base frame R_0
+    let mut tools = vec![link_frame(
+        &links[root].name,
+        0,
+        &UnitQuaternion::identity(),
+    )];
     let frame_of = |name: String, ant: usize, joint: JointType, t: &Iso| {
         let p = decompose(t);
         let mut f = FrameDesc::new(name, ant, joint, joint.is_movable());
@@ -749,6 +769,10 @@ fn build(
             limits.push((j, l.clone()));
         }
         c_of.push(s.inverse());
+        if s.angle() != 0.0 {
+            // the URDF link frame differs from R_j: a named frame fixed on R_j keeps it
+            tools.push(link_frame(&links[jt.child].name, j, &s.inverse()));
+        }
         number_of_link[jt.child] = j;
         map.set_frame(j, None, ctx.line(jt.node));
         if let Some(m) = &jt.mimic {
@@ -784,6 +808,7 @@ fn build(
     desc.links = dlinks;
     desc.notes = notes;
     desc.limits = limits.into_iter().collect();
+    desc.tools = tools;
     desc.gravity = [Expr::zero(), Expr::zero(), Expr::num(-9.81)];
     desc.notes.insert(
         0,

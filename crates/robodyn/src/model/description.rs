@@ -315,6 +315,24 @@ pub struct RobotDescription {
     pub transmission: Option<Transmission>,
     /// Joint limits by frame number (used by excitation design); absent: no limit known.
     pub limits: BTreeMap<usize, JointLimits>,
+    /// Named frames fixed on frames of the description (tool centre points, sensor frames, the
+    /// body frames of URDF links whose axes differ from R_j): TOML's `[[tool]]` tables.
+    pub tools: Vec<Tool>,
+}
+
+/// A named frame fixed on frame `frame` (0 the base, 1..NF): its placement in that frame is
+/// the translation `xyz` (m) then the rotation `rpy` (rad) in URDF's convention,
+/// Rot = Rz(yaw) Ry(pitch) Rx(roll).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Tool {
+    /// The frame's name (unique among the robot's frame, link and tool names it may shadow).
+    pub name: String,
+    /// The frame it is fixed on: 0 (base) .. NF.
+    pub frame: usize,
+    /// Origin of the tool frame in R_frame (m).
+    pub xyz: [f64; 3],
+    /// Roll, pitch, yaw of the tool frame in R_frame (rad), URDF's `rpy`.
+    pub rpy: [f64; 3],
 }
 
 /// Motor positions m = R q over the actuated joints `joints` (R square, motors x joints). With a
@@ -380,6 +398,7 @@ impl RobotDescription {
             notes: Vec::new(),
             transmission: None,
             limits: BTreeMap::new(),
+            tools: Vec::new(),
         }
     }
 

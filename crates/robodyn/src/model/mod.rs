@@ -17,7 +17,7 @@ pub use constants::{
 pub use coordinates::Coordinates;
 pub use description::{
     inertial_parameters, param, FrameDesc, JointLimits, JointType, LinkDesc, RobotDescription,
-    RotorMode, Transmission, GEOMETRIC_PARAMETERS, PARAMS_PER_LINK, STANDARD_PARAMETERS,
+    RotorMode, Tool, Transmission, GEOMETRIC_PARAMETERS, PARAMS_PER_LINK, STANDARD_PARAMETERS,
     WRENCH_COMPONENTS,
 };
 pub use environment::{BaseMotion, Environment, Wrench};
@@ -167,7 +167,46 @@ pub fn validate_structure(desc: &RobotDescription) -> Result<Structure> {
             ));
         }
     }
+    check_tools(desc)?;
     Ok(Structure::new(ant, nl, nj))
+}
+
+/// The item of tool `name` in errors (the TOML reader records its line under it).
+pub(crate) fn tool_item(name: &str) -> Item {
+    Item::Base(format!("tool `{name}`"))
+}
+
+/// Each `[[tool]]` is fixed on the base, a link frame or a twin frame, with finite numbers and
+/// a name no other tool has.
+fn check_tools(desc: &RobotDescription) -> Result<()> {
+    let (nl, nj, nf) = (desc.nl, desc.nj, desc.nf());
+    for (k, t) in desc.tools.iter().enumerate() {
+        let err = |reason: String| Err(Error::invalid(tool_item(&t.name), reason));
+        if t.name.is_empty() {
+            return err("a tool needs a name".into());
+        }
+        if desc.tools[..k].iter().any(|o| o.name == t.name) {
+            return err(format!("two tools are named `{}`", t.name));
+        }
+        if t.frame > nf {
+            return err(format!(
+                "frame {} does not exist (frames 0..{nf}, 0 the base)",
+                t.frame
+            ));
+        }
+        if t.frame > nl && t.frame <= nj {
+            return err(format!(
+                "frame {} is a cut joint's frame, which moves with the loop's cut variable: fix \
+                 the tool on its twin frame {} or on a link",
+                t.frame,
+                t.frame + nj - nl
+            ));
+        }
+        if let Some(x) = t.xyz.iter().chain(&t.rpy).find(|x| !x.is_finite()) {
+            return err(format!("{x} is not a finite number"));
+        }
+    }
+    Ok(())
 }
 
 impl Robot {

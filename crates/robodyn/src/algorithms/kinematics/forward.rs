@@ -1,0 +1,357 @@
+//! The forward kinematic pass: placements 0T_j, velocities and accelerations of every frame of
+//! the description, in R_0, into a [`KinematicsData`]; and the frame quantities read from it.
+
+use super::frames::FrameId;
+use super::{Motion, Reference};
+use crate::error::{Error, Result};
+use crate::geometry::Transform;
+use crate::model::{JointType, Robot};
+use nalgebra::{Matrix3, Vector3};
+
+/// How far the last pass of a [`KinematicsData`] went.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub(crate) enum Level {
+    /// Nothing computed yet.
+    None,
+    /// Placements only ([`placements_into`]).
+    Placements,
+    /// Placements, velocities and accelerations ([`forward_kinematics_into`]).
+    Motion,
+}
+
+/// Buffers and results of the kinematic functions for one robot (Pinocchio's `Data` for
+/// `forwardKinematics`, `computeJointJacobians`, `centerOfMass`): per frame j = 0..NF of the
+/// description (0 the base), all in R_0, at the origin O_j: the placement 0T_j, the angular
+/// velocity and acceleration, the linear velocity and (classical) acceleration of O_j. Made once
+/// per thread with [`KinematicsData::new`]; [`forward_kinematics_into`] or [`placements_into`]
+/// fill it, and the frame functions (placements, velocities, Jacobians, centre of mass) read it
+/// without allocating. Cut-joint frames (NL+1..NJ) are placed at cut variable 0 and never
+/// read (see [`Robot::frame_id_of`]).
+#[derive(Clone, Debug)]
+pub struct KinematicsData {
+    pub(crate) nf: usize,
+    pub(crate) level: Level,
+    pub(crate) rot: Vec<Matrix3<f64>>,
+    pub(crate) pos: Vec<Vector3<f64>>,
+    pub(crate) w: Vec<Vector3<f64>>,
+    pub(crate) v: Vec<Vector3<f64>>,
+    pub(crate) wd: Vec<Vector3<f64>>,
+    pub(crate) a: Vec<Vector3<f64>>,
+    /// Tree arrays (NL entries) of q, qd, qdd.
+    pub(crate) q: Vec<f64>,
+    pub(crate) qd: Vec<f64>,
+    pub(crate) qdd: Vec<f64>,
+    /// Per link (0..NL): sum over its subtree of m_j 0P_Gj, its mass (centre of mass pass).
+    pub(crate) sub_ms: Vec<Vector3<f64>>,
+    pub(crate) sub_m: Vec<f64>,
+    /// Per link (0..NL): moved by a joint; in the subtree of the last centre of mass call.
+    pub(crate) moving: Vec<bool>,
+    pub(crate) member: Vec<bool>,
+}
+
+impl KinematicsData {
+    /// The buffers of `robot`'s kinematic functions.
+    pub fn new(robot: &Robot) -> KinematicsData {
+        let nf = robot.nf();
+        let v = || vec![Vector3::zeros(); nf + 1];
+        KinematicsData {
+            nf,
+            level: Level::None,
+            rot: vec![Matrix3::identity(); nf + 1],
+            pos: v(),
+            w: v(),
+            v: v(),
+            wd: v(),
+            a: v(),
+            q: vec![0.0; robot.nl()],
+            qd: vec![0.0; robot.nl()],
+            qdd: vec![0.0; robot.nl()],
+            sub_ms: vec![Vector3::zeros(); robot.nl() + 1],
+            sub_m: vec![0.0; robot.nl() + 1],
+            moving: vec![false; robot.nl() + 1],
+            member: vec![false; robot.nl() + 1],
+        }
+    }
+
+    /// Error unless this data was made for a robot of `robot`'s size ([`Error::Dimension`]).
+    pub fn check(&self, robot: &Robot) -> Result<()> {
+        if self.nf != robot.nf() || self.q.len() != robot.nl() {
+            return Err(Error::dimension(
+                "kinematics data",
+                robot.nf(),
+                self.nf,
+                format!(
+                    "frames: the KinematicsData was made for another robot than `{}`",
+                    robot.name()
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Error unless the data fits `robot` and its last pass reached `level`.
+    pub(crate) fn ready(&self, robot: &Robot, level: Level) -> Result<()> {
+        self.check(robot)?;
+        if self.level < level {
+            let what = match level {
+                Level::Motion => "velocities and accelerations: run forward_kinematics_into",
+                _ => "placements: run placements_into or forward_kinematics_into",
+            };
+            return Err(Error::Input(format!(
+                "the KinematicsData holds no {what} first"
+            )));
+        }
+        Ok(())
+    }
+}
+
+/// Placements 0T_j of every frame for joint positions `q` (movable joints, frame order) into
+/// `data`: enough for [`frame_placement`], the Jacobians and the centre of mass position.
+/// Allocation-free.
+///
+/// Errors: [`Error::Dimension`] for a `q` of the wrong length or a `data` of another robot,
+/// [`Error::NotFinite`] for a NaN or infinite entry.
+pub fn placements_into(robot: &Robot, data: &mut KinematicsData, q: &[f64]) -> Result<()> {
+    data.check(robot)?;
+    let c = robot.coordinates();
+    c.check("q", q, "movable joints")?;
+    c.scatter(q, &mut data.q);
+    data.level = Level::None;
+    for j in 1..=robot.nf() {
+        place(robot, data, j);
+    }
+    data.level = Level::Placements;
+    Ok(())
+}
+
+/// 0T_j = 0T_a(j) a(j)T_j (cut variables 0).
+#[inline]
+fn place(robot: &Robot, data: &mut KinematicsData, j: usize) {
+    let qj = if j <= robot.nl() { data.q[j - 1] } else { 0.0 };
+    let (r, p) = robot.numeric().frame(j).transform(&qj);
+    let a = robot.ant(j);
+    data.pos[j] = data.pos[a] + data.rot[a] * p;
+    data.rot[j] = data.rot[a] * r;
+}
+
+/// The forward kinematic model of every frame for a state over the movable joints (frame
+/// order): positions `q` (rad, m), velocities `qd`, accelerations `qdd`, into `data`. Fills the
+/// placements 0T_j and, in R_0 at O_j, the angular velocity w_j, linear velocity v_j, angular
+/// acceleration wd_j and linear (classical) acceleration a_j, from the fixed base (no gravity):
+///
+/// w_j = w_i + qd_j z_j (revolute), v_j = v_i + w_i x P + qd_j z_j (prismatic),
+/// wd_j = wd_i + w_i x qd_j z_j + qdd_j z_j (revolute),
+/// a_j = a_i + wd_i x P + w_i x (w_i x P) + 2 w_i x qd_j z_j + qdd_j z_j (prismatic),
+///
+/// with i = a(j), P = O_i O_j and z_j in R_0. Allocation-free.
+///
+/// Errors: [`Error::Dimension`], [`Error::NotFinite`] for a bad input; [`Error::Numerical`]
+/// when finite inputs overflow.
+///
+/// # Example
+///
+/// ```
+/// use robodyn::{forward_kinematics_into, frame_classical_acceleration, KinematicsData, Reference};
+/// # fn main() -> robodyn::Result<()> {
+/// let urdf = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots/rx90.urdf");
+/// let rx90 = robodyn::io::load(urdf)?;
+/// let tool = rx90.frame_id("6")?; // frame 6
+/// let mut data = KinematicsData::new(&rx90);
+/// forward_kinematics_into(&rx90, &mut data, &[0.1; 6], &[0.2; 6], &[0.0; 6])?;
+/// let a = frame_classical_acceleration(&rx90, &data, &tool, Reference::LocalWorldAligned)?;
+/// assert!(a.linear.norm() > 0.0); // centripetal at constant joint speeds
+/// # Ok(())
+/// # }
+/// ```
+pub fn forward_kinematics_into(
+    robot: &Robot,
+    data: &mut KinematicsData,
+    q: &[f64],
+    qd: &[f64],
+    qdd: &[f64],
+) -> Result<()> {
+    data.check(robot)?;
+    let c = robot.coordinates();
+    c.check("q", q, "movable joints")?;
+    c.check("qd", qd, "movable joints")?;
+    c.check("qdd", qdd, "movable joints")?;
+    c.scatter(q, &mut data.q);
+    c.scatter(qd, &mut data.qd);
+    c.scatter(qdd, &mut data.qdd);
+    data.level = Level::None;
+    for j in 1..=robot.nf() {
+        place(robot, data, j);
+        propagate(robot, data, j);
+    }
+    let finite = |v: &[Vector3<f64>]| v.iter().all(|x| x.iter().all(|e| e.is_finite()));
+    if !(finite(&data.w) && finite(&data.v) && finite(&data.wd) && finite(&data.a)) {
+        return Err(Error::Numerical(
+            "the frame velocities or accelerations overflow (finite inputs too large)".into(),
+        ));
+    }
+    data.level = Level::Motion;
+    Ok(())
+}
+
+/// Velocity and acceleration of frame j from its antecedent's (after [`place`]).
+#[inline]
+fn propagate(robot: &Robot, data: &mut KinematicsData, j: usize) {
+    let i = robot.ant(j);
+    let (qd, qdd) = if j <= robot.nl() {
+        (data.qd[j - 1], data.qdd[j - 1])
+    } else {
+        (0.0, 0.0)
+    };
+    let p = data.pos[j] - data.pos[i];
+    let z: Vector3<f64> = data.rot[j].column(2).into_owned();
+    let (wi, wdi) = (data.w[i], data.wd[i]);
+    let mut w = wi;
+    let mut v = data.v[i] + wi.cross(&p);
+    let mut wd = wdi;
+    let mut a = data.a[i] + wdi.cross(&p) + wi.cross(&wi.cross(&p));
+    match robot.numeric().frame(j).joint {
+        JointType::Revolute if j <= robot.nl() => {
+            w += qd * z;
+            wd += wi.cross(&(qd * z)) + qdd * z;
+        }
+        JointType::Prismatic if j <= robot.nl() => {
+            v += qd * z;
+            a += 2.0 * wi.cross(&(qd * z)) + qdd * z;
+        }
+        _ => {}
+    }
+    data.w[j] = w;
+    data.v[j] = v;
+    data.wd[j] = wd;
+    data.a[j] = a;
+}
+
+/// The frame's placement 0T_f and, in R_0 at its origin, w, v, wd, a (a the classical
+/// acceleration of the origin).
+pub(crate) struct FrameState {
+    pub t: Transform,
+    pub w: Vector3<f64>,
+    pub v: Vector3<f64>,
+    pub wd: Vector3<f64>,
+    pub a: Vector3<f64>,
+}
+
+/// The state of frame `f` from its parent's (a rigid offset: same w, wd; v and a of the point).
+pub(crate) fn frame_state(data: &KinematicsData, f: &FrameId) -> FrameState {
+    let j = f.parent();
+    let parent = Transform {
+        rot: data.rot[j],
+        pos: data.pos[j],
+    };
+    let t = parent.compose(f.offset());
+    let r = t.pos - parent.pos;
+    let (w, wd) = (data.w[j], data.wd[j]);
+    FrameState {
+        t,
+        w,
+        v: data.v[j] + w.cross(&r),
+        wd,
+        a: data.a[j] + wd.cross(&r) + w.cross(&w.cross(&r)),
+    }
+}
+
+/// 0T_f, the placement of frame `f` in R_0, after [`placements_into`] or
+/// [`forward_kinematics_into`].
+///
+/// Errors: [`Error::Input`] when `data` holds no placements or `f` belongs to another robot,
+/// [`Error::Dimension`] for a `data` of another robot.
+pub fn frame_placement(robot: &Robot, data: &KinematicsData, f: &FrameId) -> Result<Transform> {
+    data.ready(robot, Level::Placements)?;
+    f.check(robot)?;
+    Ok(frame_state(data, f).t)
+}
+
+/// jT_k = (0T_j)^-1 0T_k, the placement of frame `k` in frame `j`.
+///
+/// Errors: as [`frame_placement`].
+pub fn relative_placement(
+    robot: &Robot,
+    data: &KinematicsData,
+    j: &FrameId,
+    k: &FrameId,
+) -> Result<Transform> {
+    let tj = frame_placement(robot, data, j)?;
+    let tk = frame_placement(robot, data, k)?;
+    Ok(tj.inverse().compose(&tk))
+}
+
+/// The velocity of frame `f` ([`Motion`], [linear; angular]) expressed in `reference`, after
+/// [`forward_kinematics_into`]: in [`Reference::LocalWorldAligned`] the velocity of its origin
+/// and its angular velocity in R_0 (Khalil's 0V_n, 0w_n); in [`Reference::Local`] the same in
+/// the frame's own axes (nV_n, nw_n); in [`Reference::World`] the spatial velocity in R_0 (the
+/// linear part is the velocity of the body point at O_0).
+///
+/// Errors: [`Error::Input`] when `data` holds no velocities or `f` belongs to another robot.
+pub fn frame_velocity(
+    robot: &Robot,
+    data: &KinematicsData,
+    f: &FrameId,
+    reference: Reference,
+) -> Result<Motion> {
+    data.ready(robot, Level::Motion)?;
+    f.check(robot)?;
+    let s = frame_state(data, f);
+    Ok(velocity_in(&s, reference))
+}
+
+fn velocity_in(s: &FrameState, reference: Reference) -> Motion {
+    match reference {
+        Reference::LocalWorldAligned => Motion::new(s.v, s.w),
+        Reference::Local => Motion::new(s.t.rot.tr_mul(&s.v), s.t.rot.tr_mul(&s.w)),
+        Reference::World => Motion::new(s.v + s.t.pos.cross(&s.w), s.w),
+    }
+}
+
+/// The spatial acceleration of frame `f` in `reference` (Pinocchio's `getFrameAcceleration`),
+/// after [`forward_kinematics_into`]: the time derivative of the spatial velocity in the
+/// reference's axes. In `Local` and `LocalWorldAligned` its linear part is the classical
+/// acceleration of the origin minus w x v; in `World`, d/dt (v + O_f x w) = a + v x w + O_f x wd.
+/// J q̈ + J̇ q̇ of the same reference ([`frame_jacobian_into`](super::frame_jacobian_into),
+/// [`frame_jacobian_time_variation_into`](super::frame_jacobian_time_variation_into)).
+///
+/// Errors: as [`frame_velocity`].
+pub fn frame_acceleration(
+    robot: &Robot,
+    data: &KinematicsData,
+    f: &FrameId,
+    reference: Reference,
+) -> Result<Motion> {
+    data.ready(robot, Level::Motion)?;
+    f.check(robot)?;
+    let s = frame_state(data, f);
+    Ok(match reference {
+        Reference::LocalWorldAligned => Motion::new(s.a - s.w.cross(&s.v), s.wd),
+        Reference::Local => {
+            let lin = s.a - s.w.cross(&s.v);
+            Motion::new(s.t.rot.tr_mul(&lin), s.t.rot.tr_mul(&s.wd))
+        }
+        Reference::World => Motion::new(s.a + s.v.cross(&s.w) + s.t.pos.cross(&s.wd), s.wd),
+    })
+}
+
+/// The classical acceleration of frame `f` in `reference` (Pinocchio's
+/// `getFrameClassicalAcceleration`): the spatial acceleration plus w x v (both in the
+/// reference). In `LocalWorldAligned`, the acceleration of the frame's origin and the angular
+/// acceleration in R_0 (Khalil's 0V̇_n, 0ẇ_n); in `Local` the same in the frame's axes; in
+/// `World` Pinocchio's definition applied to the spatial velocity at O_0 (not the acceleration
+/// of a material point).
+///
+/// Errors: as [`frame_velocity`].
+pub fn frame_classical_acceleration(
+    robot: &Robot,
+    data: &KinematicsData,
+    f: &FrameId,
+    reference: Reference,
+) -> Result<Motion> {
+    let acc = frame_acceleration(robot, data, f, reference)?;
+    let vel = frame_velocity(robot, data, f, reference)?;
+    Ok(Motion::new(
+        acc.linear + vel.angular.cross(&vel.linear),
+        acc.angular,
+    ))
+}

@@ -1,0 +1,229 @@
+//! Frame Jacobians J(q) (6 x N, rows [linear; angular], columns the movable joints in frame
+//! order) in the three references, their time derivative J̇ and the classical drift J̇ q̇,
+//! read from the placements (and velocities) of a [`KinematicsData`].
+
+use super::forward::{frame_state, placements_into, FrameState, KinematicsData, Level};
+use super::frames::FrameId;
+use super::{Motion, Reference};
+use crate::error::{Error, Result};
+use crate::model::{JointType, Robot};
+use nalgebra::{DMatrix, Vector3};
+
+/// Call `f(k, j, revolute)` for each movable tree joint j on the path from the base to frame
+/// `parent` (its ancestors and itself), k its entry in the joint vectors.
+pub(crate) fn for_each_support_joint(
+    robot: &Robot,
+    parent: usize,
+    mut f: impl FnMut(usize, usize, bool),
+) {
+    let c = robot.coordinates();
+    let mut j = parent;
+    while j != 0 {
+        if j <= robot.nl() {
+            let joint = robot.numeric().frame(j).joint;
+            if let Some(k) = c.index_of_frame(j) {
+                f(k, j, joint == JointType::Revolute);
+            }
+        }
+        j = robot.ant(j);
+    }
+}
+
+/// Error unless `out` is rows x N.
+pub(crate) fn check_matrix(
+    robot: &Robot,
+    what: &str,
+    out: &DMatrix<f64>,
+    rows: usize,
+) -> Result<()> {
+    let n = robot.dof();
+    if out.nrows() != rows || out.ncols() != n {
+        return Err(Error::dimension(
+            what,
+            rows * n,
+            out.len(),
+            format!(
+                "a {rows} x {n} matrix (movable joints), {} x {} given",
+                out.nrows(),
+                out.ncols()
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Column of the LocalWorldAligned Jacobian of the point `p` (R_0) for joint j: revolute
+/// [z_j x (p - O_j); z_j], prismatic [z_j; 0].
+#[inline]
+fn lwa_column(data: &KinematicsData, j: usize, revolute: bool, p: &Vector3<f64>) -> Motion {
+    let z: Vector3<f64> = data.rot[j].column(2).into_owned();
+    if revolute {
+        Motion::new(z.cross(&(p - data.pos[j])), z)
+    } else {
+        Motion::new(z, Vector3::zeros())
+    }
+}
+
+/// A motion given in LocalWorldAligned (at the frame's origin O_f, R_0 axes) in `reference`.
+#[inline]
+fn from_lwa(s: &FrameState, m: Motion, reference: Reference) -> Motion {
+    match reference {
+        Reference::LocalWorldAligned => m,
+        Reference::Local => Motion::new(s.t.rot.tr_mul(&m.linear), s.t.rot.tr_mul(&m.angular)),
+        // the velocity of the body point at O_0: v - w x O_f
+        Reference::World => Motion::new(m.linear + s.t.pos.cross(&m.angular), m.angular),
+    }
+}
+
+/// The Jacobian of frame `f` in `reference` into `out` (6 x N, rows [linear; angular], one
+/// column per movable joint, zero for joints not between the base and the frame), after
+/// [`placements_into`] or [`forward_kinematics_into`](super::forward_kinematics_into): J q̇ is
+/// [`frame_velocity`](super::frame_velocity) in the same reference. Computing the placements
+/// once and reading several frames' Jacobians is Pinocchio's `computeJointJacobians` then
+/// `getFrameJacobian`. Allocation-free.
+///
+/// - `LocalWorldAligned`: column j = [z_j x (O_f - O_j); z_j] (revolute), [z_j; 0]
+///   (prismatic), all in R_0: Khalil's basic Jacobian 0J_n (0V_n = linear velocity of O_n);
+/// - `Local`: the same rows in the frame's own axes: Khalil's nJ_n;
+/// - `World`: [O_j x z_j; z_j] (revolute), [z_j; 0] (prismatic), the spatial velocity in R_0.
+///
+/// Errors: [`Error::Dimension`] for an `out` that is not 6 x N or a `data` of another robot,
+/// [`Error::Input`] for a `data` without placements or a frame of another robot.
+pub fn frame_jacobian_into(
+    robot: &Robot,
+    data: &KinematicsData,
+    f: &FrameId,
+    reference: Reference,
+    out: &mut DMatrix<f64>,
+) -> Result<()> {
+    data.ready(robot, Level::Placements)?;
+    f.check(robot)?;
+    check_matrix(robot, "J", out, 6)?;
+    out.fill(0.0);
+    let s = frame_state(data, f);
+    for_each_support_joint(robot, f.parent(), |k, j, revolute| {
+        let col = from_lwa(&s, lwa_column(data, j, revolute, &s.t.pos), reference);
+        col.write_column(out, k);
+    });
+    Ok(())
+}
+
+/// The Jacobian of frame `f` in `reference` at joint positions `q` (movable joints, frame
+/// order): 6 x N, rows [linear; angular]. Allocates; use [`frame_jacobian_into`] in loops.
+///
+/// Errors: as [`placements_into`] and [`frame_jacobian_into`].
+///
+/// # Example
+///
+/// ```
+/// use robodyn::{frame_jacobian, Reference};
+/// # fn main() -> robodyn::Result<()> {
+/// let urdf = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots/rx90.urdf");
+/// let rx90 = robodyn::io::load(urdf)?;
+/// let wrist = rx90.frame_id("6")?;
+/// let j = frame_jacobian(&rx90, &[0.1; 6], &wrist, Reference::LocalWorldAligned)?;
+/// assert_eq!(j.shape(), (6, 6));
+/// assert!((j[(5, 0)] - 1.0).abs() < 1e-15); // joint 1 turns about z_0
+/// # Ok(())
+/// # }
+/// ```
+pub fn frame_jacobian(
+    robot: &Robot,
+    q: &[f64],
+    f: &FrameId,
+    reference: Reference,
+) -> Result<DMatrix<f64>> {
+    let mut data = KinematicsData::new(robot);
+    placements_into(robot, &mut data, q)?;
+    let mut out = DMatrix::zeros(6, robot.dof());
+    frame_jacobian_into(robot, &data, f, reference, &mut out)?;
+    Ok(out)
+}
+
+/// J̇ = dJ/dt of frame `f` in `reference` into `out` (6 x N) at the state of the last
+/// [`forward_kinematics_into`](super::forward_kinematics_into) (Pinocchio's
+/// `getFrameJacobianTimeVariation`): J̇ q̇ + J q̈ is
+/// [`frame_acceleration`](super::frame_acceleration) in the same reference. With ż_j = w_j x z_j:
+///
+/// - `LocalWorldAligned`: [ż_j x (O_f - O_j) + z_j x (v_f - v_j); ż_j] (revolute), [ż_j; 0];
+/// - `Local`: nA_0 (J̇_lwa - [w x] J_lwa) row block by row block;
+/// - `World`: [v_j x z_j + O_j x ż_j; ż_j] (revolute), [ż_j; 0] (prismatic).
+///
+/// Errors: as [`frame_jacobian_into`], and [`Error::Input`] for a `data` without velocities.
+pub fn frame_jacobian_time_variation_into(
+    robot: &Robot,
+    data: &KinematicsData,
+    f: &FrameId,
+    reference: Reference,
+    out: &mut DMatrix<f64>,
+) -> Result<()> {
+    data.ready(robot, Level::Motion)?;
+    f.check(robot)?;
+    check_matrix(robot, "dJ", out, 6)?;
+    out.fill(0.0);
+    let s = frame_state(data, f);
+    for_each_support_joint(robot, f.parent(), |k, j, revolute| {
+        let z: Vector3<f64> = data.rot[j].column(2).into_owned();
+        let zd = data.w[j].cross(&z);
+        let col = match (reference, revolute) {
+            (_, false) => {
+                let lwa = Motion::new(zd, Vector3::zeros());
+                let jl = Motion::new(z, Vector3::zeros());
+                local_derivative(&s, lwa, jl, reference)
+            }
+            (Reference::World, true) => {
+                Motion::new(data.v[j].cross(&z) + data.pos[j].cross(&zd), zd)
+            }
+            (_, true) => {
+                let r = s.t.pos - data.pos[j];
+                let lwa = Motion::new(zd.cross(&r) + z.cross(&(s.v - data.v[j])), zd);
+                local_derivative(&s, lwa, Motion::new(z.cross(&r), z), reference)
+            }
+        };
+        col.write_column(out, k);
+    });
+    Ok(())
+}
+
+/// The column of J̇ in `reference` from the LocalWorldAligned column `lwa` of J̇ and `jl` of J:
+/// d/dt (nA_0 x) = nA_0 (ẋ - w x x) for `Local`; `World` prismatic columns are those of
+/// LocalWorldAligned.
+#[inline]
+fn local_derivative(s: &FrameState, lwa: Motion, jl: Motion, reference: Reference) -> Motion {
+    match reference {
+        Reference::Local => {
+            let lin = lwa.linear - s.w.cross(&jl.linear);
+            let ang = lwa.angular - s.w.cross(&jl.angular);
+            Motion::new(s.t.rot.tr_mul(&lin), s.t.rot.tr_mul(&ang))
+        }
+        _ => lwa,
+    }
+}
+
+/// The classical drift of frame `f` in `reference`: its classical acceleration
+/// ([`frame_classical_acceleration`](super::frame_classical_acceleration)) at the data's q, q̇
+/// with q̈ = 0, the term a controller adds to J q̈ (in `LocalWorldAligned`, J̇ q̇ of that
+/// reference). Read after [`forward_kinematics_into`](super::forward_kinematics_into) with any
+/// q̈ (its J q̈ is taken off). Allocation-free.
+///
+/// Errors: as [`frame_jacobian_time_variation_into`].
+pub fn frame_classical_drift(
+    robot: &Robot,
+    data: &KinematicsData,
+    f: &FrameId,
+    reference: Reference,
+) -> Result<Motion> {
+    let acc = super::frame_classical_acceleration(robot, data, f, reference)?;
+    let s = frame_state(data, f);
+    let mut jqdd = Motion::new(Vector3::zeros(), Vector3::zeros());
+    for_each_support_joint(robot, f.parent(), |_, j, revolute| {
+        let col = from_lwa(&s, lwa_column(data, j, revolute, &s.t.pos), reference);
+        let qdd = data.qdd[j - 1];
+        jqdd.linear += qdd * col.linear;
+        jqdd.angular += qdd * col.angular;
+    });
+    Ok(Motion::new(
+        acc.linear - jqdd.linear,
+        acc.angular - jqdd.angular,
+    ))
+}
