@@ -259,7 +259,7 @@ fn generated_dgm_and_jacobian_fit_together() {
     let (a03, p03) = dgm(&t03, "t03", &q);
     let (a36, p36) = dgm(&t36, "t36", &q);
     assert!((a03 * a36 - a06).amax() < 1e-12 && (p03 + a03 * p36 - p06).amax() < 1e-12);
-    let jac = run_python(&j66, "j66", &[q.clone()]);
+    let jac = run_python(&j66, "j66", std::slice::from_ref(&q));
     let h = 1e-6;
     for c in 0..6 {
         let at = |d: f64| {
