@@ -83,6 +83,16 @@ fn dual_placement(
     (rot, pos)
 }
 
+/// Column c of a 6 x n Jacobian stored row by row: [iA_0 v; iA_0 w].
+fn put_column(jac: &mut [f64], c: usize, to_i: &Matrix3<f64>, v: Vector3<f64>, w: Vector3<f64>) {
+    let n = jac.len() / 6;
+    let (v, w) = (to_i * v, to_i * w);
+    for r in 0..3 {
+        jac[r * n + c] = v[r];
+        jac[(r + 3) * n + c] = w[r];
+    }
+}
+
 /// iJ_j, 6 x n row by row: d 0P_j / dq and the axial vector of d 0A_j / dq 0A_j^T for each
 /// movable joint, rotated into frame i.
 fn jacobian_reference(robot: &Robot, q: &[f64], i: usize, j: usize) -> Vec<f64> {
@@ -97,11 +107,7 @@ fn jacobian_reference(robot: &Robot, q: &[f64], i: usize, j: usize) -> Vec<f64> 
         let v = pos.map(|x| x.eps1);
         let w_skew = da * a.transpose();
         let w = Vector3::new(w_skew[(2, 1)], w_skew[(0, 2)], w_skew[(1, 0)]);
-        let (v, w) = (to_i * v, to_i * w);
-        for r in 0..3 {
-            jac[r * n + c] = v[r];
-            jac[(r + 3) * n + c] = w[r];
-        }
+        put_column(&mut jac, c, &to_i, v, w);
     }
     jac
 }
@@ -124,11 +130,7 @@ fn jacobian_differences(robot: &Robot, q: &[f64], i: usize, j: usize) -> Vec<f64
         let v = (plus.pos - minus.pos) / (2.0 * h);
         let w_skew = (plus.rot - minus.rot) / (2.0 * h) * a.transpose();
         let w = Vector3::new(w_skew[(2, 1)], w_skew[(0, 2)], w_skew[(1, 0)]);
-        let (v, w) = (to_i * v, to_i * w);
-        for r in 0..3 {
-            jac[r * n + c] = v[r];
-            jac[(r + 3) * n + c] = w[r];
-        }
+        put_column(&mut jac, c, &to_i, v, w);
     }
     jac
 }
@@ -192,6 +194,16 @@ fn setups() -> Vec<(String, RobotDescription, Frames, bool)> {
     out
 }
 
+/// The values of a program's parameters `p` (the robot's geometric symbols), in its order.
+fn parameters(prog: &Program, desc: &RobotDescription) -> Vec<f64> {
+    prog.inputs
+        .iter()
+        .filter(|g| g.by_name)
+        .flat_map(|g| g.symbols.iter().flatten())
+        .map(|s| desc.symbols[s])
+        .collect()
+}
+
 /// DGM and Jacobian programs of every setup, with three random states each and the reference
 /// outputs ([`dgm_reference`], [`jacobian_reference`]).
 pub(crate) fn kinematic_cases() -> Vec<KinematicCase> {
@@ -209,13 +221,7 @@ pub(crate) fn kinematic_cases() -> Vec<KinematicCase> {
                 ..GenOptions::default()
             };
             let prog = generate(&desc, &opt).unwrap();
-            let p: Vec<f64> = prog
-                .inputs
-                .iter()
-                .filter(|g| g.by_name)
-                .flat_map(|g| g.symbols.iter().flatten())
-                .map(|s| desc.symbols[s])
-                .collect();
+            let p = parameters(&prog, &desc);
             let reference = |q: &[f64]| match model {
                 ModelKind::Dgm(_) => dgm_reference(&robot, q, i, j),
                 _ => jacobian_reference(&robot, q, i, j),
@@ -435,13 +441,7 @@ fn generated_jacobian_equals_the_numeric_frame_jacobian() {
             ..GenOptions::default()
         };
         let prog = generate(&desc, &opt).unwrap();
-        let p: Vec<f64> = prog
-            .inputs
-            .iter()
-            .filter(|g| g.by_name)
-            .flat_map(|g| g.symbols.iter().flatten())
-            .map(|s| desc.symbols[s])
-            .collect();
+        let p = parameters(&prog, &desc);
         let id = robot.frame_id_of(j).unwrap();
         let n = robot.dof();
         let mut r = rng(800 + s as u64);
@@ -454,12 +454,9 @@ fn generated_jacobian_equals_the_numeric_frame_jacobian() {
                 .transpose();
             let mut expected = vec![0.0; 6 * n];
             for c in 0..n {
-                let v = to_i * Vector3::new(lwa[(0, c)], lwa[(1, c)], lwa[(2, c)]);
-                let w = to_i * Vector3::new(lwa[(3, c)], lwa[(4, c)], lwa[(5, c)]);
-                for k in 0..3 {
-                    expected[k * n + c] = v[k];
-                    expected[(k + 3) * n + c] = w[k];
-                }
+                let v = Vector3::new(lwa[(0, c)], lwa[(1, c)], lwa[(2, c)]);
+                let w = Vector3::new(lwa[(3, c)], lwa[(4, c)], lwa[(5, c)]);
+                put_column(&mut expected, c, &to_i, v, w);
             }
             let e = rel_err(&got, &expected);
             assert!(e < 1e-12, "{tag}: {i}J{j} off frame_jacobian by {e:e}");
