@@ -301,7 +301,7 @@ fn frame_flags_are_checked() {
     assert!(e.contains("--model dgm and jacobian"), "{e}");
     let e = err(&["generate", &torso, "--model", "dgm"]);
     assert!(
-        e.contains("terminal links (4, 7)") && e.contains("--frame J"),
+        e.contains("2 terminal links (4 `l_elbow`, 7 `r_elbow`)") && e.contains("--frame J"),
         "{e}"
     );
     let e = err(&["generate", &rx90, "--model", "jacobian", "--frame", "9"]);
