@@ -24,6 +24,8 @@ pub fn hint(e: &Error) -> Option<String> {
             "compute the base parameters with `robodyn base-params --method numeric` and pass \
              them with --base-file"
         }
+        "codegen::Frames::frame" => "choose frame j with --frame J (1..NL)",
+        "codegen::Frames::reference" => "choose frame i with --reference I (0: the base) or local",
         _ => return None,
     };
     Some(text.to_string())

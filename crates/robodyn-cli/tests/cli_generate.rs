@@ -210,3 +210,109 @@ fn generated_matlab_function_file_agrees_with_idm() {
         );
     }
 }
+
+/// `--model dgm` and `--model jacobian` with `--frame` and `--reference`, run as generated
+/// Python (numeric RX-90): 0T3 3T6 = 0T6, and the local Jacobian 6J6 equals central differences
+/// of the generated 0T6 (d0P6/dq and d0A6/dq 0A6^T, rotated into frame 6).
+#[test]
+fn generated_dgm_and_jacobian_fit_together() {
+    if !crate::harness::numpy("generated DGM and Jacobian not executed") {
+        return;
+    }
+    let rx90 = robot("rx90.toml");
+    let gen = |tag: &str, extra: &[&str]| {
+        let file = tmp("generate_kin", &format!("{tag}.py"));
+        let mut args = vec![
+            "generate",
+            &rx90,
+            "--numeric",
+            "--lang",
+            "python",
+            "--name",
+            tag,
+            "--output",
+            file.to_str().unwrap(),
+        ];
+        args.extend(extra);
+        run(&args);
+        file
+    };
+    let t06 = gen("t06", &["--model", "dgm"]);
+    let t03 = gen("t03", &["--model", "dgm", "--frame", "3"]);
+    let t36 = gen(
+        "t36",
+        &["--model", "dgm", "--reference", "3", "--frame", "6"],
+    );
+    let j66 = gen("j66", &["--model", "jacobian", "--reference", "local"]);
+    // [s n a P] column by column -> (rotation, position)
+    let split = |v: Vec<f64>| {
+        (
+            nalgebra::Matrix3::from_column_slice(&v[..9]),
+            nalgebra::Vector3::from_column_slice(&v[9..]),
+        )
+    };
+    let q = vec![0.3, -0.7, 1.1, 0.4, -1.3, 2.0];
+    let dgm = |file: &std::path::Path, name: &str, q: &[f64]| {
+        split(run_python(file, name, &[q.to_vec()]))
+    };
+    let (a06, p06) = dgm(&t06, "t06", &q);
+    let (a03, p03) = dgm(&t03, "t03", &q);
+    let (a36, p36) = dgm(&t36, "t36", &q);
+    assert!((a03 * a36 - a06).amax() < 1e-12 && (p03 + a03 * p36 - p06).amax() < 1e-12);
+    let jac = run_python(&j66, "j66", std::slice::from_ref(&q));
+    let h = 1e-6;
+    for c in 0..6 {
+        let at = |d: f64| {
+            let mut x = q.clone();
+            x[c] += d;
+            dgm(&t06, "t06", &x)
+        };
+        let ((ap, pp), (am, pm)) = (at(h), at(-h));
+        let v = a06.transpose() * (pp - pm) / (2.0 * h);
+        // skew(6w) = 6A0 (d0A6/dq 0A6^T) 0A6 = 0A6^T d0A6/dq
+        let ws = a06.transpose() * ((ap - am) / (2.0 * h));
+        let w_local = nalgebra::Vector3::new(ws[(2, 1)], ws[(0, 2)], ws[(1, 0)]);
+        for r in 0..3 {
+            assert!((jac[r * 6 + c] - v[r]).abs() < 1e-7, "linear {r} {c}");
+            assert!(
+                (jac[(r + 3) * 6 + c] - w_local[r]).abs() < 1e-7,
+                "angular {r} {c}"
+            );
+        }
+    }
+}
+
+/// Frame choices the model cannot take are one clear error each.
+#[test]
+fn frame_flags_are_checked() {
+    let err = |args: &[&str]| {
+        let out = Command::new(env!("CARGO_BIN_EXE_robodyn"))
+            .args(args)
+            .output()
+            .unwrap();
+        assert_ne!(out.status.code(), Some(0), "{args:?}");
+        let e = String::from_utf8_lossy(&out.stderr).to_string();
+        assert!(!e.contains("panicked"), "{e}");
+        e
+    };
+    let rx90 = robot("rx90.toml");
+    let torso = robot("torso2arms.toml");
+    let e = err(&["generate", &rx90, "--model", "idm", "--frame", "3"]);
+    assert!(e.contains("--model dgm and jacobian"), "{e}");
+    let e = err(&["generate", &torso, "--model", "dgm"]);
+    assert!(
+        e.contains("2 terminal links (4 `l_elbow`, 7 `r_elbow`)") && e.contains("--frame J"),
+        "{e}"
+    );
+    let e = err(&["generate", &rx90, "--model", "jacobian", "--frame", "9"]);
+    assert!(e.contains("not a frame"), "{e}");
+    let e = err(&[
+        "generate",
+        &rx90,
+        "--model",
+        "jacobian",
+        "--reference",
+        "world",
+    ]);
+    assert!(e.contains("`local`"), "{e}");
+}

@@ -83,6 +83,16 @@ fn dual_placement(
     (rot, pos)
 }
 
+/// Column c of a 6 x n Jacobian stored row by row: [iA_0 v; iA_0 w].
+fn put_column(jac: &mut [f64], c: usize, to_i: &Matrix3<f64>, v: Vector3<f64>, w: Vector3<f64>) {
+    let n = jac.len() / 6;
+    let (v, w) = (to_i * v, to_i * w);
+    for r in 0..3 {
+        jac[r * n + c] = v[r];
+        jac[(r + 3) * n + c] = w[r];
+    }
+}
+
 /// iJ_j, 6 x n row by row: d 0P_j / dq and the axial vector of d 0A_j / dq 0A_j^T for each
 /// movable joint, rotated into frame i.
 fn jacobian_reference(robot: &Robot, q: &[f64], i: usize, j: usize) -> Vec<f64> {
@@ -97,11 +107,7 @@ fn jacobian_reference(robot: &Robot, q: &[f64], i: usize, j: usize) -> Vec<f64> 
         let v = pos.map(|x| x.eps1);
         let w_skew = da * a.transpose();
         let w = Vector3::new(w_skew[(2, 1)], w_skew[(0, 2)], w_skew[(1, 0)]);
-        let (v, w) = (to_i * v, to_i * w);
-        for r in 0..3 {
-            jac[r * n + c] = v[r];
-            jac[(r + 3) * n + c] = w[r];
-        }
+        put_column(&mut jac, c, &to_i, v, w);
     }
     jac
 }
@@ -124,11 +130,7 @@ fn jacobian_differences(robot: &Robot, q: &[f64], i: usize, j: usize) -> Vec<f64
         let v = (plus.pos - minus.pos) / (2.0 * h);
         let w_skew = (plus.rot - minus.rot) / (2.0 * h) * a.transpose();
         let w = Vector3::new(w_skew[(2, 1)], w_skew[(0, 2)], w_skew[(1, 0)]);
-        let (v, w) = (to_i * v, to_i * w);
-        for r in 0..3 {
-            jac[r * n + c] = v[r];
-            jac[(r + 3) * n + c] = w[r];
-        }
+        put_column(&mut jac, c, &to_i, v, w);
     }
     jac
 }
@@ -192,6 +194,16 @@ fn setups() -> Vec<(String, RobotDescription, Frames, bool)> {
     out
 }
 
+/// The values of a program's parameters `p` (the robot's geometric symbols), in its order.
+fn parameters(prog: &Program, desc: &RobotDescription) -> Vec<f64> {
+    prog.inputs
+        .iter()
+        .filter(|g| g.by_name)
+        .flat_map(|g| g.symbols.iter().flatten())
+        .map(|s| desc.symbols[s])
+        .collect()
+}
+
 /// DGM and Jacobian programs of every setup, with three random states each and the reference
 /// outputs ([`dgm_reference`], [`jacobian_reference`]).
 pub(crate) fn kinematic_cases() -> Vec<KinematicCase> {
@@ -209,13 +221,7 @@ pub(crate) fn kinematic_cases() -> Vec<KinematicCase> {
                 ..GenOptions::default()
             };
             let prog = generate(&desc, &opt).unwrap();
-            let p: Vec<f64> = prog
-                .inputs
-                .iter()
-                .filter(|g| g.by_name)
-                .flat_map(|g| g.symbols.iter().flatten())
-                .map(|s| desc.symbols[s])
-                .collect();
+            let p = parameters(&prog, &desc);
             let reference = |q: &[f64]| match model {
                 ModelKind::Dgm(_) => dgm_reference(&robot, q, i, j),
                 _ => jacobian_reference(&robot, q, i, j),
@@ -242,20 +248,25 @@ pub(crate) fn rel_err(got: &[f64], expected: &[f64]) -> f64 {
         / scale
 }
 
+/// The program's outputs (interpreted) for one input set (one vector per input group).
+fn evaluate(prog: &Program, set: &[Vec<f64>]) -> Vec<f64> {
+    let values = |s: &str| {
+        prog.inputs.iter().zip(set).find_map(|(g, v)| {
+            g.symbols
+                .iter()
+                .position(|x| x.as_deref() == Some(s))
+                .map(|k| v[k])
+        })
+    };
+    prog.evaluate(&values).unwrap()
+}
+
 #[test]
 fn generated_dgm_and_jacobian_equal_the_numeric_routes() {
     let mut worst = 0.0f64;
     for c in kinematic_cases() {
         for (set, expected) in c.inputs.iter().zip(&c.expected) {
-            let values = |s: &str| {
-                c.prog.inputs.iter().zip(set).find_map(|(g, v)| {
-                    g.symbols
-                        .iter()
-                        .position(|x| x.as_deref() == Some(s))
-                        .map(|k| v[k])
-                })
-            };
-            let got = c.prog.evaluate(&values).unwrap();
+            let got = evaluate(&c.prog, set);
             let e = rel_err(&got, expected);
             assert!(e < 1e-12, "{}: off by {e:e}", c.what);
             worst = worst.max(e);
@@ -412,4 +423,57 @@ fn bad_frames_are_errors() {
             }
         }
     }
+}
+
+/// Against the numeric frame Jacobian of `algorithms::kinematics` (`frame_jacobian`, written
+/// independently, itself checked against Pinocchio): `LocalWorldAligned` rotated into frame i
+/// (for i = j also `Local` directly), on every setup, to 1e-12.
+#[test]
+fn generated_jacobian_equals_the_numeric_frame_jacobian() {
+    use robodyn::{frame_jacobian, Reference};
+    let mut worst = 0.0f64;
+    for (s, (tag, desc, frames, numeric)) in setups().into_iter().enumerate() {
+        let robot = Robot::new(desc.clone()).unwrap();
+        let (i, j) = frames.resolve(&desc).unwrap();
+        let opt = GenOptions {
+            model: ModelKind::Jacobian(frames),
+            numeric,
+            ..GenOptions::default()
+        };
+        let prog = generate(&desc, &opt).unwrap();
+        let p = parameters(&prog, &desc);
+        let id = robot.frame_id_of(j).unwrap();
+        let n = robot.dof();
+        let mut r = rng(800 + s as u64);
+        for _ in 0..3 {
+            let q = random_q(&mut r, n);
+            let got = evaluate(&prog, &[q.clone(), p.clone()]);
+            let lwa = frame_jacobian(&robot, &q, &id, Reference::LocalWorldAligned).unwrap();
+            let to_i = placement(&frame_transforms(&robot, &q).unwrap(), i)
+                .rot
+                .transpose();
+            let mut expected = vec![0.0; 6 * n];
+            for c in 0..n {
+                let v = Vector3::new(lwa[(0, c)], lwa[(1, c)], lwa[(2, c)]);
+                let w = Vector3::new(lwa[(3, c)], lwa[(4, c)], lwa[(5, c)]);
+                put_column(&mut expected, c, &to_i, v, w);
+            }
+            let e = rel_err(&got, &expected);
+            assert!(e < 1e-12, "{tag}: {i}J{j} off frame_jacobian by {e:e}");
+            worst = worst.max(e);
+            if i == j {
+                let local = frame_jacobian(&robot, &q, &id, Reference::Local).unwrap();
+                let row_by_row: Vec<f64> = (0..6)
+                    .flat_map(|k| (0..n).map(move |c| (k, c)))
+                    .map(|e| local[e])
+                    .collect();
+                let e = rel_err(&got, &row_by_row);
+                assert!(
+                    e < 1e-12,
+                    "{tag}: {j}J{j} off the Local frame_jacobian by {e:e}"
+                );
+            }
+        }
+    }
+    println!("generated Jacobian vs frame_jacobian: worst {worst:e}");
 }

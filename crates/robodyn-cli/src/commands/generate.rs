@@ -46,11 +46,11 @@ pub struct Args {
     /// The model to generate.
     #[arg(long, value_enum, default_value = "idm")]
     pub model: Model,
-    /// --model dgm, jacobian: frame j, 1..NL (default: the terminal link's frame).
+    /// Frame j of --model dgm and jacobian, 1..NL (default: the terminal link's frame).
     #[arg(long, value_name = "J")]
     pub frame: Option<usize>,
-    /// --model dgm, jacobian: reference frame i: the DGM is iT_j, the Jacobian is expressed in
-    /// frame i; 0 the base (world axes at O_j), `local` frame j itself.
+    /// Reference frame i of --model dgm and jacobian: the DGM is iT_j, the Jacobian is
+    /// expressed in frame i; 0 the base (world axes at O_j, the default), `local` frame j itself.
     #[arg(long, value_name = "I|local", value_parser = reference)]
     pub reference: Option<Reference>,
     /// Which inertial parameters are the model's symbols.

@@ -24,8 +24,8 @@ use robodyn_symbolic::{Assignment, Expr};
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Frames {
     /// Frame j: any frame 1..NL of the (equivalent) tree, fixed frames included. `None`: the
-    /// terminal frame, the one link that carries no other (an error names the candidates when
-    /// the robot has several).
+    /// terminal frame, the one link that carries no other and is moved by a joint (an error
+    /// names the candidates when the robot has several).
     pub frame: Option<usize>,
     /// Reference frame i, 0..NL: the DGM gives iT_j, the Jacobian is expressed in frame i
     /// (0: the base frame, Pinocchio's `LOCAL_WORLD_ALIGNED`). `None`: frame j itself (the
@@ -81,15 +81,21 @@ impl Default for Frames {
     }
 }
 
-/// The one link of the tree that carries no other frame (cut joints included), or an error
-/// naming the candidates.
+/// The one link of the tree that carries no other frame (cut joints included) and is moved by a
+/// joint, or an error naming the candidates.
 fn terminal_frame(desc: &RobotDescription) -> Result<usize> {
     let nl = desc.nl;
     let mut carries = vec![false; nl + 1];
     for k in 1..=desc.nj {
         carries[desc.frame(k).ant] = true;
     }
-    let terminal: Vec<usize> = (1..=nl).filter(|&j| !carries[j]).collect();
+    // a frame rigidly fixed to the base (no movable joint on its path) is not a candidate
+    let mut moves = vec![false; nl + 1];
+    for j in 1..=nl {
+        let f = desc.frame(j);
+        moves[j] = moves[f.ant] || f.joint.is_movable();
+    }
+    let terminal: Vec<usize> = (1..=nl).filter(|&j| !carries[j] && moves[j]).collect();
     match terminal.as_slice() {
         [j] => Ok(*j),
         _ => Err(Error::Setting {
@@ -100,7 +106,10 @@ fn terminal_frame(desc: &RobotDescription) -> Result<usize> {
                 terminal.len(),
                 terminal
                     .iter()
-                    .map(|j| j.to_string())
+                    .map(|&j| match desc.frame(j).name.as_str() {
+                        "" => j.to_string(),
+                        name => format!("{j} `{name}`"),
+                    })
                     .collect::<Vec<_>>()
                     .join(", ")
             ),
