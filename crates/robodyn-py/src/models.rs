@@ -11,7 +11,9 @@ use robodyn::algorithms::base_parameters::{
     compare_methods, geometry_robot, numeric_base_parameters_auto, standard_values,
     symbolic_base_parameters, NumericBase, NumericOptions, ParameterNames, Summary, SymbolicBase,
 };
-use robodyn::algorithms::regressor::{parameter_name, ParameterSelection, ZeroParameters};
+use robodyn::algorithms::regressor::{
+    parameter_name, Friction, ParameterSelection, ZeroParameters,
+};
 use robodyn::codegen::{generate as gen, BaseParameters as GenBase, GenOptions, ModelKind};
 use robodyn::simulation::{
     simulate as sim, Dynamics, Integrator, Recorder, SimOptions, TimeSeries, TorqueInput,
@@ -183,6 +185,11 @@ fn base_parameters_of(
                 "method = {method:?}: expected \"symbolic\", \"numeric\" or \"both\""
             )))
         }
+    };
+    let friction = if friction {
+        Friction::Actuated
+    } else {
+        Friction::None
     };
     let sel = ParameterSelection::from_description(desc, parse_rotor(rotor)?, friction)
         .with_zero_parameters(desc, zeros);
