@@ -4,8 +4,8 @@
 
 use crate::common::{choices, CliResult, RobotArgs};
 use robodyn::algorithms::base_parameters::{
-    base_robot, compare_methods, geometry_robot, numeric_base_parameters_auto, standard_values,
-    symbolic_base_parameters, NumericOptions, ParameterNames, Summary,
+    base_robot, compare_methods, generic_values_note, geometry_robot, numeric_base_parameters_auto,
+    standard_values, symbolic_base_parameters, NumericOptions, ParameterNames, Summary,
 };
 use robodyn::algorithms::regressor::{Friction, ParameterSelection, RotorMode, ZeroParameters};
 use robodyn::report::base_parameters as write;
@@ -98,17 +98,8 @@ pub fn run(a: Args) -> CliResult {
             if let Some(start) = start {
                 notes.push(format!("closed chain: {}", start.describe()));
             }
-            if !generic.is_empty() {
-                let list: Vec<String> = generic
-                    .iter()
-                    .map(|(s, v)| format!("{s} = {}", (v * 1e4).round() / 1e4))
-                    .collect();
-                notes.push(format!(
-                    "symbols without value took generic values for the numerical method ({}): \
-                     the count and the grouping hold for generic values of them, not for \
-                     special ones (give values with --set)",
-                    list.join(", ")
-                ));
+            if let Some(note) = generic_values_note(&generic) {
+                notes.push(format!("{note} (give values with --set)"));
             }
             Some((nb, notes))
         }
