@@ -521,11 +521,8 @@ impl LoopClosure {
                 residual: worst.max(newton.residual),
                 tolerance: self.tolerance,
                 at: q_a.to_vec(),
-                actuated: self.actuated.clone(),
                 guess: guess.to_vec(),
-                passive: self.passive.clone(),
                 iterations: newton.iterations,
-                hint: "the configuration is unreachable or the guess is too far".into(),
             });
         }
         // A revolute cut also vanishes with z_{k+B} = -z_k: reject that flipped assembly.
