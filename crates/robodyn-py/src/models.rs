@@ -8,10 +8,13 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 use robodyn::algorithms::base_parameters::symbolic::standard_index;
 use robodyn::algorithms::base_parameters::{
-    compare_methods, geometry_robot, numeric_base_parameters_auto, standard_values,
-    symbolic_base_parameters, NumericBase, NumericOptions, ParameterNames, Summary, SymbolicBase,
+    compare_methods, generic_values_note, geometry_robot, numeric_base_parameters_auto,
+    standard_values, symbolic_base_parameters, NumericBase, NumericOptions, ParameterNames,
+    Summary, SymbolicBase,
 };
-use robodyn::algorithms::regressor::{parameter_name, ParameterSelection, ZeroParameters};
+use robodyn::algorithms::regressor::{
+    parameter_name, Friction, ParameterSelection, ZeroParameters,
+};
 use robodyn::codegen::{generate as gen, BaseParameters as GenBase, GenOptions, ModelKind};
 use robodyn::simulation::{
     simulate as sim, Dynamics, Integrator, Recorder, SimOptions, TimeSeries, TorqueInput,
@@ -184,6 +187,11 @@ fn base_parameters_of(
             )))
         }
     };
+    let friction = if friction {
+        Friction::Actuated
+    } else {
+        Friction::None
+    };
     let sel = ParameterSelection::from_description(desc, parse_rotor(rotor)?, friction)
         .with_zero_parameters(desc, zeros);
     let names = ParameterNames::of(desc);
@@ -221,17 +229,9 @@ fn base_parameters_of(
                 if let Some(start) = start {
                     s.notes.push(format!("closed chain: {}", start.describe()));
                 }
-                if !generic.is_empty() {
-                    let list: Vec<String> = generic
-                        .iter()
-                        .map(|(s, v)| format!("{s} = {}", (v * 1e4).round() / 1e4))
-                        .collect();
-                    s.notes.push(format!(
-                        "symbols without value took generic values for the numerical method \
-                         ({}): the count and the grouping hold for generic values of them, not \
-                         for special ones (give values as keyword arguments)",
-                        list.join(", ")
-                    ));
+                if let Some(note) = generic_values_note(&generic) {
+                    s.notes
+                        .push(format!("{note} (give values as keyword arguments)"));
                 }
                 if let Some(sb) = &sb {
                     s.add_comparison(&compare_methods(sb, nb, &names));

@@ -9,7 +9,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use robodyn::algorithms::base_parameters::{base_columns, standard_columns};
 use robodyn::algorithms::regressor::{
-    regressor_into, ParameterSelection, RotorMode, ZeroParameters, PARAMS_PER_LINK,
+    regressor_into, Friction, ParameterSelection, RotorMode, ZeroParameters, PARAMS_PER_LINK,
 };
 use robodyn::batch::for_each_row;
 use robodyn::KinematicsData;
@@ -289,6 +289,11 @@ impl Robot {
         rotor: &str,
         seed: u64,
     ) -> PyResult<(Vec<usize>, Vec<String>)> {
+        let friction = if friction {
+            Friction::Actuated
+        } else {
+            Friction::None
+        };
         let sel = ParameterSelection::new(robot, parse_rotor(rotor)?, friction)
             .with_zero_parameters(robot.description(), self.zeros(None)?);
         let c = match columns {

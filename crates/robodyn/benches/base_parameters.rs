@@ -7,7 +7,7 @@ use robodyn::algorithms::base_parameters::{
     TreeSampler,
 };
 use robodyn::algorithms::regressor::{
-    tree_regressor, ParameterSelection, RotorMode, PARAMS_PER_LINK,
+    tree_regressor, Friction, ParameterSelection, RotorMode, PARAMS_PER_LINK,
 };
 use robodyn::Data;
 use robodyn_testing::{random_state, random_tree, rng, TreeOptions};
@@ -15,7 +15,7 @@ use robodyn_testing::{random_state, random_tree, rng, TreeOptions};
 fn bench(c: &mut Criterion) {
     let mut r = rng(30);
     let robot = random_tree(&mut r, 30, &TreeOptions::default());
-    let sel = ParameterSelection::new(&robot, RotorMode::All, true);
+    let sel = ParameterSelection::new(&robot, RotorMode::All, Friction::Actuated);
     let opt = NumericOptions {
         selection: sel.clone(),
         samples: None,
@@ -29,7 +29,7 @@ fn bench(c: &mut Criterion) {
     // growth: a 100-link tree (the example base_parameters_scale goes to 500 links)
     let big = random_tree(&mut rng(100), 100, &TreeOptions::default());
     let big_opt = NumericOptions {
-        selection: ParameterSelection::new(&big, RotorMode::Actuated, true),
+        selection: ParameterSelection::new(&big, RotorMode::Actuated, Friction::Actuated),
         samples: None,
         seed: 1,
     };
@@ -47,7 +47,7 @@ fn bench(c: &mut Criterion) {
     )))
     .unwrap();
     let sr_opt = NumericOptions {
-        selection: ParameterSelection::new(&sr400, RotorMode::Actuated, false),
+        selection: ParameterSelection::new(&sr400, RotorMode::Actuated, Friction::None),
         samples: None,
         seed: 1,
     };

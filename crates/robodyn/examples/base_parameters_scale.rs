@@ -12,7 +12,7 @@
 //! criterion bench `base_parameters`, never in tests.
 
 use robodyn::algorithms::base_parameters::{numeric_base_parameters, NumericOptions, TreeSampler};
-use robodyn::algorithms::regressor::{ParameterSelection, RotorMode};
+use robodyn::algorithms::regressor::{Friction, ParameterSelection, RotorMode};
 use robodyn_testing::{random_tree, rng, TreeOptions};
 
 fn main() {
@@ -25,7 +25,7 @@ fn main() {
         return;
     }
     let opt = NumericOptions {
-        selection: ParameterSelection::new(&robot, RotorMode::Actuated, true),
+        selection: ParameterSelection::new(&robot, RotorMode::Actuated, Friction::Actuated),
         samples: None,
         seed: 1,
     };

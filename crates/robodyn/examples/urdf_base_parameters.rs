@@ -8,14 +8,14 @@ use nalgebra::DVector;
 use robodyn::algorithms::base_parameters::{
     numeric_base_parameters, NumericOptions, ParameterNames, TreeSampler,
 };
-use robodyn::algorithms::regressor::{ParameterSelection, RotorMode};
+use robodyn::algorithms::regressor::{Friction, ParameterSelection, RotorMode};
 use robodyn::{inverse_dynamics, regressor};
 
 fn main() -> robodyn::Result<()> {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots/rx90.urdf");
     let robot = robodyn::io::load(path)?;
     // inertial parameters only (URDF damping/friction would add FV, FS)
-    let selection = ParameterSelection::new(&robot, RotorMode::None, false);
+    let selection = ParameterSelection::new(&robot, RotorMode::None, Friction::None);
     let opt = NumericOptions {
         selection,
         samples: None,

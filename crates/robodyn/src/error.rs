@@ -168,7 +168,7 @@ pub enum Error {
         hint: String,
     },
     /// The loop-closure equations have no solution near the guess.
-    #[error("{loop_label} does not close at q_a = {} (joints {actuated:?}), after {iterations} damped Newton iterations from the guess q_p = {} (joints {passive:?}): closure residual {residual:.3e} (tolerance {tolerance:.1e}); {hint}", fmt_values(.at), fmt_values(.guess))]
+    #[error("{loop_label} does not close at q_a = {} (actuated joints), after {iterations} damped Newton iterations from the guess q_p = {} (passive joints): closure residual {residual:.3e} (tolerance {tolerance:.1e}); the configuration is unreachable or the guess is too far", fmt_values(.at), fmt_values(.guess))]
     LoopNotClosed {
         /// "loop 1 (cut joint 5 between links 2 and 4)".
         loop_label: String,
@@ -178,16 +178,10 @@ pub enum Error {
         tolerance: f64,
         /// The actuated values q_a (rad, m).
         at: Vec<f64>,
-        /// The actuated joints (frame numbers), in the order of `at`.
-        actuated: Vec<usize>,
         /// The passive values the damped Newton started from (rad, m).
         guess: Vec<f64>,
-        /// The passive joints (frame numbers), in the order of `guess`.
-        passive: Vec<usize>,
         /// Damped Newton iterations made.
         iterations: usize,
-        /// What to do.
-        hint: String,
     },
     /// A configuration cannot be reached on the branch tracker's assembly branch.
     #[error("q_a = {} cannot be reached on the assembly branch: {reason}", fmt_values(.at))]

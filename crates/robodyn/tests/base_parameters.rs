@@ -10,7 +10,7 @@ use robodyn::algorithms::base_parameters::{
     numeric_base_parameters, ConsistentSample, NumericBase, NumericOptions, Sampler, TreeSampler,
 };
 use robodyn::algorithms::regressor::{
-    parameter_name, tree_regressor, ParameterSelection, RotorMode, PARAMS_PER_LINK,
+    parameter_name, tree_regressor, Friction, ParameterSelection, RotorMode, PARAMS_PER_LINK,
 };
 use robodyn::{Data, Expr, Robot, RobotDescription};
 use robodyn_testing::{random_inertial, random_tree, rng, TreeOptions};
@@ -151,7 +151,7 @@ fn check_reproduces(robot: &Robot, nb: &NumericBase, sampler: &mut dyn Sampler, 
 fn sr400_numeric_has_42_base_parameters_as_table_10_2() {
     let robot = sr400();
     let opt = NumericOptions {
-        selection: ParameterSelection::new(&robot, RotorMode::Actuated, false),
+        selection: ParameterSelection::new(&robot, RotorMode::Actuated, Friction::None),
         samples: None,
         seed: 1,
     };
@@ -176,7 +176,7 @@ fn sr400_numeric_has_42_base_parameters_as_table_10_2() {
 fn rx90_numeric_has_40_base_parameters() {
     let robot = rx90(5);
     let opt = NumericOptions {
-        selection: ParameterSelection::new(&robot, RotorMode::Actuated, false),
+        selection: ParameterSelection::new(&robot, RotorMode::Actuated, Friction::None),
         samples: None,
         seed: 2,
     };
@@ -209,7 +209,7 @@ fn random_trees_numeric_base_model_reproduces_torques() {
         };
         let robot = random_tree(&mut r, n, &opt);
         let nopt = NumericOptions {
-            selection: ParameterSelection::new(&robot, RotorMode::All, true),
+            selection: ParameterSelection::new(&robot, RotorMode::All, Friction::Actuated),
             samples: None,
             seed,
         };
@@ -279,7 +279,7 @@ fn parse(s: &str) -> Expr {
 #[test]
 fn sr400_symbolic_matches_table_10_2_and_the_chapter_listing() {
     let robot = sr400();
-    let sel = ParameterSelection::new(&robot, RotorMode::Actuated, false);
+    let sel = ParameterSelection::new(&robot, RotorMode::Actuated, Friction::None);
     // the symbolic method works on the description with symbolic inertial parameters
     let mut desc = robot.description().clone();
     for j in 1..=8 {
@@ -383,7 +383,7 @@ fn sr400_symbolic_matches_table_10_2_and_the_chapter_listing() {
 #[test]
 fn rx90_symbolic_has_40_base_parameters() {
     let robot = rx90(5);
-    let sel = ParameterSelection::new(&robot, RotorMode::Actuated, false);
+    let sel = ParameterSelection::new(&robot, RotorMode::Actuated, Friction::None);
     let sb = symbolic_base_parameters(robot.description(), &sel).unwrap();
     let mut table = expected("ZZ1 XX2 XY2 XZ2 YZ2 ZZ2 MX2 MY2");
     for j in 3..=6 {
@@ -427,9 +427,9 @@ fn random_trees_symbolic_agrees_with_numeric() {
         };
         let robot = random_tree(&mut r, n, &opt);
         let (rotor, friction) = match seed % 3 {
-            0 => (RotorMode::None, false),
-            1 => (RotorMode::All, false),
-            _ => (RotorMode::Actuated, true),
+            0 => (RotorMode::None, Friction::None),
+            1 => (RotorMode::All, Friction::None),
+            _ => (RotorMode::Actuated, Friction::Actuated),
         };
         let sel = ParameterSelection::new(&robot, rotor, friction);
         let nopt = NumericOptions {
@@ -493,7 +493,7 @@ fn base_robot_file_reproduces_the_full_model() {
     let dir = std::env::temp_dir().join(format!("robodyn-basep-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     for (name, robot, closed) in [("sr400", sr400(), true), ("rx90", rx90(9), false)] {
-        let sel = ParameterSelection::new(&robot, RotorMode::Actuated, true);
+        let sel = ParameterSelection::new(&robot, RotorMode::Actuated, Friction::Actuated);
         // the full model restricted to the selection (drive parameters outside it are zero)
         let mut k = robot.standard_parameters();
         let cols: std::collections::BTreeSet<usize> = sel.columns().into_iter().collect();
@@ -546,7 +546,7 @@ fn report_formats_carry_count_and_lists() {
     use robodyn::algorithms::base_parameters::{ParameterNames, Summary};
     use robodyn::report::base_parameters as write;
     let robot = sr400();
-    let sel = ParameterSelection::new(&robot, RotorMode::Actuated, false);
+    let sel = ParameterSelection::new(&robot, RotorMode::Actuated, Friction::None);
     let sb = symbolic_base_parameters(robot.description(), &sel).unwrap();
     let rep = Summary::from_symbolic(
         robot.description(),
@@ -580,7 +580,7 @@ fn symbolic_method_on_a_description_without_values() {
     for j in 1..=6 {
         *desc.link_mut(j) = robodyn::model::LinkDesc::symbolic(j);
     }
-    let sel = ParameterSelection::from_description(&desc, RotorMode::Actuated, false);
+    let sel = ParameterSelection::from_description(&desc, RotorMode::Actuated, Friction::None);
     let sb = symbolic_base_parameters(&desc, &sel).unwrap();
     assert_eq!(sb.count(), 40);
     let names = names(&sb.base);
@@ -609,9 +609,9 @@ fn sr400_other_selections_symbolic_equals_numeric() {
         absent: Default::default(),
     };
     let cases = [
-        ParameterSelection::new(&robot, RotorMode::All, true),
-        ParameterSelection::new(&robot, RotorMode::None, false),
-        ParameterSelection::new(&robot, RotorMode::Actuated, true),
+        ParameterSelection::new(&robot, RotorMode::All, Friction::Actuated),
+        ParameterSelection::new(&robot, RotorMode::None, Friction::None),
+        ParameterSelection::new(&robot, RotorMode::Actuated, Friction::Actuated),
         every,
     ];
     for (n, sel) in cases.into_iter().enumerate() {

@@ -14,7 +14,7 @@ use robodyn::algorithms::base_parameters::{
     NumericBase, NumericOptions, ParameterNames, Sampler, Summary, SymbolicBase, TreeSampler,
 };
 use robodyn::algorithms::regressor::{
-    parameter_name, tree_regressor, tree_wrench_torques, ParameterSelection, RotorMode,
+    parameter_name, tree_regressor, tree_wrench_torques, Friction, ParameterSelection, RotorMode,
     PARAMS_PER_LINK,
 };
 use robodyn::{closed_inverse_dynamics, inverse_dynamics, ClosedChain};
@@ -283,7 +283,7 @@ fn sampler_states_close_the_loops_and_satisfy_the_velocity_constraints() {
 fn sr400_general_sampler_gives_table_10_2() {
     for file in ["sr400.toml", "sr400.par"] {
         let robot = load(file);
-        let sel = ParameterSelection::new(&robot, RotorMode::Actuated, false);
+        let sel = ParameterSelection::new(&robot, RotorMode::Actuated, Friction::None);
         let nb = numeric(&robot, &sel, 1);
         let table = expected(
             "ZZ1 XX2 XY2 XZ2 YZ2 ZZ2 MX2 MY2 XX3 XY3 XZ3 YZ3 ZZ3 MX3 MY3 \
@@ -328,11 +328,14 @@ fn sr400_general_sampler_gives_table_10_2() {
 fn every_bundled_robot_counts_bounds_and_reproduces_the_full_model() {
     for (n, file) in TREES.iter().chain(CLOSED.iter()).enumerate() {
         let robot = load(file);
-        for (m, (rotor, friction)) in [(RotorMode::Actuated, true), (RotorMode::All, false)]
-            .into_iter()
-            .enumerate()
+        for (m, (rotor, friction)) in [
+            (RotorMode::Actuated, Friction::Actuated),
+            (RotorMode::All, Friction::None),
+        ]
+        .into_iter()
+        .enumerate()
         {
-            let label = format!("{file} ({rotor:?} rotors, friction {friction})");
+            let label = format!("{file} ({rotor:?} rotors, friction {friction:?})");
             let sel = ParameterSelection::new(&robot, rotor, friction);
             let seed = (10 * n + m) as u64;
             let nb = numeric(&robot, &sel, seed);
@@ -448,7 +451,7 @@ fn closed_sampler_rejects_a_tree_and_reports_unclosable_assemblies() {
 #[test]
 fn a_wrong_grouping_is_named() {
     let robot = load("fourbar.toml");
-    let sel = ParameterSelection::new(&robot, RotorMode::Actuated, false);
+    let sel = ParameterSelection::new(&robot, RotorMode::Actuated, Friction::None);
     let nb = numeric(&robot, &sel, 3);
     let mut g = Grouping::numeric(&nb);
     let zz1 = nb
@@ -493,7 +496,7 @@ fn closed_numeric_result_is_seed_independent() {
     let kappa = |nb: &NumericBase| nb.singular_values[0] / sigma(nb);
     for file in CLOSED {
         let robot = load(file);
-        let sel = ParameterSelection::new(&robot, RotorMode::Actuated, true);
+        let sel = ParameterSelection::new(&robot, RotorMode::Actuated, Friction::Actuated);
         let k = random_parameters(&robot, &sel, 5);
         let reference = numeric(&robot, &sel, 1000);
         let vr = reference.base_values(&k);

@@ -17,7 +17,7 @@ use robodyn::algorithms::base_parameters::{
     compare_methods, geometry_robot, numeric_base_parameters_auto, symbolic_base_parameters,
     NumericOptions, ParameterNames,
 };
-use robodyn::algorithms::regressor::{ParameterSelection, RotorMode, ZeroParameters};
+use robodyn::algorithms::regressor::{Friction, ParameterSelection, RotorMode, ZeroParameters};
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -182,7 +182,12 @@ fn every_external_file_symbolic_and_numeric_counts_agree_or_are_explained() {
         let idm = idm_matches_lagrangian(&desc);
         let mut counts = Vec::new();
         for friction in [true, false] {
-            let sel = ParameterSelection::from_description(&desc, RotorMode::Actuated, friction)
+            let selected = if friction {
+                Friction::Actuated
+            } else {
+                Friction::None
+            };
+            let sel = ParameterSelection::from_description(&desc, RotorMode::Actuated, selected)
                 .with_zero_parameters(&desc, ZeroParameters::for_path(&path));
             let names = ParameterNames::of(&desc);
             let sb = symbolic_base_parameters(&desc, &sel)
@@ -596,8 +601,9 @@ fn twoloops_twin_frame_on_a_twin_frame_closes_on_its_link() {
         }
         println!("{file}: W vs central differences, max relative error {worst_w:.2e}");
         // base parameters: the same for both writings, by both methods
-        let sel = ParameterSelection::from_description(&desc, RotorMode::Actuated, true)
-            .with_zero_parameters(&desc, ZeroParameters::Absent);
+        let sel =
+            ParameterSelection::from_description(&desc, RotorMode::Actuated, Friction::Actuated)
+                .with_zero_parameters(&desc, ZeroParameters::Absent);
         let opt = NumericOptions {
             selection: sel.clone(),
             samples: None,

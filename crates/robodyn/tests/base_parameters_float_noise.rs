@@ -8,7 +8,7 @@
 use robodyn::algorithms::base_parameters::{
     numeric_base_parameters, symbolic_base_parameters, NumericOptions, SymbolicBase, TreeSampler,
 };
-use robodyn::algorithms::regressor::{parameter_name, ParameterSelection, RotorMode};
+use robodyn::algorithms::regressor::{parameter_name, Friction, ParameterSelection, RotorMode};
 use robodyn::{Expr, Robot, RobotDescription};
 use std::path::Path;
 
@@ -22,7 +22,7 @@ fn names(v: &[usize]) -> Vec<String> {
 
 /// Symbolic (with the float tolerance) against numeric and against the full model.
 fn check(label: &str, robot: &Robot) -> SymbolicBase {
-    let sel = ParameterSelection::new(robot, RotorMode::Actuated, true);
+    let sel = ParameterSelection::new(robot, RotorMode::Actuated, Friction::Actuated);
     let sb = symbolic_base_parameters(robot.description(), &sel).unwrap();
     let nopt = NumericOptions {
         selection: sel,
@@ -57,7 +57,7 @@ fn rx90_urdf_noise_is_dropped_and_the_rules_still_agree_with_numeric() {
     assert!(sb.dropped_float_terms > 0, "the float angles make noise");
     // the same robot from its exact .par: nothing to drop, same number of base parameters
     let exact = robodyn::io::load(bundled("rx90.par")).unwrap();
-    let sel = ParameterSelection::new(&exact, RotorMode::Actuated, true);
+    let sel = ParameterSelection::new(&exact, RotorMode::Actuated, Friction::Actuated);
     let se = symbolic_base_parameters(exact.description(), &sel).unwrap();
     assert_eq!(se.dropped_float_terms, 0);
 }
@@ -73,7 +73,8 @@ fn exact_inputs_drop_nothing() {
         "torso2arms.toml",
     ] {
         let desc = robodyn::io::load_description(bundled(name)).unwrap();
-        let sel = ParameterSelection::from_description(&desc, RotorMode::Actuated, true);
+        let sel =
+            ParameterSelection::from_description(&desc, RotorMode::Actuated, Friction::Actuated);
         let sb = symbolic_base_parameters(&desc, &sel).unwrap();
         assert_eq!(sb.dropped_float_terms, 0, "{name}");
     }
@@ -85,7 +86,7 @@ fn exact_inputs_drop_nothing() {
 fn the_tolerance_does_not_depend_on_the_length_unit() {
     let desc = float_rx90();
     let mm = scaled(&desc, 1000.0);
-    let sel = ParameterSelection::from_description(&desc, RotorMode::Actuated, true);
+    let sel = ParameterSelection::from_description(&desc, RotorMode::Actuated, Friction::Actuated);
     let a = symbolic_base_parameters(&desc, &sel).unwrap();
     let b = symbolic_base_parameters(&mm, &sel).unwrap();
     assert!(a.dropped_float_terms > 0);
@@ -121,7 +122,7 @@ fn scaled(desc: &RobotDescription, s: f64) -> RobotDescription {
 #[test]
 fn a_term_above_the_tolerance_is_kept() {
     let desc = robodyn::io::load_description(bundled("rx90.par")).unwrap();
-    let sel = ParameterSelection::from_description(&desc, RotorMode::Actuated, true);
+    let sel = ParameterSelection::from_description(&desc, RotorMode::Actuated, Friction::Actuated);
     let mut tilted = desc.clone();
     tilted.frame_mut(3).alpha = Expr::num(1e-7 + 1e-15);
     let sb = symbolic_base_parameters(&tilted, &sel).unwrap();

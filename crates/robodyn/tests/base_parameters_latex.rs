@@ -10,11 +10,11 @@ use robodyn::algorithms::base_parameters::{
     compare_methods, geometry_robot, numeric_base_parameters_auto, standard_values,
     symbolic_base_parameters, NumericOptions, ParameterNames, Summary,
 };
-use robodyn::algorithms::regressor::{ParameterSelection, RotorMode, ZeroParameters};
+use robodyn::algorithms::regressor::{Friction, ParameterSelection, RotorMode, ZeroParameters};
 use std::path::Path;
 use std::process::{Command, Stdio};
 
-fn report(path: &Path, friction: bool, both: bool) -> Summary {
+fn report(path: &Path, friction: Friction, both: bool) -> Summary {
     let desc = robodyn::io::load_description(path).unwrap();
     let sel = ParameterSelection::from_description(&desc, RotorMode::Actuated, friction)
         .with_zero_parameters(&desc, ZeroParameters::for_path(path));
@@ -40,7 +40,7 @@ fn report(path: &Path, friction: bool, both: bool) -> Summary {
 #[test]
 fn base_parameter_latex_typesets() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
-    let sr400 = report(&root.join("robots/sr400.toml"), false, true);
+    let sr400 = report(&root.join("robots/sr400.toml"), Friction::None, true);
     let latex = robodyn::report::base_parameters::latex(&sr400);
     // checks that need no pdflatex: math cells, values, legend
     assert!(latex.contains("$ZZR_{1}$ & 0"), "{latex}");
@@ -60,14 +60,14 @@ fn base_parameter_latex_typesets() {
         return;
     }
     let mut docs = vec![("sr400", latex)];
-    let rx90 = report(&root.join("robots/rx90.toml"), true, false);
+    let rx90 = report(&root.join("robots/rx90.toml"), Friction::Actuated, false);
     docs.push(("rx90", robodyn::report::base_parameters::latex(&rx90)));
     // the Orthoglide (SYMORO+ file, own names) when shared/ is there
     let mut dir = Some(Path::new(env!("CARGO_MANIFEST_DIR")));
     while let Some(d) = dir {
         let f = d.join("shared/cases/external/freecad-symoro/orthoglide.par");
         if f.exists() {
-            let r = report(&f, true, false);
+            let r = report(&f, Friction::Actuated, false);
             let tex = robodyn::report::base_parameters::latex(&r);
             // link 1's mass is the file's M11: grouped, MR11 (no robodyn name for link 11)
             assert!(tex.contains("$MR_{11}$"), "{tex}");

@@ -11,7 +11,7 @@ use robodyn::algorithms::base_parameters::{
     standard_values, symbolic_base_parameters, ClosedChainSampler, NumericOptions, ParameterNames,
     Summary, TreeSampler,
 };
-use robodyn::algorithms::regressor::{ParameterSelection, RotorMode, ZeroParameters};
+use robodyn::algorithms::regressor::{Friction, ParameterSelection, RotorMode, ZeroParameters};
 use robodyn::{Expr, RobotDescription};
 use robodyn_testing::{random_tree, rng, TreeOptions};
 use std::path::Path;
@@ -52,7 +52,7 @@ fn a_literal_zero_is_not_a_parameter_a_symbol_with_value_zero_is() {
         }
     }
     let sel = |d: &RobotDescription, z| {
-        ParameterSelection::from_description(d, RotorMode::Actuated, true)
+        ParameterSelection::from_description(d, RotorMode::Actuated, Friction::Actuated)
             .with_zero_parameters(d, z)
     };
     let full = both(&desc, &sel(&desc, ZeroParameters::Absent));
@@ -88,7 +88,7 @@ fn an_absent_parameter_can_hold_grouped_ones() {
     let mut desc = bundled("rx90.par");
     let mx2 = 13 + 6;
     desc.link_mut(2).params[6] = Expr::zero();
-    let sel = ParameterSelection::from_description(&desc, RotorMode::Actuated, false)
+    let sel = ParameterSelection::from_description(&desc, RotorMode::Actuated, Friction::None)
         .with_zero_parameters(&desc, ZeroParameters::Absent);
     let sb = symbolic_base_parameters(&desc, &sel).unwrap();
     let r = sb
@@ -150,7 +150,7 @@ fn equations_use_the_files_names_without_clash() {
         .flat_map(|l| l.params.iter().flat_map(|e| e.symbols()))
         .collect();
     assert!(!file_symbols.contains(names.name(m11)));
-    let sel = ParameterSelection::from_description(&desc, RotorMode::Actuated, true);
+    let sel = ParameterSelection::from_description(&desc, RotorMode::Actuated, Friction::Actuated);
     let sb = symbolic_base_parameters(&desc, &sel).unwrap();
     let rep = Summary::from_symbolic(&desc, &sb, &names);
     for b in &rep.base {
@@ -181,7 +181,7 @@ fn equations_use_the_files_names_without_clash() {
 fn numeric_method_without_values_uses_generic_geometry() {
     let mut desc = bundled("rx90.par");
     desc.symbols.clear();
-    let sel = ParameterSelection::from_description(&desc, RotorMode::Actuated, true)
+    let sel = ParameterSelection::from_description(&desc, RotorMode::Actuated, Friction::Actuated)
         .with_zero_parameters(&desc, ZeroParameters::Absent);
     let (robot, generic) = geometry_robot(&desc).unwrap();
     let names: Vec<&str> = generic.iter().map(|(s, _)| s.as_str()).collect();
@@ -213,7 +213,7 @@ fn numeric_method_without_values_uses_generic_geometry() {
 #[test]
 fn float_noise_of_the_geometry_is_not_a_grouping_term() {
     let mut desc = bundled("rx90.par");
-    let sel = ParameterSelection::from_description(&desc, RotorMode::Actuated, false);
+    let sel = ParameterSelection::from_description(&desc, RotorMode::Actuated, Friction::None);
     let exact = symbolic_base_parameters(&desc, &sel).unwrap();
     assert_eq!(exact.dropped_float_terms, 0);
     for j in 1..=6 {
@@ -265,7 +265,7 @@ fn closed_sampler_never_starts_from_a_singular_configuration() {
     assert!(start.wp_ratio >= 1e-2);
     assert_eq!(start.parallelograms, vec![9]);
     assert!(start.describe().contains("parallelogram branch"));
-    let sel = ParameterSelection::new(&robot, RotorMode::Actuated, false);
+    let sel = ParameterSelection::new(&robot, RotorMode::Actuated, Friction::None);
     let opt = NumericOptions {
         selection: sel,
         samples: None,
@@ -286,7 +286,7 @@ fn closed_sampler_never_starts_from_a_singular_configuration() {
 fn numeric_method_refuses_beyond_its_memory_limit() {
     let robot = random_tree(&mut rng(1), 2000, &TreeOptions::default());
     let opt = NumericOptions {
-        selection: ParameterSelection::new(&robot, RotorMode::All, true),
+        selection: ParameterSelection::new(&robot, RotorMode::All, Friction::Actuated),
         samples: None,
         seed: 1,
     };

@@ -4,10 +4,10 @@
 
 use crate::common::{choices, CliResult, RobotArgs};
 use robodyn::algorithms::base_parameters::{
-    base_robot, compare_methods, geometry_robot, numeric_base_parameters_auto, standard_values,
-    symbolic_base_parameters, NumericOptions, ParameterNames, Summary,
+    base_robot, compare_methods, generic_values_note, geometry_robot, numeric_base_parameters_auto,
+    standard_values, symbolic_base_parameters, NumericOptions, ParameterNames, Summary,
 };
-use robodyn::algorithms::regressor::{ParameterSelection, RotorMode, ZeroParameters};
+use robodyn::algorithms::regressor::{Friction, ParameterSelection, RotorMode, ZeroParameters};
 use robodyn::report::base_parameters as write;
 use std::path::PathBuf;
 
@@ -60,13 +60,24 @@ pub struct Args {
     pub write_robot: Option<PathBuf>,
 }
 
+impl Args {
+    /// The friction parameters `--no-friction` selects.
+    fn friction(&self) -> Friction {
+        if self.no_friction {
+            Friction::None
+        } else {
+            Friction::Actuated
+        }
+    }
+}
+
 pub fn run(a: Args) -> CliResult {
     let (desc, _) = a.robot.description()?;
     let rotor = a.rotor;
     let zeros = a
         .zeros
         .unwrap_or_else(|| ZeroParameters::for_path(&a.robot.robot));
-    let sel = ParameterSelection::from_description(&desc, rotor, !a.no_friction)
+    let sel = ParameterSelection::from_description(&desc, rotor, a.friction())
         .with_zero_parameters(&desc, zeros);
     let names = ParameterNames::of(&desc);
     let symbolic = match a.method {
@@ -87,17 +98,8 @@ pub fn run(a: Args) -> CliResult {
             if let Some(start) = start {
                 notes.push(format!("closed chain: {}", start.describe()));
             }
-            if !generic.is_empty() {
-                let list: Vec<String> = generic
-                    .iter()
-                    .map(|(s, v)| format!("{s} = {}", (v * 1e4).round() / 1e4))
-                    .collect();
-                notes.push(format!(
-                    "symbols without value took generic values for the numerical method ({}): \
-                     the count and the grouping hold for generic values of them, not for \
-                     special ones (give values with --set)",
-                    list.join(", ")
-                ));
+            if let Some(note) = generic_values_note(&generic) {
+                notes.push(format!("{note} (give values with --set)"));
             }
             Some((nb, notes))
         }

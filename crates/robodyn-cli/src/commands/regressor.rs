@@ -14,7 +14,7 @@ use crate::common::{
 use crate::states::{CarryArg, Chunk, StateInput, StateRequest};
 use robodyn::algorithms::base_parameters::{base_columns, standard_columns};
 use robodyn::algorithms::regressor::{
-    ParameterSelection, RotorMode, ZeroParameters, PARAMS_PER_LINK,
+    Friction, ParameterSelection, RotorMode, ZeroParameters, PARAMS_PER_LINK,
 };
 use robodyn::{closed_regressor_into, regressor_batch, ClosedChain, ClosedData, Coordinates};
 use std::path::PathBuf;
@@ -50,11 +50,15 @@ pub fn run(a: Args) -> CliResult {
     let mut t = Phases::start(a.timings);
     let robot = a.robot.load()?;
     // a literal 0 in a SYMORO file means the parameter does not exist (docs/robot-format.md)
-    let sel = ParameterSelection::new(&robot, RotorMode::Actuated, !a.no_friction)
-        .with_zero_parameters(
-            robot.description(),
-            ZeroParameters::for_path(&a.robot.robot),
-        );
+    let friction = if a.no_friction {
+        Friction::None
+    } else {
+        Friction::Actuated
+    };
+    let sel = ParameterSelection::new(&robot, RotorMode::Actuated, friction).with_zero_parameters(
+        robot.description(),
+        ZeroParameters::for_path(&a.robot.robot),
+    );
     let columns = if a.base {
         base_columns(&robot, &sel, a.seed)?
     } else {

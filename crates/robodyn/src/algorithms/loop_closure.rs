@@ -29,7 +29,7 @@
 //! model [`crate::ClosedChain`]) and its equations; the public way to solve the loops is the
 //! branch tracker ([`crate::Branch`], [`crate::algorithms::closed_chain::loop_closure`]).
 
-use crate::error::{Error, Result};
+use crate::error::{check_vector, Error, Result};
 use crate::model::{ClosedLoop, JointType, Robot};
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 use rand::Rng;
@@ -493,23 +493,6 @@ impl LoopClosure {
         }
     }
 
-    fn check_len(&self, name: &str, v: &[f64], n: usize, what: &str) -> Result<()> {
-        if v.len() != n {
-            return Err(Error::Input(format!(
-                "{name} has {} entries, the robot has {n} {what}",
-                v.len()
-            )));
-        }
-        if let Some(k) = v.iter().position(|x| !x.is_finite()) {
-            return Err(Error::Input(format!(
-                "{name}[{}] = {} is not a finite number",
-                k + 1,
-                v[k]
-            )));
-        }
-        Ok(())
-    }
-
     /// Solve the closure equations for q_p given q_a by damped Newton (Levenberg–Marquardt),
     /// starting from `guess` (q_p): the start of a branch (allocates).
     pub fn solve_from_guess(
@@ -519,18 +502,12 @@ impl LoopClosure {
         guess: &[f64],
     ) -> Result<GuessSolution> {
         let (n, p) = (self.actuated.len(), self.p);
-        self.check_len(
-            "q_a",
-            q_a,
-            n,
-            &format!("actuated joints {:?}", self.actuated),
-        )?;
-        self.check_len(
-            "guess",
-            guess,
-            p,
-            &format!("passive joints {:?}", self.passive),
-        )?;
+        check_vector("q_a", q_a, n, || {
+            format!("actuated joints {:?}", self.actuated)
+        })?;
+        check_vector("guess", guess, p, || {
+            format!("passive joints {:?}", self.passive)
+        })?;
         let mut q = std::mem::take(&mut ws.q);
         let newton = self.damped_newton(ws, &mut q, q_a, guess);
         // restore placements of the current qp
@@ -544,11 +521,8 @@ impl LoopClosure {
                 residual: worst.max(newton.residual),
                 tolerance: self.tolerance,
                 at: q_a.to_vec(),
-                actuated: self.actuated.clone(),
                 guess: guess.to_vec(),
-                passive: self.passive.clone(),
                 iterations: newton.iterations,
-                hint: "the configuration is unreachable or the guess is too far".into(),
             });
         }
         // A revolute cut also vanishes with z_{k+B} = -z_k: reject that flipped assembly.

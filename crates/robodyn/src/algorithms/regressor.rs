@@ -94,18 +94,6 @@ pub enum Friction {
     None,
 }
 
-/// `true` is [`Friction::Actuated`], `false` [`Friction::None`] (the former bare flag of
-/// [`ParameterSelection::new`]; write the variant instead).
-impl From<bool> for Friction {
-    fn from(on: bool) -> Friction {
-        if on {
-            Friction::Actuated
-        } else {
-            Friction::None
-        }
-    }
-}
-
 /// Which of the drive parameters IA, FS, FV are kept, joint by joint (index j-1), and which
 /// standard parameters do not exist (`absent`, K indices: written as a literal 0 in a SYMORO
 /// file). The ten inertial parameters of every link are in K unless absent.
@@ -122,17 +110,13 @@ pub struct ParameterSelection {
 impl ParameterSelection {
     /// Rotor inertias by `rotor`, Coulomb and viscous friction by `friction`
     /// ([`Friction::Actuated`]: on the actuated joints).
-    pub fn new(robot: &Robot, rotor: RotorMode, friction: impl Into<Friction>) -> Self {
+    pub fn new(robot: &Robot, rotor: RotorMode, friction: Friction) -> Self {
         Self::from_description(robot.description(), rotor, friction)
     }
 
     /// As [`ParameterSelection::new`], from a description (symbols may lack values).
-    pub fn from_description(
-        desc: &RobotDescription,
-        rotor: RotorMode,
-        friction: impl Into<Friction>,
-    ) -> Self {
-        let friction = friction.into() == Friction::Actuated;
+    pub fn from_description(desc: &RobotDescription, rotor: RotorMode, friction: Friction) -> Self {
+        let friction = friction == Friction::Actuated;
         let nl = desc.nl;
         let f = |j: usize| desc.frame(j);
         ParameterSelection {

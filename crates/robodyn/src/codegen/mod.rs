@@ -739,11 +739,18 @@ impl BaseParameters {
         zeros: ZeroParameters,
     ) -> Result<BaseParameters> {
         use crate::algorithms::base_parameters::symbolic::symbolic_base_parameters;
-        use crate::algorithms::regressor::{parameter_name, ParameterSelection, RotorMode};
+        use crate::algorithms::regressor::{
+            parameter_name, Friction, ParameterSelection, RotorMode,
+        };
         let mode = if rotor {
             RotorMode::Actuated
         } else {
             RotorMode::None
+        };
+        let friction = if friction {
+            Friction::Actuated
+        } else {
+            Friction::None
         };
         let sel = ParameterSelection::from_description(desc, mode, friction)
             .with_zero_parameters(desc, zeros);

@@ -14,7 +14,7 @@ use crate::algorithms::direct_dynamics::{ddm, Method};
 use crate::algorithms::inertia_matrix::inertia_matrix;
 use crate::algorithms::inverse_dynamics::rnea;
 use crate::algorithms::regressor::{
-    tree_regressor, tree_wrench_torques, ParameterSelection, PARAMS_PER_LINK,
+    tree_regressor, tree_wrench_torques, Friction, ParameterSelection, PARAMS_PER_LINK,
 };
 use crate::data::Data;
 use crate::error::{Error, Result};
@@ -210,7 +210,15 @@ impl ModelAccess {
     /// with the same names and equations).
     pub fn base_parameters(&self, rotors: Rotors, friction: bool, seed: u64) -> Result<BaseSet> {
         let opt = NumericOptions {
-            selection: ParameterSelection::new(&self.robot, rotors, friction),
+            selection: ParameterSelection::new(
+                &self.robot,
+                rotors,
+                if friction {
+                    Friction::Actuated
+                } else {
+                    Friction::None
+                },
+            ),
             samples: None,
             seed,
         };

@@ -99,6 +99,25 @@ pub fn geometry_robot(desc: &RobotDescription) -> Result<(Robot, Vec<(String, f6
     Ok((robot, generic))
 }
 
+/// The note of the numerical method on a geometry with generic values (the symbols of
+/// [`geometry_robot`]): "symbols without value took generic values for the numerical method
+/// (L3 = 0.4142, ...): the count and the grouping hold for generic values of them, not for
+/// special ones". None when every symbol had a value. A surface adds how to give values.
+pub fn generic_values_note(generic: &[(String, f64)]) -> Option<String> {
+    if generic.is_empty() {
+        return None;
+    }
+    let list: Vec<String> = generic
+        .iter()
+        .map(|(s, v)| format!("{s} = {}", (v * 1e4).round() / 1e4))
+        .collect();
+    Some(format!(
+        "symbols without value took generic values for the numerical method ({}): the count \
+         and the grouping hold for generic values of them, not for special ones",
+        list.join(", ")
+    ))
+}
+
 /// The numerical method with the sampler the structure needs: random states for a tree, the
 /// loop-closure sampler ([`ClosedChainSampler`]) for a closed chain, whose start (and branch)
 /// is returned too.

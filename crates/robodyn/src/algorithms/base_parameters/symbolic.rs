@@ -46,18 +46,7 @@ use std::collections::{BTreeMap, BTreeSet};
 
 use super::super::regressor::{ParameterSelection, PARAMS_PER_LINK};
 use super::names::ParameterNames;
-
-const XX: usize = 0;
-const XY: usize = 1;
-const XZ: usize = 2;
-const YY: usize = 3;
-const YZ: usize = 4;
-const ZZ: usize = 5;
-const MX: usize = 6;
-const MY: usize = 7;
-const MZ: usize = 8;
-const M: usize = 9;
-const IA: usize = 10;
+use crate::model::param::{IA, M, MX, MY, MZ, XX, XY, XZ, YY, YZ, ZZ};
 
 /// Geometric tolerance of the parallel/perpendicular tests (unit vectors).
 pub const GEOMETRY_TOLERANCE: f64 = 1e-9;

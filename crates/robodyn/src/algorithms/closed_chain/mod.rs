@@ -7,7 +7,7 @@
 //!   Γ_cl = Γ_a + Wa^T λ (10.36, upper part);
 //! - direct model: A_cl (10.46), H_cl (10.47), qdd_a = A_cl^-1 (Γ_cl - H_cl) (10.48, Cholesky).
 //!
-//! [`ClosedChain`] is the model (built once from a [`Robot`]), [`ClosedData`] its per-evaluation
+//! [`ClosedChain`] is the model (built once from a [`Robot`](crate::Robot)), [`ClosedData`] its per-evaluation
 //! buffers and [`Branch`] the branch tracker: the assembly branch (sign of det Wp) and the last
 //! closed point reached on it. Every evaluation at q_a first moves the tracker to q_a by
 //! continuation along the straight path in q_a (predictor q_p + W dq_a, Newton corrector, steps
