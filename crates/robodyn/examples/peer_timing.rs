@@ -171,10 +171,14 @@ fn main() -> Result<(), Error> {
         return Err("usage: peer_timing URDF STATES RESULTS [--samples N] [--target-us T]".into());
     }
     let (mut samples, mut target_us) = (21usize, 400.0);
+    // the frame of the kinematics' comparison: the last joint's child link (its frame is the
+    // joint's frame in a URDF, Pinocchio's joint frame); default the last joint's own frame
+    let mut tip_name: Option<String> = None;
     for kv in args[4..].chunks(2) {
         match (kv[0].as_str(), kv.get(1)) {
             ("--samples", Some(v)) => samples = v.parse()?,
             ("--target-us", Some(v)) => target_us = v.parse()?,
+            ("--tip", Some(v)) => tip_name = Some(v.clone()),
             _ => return Err(format!("unknown option {}", kv[0]).into()),
         }
     }
@@ -187,7 +191,10 @@ fn main() -> Result<(), Error> {
     let mut out = vec![0.0; n];
     let (cmp, aba) = (Method::Composite, Method::ArticulatedBody);
     let frames = joint_frames(&robot, Path::new(&args[2]))?;
-    let tip = *frames.last().ok_or("no joint")?;
+    let tip = match &tip_name {
+        Some(name) => robot.frame_id(name)?,
+        None => *frames.last().ok_or("no joint")?,
+    };
     let mut kin = KinematicsData::new(&robot);
     let (mut jac, mut jcom) = (DMatrix::zeros(6, n), DMatrix::zeros(3, n));
 

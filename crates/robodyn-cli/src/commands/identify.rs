@@ -12,16 +12,6 @@ use robodyn::identification::{identify, report, EssentialOptions, Estimator, Opt
 use std::path::PathBuf;
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum EstimatorArg {
-    /// Ordinary least squares.
-    Ols,
-    /// Weighted least squares, each joint's rows weighted by 1/sigma_j (Gautier).
-    Wls,
-    /// Instrumental variables (IDIM-IV), weighted like WLS.
-    Iv,
-}
-
-#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Format {
     /// Text for reading: processing, the parameter table (units, values, standard deviations,
     /// grouping equations), per-joint errors, warnings.
@@ -41,8 +31,9 @@ pub struct Args {
     #[arg(long)]
     pub data: PathBuf,
     /// Estimator of the parameters.
-    #[arg(long, value_enum, default_value = "wls")]
-    pub estimator: EstimatorArg,
+    #[arg(long, default_value = "wls",
+          value_parser = choices(&Estimator::ALL, Estimator::key, Estimator::describe))]
+    pub estimator: Estimator,
     /// Identify under the physical-consistency constraints (pseudo-inertia PSD, friction and
     /// rotor inertia >= 0), solved as an SDP.
     #[arg(long)]
@@ -246,11 +237,7 @@ fn options(a: &Args, gains: Option<Vec<f64>>) -> CliResult<Options> {
             offsets: a.offsets,
             seed: a.seed,
         },
-        estimator: match a.estimator {
-            EstimatorArg::Ols => Estimator::Ols,
-            EstimatorArg::Wls => Estimator::Wls,
-            EstimatorArg::Iv => Estimator::Iv,
-        },
+        estimator: a.estimator,
         consistent: a.consistent,
         standard: a.write_robot.is_some(),
         consistency_solver: Default::default(),

@@ -250,7 +250,7 @@ def main():
             sys.exit(f"{tool} not found")
     pin_exe = build_pinocchio(prefix)
     rd_exe = build_robodyn()
-    files = {}
+    files, tips = {}, {}
     for key in robots:
         urdf = urdf_path(prefix, ROBOTS[key][1])
         model = pin.buildModelFromUrdf(urdf)
@@ -258,7 +258,11 @@ def main():
         dump_model(model, mfile)
         write_states(pin, model, sfile)
         merged_urdf(pin, model, merged)
+        # the last joint's child link: its frame is that joint's frame (Pinocchio's joint frame)
+        tip = next(f.name for f in model.frames
+                   if f.parentJoint == model.njoints - 1 and str(f.type) == "BODY")
         files[key] = (urdf, mfile, sfile, model.nv, merged)
+        tips[key] = tip
 
     print(f"pinocchio {pin.__version__}; {N_STATES} states per robot; agreement (max |robodyn - pinocchio|, "
           "relative to max(1, max |pinocchio|)):")
@@ -269,7 +273,8 @@ def main():
         run([pin_exe, mfile, sfile, pres, "--samples", "1", "--target-us", "1"], capture_output=True)
         for label, path in [("robodyn", urdf)] + ([("merged", merged)] if args.merged else []):
             rres = os.path.join(BUILD, f"{key}.{label}.results")
-            run([rd_exe, path, sfile, rres, "--samples", "1", "--target-us", "1"], capture_output=True)
+            run([rd_exe, path, sfile, rres, "--samples", "1", "--target-us", "1", "--tip", tips[key]],
+                capture_output=True)
             for alg, (d, rel) in agreement(read_results(pres), read_results(rres)).items():
                 flag = "" if rel < 1e-9 else "   <-- DISAGREE"
                 ok &= rel < 1e-9
@@ -281,7 +286,7 @@ def main():
 
     def sides(key):
         urdf, mfile, sfile, _, merged = files[key]
-        out = [("pin", [pin_exe, mfile, sfile, os.devnull, *opts]), ("rd", [rd_exe, urdf, sfile, os.devnull, *opts])]
+        out = [("pin", [pin_exe, mfile, sfile, os.devnull, *opts]), ("rd", [rd_exe, urdf, sfile, os.devnull, *opts, "--tip", tips[key]])]
         if args.merged:
             out.append(("merged", [rd_exe, merged, sfile, os.devnull, *opts]))
         return out

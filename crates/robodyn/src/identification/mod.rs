@@ -57,6 +57,33 @@ pub enum Estimator {
 }
 
 impl Estimator {
+    /// Every estimator.
+    pub const ALL: [Estimator; 3] = [Estimator::Ols, Estimator::Wls, Estimator::Iv];
+
+    /// Its key in options and files: `ols`, `wls`, `iv` ([`Estimator::from_key`] reads it back;
+    /// [`Estimator::name`] is the report's spelling).
+    pub fn key(self) -> &'static str {
+        match self {
+            Estimator::Ols => "ols",
+            Estimator::Wls => "wls",
+            Estimator::Iv => "iv",
+        }
+    }
+
+    /// The estimator of a key of [`Estimator::key`].
+    pub fn from_key(key: &str) -> Option<Estimator> {
+        Estimator::ALL.into_iter().find(|e| e.key() == key)
+    }
+
+    /// What the estimator is, in a few words.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Estimator::Ols => "ordinary least squares",
+            Estimator::Wls => "weighted least squares, each joint's rows weighted by 1/sigma_j (Gautier)",
+            Estimator::Iv => "instrumental variables (IDIM-IV), weighted like WLS",
+        }
+    }
+
     /// Its name in the report: `OLS`, `WLS`, `IDIM-IV`.
     pub fn name(self) -> &'static str {
         match self {
