@@ -317,7 +317,8 @@ def main():
             rm, rs = stat(rd, rname)
             best = min(pnames, key=lambda n: stat(pn, n)[0])
             pm, ps = stat(pn, best)
-            variant = best.rsplit("_", 1)[1] if best.endswith(("_local", "_world")) else "-"
+            variant = best.rsplit("_", 1)[1] if best.endswith(("_local", "_world")) else (
+                "local" if best == "rnea" else "-")
             # the ratio of each round (the two programs ran back to back): its median and range
             # are robust to the VM's speed changing between rounds
             ratios = [a[rname] / b[best] for a, b in zip(rd, pn)]
