@@ -79,7 +79,9 @@ impl Estimator {
     pub fn describe(self) -> &'static str {
         match self {
             Estimator::Ols => "ordinary least squares",
-            Estimator::Wls => "weighted least squares, each joint's rows weighted by 1/sigma_j (Gautier)",
+            Estimator::Wls => {
+                "weighted least squares, each joint's rows weighted by 1/sigma_j (Gautier)"
+            }
             Estimator::Iv => "instrumental variables (IDIM-IV), weighted like WLS",
         }
     }

@@ -10,21 +10,21 @@ use crate::algorithms::base_parameters::{
     Sampler, Summary, TreeSampler,
 };
 use crate::algorithms::closed_chain::{closed_state, Branch, ClosedChain};
-use crate::algorithms::direct_dynamics::{ddm, Method};
+use crate::algorithms::direct_dynamics::{direct_dynamics_into, Method};
 use crate::algorithms::inertia_matrix::inertia_matrix;
-use crate::algorithms::inverse_dynamics::rnea;
+use crate::algorithms::inverse_dynamics::inverse_dynamics_into;
 use crate::algorithms::regressor::{
-    tree_regressor, tree_wrench_torques, Friction, ParameterSelection, PARAMS_PER_LINK,
+    regressor_into, wrench_torques_into, Friction, ParameterSelection, PARAMS_PER_LINK,
 };
 use crate::data::Data;
 use crate::error::{Error, Result};
 use crate::model::param::FS;
-use crate::model::{DynModel, JointLimits, JointType, RobotDescription, Transmission};
+use crate::model::{JointLimits, JointType, RobotDescription, Transmission};
 use crate::simulation::{
     simulate, ClosedChainDynamics, Dynamics, Integrator, Recorder, SimOptions, TimeSeries,
     TorqueInput, TreeDynamics,
 };
-use crate::{Expr, Robot};
+use crate::Robot;
 use nalgebra::{DMatrix, DVector};
 
 /// The sign of a velocity in the Coulomb friction Fs sign(v), with a dead band: 0 where
@@ -85,7 +85,7 @@ impl ModelAccess {
     pub fn new(desc: RobotDescription) -> Result<ModelAccess> {
         let transmission = desc.transmission.clone();
         let robot = Robot::new(desc)?;
-        let nl = robot.nl();
+        let (n, nl) = (robot.dof(), robot.nl());
         let (actuated, closed) = if robot.is_tree() {
             let movable = robot.movable_joints();
             if let Some(j) = movable.iter().find(|&&j| !robot.frame(j).actuated) {
@@ -118,11 +118,11 @@ impl ModelAccess {
         }
         Ok(ModelAccess {
             ws: Data::new(&robot),
-            phi: DMatrix::zeros(nl, PARAMS_PER_LINK * nl),
-            q: vec![0.0; nl],
-            qd: vec![0.0; nl],
-            qdd: vec![0.0; nl],
-            tau_e: vec![0.0; nl],
+            phi: DMatrix::zeros(n, PARAMS_PER_LINK * nl),
+            q: vec![0.0; n],
+            qd: vec![0.0; n],
+            qdd: vec![0.0; n],
+            tau_e: vec![0.0; n],
             robot,
             transmission,
             actuated,
@@ -262,20 +262,26 @@ impl ModelAccess {
         let mut out = Vec::with_capacity(count);
         for _ in 0..count {
             let s = sampler.sample(&self.robot, &mut rng)?;
-            tree_regressor(
-                self.robot.numeric(),
+            // the sample's tree arrays (NL) on the movable joints, the checked path's vectors
+            let movable = self.robot.coordinates().frames();
+            let gather = |v: &[f64]| -> Vec<f64> { movable.iter().map(|&j| v[j - 1]).collect() };
+            let (q, qd, qdd) = (gather(&s.q), gather(&s.qd), gather(&s.qdd));
+            regressor_into(
+                &self.robot,
                 &mut self.ws,
                 &env,
-                &s.q,
-                &s.qd,
-                &s.qdd,
+                &q,
+                &qd,
+                &qdd,
                 &mut self.phi,
-            );
+            )?;
             let pick = |v: &[f64]| self.actuated.iter().map(|&j| v[j - 1]).collect();
             let state = [pick(&s.q), pick(&s.qd), pick(&s.qdd)];
             let mut rows = vec![0.0; n * cols.len()];
             match &s.g {
                 Some(g) => {
+                    let g =
+                        DMatrix::from_fn(movable.len(), g.ncols(), |k, c| g[(movable[k] - 1, c)]);
                     let y = g.transpose() * &self.phi;
                     for r in 0..n {
                         for (c, &k) in cols.iter().enumerate() {
@@ -284,9 +290,10 @@ impl ModelAccess {
                     }
                 }
                 None => {
-                    for (r, &j) in self.actuated.iter().enumerate() {
+                    // a tree: the actuated joints are its movable joints
+                    for r in 0..n {
                         for (c, &k) in cols.iter().enumerate() {
-                            rows[r * cols.len() + c] = self.phi[(j - 1, k)];
+                            rows[r * cols.len() + c] = self.phi[(r, k)];
                         }
                     }
                 }
@@ -304,8 +311,9 @@ impl ModelAccess {
     }
 
     /// The equivalent tree's state for (q_a, qd_a, qdd_a) into `self.q`, `self.qd`, `self.qdd`
-    /// (tree arrays); for a closed chain q_p by the branch tracker (continuation from the
-    /// previous sample, the first from the assembly) and G (NL x N, tree arrays) returned.
+    /// (the movable joints, the checked path's vectors); for a closed chain q_p by the branch
+    /// tracker (continuation from the previous sample, the first from the assembly) and G
+    /// (movable joints x N) returned.
     fn tree_state(
         &mut self,
         qa: &[f64],
@@ -314,11 +322,10 @@ impl ModelAccess {
     ) -> Result<Option<DMatrix<f64>>> {
         match &mut self.closed {
             None => {
-                for (k, &j) in self.actuated.iter().enumerate() {
-                    self.q[j - 1] = qa[k];
-                    self.qd[j - 1] = qda[k];
-                    self.qdd[j - 1] = qdda[k];
-                }
+                // a tree: the actuated joints are its movable joints, in the same order
+                self.q.copy_from_slice(qa);
+                self.qd.copy_from_slice(qda);
+                self.qdd.copy_from_slice(qdda);
                 Ok(None)
             }
             Some(c) => {
@@ -327,18 +334,10 @@ impl ModelAccess {
                 }
                 let branch = c.branch.as_mut().expect("set above");
                 let st = closed_state(&c.chain, branch, qa, qda, qdda)?;
-                let movable = c.chain.robot().coordinates().frames();
-                let mut g = DMatrix::zeros(self.q.len(), qa.len());
-                for x in [&mut self.q, &mut self.qd, &mut self.qdd] {
-                    x.iter_mut().for_each(|v| *v = 0.0);
-                }
-                for (k, &j) in movable.iter().enumerate() {
-                    self.q[j - 1] = st.q[k];
-                    self.qd[j - 1] = st.qd[k];
-                    self.qdd[j - 1] = st.qdd[k];
-                    g.row_mut(j - 1).copy_from(&st.g.row(k));
-                }
-                Ok(Some(g))
+                self.q.copy_from_slice(st.q.as_slice());
+                self.qd.copy_from_slice(st.qd.as_slice());
+                self.qdd.copy_from_slice(st.qdd.as_slice());
+                Ok(Some(st.g))
             }
         }
     }
@@ -360,32 +359,25 @@ impl ModelAccess {
         tau_e: &mut [f64],
     ) -> Result<()> {
         let g = self.tree_state(qa, qda, qdda)?;
-        let model = self.robot.numeric();
-        let env = self.robot.environment();
-        tree_regressor(
-            model,
-            &mut self.ws,
-            env,
-            &self.q,
-            &self.qd,
-            &self.qdd,
-            &mut self.phi,
-        );
+        let (robot, env) = (&self.robot, self.robot.environment());
+        let (q, qd, qdd) = (&self.q, &self.qd, &self.qdd);
+        regressor_into(robot, &mut self.ws, env, q, qd, qdd, &mut self.phi)?;
         if coulomb_band > 0.0 {
-            // the FS_j column is sign(qd_j) in row j alone (10.12)
-            for (j, qd) in self.qd.iter().enumerate() {
-                self.phi[(j, PARAMS_PER_LINK * j + FS)] = coulomb_sign(*qd, coulomb_band);
+            // the FS_j column is sign(qd_j) in joint j's row alone (10.12)
+            for (k, &j) in robot.coordinates().frames().iter().enumerate() {
+                let col = PARAMS_PER_LINK * (j - 1) + FS;
+                self.phi[(k, col)] = coulomb_sign(qd[k], coulomb_band);
             }
         }
-        tree_wrench_torques(model, &mut self.ws, env, &self.q, &mut self.tau_e);
+        wrench_torques_into(robot, &mut self.ws, env, q, &mut self.tau_e)?;
         let m = cols.len();
         match g {
             None => {
-                for (r, &j) in self.actuated.iter().enumerate() {
+                for r in 0..self.actuated.len() {
                     for (c, &k) in cols.iter().enumerate() {
-                        rows[r * m + c] = self.phi[(j - 1, k)];
+                        rows[r * m + c] = self.phi[(r, k)];
                     }
-                    tau_e[r] = self.tau_e[j - 1];
+                    tau_e[r] = self.tau_e[r];
                 }
             }
             Some(g) => {
@@ -408,17 +400,19 @@ impl ModelAccess {
     /// transmission not applied): Newton–Euler, G^T Gamma_tr for a closed chain.
     pub fn inverse_dynamics(&mut self, qa: &[f64], qda: &[f64], qdda: &[f64]) -> Result<Vec<f64>> {
         let g = self.tree_state(qa, qda, qdda)?;
-        let mut tau = vec![0.0; self.robot.nl()];
-        rnea(
-            self.robot.numeric(),
+        let mut tau = vec![0.0; self.robot.dof()];
+        let (robot, env) = (&self.robot, self.robot.environment());
+        inverse_dynamics_into(
+            robot,
             &mut self.ws,
+            env,
             &self.q,
             &self.qd,
             &self.qdd,
             &mut tau,
-        );
+        )?;
         Ok(match g {
-            None => self.actuated.iter().map(|&j| tau[j - 1]).collect(),
+            None => tau,
             Some(g) => (g.transpose() * DVector::from_column_slice(&tau))
                 .iter()
                 .copied()
@@ -474,28 +468,13 @@ impl ModelAccess {
             }
         }
         if self.robot.is_tree() {
-            let desc = self.robot.description();
-            let model = DynModel::build(
-                desc,
-                |e: &Expr| self.robot.value(e).expect("validated"),
-                |j, p, e| {
-                    if p < PARAMS_PER_LINK {
-                        k[PARAMS_PER_LINK * (j - 1) + p]
-                    } else {
-                        self.robot.value(e).expect("validated")
-                    }
-                },
-            );
-            let nl = model.nl;
+            let robot = self.robot.with_standard_parameters(&k)?;
+            let n = robot.dof();
             Ok(TrackingModel::Tree {
                 smoothing,
-                ws: Box::new(Data::from_model(&model)),
-                model: Box::new(model),
-                joints: self.actuated.clone(),
-                q: vec![0.0; nl],
-                qd: vec![0.0; nl],
-                tau: vec![0.0; nl],
-                qdd: vec![0.0; nl],
+                ws: Box::new(Data::new(&robot)),
+                robot: Box::new(robot),
+                tau: vec![0.0; n],
             })
         } else {
             let robot = self.robot.with_standard_parameters(&k)?;
@@ -574,20 +553,12 @@ pub enum TrackingModel {
     Tree {
         /// Coulomb friction sign(qd) replaced by tanh(qd / smoothing) (rad/s or m/s).
         smoothing: f64,
-        /// The numeric model with the current parameters.
-        model: Box<DynModel<f64>>,
+        /// The robot with the current parameters.
+        robot: Box<Robot>,
         /// Its buffers.
         ws: Box<Data>,
-        /// Frame numbers of the actuated joints (the simulated coordinates).
-        joints: Vec<usize>,
-        /// Scratch: tree positions (NL).
-        q: Vec<f64>,
-        /// Scratch: tree velocities (NL).
-        qd: Vec<f64>,
-        /// Scratch: tree torques (NL).
+        /// Scratch: the torques with the smoothed Coulomb friction (movable joints).
         tau: Vec<f64>,
-        /// Scratch: tree accelerations (NL).
-        qdd: Vec<f64>,
     },
     /// A closed chain: qdd_a = A_cl^-1 (Gamma_cl - H_cl) on its assembly branch (10.46–10.48).
     Closed(Box<ClosedChainDynamics>),
@@ -624,26 +595,20 @@ impl TrackingModel {
         match self {
             TrackingModel::Tree {
                 smoothing,
-                model,
+                robot,
                 ws,
-                joints,
-                q,
-                qd,
                 tau,
-                qdd,
             } => {
-                for (k, &j) in joints.iter().enumerate() {
-                    q[j - 1] = qa[k];
-                    qd[j - 1] = qda[k];
-                    let (fs, s) = (model.link(j).fs, qda[k]);
-                    tau[j - 1] =
+                // a tree's actuated joints are its movable joints: the vectors pass through
+                let frames = robot.coordinates().frames();
+                for (k, &j) in frames.iter().enumerate() {
+                    let (fs, s) = (robot.numeric().link(j).fs, qda[k]);
+                    tau[k] =
                         taua[k] + fs * (s.signum() * f64::from(s != 0.0) - (s / *smoothing).tanh());
                 }
-                ddm(model, ws, &model.env, Method::Composite, q, qd, tau, qdd)?;
-                for (k, &j) in joints.iter().enumerate() {
-                    qdda[k] = qdd[j - 1];
-                }
-                Ok(())
+                let env = robot.environment();
+                let method = Method::Composite;
+                direct_dynamics_into(robot, ws, env, qa, qda, tau, method, qdda)
             }
             TrackingModel::Closed(d) => d.accel(0.0, qa, qda, taua, qdda),
         }
