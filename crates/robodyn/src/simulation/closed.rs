@@ -111,14 +111,12 @@ impl Dynamics for ClosedChainDynamics {
             &mut self.qdd,
         )
         .map_err(|e| self.hint(e))?;
+        // the tree state the evaluation reached (tree arrays) on the movable joints
         let (q_tr, qd_tr) = last_tree_state(&self.data);
-        let (q_tr, qd_tr) = (q_tr.to_vec(), qd_tr.to_vec());
-        Ok(mechanical_energy(
-            self.chain.robot(),
-            self.data.tree_mut(),
-            &q_tr,
-            &qd_tr,
-        ))
+        let movable = self.chain.robot().coordinates().frames();
+        let q_m: Vec<f64> = movable.iter().map(|&j| q_tr[j - 1]).collect();
+        let qd_m: Vec<f64> = movable.iter().map(|&j| qd_tr[j - 1]).collect();
+        mechanical_energy(self.chain.robot(), self.data.tree_mut(), &q_m, &qd_m)
     }
     fn extra_columns(&self) -> Vec<String> {
         let mut c = vec!["closure_residual".to_string()];

@@ -108,9 +108,6 @@ pub struct TreeDynamics<'a> {
     env: Environment,
     /// The torque given to the direct model (smoothed Coulomb friction added), movable joints.
     tau: Vec<f64>,
-    /// Tree arrays (NL entries) of the energy.
-    q_tree: Vec<f64>,
-    qd_tree: Vec<f64>,
     coulomb_smoothing: Option<f64>,
 }
 
@@ -118,15 +115,12 @@ impl<'a> TreeDynamics<'a> {
     /// The simulated system of a tree robot under its own environment (gravity, base motion,
     /// wrenches), with direct model `method`.
     pub fn new(robot: &'a Robot, method: Method) -> Self {
-        let nl = robot.nl();
         TreeDynamics {
             robot,
             method,
             ws: Data::new(robot),
             env: robot.environment().clone(),
             tau: vec![0.0; robot.dof()],
-            q_tree: vec![0.0; nl],
-            qd_tree: vec![0.0; nl],
             coulomb_smoothing: None,
         }
     }
@@ -187,17 +181,7 @@ impl Dynamics for TreeDynamics<'_> {
         )
     }
     fn energy(&mut self, q: &[f64], qd: &[f64]) -> Result<f64> {
-        let c = self.robot.coordinates();
-        c.check("q", q, "movable joints")?;
-        c.check("qd", qd, "movable joints")?;
-        c.scatter(q, &mut self.q_tree);
-        c.scatter(qd, &mut self.qd_tree);
-        Ok(mechanical_energy(
-            self.robot,
-            &mut self.ws,
-            &self.q_tree,
-            &self.qd_tree,
-        ))
+        mechanical_energy(self.robot, &mut self.ws, q, qd)
     }
 }
 
