@@ -2,11 +2,9 @@
 //! from `--q/--qd/--qdd` (a closed chain's actuated joints, completed on the assembly branch),
 //! and the frames named by `--frame`.
 
-use crate::common::{parse_list, start_branch, CliResult, RobotArgs};
+use crate::common::{parse_list, start_branch, warn_conditioning, CliResult, RobotArgs};
 use nalgebra::DMatrix;
-use robodyn::{
-    closed_state, forward_kinematics_into, Branch, ClosedChain, FrameId, KinematicsData, Robot,
-};
+use robodyn::{closed_state, forward_kinematics_into, ClosedChain, FrameId, KinematicsData, Robot};
 
 /// `--q`, `--qd`, `--qdd` and `--guess` of the kinematic commands.
 #[derive(clap::Args, Debug)]
@@ -30,14 +28,15 @@ pub struct StateArgs {
 }
 
 /// A robot at one state: the tree's joint vectors (a closed chain's completed on its branch),
-/// the kinematics computed, and the chain with its branch for closed-chain Jacobians.
+/// the kinematics computed, and for a closed chain G (tree joints x actuated joints), which
+/// maps a tree Jacobian to the actuated coordinates (J_a = J_tr G).
 pub struct Evaluated {
     pub robot: Robot,
     pub data: KinematicsData,
-    /// The tree's q (all movable joints).
+    /// The state's q: the movable joints (closed chains: the actuated joints given).
     pub q: Vec<f64>,
-    /// The chain, its branch at the state and the actuated joints' q (closed chains).
-    pub closed: Option<(ClosedChain, Branch, Vec<f64>)>,
+    /// The chain and its G at the state (closed chains).
+    pub closed: Option<(ClosedChain, DMatrix<f64>)>,
 }
 
 impl StateArgs {
@@ -63,17 +62,21 @@ impl StateArgs {
             list("qdd", &self.qdd)?,
         );
         let mut data = KinematicsData::new(&robot);
-        let (tree, closed) = match chain {
-            None => ([q, qd, qdd], None),
+        let closed = match chain {
+            None => {
+                forward_kinematics_into(&robot, &mut data, &q, &qd, &qdd)?;
+                None
+            }
             Some(c) => {
                 let mut branch = start_branch(&c, &q, self.guess.as_deref())?;
                 let s = closed_state(&c, &mut branch, &q, &qd, &qdd)?;
-                let tree = [s.q, s.qd, s.qdd].map(|v| v.as_slice().to_vec());
-                (tree, Some((c, branch, q)))
+                // near a singular configuration the results are sensitive to their inputs
+                warn_conditioning(&c, None, &s.conditioning);
+                let tree = [&s.q, &s.qd, &s.qdd].map(|v| v.as_slice());
+                forward_kinematics_into(&robot, &mut data, tree[0], tree[1], tree[2])?;
+                Some((c, s.g))
             }
         };
-        forward_kinematics_into(&robot, &mut data, &tree[0], &tree[1], &tree[2])?;
-        let [q, ..] = tree;
         Ok(Evaluated {
             robot,
             data,

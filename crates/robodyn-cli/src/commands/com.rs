@@ -6,7 +6,6 @@
 use crate::common::{format_number, write_text, CliResult, TableFormat};
 use crate::kinematic_state::{rows, StateArgs};
 use robodyn::algorithms::kinematics::{center_of_mass, center_of_mass_jacobian_into};
-use robodyn::closed_state;
 use std::path::PathBuf;
 
 #[derive(clap::Args, Debug)]
@@ -45,13 +44,9 @@ pub fn run(a: Args) -> CliResult {
     let jacobian = if a.jacobian {
         let mut j = nalgebra::DMatrix::zeros(3, e.robot.dof());
         center_of_mass_jacobian_into(&e.robot, &mut e.data, root.as_ref(), &mut j)?;
-        Some(match &mut e.closed {
+        Some(match &e.closed {
             None => (j, e.robot.coordinates().names().to_vec()),
-            Some((chain, branch, q_a)) => {
-                let zeros = vec![0.0; chain.dof()];
-                let s = closed_state(chain, branch, q_a, &zeros, &zeros)?;
-                (j * s.g, chain.coordinates().names().to_vec())
-            }
+            Some((chain, g)) => (j * g, chain.coordinates().names().to_vec()),
         })
     } else {
         None

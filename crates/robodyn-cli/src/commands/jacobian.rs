@@ -5,7 +5,6 @@
 
 use crate::common::{choices, format_number, write_text, CliResult, TableFormat};
 use crate::kinematic_state::{rows, StateArgs};
-use robodyn::algorithms::kinematics::closed_frame_jacobian;
 use robodyn::{frame_jacobian_into, Reference};
 use std::path::PathBuf;
 
@@ -33,18 +32,14 @@ pub struct Args {
 const ROWS: [&str; 6] = ["vx", "vy", "vz", "wx", "wy", "wz"];
 
 pub fn run(a: Args) -> CliResult {
-    let mut e = a.state.evaluate()?;
+    let e = a.state.evaluate()?;
     let f = e.robot.frame_id(&a.frame)?;
-    let (j, joints) = match &mut e.closed {
-        None => {
-            let mut j = nalgebra::DMatrix::zeros(6, e.robot.dof());
-            frame_jacobian_into(&e.robot, &e.data, &f, a.reference, &mut j)?;
-            (j, e.robot.coordinates().names().to_vec())
-        }
-        Some((chain, branch, q_a)) => {
-            let cj = closed_frame_jacobian(chain, branch, q_a, &f, a.reference)?;
-            (cj.j_a, chain.coordinates().names().to_vec())
-        }
+    let mut j = nalgebra::DMatrix::zeros(6, e.robot.dof());
+    frame_jacobian_into(&e.robot, &e.data, &f, a.reference, &mut j)?;
+    // closed chains: J_a = J_tr G at the state evaluate() reached on the branch
+    let (j, joints) = match &e.closed {
+        None => (j, e.robot.coordinates().names().to_vec()),
+        Some((chain, g)) => (j * g, chain.coordinates().names().to_vec()),
     };
     let rows = rows(&j);
     crate::common::check_finite("J", &rows.concat())?;
@@ -64,7 +59,7 @@ pub fn run(a: Args) -> CliResult {
         TableFormat::Json => {
             let v = serde_json::json!({
                 "frame": a.frame, "reference": a.reference.name(), "joints": joints,
-                "q": e.closed.as_ref().map_or(&e.q, |c| &c.2), "J": rows,
+                "q": e.q, "J": rows,
             });
             serde_json::to_string_pretty(&v)? + "\n"
         }
