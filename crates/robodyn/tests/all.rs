@@ -63,6 +63,8 @@ mod geometry;
 mod identification_conic;
 #[path = "identification_consistency.rs"]
 mod identification_consistency;
+#[path = "identification_coverage.rs"]
+mod identification_coverage;
 #[path = "identification_hostile.rs"]
 mod identification_hostile;
 #[path = "identification_synthetic.rs"]

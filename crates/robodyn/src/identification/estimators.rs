@@ -172,9 +172,10 @@ pub const RANK_TOLERANCE: f64 = 1e-12;
 pub struct LsSolution {
     /// The estimate (p entries).
     pub x: Vec<f64>,
-    /// Standard deviation of each parameter: sqrt of the diagonal of sigma^2 (W^T W)^-1.
+    /// Standard deviation of each parameter: sqrt of the diagonal of the covariance.
     pub std: Vec<f64>,
-    /// Covariance sigma^2 (W^T W)^-1 (p x p, row-major).
+    /// Covariance sigma^2 (W^T W)^-1 (p x p, row-major), times the inflation of correlated
+    /// residuals where [`LsSolution::inflate`] was applied.
     pub covariance: Vec<f64>,
     /// sigma^2 = ||rho||^2 / (r - p).
     pub sigma2: f64,
@@ -194,6 +195,20 @@ impl LsSolution {
     /// ||y - W x|| / ||y||.
     pub fn relative_error(&self) -> f64 {
         (self.residual_sq / self.output_sq.max(f64::MIN_POSITIVE)).sqrt()
+    }
+
+    /// Multiply the covariance by `factor` (and the standard deviations by its square root):
+    /// the correlation of the residuals, see
+    /// [`super::signal::Butterworth::decimated_noise_gain`]. `sigma2` stays the residual
+    /// variance.
+    pub fn inflate(&mut self, factor: f64) {
+        for c in &mut self.covariance {
+            *c *= factor;
+        }
+        let s = factor.sqrt();
+        for d in &mut self.std {
+            *d *= s;
+        }
     }
 
     /// 100 std / |x| (infinite for x = 0).

@@ -321,6 +321,11 @@ pub struct ProcessingReport {
     pub border: usize,
     /// Samples dropped at the start by the settling of the decimation filter.
     pub decimation_skip: usize,
+    /// Factor applied to the covariance of the estimate (1 without decimation): the decimation
+    /// low-pass leaves the decimated residuals correlated, and for white torque noise at the
+    /// log's rate the usual sigma^2 (W^T W)^-1 is too small by this factor
+    /// ([`signal::Butterworth::decimated_noise_gain`]).
+    pub std_inflation: f64,
     /// The `min_speed` applied (rad/s or m/s).
     pub min_speed: f64,
     /// The dead band of the Coulomb sign applied (rad/s or m/s; 0: the exact sign).
@@ -593,6 +598,9 @@ pub fn processing(summary: &LogSummary, opt: &Options) -> Result<(Processing, Pr
     let decimation_skip = decimation_filter
         .as_ref()
         .map_or(0, |f| f.settling_samples(1e-3));
+    let std_inflation = decimation_filter
+        .as_ref()
+        .map_or(1.0, |f| f.decimated_noise_gain(nd));
     let duration = summary.duration();
     let validation = opt.validation.map(|(a, b)| {
         let end = if b >= 1.0 {
@@ -641,6 +649,7 @@ pub fn processing(summary: &LogSummary, opt: &Options) -> Result<(Processing, Pr
         decimation_filter: decimation_filter.map(|f| (f.order, f.cutoff)),
         border,
         decimation_skip,
+        std_inflation,
         min_speed: opt.min_speed,
         coulomb_band,
         fit_samples: 0,
@@ -793,6 +802,8 @@ pub fn identify(
         warnings.extend(warning);
         iv_report = Some(report);
     }
+    // the decimated residuals are correlated: the covariance accounts for it
+    sol.inflate(preport.std_inflation);
     let tw = weighted(&ts, sigma.as_deref());
     // physically consistent parameters: the constrained least squares, which is also the
     // consistent set nearest to the unconstrained estimate in the metric of its covariance
@@ -814,7 +825,13 @@ pub fn identify(
     }
     // essential parameters
     let essential = match opt.essential {
-        Some(e) => Some(essential_parameters(&tw, &ts, rows, &names, &e)?),
+        Some(e) => Some(essential_parameters(
+            &tw,
+            &ts,
+            (rows, preport.std_inflation),
+            &names,
+            &e,
+        )?),
         None => None,
     };
     let relative_std = sol.relative_std();
@@ -1205,7 +1222,7 @@ fn quality_warnings(
 fn essential_parameters(
     tw: &Mat<f64>,
     ts: &[Mat<f64>],
-    rows: usize,
+    (rows, inflation): (usize, f64),
     names: &[String],
     opt: &EssentialOptions,
 ) -> Result<Essential> {
@@ -1222,7 +1239,9 @@ fn essential_parameters(
     let mut keep: Vec<usize> = (0..p).collect();
     let sub = |keep: &[usize]| -> Result<LsSolution> {
         let names: Vec<String> = keep.iter().map(|&i| names[i].clone()).collect();
-        least_squares(&restrict(tw, keep), rows, &names)
+        let mut sol = least_squares(&restrict(tw, keep), rows, &names)?;
+        sol.inflate(inflation);
+        Ok(sol)
     };
     let mut sol = sub(&keep)?;
     let e0 = rel_error(&keep, &sol.x);

@@ -182,6 +182,14 @@ fn processing_text(id: &Identification) -> String {
         )),
         None => s.push_str("No decimation\n"),
     }
+    if pr.std_inflation != 1.0 {
+        s.push_str(&format!(
+            "Standard deviations: the decimated residuals are correlated by the decimation \
+             low-pass; the covariance is multiplied by its noise gain {:.3} (exact for white \
+             torque noise at the log's rate)\n",
+            pr.std_inflation
+        ));
+    }
     s.push_str(&format!(
         "Border: {} samples dropped at each end; decimation transient: {} samples\n",
         pr.border, pr.decimation_skip
@@ -372,6 +380,7 @@ pub fn to_json(id: &Identification) -> serde_json::Value {
             "decimation_filter": pr.decimation_filter.map(|(o, f)| json!({"order": o, "cutoff": f})),
             "border": pr.border,
             "decimation_skip": pr.decimation_skip,
+            "std_inflation": pr.std_inflation,
             "min_speed": pr.min_speed,
             "coulomb_band": pr.coulomb_band,
             "fit_samples": pr.fit_samples,

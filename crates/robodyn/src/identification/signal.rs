@@ -156,6 +156,36 @@ impl Butterworth {
         (((-factor.ln()) / sigma * self.sample_rate).ceil() as usize).saturating_add(1)
     }
 
+    /// Variance inflation of a least-squares estimate whose residuals are white noise passed
+    /// through this (causal) filter and then kept every `stride`-th sample (the parallel
+    /// decimation): the kept noise is correlated, with autocorrelation rho(k) = r(k stride) /
+    /// r(0), r(l) = sum_i h_i h_(i+l) over the impulse response h, and for regressors that vary
+    /// slowly over the correlation length the covariance sigma^2 (W^T W)^-1 is too small by
+    /// 1 + 2 sum_(k >= 1) rho(k) (the long-run over the short-run variance). Returns that
+    /// factor (1 for a stride whose kept samples are uncorrelated).
+    pub fn decimated_noise_gain(&self, stride: usize) -> f64 {
+        let stride = stride.max(1);
+        let len = self
+            .settling_samples(1e-12)
+            .clamp(16, 1 << 20)
+            .saturating_add(stride);
+        let mut state = SosState::new(self);
+        let h: Vec<f64> = (0..len)
+            .map(|i| state.step(if i == 0 { 1.0 } else { 0.0 }))
+            .collect();
+        let r = |lag: usize| -> f64 { h.iter().zip(&h[lag..]).map(|(a, b)| a * b).sum() };
+        let r0 = r(0);
+        if r0 <= 0.0 {
+            return 1.0;
+        }
+        let tail: f64 = (1..)
+            .map(|k| k * stride)
+            .take_while(|&lag| lag < h.len())
+            .map(r)
+            .sum();
+        (1.0 + 2.0 * tail / r0).max(f64::MIN_POSITIVE)
+    }
+
     /// Zero-phase filtering of a whole signal (scipy's `sosfiltfilt` with its default odd
     /// padding). Signals shorter than the padding plus one sample are an error.
     pub fn filtfilt(&self, x: &[f64]) -> Result<Vec<f64>> {
@@ -483,6 +513,52 @@ mod tests {
     /// and the steady-state initial conditions matter). The sections themselves may be paired
     /// differently (scipy attaches two zeros to the real pole of an odd order); the filter and
     /// its zero-phase output are the same.
+    #[test]
+    fn decimated_noise_gain_against_simulated_noise() {
+        // 8th-order low-pass at 0.8 x the Nyquist frequency of a decimation by 10, as the
+        // identification's parallel decimation at 500 Hz
+        let f = Butterworth::lowpass(8, 20.0, 500.0).unwrap();
+        // stride 1: the long-run variance of filtered white noise is the DC gain squared (1)
+        // over the variance sum h^2, i.e. the closed form 1 / sum h^2
+        let mut st = SosState::new(&f);
+        let h2: f64 = (0..20_000)
+            .map(|i| st.step(if i == 0 { 1.0 } else { 0.0 }).powi(2))
+            .sum();
+        let g1 = f.decimated_noise_gain(1);
+        assert!((g1 - 1.0 / h2).abs() < 1e-9 * g1, "{g1} vs {}", 1.0 / h2);
+        // a stride far beyond the impulse response: uncorrelated kept samples
+        assert!((f.decimated_noise_gain(100_000) - 1.0).abs() < 1e-12);
+        // stride 10: against the variance of the means of batches of filtered, decimated
+        // pseudo-random noise (an independent estimate of the long-run variance)
+        let g10 = f.decimated_noise_gain(10);
+        let mut st = SosState::new(&f);
+        let mut seed = 0x2545_f491_4f6c_dd1d_u64;
+        let mut uniform = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        let kept: Vec<f64> = (0..4_000_000)
+            .map(|_| st.step(uniform()))
+            .skip(1000)
+            .step_by(10)
+            .collect();
+        let var = kept.iter().map(|x| x * x).sum::<f64>() / kept.len() as f64;
+        let batch = 200;
+        let means: Vec<f64> = kept
+            .chunks_exact(batch)
+            .map(|c| c.iter().sum::<f64>() / batch as f64)
+            .collect();
+        let long_run = batch as f64 * means.iter().map(|m| m * m).sum::<f64>() / means.len() as f64;
+        let estimate = long_run / var;
+        // 2000 batches: the estimate's relative standard error is sqrt(2 / 2000) ~ 3 %
+        assert!(
+            (estimate - g10).abs() < 0.1 * g10 && g10 > 1.1,
+            "noise gain {g10} vs simulated {estimate}"
+        );
+    }
+
     #[test]
     fn matches_scipy_butter_and_sosfiltfilt() {
         type Case<'a> = (usize, f64, f64, &'a [(usize, f64)]);
