@@ -70,10 +70,10 @@ fn coverage(
     for run in 0..runs {
         let mut r = rng(5000 + run);
         let mut log = clean.clone();
-        for j in 0..n {
+        for (j, rms) in rms.iter().enumerate() {
             let e = noise(&mut r, samples);
             for (s, e) in log.samples.iter_mut().zip(e) {
-                s.y[j] += 0.01 * (1.0 + j as f64) * rms[j] * e;
+                s.y[j] += 0.01 * (1.0 + j as f64) * rms * e;
             }
         }
         let id = identify(&mut acc, &log, &opt).unwrap();
