@@ -165,6 +165,11 @@ fn floating_dynamics_match_pinocchio_free_flyer() {
             + (1..=robot.dof())
                 .map(|k| robot.dynamic().link(k).mass)
                 .sum::<f64>();
+        let total = robodyn::algorithms::kinematics::total_mass(robot);
+        assert!(
+            (total - mass).abs() < 1e-9 * mass,
+            "{name}: total_mass {total} vs {mass}"
+        );
         assert!(
             (mass - r["mass"].as_f64().unwrap()).abs() < 1e-9 * mass,
             "{name}: total mass {mass} vs {}",

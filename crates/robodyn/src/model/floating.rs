@@ -46,6 +46,20 @@ pub const BASE_VELOCITY_NAMES: [&str; 6] = [
 /// larger gap is an error, not a silent renormalization of a wrong input.
 pub const QUATERNION_TOLERANCE: f64 = 1e-6;
 
+/// The refusal of a function that does not support floating bases yet (`what` names it),
+/// for a description whose base floats: an error, never a fixed-base answer.
+pub fn require_fixed_base(desc: &super::RobotDescription, what: &str) -> crate::Result<()> {
+    if desc.floating_base.is_some() {
+        return Err(crate::Error::Input(format!(
+            "{what}: robot `{}` has a floating base, which {what} does not support yet (the \
+             floating-base models are inverse_dynamics, inertia_matrix, h_vector and \
+             direct_dynamics over nq / nv vectors)",
+            desc.name
+        )));
+    }
+    Ok(())
+}
+
 /// The numeric floating base: the body of link 0 with every link rigidly attached to it
 /// (through fixed frames only) folded in, and those links (for their external wrenches).
 #[derive(Clone, Debug)]

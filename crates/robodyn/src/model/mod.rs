@@ -23,7 +23,8 @@ pub use description::{
 };
 pub use environment::{BaseMotion, Environment, Wrench};
 pub use floating::{
-    BaseKind, FloatingBase, BASE_CONFIGURATION_NAMES, BASE_VELOCITY_NAMES, QUATERNION_TOLERANCE,
+    require_fixed_base, BaseKind, FloatingBase, BASE_CONFIGURATION_NAMES, BASE_VELOCITY_NAMES,
+    QUATERNION_TOLERANCE,
 };
 pub use structure::{path_from_base, ClosedLoop, Structure, StructureType};
 
@@ -389,17 +390,7 @@ impl Robot {
     /// Error unless the base is fixed or mobile: the refusal of the functions that do not
     /// support floating bases yet (`what` names the function), never a wrong number.
     pub fn require_fixed_base(&self, what: &str) -> Result<()> {
-        if self.is_floating() {
-            return Err(Error::Input(format!(
-                "{what}: robot `{}` has a floating base, which {what} does not support yet \
-                 (inverse_dynamics, inertia_matrix, h_vector and direct_dynamics take its \
-                 nq = {} / nv = {} vectors)",
-                self.name(),
-                self.nq(),
-                self.nv()
-            )));
-        }
-        Ok(())
+        require_fixed_base(&self.desc, what)
     }
 
     /// nq, the entries of a configuration: N for a fixed or mobile base, 7 + N for a floating
