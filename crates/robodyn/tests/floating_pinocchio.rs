@@ -56,7 +56,10 @@ fn random_state<R: Rng>(rng: &mut R, robot: &Robot) -> [Vec<f64>; 4] {
     ]
 }
 
-fn pinocchio_reference(cases: &[(&str, Robot, Vec<[Vec<f64>; 4]>)], dir: &Path) -> Value {
+/// A robot's file name, the robot and its random states (q, v, a, tau).
+type Case = (&'static str, Robot, Vec<[Vec<f64>; 4]>);
+
+fn pinocchio_reference(cases: &[Case], dir: &Path) -> Value {
     let mut spec = Vec::new();
     for (name, robot, states) in cases {
         let coords = robot.coordinates();

@@ -327,13 +327,19 @@ fn free_joint_parent(
     let Some(&(parent, _, node)) = free.first() else {
         return Ok(None);
     };
-    let what = "joint of type `floating`";
+    let name = |n: roxmltree::Node| n.attribute("name").unwrap_or("").to_string();
     if free.len() > 1 {
         return Err(ctx.err(
             free[1].2,
-            format!("a second {what}: robodyn models one floating base, the root link's"),
+            format!(
+                "joint `{}`: type `floating` a second time (after `{}`): robodyn models one \
+                 floating base, the root link's",
+                name(free[1].2),
+                name(node)
+            ),
         ));
     }
+    let what = format!("joint `{}`: type `floating`", name(node));
     let has_parent = joints.iter().any(|j| j.child == parent);
     let has_children = joints.iter().any(|j| j.parent == parent);
     let massive = links[parent].inertial.as_ref().is_some_and(|i| i.1 != 0.0);
@@ -341,13 +347,13 @@ fn free_joint_parent(
         return Err(ctx.err(
             node,
             format!(
-                "{what}: its parent link `{}` must be the massless world link, with no other \
-                 joint (the floating joint's child is the floating base)",
+                "{what} is accepted as the root joint only: its parent link `{}` must be the \
+                 massless world link, with no other joint (its child is the floating base)",
                 links[parent].name
             ),
         ));
     }
-    let o = origin(ctx, node, what)?;
+    let o = origin(ctx, node, &what)?;
     if o.translation.vector.norm() != 0.0 || o.rotation.angle() != 0.0 {
         return Err(ctx.err(
             node,
