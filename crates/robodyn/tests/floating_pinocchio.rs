@@ -14,7 +14,9 @@
 use nalgebra::{DMatrix, UnitQuaternion, Vector3};
 use rand::Rng;
 use robodyn::io::LoadOptions;
-use robodyn::{direct_dynamics_into, inertia_matrix_into, Data, Method};
+use robodyn::{
+    centroidal_momentum, direct_dynamics_into, inertia_matrix_into, integrate, Data, Method,
+};
 use robodyn::{Robot, State};
 use robodyn_testing as testing;
 use serde_json::{json, Value};
@@ -182,7 +184,7 @@ fn floating_dynamics_match_pinocchio_free_flyer() {
         let env = robot.environment();
         let (mut tau, mut qdd) = (vec![0.0; nv], vec![0.0; nv]);
         let mut a_mat = DMatrix::zeros(nv, nv);
-        let mut worst = [0.0f64; 4];
+        let mut worst = [0.0f64; 6];
         for (s, [q, v, a, t]) in states.iter().enumerate() {
             let p = &r["states"][s];
             let ctx = format!("{name}, state {s}");
@@ -219,10 +221,39 @@ fn floating_dynamics_match_pinocchio_free_flyer() {
                 worst[w] = worst[w].max(e);
                 assert!(e <= TOL, "{ctx}: {} differs from aba by {e:e}", m.name());
             }
+            // centroidal momentum and centre of mass (world frame)
+            let c = centroidal_momentum(robot, &mut data, q, v).unwrap();
+            let ours: Vec<f64> = c.linear.iter().chain(c.angular.iter()).copied().collect();
+            let e = rel_gap(&ours, &vector(&p["hg"]));
+            worst[4] = worst[4].max(e);
+            assert!(e <= TOL, "{ctx}: centroidal momentum differs by {e:e}");
+            let e = rel_gap(c.com.as_slice(), &vector(&p["com"]));
+            assert!(e <= TOL, "{ctx}: centre of mass differs by {e:e}");
+            assert!((c.mass - mass).abs() < 1e-9 * mass);
+            // integration on SE(3): the base pose after 0.01 s at v (quaternion up to sign)
+            let next = integrate(robot, q, v, 0.01).unwrap();
+            let pin_next = vector(&p["integrate"]);
+            let sign = if next[6] * pin_next[6] < 0.0 {
+                -1.0
+            } else {
+                1.0
+            };
+            let ours: Vec<f64> = (0..7)
+                .map(|k| if k >= 3 { sign * next[k] } else { next[k] })
+                .collect();
+            let e = rel_gap(&ours, &pin_next);
+            worst[5] = worst[5].max(e);
+            assert!(e <= TOL, "{ctx}: integrate differs by {e:e}");
+            let qn = nalgebra::Vector4::new(next[3], next[4], next[5], next[6]).norm();
+            assert!((qn - 1.0).abs() < 1e-14, "{ctx}: |quaternion| = {qn}");
+            for k in 0..robot.dof() {
+                assert_eq!(next[7 + k], q[7 + k] + v[6 + k] * 0.01);
+            }
         }
         eprintln!(
-            "{name}: worst relative gaps rnea {:.1e}, crba {:.1e}, composite {:.1e}, aba {:.1e}",
-            worst[0], worst[1], worst[2], worst[3]
+            "{name}: worst relative gaps rnea {:.1e}, crba {:.1e}, composite {:.1e}, aba {:.1e}, \
+             centroidal {:.1e}, integrate {:.1e}",
+            worst[0], worst[1], worst[2], worst[3], worst[4], worst[5]
         );
     }
 }

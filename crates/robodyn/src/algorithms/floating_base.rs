@@ -404,3 +404,116 @@ fn aba(
 fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
+
+/// q ⊕ v dt into `out` (nq): the configuration reached from `q` (nq) moving at the constant
+/// velocity `v` (nv) for `dt` seconds. A floating base moves on SE(3), as Pinocchio's
+/// `integrate`: its placement becomes M exp(v dt), the twist (v_0, w_0) being in the base
+/// frame, so the quaternion stays a unit quaternion (never q + v dt); the joints move by v dt.
+/// For a fixed or mobile base, q + v dt.
+pub fn integrate_into(robot: &Robot, q: &[f64], v: &[f64], dt: f64, out: &mut [f64]) -> Result<()> {
+    let (nq, nv, n) = (robot.nq(), robot.nv(), robot.dof());
+    check_vector("q", q, nq, || format!("nq = {nq}"))?;
+    check_vector("v", v, nv, || format!("nv = {nv}"))?;
+    check_vector("dt", &[dt], 1, || "a time step".into())?;
+    if out.len() != nq {
+        return Err(Error::dimension(
+            "q_next",
+            nq,
+            out.len(),
+            format!("nq = {nq}"),
+        ));
+    }
+    let (qb, vb) = (nq - n, nv - n);
+    for k in 0..n {
+        out[qb + k] = q[qb + k] + v[vb + k] * dt;
+    }
+    if robot.is_floating() {
+        let rot = base_rotation(q)?;
+        let (lin, w) = (v3(&v[0..3]) * dt, v3(&v[3..6]) * dt);
+        let p = v3(&q[0..3]) + rot * (exp3_left_jacobian(&w) * lin);
+        let next = rot * UnitQuaternion::from_scaled_axis(w);
+        out[..3].copy_from_slice(p.as_slice());
+        out[3..7].copy_from_slice(&[next.i, next.j, next.k, next.w]);
+    }
+    check_finite_result("q_next", out)
+}
+
+/// [`integrate_into`], allocating its result.
+pub fn integrate(robot: &Robot, q: &[f64], v: &[f64], dt: f64) -> Result<nalgebra::DVector<f64>> {
+    let mut out = nalgebra::DVector::zeros(robot.nq());
+    integrate_into(robot, q, v, dt, out.as_mut_slice())?;
+    Ok(out)
+}
+
+/// V(w) = I + (1 - cos t)/t² [w]x + (t - sin t)/t³ [w]x², t = |w|: the translation of
+/// exp([v; w]) is V(w) v (series below t = 1e-4).
+fn exp3_left_jacobian(w: &Vector3<f64>) -> Matrix3<f64> {
+    let t2 = w.norm_squared();
+    let t = t2.sqrt();
+    let (a, b) = if t < 1e-4 {
+        (0.5 - t2 / 24.0, 1.0 / 6.0 - t2 / 120.0)
+    } else {
+        ((1.0 - t.cos()) / t2, (t - t.sin()) / (t2 * t))
+    };
+    let k = skew(w);
+    Matrix3::identity() + k * a + k * k * b
+}
+
+/// The centroidal quantities of a floating robot: mass, centre of mass and momentum.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Centroidal {
+    /// Total mass (kg), the base included.
+    pub mass: f64,
+    /// Centre of mass in the world frame (m).
+    pub com: Vector3<f64>,
+    /// Linear momentum (kg m/s), world components.
+    pub linear: Vector3<f64>,
+    /// Angular momentum about the centre of mass (kg m²/s), world components.
+    pub angular: Vector3<f64>,
+}
+
+/// Mass, centre of mass and centroidal momentum (linear, and angular about the centre of mass,
+/// Pinocchio's `computeCentroidalMomentum` hg, world components) of a floating robot at q (nq),
+/// v (nv). The spatial momentum about O_0 in R_0 is the base rows of A times v (the momentum
+/// conjugate to the base twist), moved to the centre of mass and rotated to the world.
+/// Allocation-free.
+pub fn centroidal_momentum(
+    robot: &Robot,
+    data: &mut Data,
+    q: &[f64],
+    v: &[f64],
+) -> Result<Centroidal> {
+    if !robot.is_floating() {
+        return Err(Error::Input(format!(
+            "centroidal momentum: robot `{}` has a {} base; the centroidal momentum is that of \
+             a floating base (nq = 7 + N, nv = 6 + N)",
+            robot.name(),
+            robot.base_kind().name()
+        )));
+    }
+    let rot = check_state(robot, data, None, q, &[("v", v)], ("v", robot.nv()))?;
+    let abb = composite_blocks(robot, data, q);
+    gather_base_rows(robot, data);
+    let n = robot.dof();
+    let base = Vector6::from_column_slice(&v[..6]);
+    let h = Vector6::from_fn(|c, _| {
+        (abb.row(c) * base)[0] + dot(&data.base_rows[c * n..(c + 1) * n], &v[6..])
+    });
+    let mass = abb[(0, 0)];
+    if mass.is_nan() || mass <= 0.0 {
+        return Err(Error::Input(format!(
+            "centroidal momentum: robot `{}` has no mass (total {mass} kg)",
+            robot.name()
+        )));
+    }
+    // skew(MS) sits at rows 3..6, columns 0..3 of the base block
+    let c = Vector3::new(abb[(5, 1)], abb[(3, 2)], abb[(4, 0)]) / mass;
+    let (lin, ang) = (v3(&h.as_slice()[0..3]), v3(&h.as_slice()[3..6]));
+    let r = rot;
+    Ok(Centroidal {
+        mass,
+        com: v3(&q[0..3]) + r * c,
+        linear: r * lin,
+        angular: r * (ang - c.cross(&lin)),
+    })
+}

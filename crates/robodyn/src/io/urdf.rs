@@ -391,10 +391,10 @@ fn legged_warning(ctx: &Ctx, links: &[ULink], root: usize) -> Option<Warning> {
     let mut w = Warning::new(
         Item::Robot,
         format!(
-            "links {}{more} look like the feet of a legged robot, whose base floats: the root \
-             link `{}` is loaded as a fixed base (frame 0; its inertia plays no role), so the \
-             models are those of the robot with its base held fixed; load it with a floating \
-             base to model the free robot",
+            "links {}{more} look like the feet of a legged robot, whose base floats: robodyn \
+             loads the root link `{}` as a fixed base (frame 0; its inertia plays no role), so \
+             the models are those of the robot with its base held fixed; load it with a \
+             floating base to model the free robot",
             shown.join(", "),
             links[root].name
         ),

@@ -5,7 +5,9 @@ Usage: python3 pinocchio_floating.py IN.json OUT.json
 IN: {"robots": [{"urdf": path, "states": [{"base_q": [7], "base_v": [6], "base_a": [6],
      "base_tau": [6], "q": {joint: x}, "v": {...}, "a": {...}, "tau": {...}}]}]}
 OUT: {"robots": [{"nv": int, "joints": [names in Pinocchio's v order, after the base],
-      "mass": float, "states": [{"rnea": [nv], "crba": [[nv]], "aba": [nv]}]}]}
+      "mass": float, "states": [{"rnea": [nv], "crba": [[nv]], "aba": [nv], "hg": [6]
+      (centroidal momentum, linear then angular, world frame at the CoM), "com": [3],
+      "integrate": [7] (the base part of integrate(q, v * 0.01))}]}]}
 Vectors are in Pinocchio's v order (base 6 first). Continuous joints (nq = 2) get (cos, sin).
 Gravity is Pinocchio's default (0, 0, -9.81).
 """
@@ -60,7 +62,12 @@ def main():
             m = pin.crba(model, data, q)
             m = np.triu(m) + np.triu(m, 1).T
             dd = pin.aba(model, data, q, v, tau)
-            res.append({"rnea": r.tolist(), "crba": m.tolist(), "aba": dd.tolist()})
+            hg = pin.computeCentroidalMomentum(model, data, q, v)
+            com = pin.centerOfMass(model, data, q)
+            qn = pin.integrate(model, q, v * 0.01)
+            res.append({"rnea": r.tolist(), "crba": m.tolist(), "aba": dd.tolist(),
+                        "hg": np.concatenate([hg.linear, hg.angular]).tolist(),
+                        "com": np.asarray(com).tolist(), "integrate": qn[:7].tolist()})
         out.append({
             "nv": int(model.nv),
             "joints": names[6:],
