@@ -36,7 +36,7 @@ fn base_of(robot: &Robot) -> &FloatingBase {
         .expect("called for floating robots only")
 }
 
-/// 0R_w... the orientation of the base in the world, wR_0, from entries 3..7 of q (x, y, z, w),
+/// wR_0, the orientation of the base in the world, from entries 3..7 of q (x, y, z, w),
 /// normalized; an error when its norm is farther than [`QUATERNION_TOLERANCE`] from 1.
 pub fn base_rotation(q: &[f64]) -> Result<UnitQuaternion<f64>> {
     let quat = Quaternion::new(q[6], q[3], q[4], q[5]);

@@ -411,25 +411,18 @@ impl Robot {
     /// Names of the nq configuration entries ([`BASE_CONFIGURATION_NAMES`] first for a
     /// floating base, then the joint names).
     pub fn configuration_names(&self) -> Vec<String> {
-        let base: &[&str] = if self.is_floating() {
-            &BASE_CONFIGURATION_NAMES
-        } else {
-            &[]
-        };
-        base.iter()
-            .map(|s| s.to_string())
-            .chain(self.coords.names().iter().cloned())
-            .collect()
+        self.names_after_base(&BASE_CONFIGURATION_NAMES)
     }
 
     /// Names of the nv velocity entries ([`BASE_VELOCITY_NAMES`] first for a floating base,
     /// then the joint names).
     pub fn velocity_names(&self) -> Vec<String> {
-        let base: &[&str] = if self.is_floating() {
-            &BASE_VELOCITY_NAMES
-        } else {
-            &[]
-        };
+        self.names_after_base(&BASE_VELOCITY_NAMES)
+    }
+
+    /// `base` (for a floating base only), then the joint names.
+    fn names_after_base(&self, base: &[&str]) -> Vec<String> {
+        let base = if self.is_floating() { base } else { &[] };
         base.iter()
             .map(|s| s.to_string())
             .chain(self.coords.names().iter().cloned())
