@@ -125,11 +125,16 @@ fn urdf_unknown_link_and_floating_joint() {
     );
     let f = tmp(
         "floating.urdf",
-        &format!("{URDF_LINKS}  <joint name=\"free\" type=\"floating\"><parent link=\"base\"/><child link=\"a\"/></joint>\n</robot>\n"),
+        &format!("{URDF_LINKS}  <joint name=\"j1\" type=\"revolute\"><parent link=\"base\"/><child link=\"a\"/></joint>\n  \
+                  <joint name=\"free\" type=\"floating\"><parent link=\"a\"/><child link=\"b\"/></joint>\n</robot>\n"),
     );
+    // a floating joint is the root joint of a floating base, nowhere else
     let e = fails(&["info", path(&f)]);
-    assert!(e.contains(&format!("{}:5:", path(&f))), "{e}");
-    assert!(e.contains("joint `free`: type `floating`"), "{e}");
+    assert!(e.contains(&format!("{}:6:", path(&f))), "{e}");
+    assert!(
+        e.contains("joint `free`: type `floating` is accepted as the root joint only"),
+        "{e}"
+    );
 }
 
 #[test]

@@ -153,6 +153,34 @@ pub fn random_tree<R: Rng>(rng: &mut R, n: usize, opt: &TreeOptions) -> Robot {
     Robot::new(random_tree_description(rng, n, opt)).expect("random trees are valid")
 }
 
+/// A validated random tree with a floating base: link 0 with random physical inertial
+/// parameters ([`random_inertial`]).
+pub fn random_floating_tree<R: Rng>(rng: &mut R, n: usize, opt: &TreeOptions) -> Robot {
+    let mut d = random_tree_description(rng, n, opt);
+    let mut base = LinkDesc::zero("base");
+    for (k, v) in random_inertial(rng).iter().enumerate() {
+        base.params[k] = Expr::num(*v);
+    }
+    d.floating_base = Some(base);
+    Robot::new(d).expect("random floating trees are valid")
+}
+
+/// A random state (q, v, a) of a floating robot with `n` joints: q = [p, unit quaternion
+/// (x, y, z, w), joints] (nq = 7 + n), v and a over nv = 6 + n.
+pub fn random_floating_state<R: Rng>(rng: &mut R, n: usize) -> [Vec<f64>; 3] {
+    let [qj, vj, aj] = random_state(rng, n + 6);
+    let axis = Vector3::new(
+        rng.random_range(-1.0..1.0),
+        rng.random_range(-1.0..1.0),
+        rng.random_range(-1.0..1.0),
+    );
+    let quat = nalgebra::UnitQuaternion::new(axis * rng.random_range(0.0..3.0));
+    let mut q = qj[..3].to_vec();
+    q.extend([quat.i, quat.j, quat.k, quat.w]);
+    q.extend_from_slice(&qj[6..]);
+    [q, vj, aj]
+}
+
 /// A random state (q, qd, qdd) for `n` joints.
 pub fn random_state<R: Rng>(rng: &mut R, n: usize) -> [Vec<f64>; 3] {
     let mut v = |s: f64| {

@@ -62,6 +62,11 @@ pub struct Data<T: DynScalar = f64> {
     pub(crate) qdd: Vec<T>,
     pub(crate) h: Vec<T>,
     pub(crate) zeros: Vec<T>,
+    /// Floating base: the 6 base rows B of A over the joints (row c at c N), then
+    /// X = A_jj^-1 B' (column d at 6 N + d N), and H and zeros over nv = 6 + N entries.
+    pub(crate) base_rows: Vec<T>,
+    pub(crate) h_v: Vec<T>,
+    pub(crate) zeros_v: Vec<T>,
 }
 
 impl Data<f64> {
@@ -164,6 +169,9 @@ impl<T: DynScalar> Data<T> {
             qdd: z(),
             h: z(),
             zeros: z(),
+            base_rows: vec![T::zero(); 12 * nl],
+            h_v: vec![T::zero(); nl + 6],
+            zeros_v: vec![T::zero(); nl + 6],
         }
     }
 

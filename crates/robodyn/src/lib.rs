@@ -103,6 +103,7 @@ pub use algorithms::closed_chain::{
 pub use algorithms::direct_dynamics::{
     direct_dynamics, direct_dynamics_into, direct_dynamics_state_into, DirectState, Method,
 };
+pub use algorithms::floating_base::{centroidal_momentum, integrate, integrate_into, Centroidal};
 pub use algorithms::inertia_matrix::{
     h_vector, h_vector_into, inertia_matrix, inertia_matrix_into,
 };

@@ -55,6 +55,10 @@ mod direct_dynamics;
 mod finite_results;
 #[path = "fixed_frames.rs"]
 mod fixed_frames;
+#[path = "floating_base.rs"]
+mod floating_base;
+#[path = "floating_pinocchio.rs"]
+mod floating_pinocchio;
 #[path = "fuzz_regressions.rs"]
 mod fuzz_regressions;
 #[path = "geometry.rs"]

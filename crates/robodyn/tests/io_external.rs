@@ -20,7 +20,7 @@ fn external() -> PathBuf {
 }
 
 /// The files refused, with a part of the reason the error must give.
-const REFUSED: [(&str, &str); 4] = [
+const REFUSED: [(&str, &str); 2] = [
     // the files themselves are inconsistent (NF = 6 but 14 / 10 frames listed)
     (
         "freecad-symoro/AKR3000.par",
@@ -29,15 +29,6 @@ const REFUSED: [(&str, &str); 4] = [
     (
         "freecad-symoro/sr400.par",
         "Ant has 10 entries, NF = 6 expected",
-    ),
-    // a free-floating base
-    (
-        "symoro-robots/rx90float.par",
-        "floating (free) base is not supported",
-    ),
-    (
-        "symoro-robots/floatplanar2r.par",
-        "is_floating = True: a floating (free) base",
     ),
 ];
 

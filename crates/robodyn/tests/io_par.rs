@@ -285,18 +285,19 @@ fn opensymoro_mobile_base_flexibility_and_floating() {
     // the NL-entry form is accepted too
     let d2 = parse("NL = 2\nNJ = 2\nNF = 2\nis_mobile = 1\nM = {1, 2}\n").unwrap();
     assert_eq!(d2.links[1].params[param::M].to_string(), "2");
-    // flexible joints are noted, floating bases refused
+    // flexible joints are noted; a floating base reads link 0's parameters
     let d3 = parse("NL = 2\nNJ = 2\nNF = 2\neta = {1, 0}\nk = {k1, 0}\n").unwrap();
     assert!(
         d3.notes.iter().any(|n| n.contains("flexib")),
         "{:?}",
         d3.notes
     );
-    let m = err("NL = 2\nNJ = 2\nNF = 2\nis_floating = 1\n");
-    assert!(
-        m.starts_with("test.par:4:") && m.contains("floating"),
-        "{m}"
-    );
+    let d4 = parse("NL = 2\nNJ = 2\nNF = 2\nis_floating = 1\nM = {M0, 1, 2}\n").unwrap();
+    let base = d4.floating_base.as_ref().expect("a floating base");
+    assert_eq!(base.params[param::M].to_string(), "M0");
+    assert_eq!(d4.links[0].params[param::M].to_string(), "1");
+    let back = parse(&par::write_description(&d4)).unwrap();
+    assert_eq!(back, d4);
 }
 
 #[test]
@@ -362,8 +363,8 @@ fn joint_variables_are_read_as_symoro_reads_them() {
     }
     let m = err(&format!("{HEAD}is_mobile = yes\n"));
     assert!(m.starts_with("test.par:5:") && m.contains("0 or 1"), "{m}");
-    let m = err(&format!("{HEAD}is_floating = True\n"));
-    assert!(m.contains("floating (free) base is not supported"), "{m}");
+    let d = parse(&format!("{HEAD}is_floating = True\n")).unwrap();
+    assert!(d.floating_base.is_some() && !d.mobile_base);
 }
 
 #[test]

@@ -69,11 +69,11 @@ impl Method {
 
 /// A usable pivot: finite and above the relative tolerance (false for NaN).
 #[inline]
-fn pivot_ok(d: f64, scale: f64) -> bool {
+pub(crate) fn pivot_ok(d: f64, scale: f64) -> bool {
     d.is_finite() && d > PIVOT_TOL * scale
 }
 
-fn singular(j: usize, what: &str, value: f64, scale: f64) -> Error {
+pub(crate) fn singular(j: usize, what: &str, value: f64, scale: f64) -> Error {
     Error::Singular {
         what: format!("{what} of joint {j}"),
         rcond: if scale > 0.0 { value / scale } else { 0.0 },
@@ -183,7 +183,7 @@ pub fn ltdl_solve(model: &DynModel<f64>, a: &DMatrix<f64>, x: &mut [f64]) {
     }
 }
 
-fn check_finite(qdd: &[f64]) -> Result<()> {
+pub(crate) fn check_finite(qdd: &[f64]) -> Result<()> {
     match qdd.iter().position(|x| !x.is_finite()) {
         Some(k) => Err(Error::Numerical(format!(
             "joint {}: the direct dynamic model gives a non-finite acceleration ({})",
@@ -316,10 +316,32 @@ pub fn ddm_aba(
     tau: &[f64],
     qdd: &mut [f64],
 ) -> Result<()> {
+    let scale = aba_links(model, b, env, env.base.w0, q, qd, tau);
+    aba_articulated(model, b, scale, false)?;
+    let g = env.base.vp0 - env.gravity;
+    let wp0 = env.base.wp0;
+    let acc0 = Vector6::new(g.x, g.y, g.z, wp0.x, wp0.y, wp0.z);
+    aba_accelerations(model, b, acc0, qdd);
+    check_finite(qdd)
+}
+
+/// First pass of the articulated-body model, base to tips from the base's angular velocity
+/// `w0` (in R_0): link velocities, gamma_j, link inertias J_j and biases beta_j (external
+/// wrenches included), Gamma_j minus friction. Returns the scale of the pivots (the largest
+/// mass, inertia trace or rotor inertia).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn aba_links(
+    model: &DynModel<f64>,
+    b: &mut Data,
+    env: &Environment,
+    w0: Vector3<f64>,
+    q: &[f64],
+    qd: &[f64],
+    tau: &[f64],
+) -> f64 {
     let n = model.nl;
     let mut scale: f64 = 0.0;
-    // Forward: velocities, gamma_j, link inertias and biases.
-    b.w[0] = env.base.w0;
+    b.w[0] = w0;
     for j in 1..=n {
         let fr = model.frame(j);
         let i = fr.ant;
@@ -343,17 +365,9 @@ pub fn ddm_aba(
         }
         b.gamma[j] = Vector6::new(lin.x, lin.y, lin.z, ang.x, ang.y, ang.z);
         let l = model.link(j);
-        let mut ia = Matrix6::zeros();
-        ia.fixed_view_mut::<3, 3>(0, 0)
-            .copy_from(&(Matrix3::identity() * l.mass));
-        let sm = skew(&l.ms);
-        ia.fixed_view_mut::<3, 3>(0, 3).copy_from(&(-sm));
-        ia.fixed_view_mut::<3, 3>(3, 0).copy_from(&sm);
-        ia.fixed_view_mut::<3, 3>(3, 3).copy_from(&l.inertia);
         let e = env.wrench(model.wrench_link(j));
-        let f = w.cross(&w.cross(&l.ms)) + e.force;
-        let m = w.cross(&(l.inertia * w)) + e.moment;
-        b.art_bias[j] = Vector6::new(f.x, f.y, f.z, m.x, m.y, m.z);
+        let (ia, bias) = body_inertia_and_bias(l, &w, &e.force, &e.moment);
+        b.art_bias[j] = bias;
         b.art_inertia[j] = ia;
         b.rot[j] = rot;
         b.pos[j] = pos;
@@ -372,8 +386,40 @@ pub fn ddm_aba(
             b.art_bias[fl.host] += Vector6::new(f.x, f.y, f.z, m.x, m.y, m.z);
         }
     }
-    // Backward: articulated inertias.
-    for k in (1..=n).rev() {
+    scale
+}
+
+/// The spatial inertia about O_j J_j = [[M I, -skew(MS)], [skew(MS), J]] of a body and its
+/// bias beta_j = [w x (w x MS) + fe; w x (J w) + me] at angular velocity `w`, with the
+/// external wrench (fe, me) it exerts on the environment.
+pub(crate) fn body_inertia_and_bias(
+    l: &crate::model::LinkConstants<f64>,
+    w: &Vector3<f64>,
+    fe: &Vector3<f64>,
+    me: &Vector3<f64>,
+) -> (Matrix6<f64>, Vector6<f64>) {
+    let mut ia = Matrix6::zeros();
+    ia.fixed_view_mut::<3, 3>(0, 0)
+        .copy_from(&(Matrix3::identity() * l.mass));
+    let sm = skew(&l.ms);
+    ia.fixed_view_mut::<3, 3>(0, 3).copy_from(&(-sm));
+    ia.fixed_view_mut::<3, 3>(3, 0).copy_from(&sm);
+    ia.fixed_view_mut::<3, 3>(3, 3).copy_from(&l.inertia);
+    let f = w.cross(&w.cross(&l.ms)) + fe;
+    let m = w.cross(&(l.inertia * w)) + me;
+    (ia, Vector6::new(f.x, f.y, f.z, m.x, m.y, m.z))
+}
+
+/// Backward pass of the articulated-body model: articulated inertias J*_j and biases beta*_j,
+/// each carried to its antecedent; with `into_base`, the children of the base are carried into
+/// `art_inertia[0]`, `art_bias[0]` too (a floating base, whose own body is already there).
+pub(crate) fn aba_articulated(
+    model: &DynModel<f64>,
+    b: &mut Data,
+    scale: f64,
+    into_base: bool,
+) -> Result<()> {
+    for k in (1..=model.nl).rev() {
         let fr = model.frame(k);
         let (kk, alpha) = match axis_index(fr.joint) {
             Some(ax) => {
@@ -400,16 +446,24 @@ pub fn ddm_aba(
             ),
         };
         let i = fr.ant;
-        if i != 0 {
+        if i != 0 || into_base {
             b.art_inertia[i] += inertia_to_parent(&b.rot[k], &b.pos[k], &kk);
             b.art_bias[i] += wrench_to_parent(&b.rot[k], &b.pos[k], &alpha);
         }
     }
-    // Forward: accelerations.
-    let g = env.base.vp0 - env.gravity;
-    let wp0 = env.base.wp0;
-    b.acc[0] = Vector6::new(g.x, g.y, g.z, wp0.x, wp0.y, wp0.z);
-    for j in 1..=n {
+    Ok(())
+}
+
+/// Last pass of the articulated-body model, base to tips from the base's classical
+/// acceleration minus gravity `acc0` = [Vd_0 - g; wd_0] (in R_0): the joint accelerations.
+pub(crate) fn aba_accelerations(
+    model: &DynModel<f64>,
+    b: &mut Data,
+    acc0: Vector6<f64>,
+    qdd: &mut [f64],
+) {
+    b.acc[0] = acc0;
+    for j in 1..=model.nl {
         let fr = model.frame(j);
         let mut acc = motion_to_child(&b.rot[j], &b.pos[j], &b.acc[fr.ant]) + b.gamma[j];
         match axis_index(fr.joint) {
@@ -422,7 +476,6 @@ pub fn ddm_aba(
         }
         b.acc[j] = acc;
     }
-    check_finite(qdd)
 }
 
 /// Run one of the two kernels on tree arrays.
@@ -460,6 +513,11 @@ pub fn direct_dynamics_into(
     method: Method,
     qdd: &mut [f64],
 ) -> Result<()> {
+    if robot.is_floating() {
+        return crate::algorithms::floating_base::direct_dynamics_into(
+            robot, data, env, q, qd, tau, method, qdd,
+        );
+    }
     let names = ["q", "qd", "tau"];
     tree_vector_map(
         robot,
@@ -553,7 +611,7 @@ pub fn direct_dynamics(
     tau: &[f64],
     method: Method,
 ) -> Result<DVector<f64>> {
-    let mut qdd = DVector::zeros(robot.dof());
+    let mut qdd = DVector::zeros(robot.nv());
     with_data(robot, |data| {
         direct_dynamics_into(
             robot,

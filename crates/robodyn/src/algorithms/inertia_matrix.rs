@@ -142,7 +142,7 @@ pub fn composite_inertia_matrix<T: DynScalar>(
 /// loop over the six component arrays, the form's zeros skipped at compile time
 /// ([`form_row`]): independent iterations, vectorized for f64.
 #[inline]
-fn transport<T: DynScalar>(
+pub(crate) fn transport<T: DynScalar>(
     form: RotationForm,
     rot: &Matrix3<T>,
     pos: &Vector3<T>,
@@ -250,6 +250,9 @@ pub fn inertia_matrix_into(
     q: &[f64],
     a: &mut DMatrix<f64>,
 ) -> Result<()> {
+    if robot.is_floating() {
+        return crate::algorithms::floating_base::inertia_matrix_into(robot, data, q, a);
+    }
     data.check(robot)?;
     let c = robot.coordinates();
     c.check("q", q, "movable joints")?;
@@ -269,7 +272,7 @@ pub fn inertia_matrix_into(
 
 /// A(q) (N x N over the movable joints); checks its input and allocates.
 pub fn inertia_matrix(robot: &Robot, q: &[f64]) -> Result<DMatrix<f64>> {
-    let n = robot.dof();
+    let n = robot.nv();
     let mut a = DMatrix::zeros(n, n);
     with_data(robot, |data| inertia_matrix_into(robot, data, q, &mut a))?;
     Ok(a)
@@ -286,6 +289,9 @@ pub fn h_vector_into(
     qd: &[f64],
     h: &mut [f64],
 ) -> Result<()> {
+    if robot.is_floating() {
+        return crate::algorithms::floating_base::h_vector_into(robot, data, env, q, qd, h);
+    }
     let names = ["q", "qd", "qd"];
     tree_vector_map(
         robot,
@@ -306,7 +312,7 @@ pub fn h_vector_into(
 
 /// H(q, qd) over the movable joints with the robot's environment; allocates.
 pub fn h_vector(robot: &Robot, q: &[f64], qd: &[f64]) -> Result<DVector<f64>> {
-    let mut h = DVector::zeros(robot.dof());
+    let mut h = DVector::zeros(robot.nv());
     with_data(robot, |data| {
         h_vector_into(robot, data, robot.environment(), q, qd, h.as_mut_slice())
     })?;

@@ -210,11 +210,39 @@ pub(crate) fn forward_pass<T: DynScalar>(
     qdd: &[T],
     shared: &[Option<SharedOrientation<T>>],
 ) {
-    ws.w[0] = env.base.w0.clone();
-    ws.wd[0] = env.base.wp0.clone();
-    ws.vd[0] = &env.base.vp0 - &env.gravity;
-    let (p0, sq0) = w_products(&ws.w[0]);
-    ws.u[0] = u_matrix(&p0, &sq0, &ws.wd[0], 0);
+    let vd0 = &env.base.vp0 - &env.gravity;
+    set_base_motion(ws, env.base.w0.clone(), env.base.wp0.clone(), vd0);
+    forward_links(model, env, ws, q, qd, qdd, shared);
+}
+
+/// The motion of the root of the recursion, in R_0: angular velocity `w0`, angular acceleration
+/// `wd0` and acceleration of O_0 minus gravity `vd0` (gravity as a base acceleration), with
+/// 0U_0.
+pub(crate) fn set_base_motion<T: DynScalar>(
+    ws: &mut Data<T>,
+    w0: Vector3<T>,
+    wd0: Vector3<T>,
+    vd0: Vector3<T>,
+) {
+    let (p0, sq0) = w_products(&w0);
+    ws.u[0] = u_matrix(&p0, &sq0, &wd0, 0);
+    ws.w[0] = w0;
+    ws.wd[0] = wd0;
+    ws.vd[0] = vd0;
+}
+
+/// The forward recursion over links 1..NL from the base motion already in `ws`
+/// ([`set_base_motion`]).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn forward_links<T: DynScalar>(
+    model: &DynModel<T>,
+    env: &Environment<T>,
+    ws: &mut Data<T>,
+    q: &[T],
+    qd: &[T],
+    qdd: &[T],
+    shared: &[Option<SharedOrientation<T>>],
+) {
     // no allocation without shared links (the numeric rnea)
     let order = sharing_order(model, shared);
     for idx in 0..model.nl {
@@ -553,6 +581,11 @@ pub fn inverse_dynamics_into(
     qdd: &[f64],
     tau: &mut [f64],
 ) -> Result<()> {
+    if robot.is_floating() {
+        return crate::algorithms::floating_base::inverse_dynamics_into(
+            robot, data, env, q, qd, qdd, tau,
+        );
+    }
     let names = ["q", "qd", "qdd"];
     tree_vector_map(
         robot,
@@ -617,7 +650,7 @@ pub fn inverse_dynamics_state_into(
 /// [`inverse_dynamics_into`] in loops (this form allocates only its result: its buffers are
 /// the thread's kept [`Data`]).
 pub fn inverse_dynamics(robot: &Robot, q: &[f64], qd: &[f64], qdd: &[f64]) -> Result<DVector<f64>> {
-    let mut tau = DVector::zeros(robot.dof());
+    let mut tau = DVector::zeros(robot.nv());
     with_data(robot, |data| {
         inverse_dynamics_into(
             robot,

@@ -4,6 +4,7 @@ pub mod base_parameters;
 pub mod closed_chain;
 pub mod direct_dynamics;
 pub mod energy;
+pub mod floating_base;
 pub mod inertia_matrix;
 pub mod inverse_dynamics;
 pub mod inverse_geometry;

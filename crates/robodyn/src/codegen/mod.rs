@@ -348,6 +348,7 @@ pub fn generate_with_progress(
     progress: &mut dyn FnMut(&str),
 ) -> Result<Program> {
     crate::model::validate_structure(desc)?;
+    crate::model::require_fixed_base(desc, "code generation")?;
     progress("building the symbolic model");
     let model = symbolic_model(desc, opt)?;
     let nl = desc.nl;

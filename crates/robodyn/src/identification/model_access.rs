@@ -83,6 +83,7 @@ pub struct ModelAccess {
 impl ModelAccess {
     /// From a description: validated into the library's robot (the transmission is kept aside).
     pub fn new(desc: RobotDescription) -> Result<ModelAccess> {
+        crate::model::require_fixed_base(&desc, "identification")?;
         let transmission = desc.transmission.clone();
         let robot = Robot::new(desc)?;
         let (n, nl) = (robot.dof(), robot.nl());

@@ -168,6 +168,33 @@ pub fn load_description_with(
     path: impl AsRef<Path>,
     overrides: &BTreeMap<String, f64>,
 ) -> Result<(RobotDescription, SourceMap)> {
+    load_description_with_options(path, overrides, &LoadOptions::default())
+}
+
+/// How a file is read beyond what it says.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+#[non_exhaustive]
+pub struct LoadOptions {
+    /// Make the base floating: a URDF's root link becomes link 0 of a free-flyer base, with its
+    /// `<inertial>` (Pinocchio's `JointModelFreeFlyer` root). A `.toml` or `.par` file says it
+    /// itself (`base = "floating"`, `is_floating = 1`); for them this is an error unless the
+    /// file's base already floats.
+    pub floating: bool,
+}
+
+impl LoadOptions {
+    /// The options with a floating base.
+    pub fn floating() -> LoadOptions {
+        LoadOptions { floating: true }
+    }
+}
+
+/// [`load_description_with`] with [`LoadOptions`].
+pub fn load_description_with_options(
+    path: impl AsRef<Path>,
+    overrides: &BTreeMap<String, f64>,
+    options: &LoadOptions,
+) -> Result<(RobotDescription, SourceMap)> {
     let path = path.as_ref();
     let text = read(path)?;
     let (file, format) = if is_stdio(path) {
@@ -178,8 +205,16 @@ pub fn load_description_with(
     let (mut desc, mut map) = match format {
         Format::Toml => toml_format::parse_description(&text, Some(&file)),
         Format::Par => par::parse_description(&text, Some(&file)),
-        Format::Urdf => urdf::parse_description(&text, Some(&file)),
+        Format::Urdf => urdf::parse_description_with(&text, Some(&file), options.floating),
     }?;
+    if options.floating && desc.floating_base.is_none() {
+        return Err(Error::Input(format!(
+            "{file}: a floating base is asked for, but the file's base is {}: a .toml file \
+             says base = \"floating\" (with [base_link]), a .par file is_floating = 1 with \
+             link 0's parameters (only a URDF's root link is made floating on request)",
+            if desc.mobile_base { "mobile" } else { "fixed" }
+        )));
+    }
     for w in physical_consistency(&desc) {
         map.warn(w);
     }
@@ -219,6 +254,17 @@ pub fn load_with_warnings(
     let (desc, map) = load_description_with(path, overrides)?;
     let robot = Robot::new(desc).map_err(|e| map.locate(e))?;
     Ok((robot, map.warnings))
+}
+
+/// Read and validate a robot with [`LoadOptions`] (e.g. a URDF with a floating base:
+/// `load_with_options(path, &Default::default(), &LoadOptions::floating())`).
+pub fn load_with_options(
+    path: impl AsRef<Path>,
+    overrides: &BTreeMap<String, f64>,
+    options: &LoadOptions,
+) -> Result<Robot> {
+    let (desc, map) = load_description_with_options(path, overrides, options)?;
+    Robot::new(desc).map_err(|e| map.locate(e))
 }
 
 /// Read a robot description from a file.

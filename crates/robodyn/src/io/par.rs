@@ -36,8 +36,8 @@ use crate::io::source::LineIndex;
 use crate::io::toml_format::is_symbol_name;
 use crate::io::{SourceMap, Warning};
 use crate::model::{
-    validate_structure, JointType, RobotDescription, GEOMETRIC_PARAMETERS, STANDARD_PARAMETERS,
-    WRENCH_COMPONENTS,
+    validate_structure, JointType, LinkDesc, RobotDescription, GEOMETRIC_PARAMETERS,
+    STANDARD_PARAMETERS, WRENCH_COMPONENTS,
 };
 use robodyn_symbolic::Expr;
 use std::collections::{BTreeMap, BTreeSet};
@@ -765,15 +765,9 @@ pub fn parse_description(text: &str, file: Option<&str>) -> Result<(RobotDescrip
     if let Some((m, _)) = keys.flag("is_mobile")? {
         desc.mobile_base = m;
     }
-    if let Some((true, at)) = keys.flag("is_floating")? {
-        return Err(ctx.err_line(
-            at,
-            format!(
-                "is_floating = {}: a floating (free) base is not supported; robodyn's base is \
-                 fixed or moves as given by W0 WP0 V0 VP0 (is_mobile = 1)",
-                keys.by_key["is_floating"].entries[0].0
-            ),
-        ));
+    if let Some((true, _)) = keys.flag("is_floating")? {
+        // link 0's parameters come with the link lists (NL + 1 entries)
+        desc.floating_base = Some(LinkDesc::zero("base"));
     }
     let mut ex = Extras::default();
     for (c, at) in &comments {
@@ -925,14 +919,25 @@ fn link_lists(keys: &Keys, desc: &mut RobotDescription, map: &mut SourceMap) -> 
     {
         // with a mobile base, OpenSYMORO lists link 0 (the base) first: NL + 1 entries
         let key = pname.to_ascii_lowercase();
+        let with_base = desc.mobile_base || desc.floating_base.is_some();
         let skip = match keys.by_key.get(key.as_str()) {
-            Some(st) if desc.mobile_base && st.entries.len() == nl + 1 => 1,
+            Some(st) if with_base && st.entries.len() == nl + 1 => 1,
             _ => 0,
         };
         let Some(st) = keys.list(&key, nl + skip, "NL")? else {
             continue;
         };
-        if skip == 1 && !st.entries[0].0.trim().eq("0") {
+        if let (1, Some(base)) = (skip, desc.floating_base.as_mut()) {
+            // a floating base: link 0's own parameters (SYMORO's is_floating)
+            let (v, at) = &st.entries[0];
+            let e = ctx.expr(&format!("link 0, {}", st.key), v, *at)?;
+            map.set_link(0, Some(pname), ctx.line(*at));
+            if k < 13 {
+                base.params[k] = e;
+            } else {
+                base.wrench[k - 13] = e;
+            }
+        } else if skip == 1 && !st.entries[0].0.trim().eq("0") {
             desc.notes.push(format!(
                 "{}: the entry of link 0 (the mobile base) is not used: the base motion is \
                  prescribed by W0 WP0 V0 VP0",
@@ -1180,6 +1185,9 @@ fn write_header(s: &mut String, desc: &RobotDescription) {
         structure_type(desc),
         u8::from(desc.mobile_base)
     ));
+    if desc.floating_base.is_some() {
+        s.push_str("is_floating = 1\n");
+    }
 }
 
 /// The geometric parameters, the joint variables named after no symbol of the description.
@@ -1265,7 +1273,7 @@ fn write_dynamics(s: &mut String, desc: &RobotDescription) {
         let base = desc.mobile_base.then(|| "0".to_string());
         let items: Vec<String> = base
             .into_iter()
-            .chain(desc.links.iter().map(|l| {
+            .chain(desc.floating_base.iter().chain(&desc.links).map(|l| {
                 match STANDARD_PARAMETERS.iter().position(|p| *p == name) {
                     Some(k) => l.params[k].decimal().to_string(),
                     None => {

@@ -39,6 +39,8 @@ struct FileTop {
     nl: Option<Spanned<usize>>,
     nj: Option<Spanned<usize>>,
     mobile_base: Option<bool>,
+    base: Option<Spanned<String>>,
+    base_link: Option<Spanned<LinkTable>>,
     gravity: Option<Spanned<Vec<SV>>>,
     w0: Option<Spanned<Vec<SV>>>,
     wp0: Option<Spanned<Vec<SV>>>,
@@ -438,26 +440,88 @@ impl<'a> Reader<'a> {
         for (idx, lt) in top.link.iter().enumerate() {
             let j = idx + 1;
             self.map.set_link(j, None, self.line(lt.span()));
-            let l = lt.get_ref();
-            self.check_number("link", j, &l.j)?;
-            let mut ld = LinkDesc::zero(l.name.clone().unwrap_or_else(|| format!("link{j}")));
-            let entries = l
-                .params()
-                .into_iter()
-                .zip(STANDARD_PARAMETERS)
-                .chain(l.wrench().into_iter().zip(WRENCH_COMPONENTS));
-            for (k, (v, pname)) in entries.enumerate() {
-                if let Some(v) = v {
-                    self.map.set_link(j, Some(pname), self.line(v.span()));
-                    let e = self.expr(&format!("link {j}, {pname}"), v)?;
-                    if k < 13 {
-                        ld.params[k] = e;
-                    } else {
-                        ld.wrench[k - 13] = e;
-                    }
+            self.check_number("link", j, &lt.get_ref().j)?;
+            desc.links[idx] = self.link_desc(j, lt.get_ref())?;
+        }
+        Ok(())
+    }
+
+    /// The link of table `l` as link `j` (0: a floating base's `[base_link]`).
+    fn link_desc(&mut self, j: usize, l: &LinkTable) -> Result<LinkDesc> {
+        let default = if j == 0 {
+            "base".to_string()
+        } else {
+            format!("link{j}")
+        };
+        let mut ld = LinkDesc::zero(l.name.clone().unwrap_or(default));
+        let entries = l
+            .params()
+            .into_iter()
+            .zip(STANDARD_PARAMETERS)
+            .chain(l.wrench().into_iter().zip(WRENCH_COMPONENTS));
+        for (k, (v, pname)) in entries.enumerate() {
+            if let Some(v) = v {
+                self.map.set_link(j, Some(pname), self.line(v.span()));
+                let e = self.expr(&format!("link {j}, {pname}"), v)?;
+                if k < 13 {
+                    ld.params[k] = e;
+                } else {
+                    ld.wrench[k - 13] = e;
                 }
             }
-            desc.links[idx] = ld;
+        }
+        Ok(ld)
+    }
+
+    /// `base = "fixed" | "mobile" | "floating"` (with `mobile_base`, which it may repeat but
+    /// not contradict) and a floating base's `[base_link]` (link 0's parameters).
+    fn base_kind(&mut self, top: &FileTop, desc: &mut RobotDescription) -> Result<()> {
+        let kind = top.base.as_ref().map(|b| (b.get_ref().as_str(), b.span()));
+        let floating = match kind {
+            None | Some(("fixed", _)) => false,
+            Some(("mobile", _)) => {
+                desc.mobile_base = true;
+                false
+            }
+            Some(("floating", span)) => {
+                if desc.mobile_base {
+                    return Err(self.err(
+                        span,
+                        "base = \"floating\" with mobile_base = true: a base is either mobile \
+                         (its motion imposed) or floating (its motion from the dynamics)",
+                    ));
+                }
+                true
+            }
+            Some((other, span)) => {
+                return Err(self.err(
+                    span,
+                    format!("base = \"{other}\": expected \"fixed\", \"mobile\" or \"floating\""),
+                ))
+            }
+        };
+        if matches!(
+            top.base.as_ref().map(|b| b.get_ref().as_str()),
+            Some("fixed")
+        ) && desc.mobile_base
+        {
+            let span = top.base.as_ref().expect("given").span();
+            return Err(self.err(span, "base = \"fixed\" with mobile_base = true"));
+        }
+        match (&top.base_link, floating) {
+            (Some(bl), true) => {
+                self.map.set_link(0, None, self.line(bl.span()));
+                self.check_number("link", 0, &bl.get_ref().j)?;
+                desc.floating_base = Some(self.link_desc(0, bl.get_ref())?);
+            }
+            (None, true) => desc.floating_base = Some(LinkDesc::zero("base")),
+            (Some(bl), false) => {
+                return Err(self.err(
+                    bl.span(),
+                    "[base_link] gives the parameters of a floating base: add base = \"floating\"",
+                ))
+            }
+            (None, false) => {}
         }
         Ok(())
     }
@@ -537,6 +601,7 @@ pub fn parse_description(text: &str, file: Option<&str>) -> Result<(RobotDescrip
     r.symbols(&top, &mut desc)?;
     r.frames(&top, &mut desc)?;
     r.links(&top, &mut desc)?;
+    r.base_kind(&top, &mut desc)?;
     r.base(&top, &mut desc)?;
     r.assembly(&top, &mut desc)?;
     if let Some(t) = &top.transmission {
@@ -770,6 +835,9 @@ pub fn write_description(desc: &RobotDescription) -> String {
     if desc.mobile_base {
         s.push_str("mobile_base = true\n");
     }
+    if desc.floating_base.is_some() {
+        s.push_str("base = \"floating\"\n");
+    }
     let arr = |a: &[Expr; 3]| {
         format!(
             "[{}]",
@@ -829,10 +897,11 @@ pub fn write_description(desc: &RobotDescription) -> String {
             s.push_str(&format!("limits = {{ {} }}\n", parts.join(", ")));
         }
     }
-    for (idx, l) in desc.links.iter().enumerate() {
+    let base = desc.floating_base.iter().map(|l| (0, l));
+    for (j, l) in base.chain(desc.links.iter().enumerate().map(|(i, l)| (i + 1, l))) {
+        let table = if j == 0 { "[base_link]" } else { "[[link]]" };
         s.push_str(&format!(
-            "\n[[link]]\nj = {}\nname = {}\n",
-            idx + 1,
+            "\n{table}\nj = {j}\nname = {}\n",
             toml_string(&l.name)
         ));
         for (k, e) in l.params.iter().enumerate() {

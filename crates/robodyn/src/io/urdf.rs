@@ -20,12 +20,14 @@
 //!   z_i and z_j ([`decompose`]); parallel or coincident axes take the normal through R_j's
 //!   origin (r = 0);
 //! - `fixed` joints become sigma = 2 frames, `revolute`/`continuous` sigma = 0, `prismatic`
-//!   sigma = 1; `floating` and `planar` are refused;
+//!   sigma = 1; a root joint of type `floating` (from a massless world link) makes the root link
+//!   a floating base; `planar` joints are refused;
 //! - `<inertial>` (COM frame xyz/rpy, mass, inertia about the COM) becomes the standard
 //!   parameters about O_j in R_j: c = C_j xyz, R = C_j Rot(rpy), J_O = R J_G R^T + m (c'c I - c c'),
 //!   MS = m c; `<dynamics damping friction>` give FV and FS;
 //! - `mimic` joints are imported as independent joints and flagged in the notes;
-//! - the root link is the fixed base (link 0); gravity is [0, 0, -9.81].
+//! - the root link is the fixed base (link 0), or the floating base with its `<inertial>`
+//!   ([`parse_description_with`]); gravity is [0, 0, -9.81].
 
 use crate::error::{Error, Item, Location, Result};
 use crate::io::source::LineIndex;
@@ -243,8 +245,20 @@ fn axis_rotation(a: &Vector3<f64>) -> UnitQuaternion<f64> {
     }
 }
 
-/// Parse a URDF tree robot. `file` names the source in error messages.
+/// Parse a URDF tree robot. `file` names the source in error messages. The root link is a
+/// fixed base, or link 0 of a floating base when the file's root joint is of type `floating`.
 pub fn parse_description(text: &str, file: Option<&str>) -> Result<(RobotDescription, SourceMap)> {
+    parse_description_with(text, file, false)
+}
+
+/// [`parse_description`] with the root link made a floating base (link 0, with its
+/// `<inertial>`) when `floating` is true (Pinocchio's `buildModelFromUrdf(path,
+/// JointModelFreeFlyer())`); a root joint of type `floating` in the file does the same.
+pub fn parse_description_with(
+    text: &str,
+    file: Option<&str>,
+    floating: bool,
+) -> Result<(RobotDescription, SourceMap)> {
     let doc = roxmltree::Document::parse(text).map_err(|e| Error::Parse {
         location: Location {
             file: file.map(str::to_string),
@@ -269,13 +283,84 @@ pub fn parse_description(text: &str, file: Option<&str>) -> Result<(RobotDescrip
     }
     let robot_name = robot.attribute("name").unwrap_or("robot").to_string();
     let (links, link_index) = read_links(&ctx, robot)?;
-    let joints = read_joints(&ctx, robot, &links, &link_index)?;
-    let (root, order) = tree_order(&ctx, robot, &links, &joints)?;
-    let (desc, mut map) = build(&ctx, robot_name, &links, &joints, root, &order)?;
-    if let Some(w) = legged_warning(&ctx, &links, root) {
+    let mut free = Vec::new();
+    let joints = read_joints(&ctx, robot, &links, &link_index, &mut free)?;
+    let world = free_joint_parent(&ctx, &links, &joints, &free)?;
+    let (root, order) = tree_order(&ctx, robot, &links, &joints, world)?;
+    let (mut desc, mut map) = build(&ctx, robot_name, &links, &joints, root, &order)?;
+    if floating || world.is_some() {
+        make_floating(&mut desc, &mut map, &ctx, &links[root]);
+    } else if let Some(w) = legged_warning(&ctx, &links, root) {
         map.warn(w);
     }
     Ok((desc, map))
+}
+
+/// The root link becomes link 0 of a floating base, with its `<inertial>` about O_0 in R_0
+/// (the root link's frame).
+fn make_floating(desc: &mut RobotDescription, map: &mut SourceMap, ctx: &Ctx, root: &ULink) {
+    let mut l = LinkDesc::zero(root.name.clone());
+    map.set_link(0, None, ctx.line(root.node));
+    if let Some((com, m, jg, mass_node)) = &root.inertial {
+        map.set_link(0, Some("M"), ctx.line(*mass_node));
+        let vals = inertial_about_origin(&UnitQuaternion::identity(), com, *m, jg);
+        for (k, v) in vals.iter().enumerate() {
+            l.params[k] = num_expr(*v, false);
+        }
+    }
+    desc.floating_base = Some(l);
+    desc.notes[0] = format!(
+        "imported from URDF; root link `{}` is the floating base (link 0, frame 0)",
+        root.name
+    );
+}
+
+/// A root joint of type `floating` (`free`: its parent and child links, its node): at most
+/// one, from a massless root link (the world) to the floating base, at the identity placement.
+/// Returns the world link, which the tree then leaves out.
+fn free_joint_parent(
+    ctx: &Ctx,
+    links: &[ULink],
+    joints: &[UJoint],
+    free: &[(usize, usize, roxmltree::Node)],
+) -> Result<Option<usize>> {
+    let Some(&(parent, _, node)) = free.first() else {
+        return Ok(None);
+    };
+    let name = |n: roxmltree::Node| n.attribute("name").unwrap_or("").to_string();
+    if free.len() > 1 {
+        return Err(ctx.err(
+            free[1].2,
+            format!(
+                "joint `{}`: type `floating` a second time (after `{}`): robodyn models one \
+                 floating base, the root link's",
+                name(free[1].2),
+                name(node)
+            ),
+        ));
+    }
+    let what = format!("joint `{}`: type `floating`", name(node));
+    let has_parent = joints.iter().any(|j| j.child == parent);
+    let has_children = joints.iter().any(|j| j.parent == parent);
+    let massive = links[parent].inertial.as_ref().is_some_and(|i| i.1 != 0.0);
+    if has_parent || has_children || massive {
+        return Err(ctx.err(
+            node,
+            format!(
+                "{what} is accepted as the root joint only: its parent link `{}` must be the \
+                 massless world link, with no other joint (its child is the floating base)",
+                links[parent].name
+            ),
+        ));
+    }
+    let o = origin(ctx, node, &what)?;
+    if o.translation.vector.norm() != 0.0 || o.rotation.angle() != 0.0 {
+        return Err(ctx.err(
+            node,
+            format!("{what}: its <origin> must be the identity (the base pose is in q)"),
+        ));
+    }
+    Ok(Some(parent))
 }
 
 /// A warning when the links look like the feet of a legged robot (two or more links named
@@ -307,9 +392,9 @@ fn legged_warning(ctx: &Ctx, links: &[ULink], root: usize) -> Option<Warning> {
         Item::Robot,
         format!(
             "links {}{more} look like the feet of a legged robot, whose base floats: robodyn \
-             does not model floating bases yet and loads the root link `{}` as a fixed base \
-             (frame 0; its inertia plays no role), so the models are those of the robot with \
-             its base held fixed",
+             loads the root link `{}` as a fixed base (frame 0; its inertia plays no role), so \
+             the models are those of the robot with its base held fixed; load it with a \
+             floating base to model the free robot",
             shown.join(", "),
             links[root].name
         ),
@@ -384,6 +469,7 @@ fn read_joints<'a>(
     robot: roxmltree::Node<'a, 'a>,
     links: &[ULink<'a>],
     link_index: &HashMap<String, usize>,
+    free: &mut Vec<(usize, usize, roxmltree::Node<'a, 'a>)>,
 ) -> Result<Vec<UJoint<'a>>> {
     let mut joints: Vec<UJoint> = Vec::new();
     let mut joint_names: HashMap<String, usize> = HashMap::new();
@@ -407,8 +493,9 @@ fn read_joints<'a>(
             "revolute" | "continuous" => JointType::Revolute,
             "prismatic" => JointType::Prismatic,
             "fixed" => JointType::Fixed,
-            "floating" | "planar" => {
-                return Err(ctx.err(n, format!("{what}: type `{kind}` has several degrees of freedom; robodyn imports revolute, continuous, prismatic and fixed joints only (model a floating base with the base velocity/acceleration, or a planar joint as two prismatic and one revolute joint)")))
+            "floating" => JointType::Fixed,
+            "planar" => {
+                return Err(ctx.err(n, format!("{what}: type `{kind}` has several degrees of freedom; robodyn imports revolute, continuous, prismatic, fixed and (as the root joint) floating joints only (model a planar joint as two prismatic and one revolute joint)")))
             }
             other => return Err(ctx.err(n, format!("{what}: unknown joint type `{other}`"))),
         };
@@ -430,6 +517,10 @@ fn read_joints<'a>(
                     links[parent].name
                 ),
             ));
+        }
+        if kind == "floating" {
+            free.push((parent, childl, n));
+            continue;
         }
         let axis = joint_axis(ctx, n, &what, joint)?;
         let mimic = joint_mimic(ctx, n, &what)?;
@@ -590,6 +681,7 @@ fn tree_order(
     robot: roxmltree::Node,
     links: &[ULink],
     joints: &[UJoint],
+    world: Option<usize>,
 ) -> Result<(usize, Vec<usize>)> {
     // tree check: each link at most one parent joint, exactly one root, everything reachable
     let mut parent_joint: Vec<Option<usize>> = vec![None; links.len()];
@@ -611,7 +703,7 @@ fn tree_order(
         parent_joint[jt.child] = Some(k);
     }
     let roots: Vec<usize> = (0..links.len())
-        .filter(|&l| parent_joint[l].is_none())
+        .filter(|&l| parent_joint[l].is_none() && Some(l) != world)
         .collect();
     if links.is_empty() {
         return Err(ctx.err(robot, "the robot has no <link>"));

@@ -34,6 +34,9 @@ pub struct Coordinates {
     index: Vec<Option<usize>>,
     /// NL: the length of the tree arrays the entries scatter into.
     nl: usize,
+    /// The robot's base floats: its state vectors have nq / nv entries, so a joint vector
+    /// checked here (by a function that does not support floating bases) is refused.
+    pub(crate) floating: bool,
 }
 
 impl Coordinates {
@@ -49,6 +52,7 @@ impl Coordinates {
             names,
             index,
             nl,
+            floating: false,
         }
     }
 
@@ -101,11 +105,13 @@ impl Coordinates {
 
     /// Check a joint vector: length and finiteness (typed errors).
     pub(crate) fn check(&self, what: &str, v: &[f64], kind: &str) -> Result<()> {
+        self.refuse_floating(what)?;
         check_vector(what, v, self.len(), || self.describe(kind))
     }
 
     /// Check the length of an output vector.
     pub(crate) fn check_output(&self, what: &str, v: &[f64], kind: &str) -> Result<()> {
+        self.refuse_floating(what)?;
         if v.len() != self.len() {
             return Err(crate::Error::dimension(
                 what,
@@ -113,6 +119,24 @@ impl Coordinates {
                 v.len(),
                 self.describe(kind),
             ));
+        }
+        Ok(())
+    }
+
+    /// The refusal of a joint vector of a floating robot by a function that takes joint
+    /// vectors over the movable joints only (the floating-base models take nq / nv vectors and
+    /// check them themselves).
+    fn refuse_floating(&self, what: &str) -> Result<()> {
+        if self.floating {
+            return Err(crate::Error::Input(format!(
+                "`{what}` over the {} movable joints: the robot has a floating base, which this \
+                 function does not support yet (the floating-base models inverse_dynamics, \
+                 inertia_matrix, h_vector, direct_dynamics take configurations of nq = 7 + {} \
+                 and velocities of nv = 6 + {} entries)",
+                self.len(),
+                self.len(),
+                self.len()
+            )));
         }
         Ok(())
     }

@@ -303,6 +303,11 @@ pub struct RobotDescription {
     pub vp0: [Expr; 3],
     /// Whether the base is mobile (SYMORO's `is_mobile`).
     pub mobile_base: bool,
+    /// `Some(link 0)` when the base floats (SYMORO's `is_floating`): link 0's standard
+    /// inertial parameters (XX..M about O_0 in R_0; its IA, FS, FV are not used) and its
+    /// external wrench. Its motion then results from the dynamics: the state holds the base
+    /// pose and twist (docs/models/floating_base.md), and W0 WP0 V0 VP0 are not used.
+    pub floating_base: Option<LinkDesc>,
     /// Numeric values of the symbols used in the expressions.
     pub symbols: BTreeMap<String, f64>,
     /// Joint values of the tree joints 1..NL at an assembled configuration (closed loops
@@ -393,6 +398,7 @@ impl RobotDescription {
             v0: zero3(),
             vp0: zero3(),
             mobile_base: false,
+            floating_base: None,
             symbols: BTreeMap::new(),
             assembly: None,
             notes: Vec::new(),
@@ -462,7 +468,7 @@ impl RobotDescription {
         for f in &self.frames {
             f.geometric().into_iter().for_each(&mut add);
         }
-        for l in &self.links {
+        for l in self.floating_base.iter().chain(&self.links) {
             l.params.iter().chain(&l.wrench).for_each(&mut add);
         }
         for v in [&self.gravity, &self.w0, &self.wp0, &self.v0, &self.vp0] {

@@ -6,6 +6,7 @@ mod constants;
 mod coordinates;
 mod description;
 mod environment;
+mod floating;
 pub mod inertial;
 mod structure;
 
@@ -21,6 +22,10 @@ pub use description::{
     WRENCH_COMPONENTS,
 };
 pub use environment::{BaseMotion, Environment, Wrench};
+pub use floating::{
+    require_fixed_base, BaseKind, FloatingBase, BASE_CONFIGURATION_NAMES, BASE_VELOCITY_NAMES,
+    QUATERNION_TOLERANCE,
+};
 pub use structure::{path_from_base, ClosedLoop, Structure, StructureType};
 
 use crate::error::{Error, Item, Result};
@@ -37,6 +42,8 @@ pub struct Robot {
     /// `numeric` with the fixed frames folded out ([`DynModel::fold_fixed`]).
     dynamic: DynModel<f64>,
     coords: Coordinates,
+    /// The floating base (link 0's body), when the base floats.
+    floating: Option<FloatingBase>,
 }
 
 /// Check counts and antecedents and derive the topology. Needs no numeric values, so it also
@@ -237,6 +244,32 @@ fn check_tools(desc: &RobotDescription) -> Result<()> {
     Ok(())
 }
 
+/// Link 0 of a floating base: every parameter and wrench component has a finite value, mass
+/// non-negative. Returns its 13 standard parameters.
+fn check_link0(
+    l: &LinkDesc,
+    eval: &impl Fn(&Expr, Item) -> Result<f64>,
+) -> Result<[f64; PARAMS_PER_LINK]> {
+    let mut p = [0.0; PARAMS_PER_LINK];
+    for (k, e) in l.params.iter().enumerate() {
+        let item = || Item::Link(0, Some(STANDARD_PARAMETERS[k].into()));
+        p[k] = eval(e, item())?;
+        if k == param::M && p[k] < 0.0 {
+            return Err(Error::physical(item(), format!("M = {} is negative", p[k])));
+        }
+    }
+    for (k, e) in l.wrench.iter().enumerate() {
+        if eval(e, Item::Link(0, Some(WRENCH_COMPONENTS[k].into())))? != 0.0 {
+            return Err(Error::invalid(
+                Item::Link(0, Some(WRENCH_COMPONENTS[k].into())),
+                "an external wrench on the floating base (link 0) is not supported yet: put it \
+                 on a link fixed to the base",
+            ));
+        }
+    }
+    Ok(p)
+}
+
 impl Robot {
     /// Validate a description and build its numeric model. Every symbol must have a value, every
     /// value must be finite, masses, rotor inertias and friction coefficients non-negative.
@@ -288,6 +321,17 @@ impl Robot {
                 eval(e, Item::Link(idx + 1, Some(WRENCH_COMPONENTS[k].into())))?;
             }
         }
+        let link0 = match &desc.floating_base {
+            Some(l) => Some(check_link0(l, &eval)?),
+            None => None,
+        };
+        if desc.floating_base.is_some() && desc.mobile_base {
+            return Err(Error::invalid(
+                Item::Base("is_mobile".into()),
+                "a base cannot be both mobile (its motion imposed) and floating (its motion \
+                 resulting from the dynamics)",
+            ));
+        }
         for (name, v) in [
             ("G", &desc.gravity),
             ("W0", &desc.w0),
@@ -306,15 +350,83 @@ impl Robot {
             .iter()
             .map(|&j| desc.frame(j).name.clone())
             .collect();
-        let coords = Coordinates::new(movable, names, desc.nl);
+        let mut coords = Coordinates::new(movable, names, desc.nl);
+        coords.floating = link0.is_some();
         let dynamic = numeric.fold_fixed();
+        let floating = link0.map(|p| FloatingBase::new(p, &numeric));
         Ok(Robot {
             desc,
             structure,
             numeric,
             dynamic,
             coords,
+            floating,
         })
+    }
+
+    /// What moves the base: fixed, mobile (imposed motion) or floating.
+    pub fn base_kind(&self) -> BaseKind {
+        if self.floating.is_some() {
+            BaseKind::Floating
+        } else if self.desc.mobile_base {
+            BaseKind::Mobile
+        } else {
+            BaseKind::Fixed
+        }
+    }
+
+    /// True when the base floats ([`BaseKind::Floating`]).
+    #[inline]
+    pub fn is_floating(&self) -> bool {
+        self.floating.is_some()
+    }
+
+    /// The floating base's body (link 0 and the links fixed on it), when the base floats.
+    #[inline]
+    pub fn floating_base(&self) -> Option<&FloatingBase> {
+        self.floating.as_ref()
+    }
+
+    /// Error unless the base is fixed or mobile: the refusal of the functions that do not
+    /// support floating bases yet (`what` names the function), never a wrong number.
+    pub fn require_fixed_base(&self, what: &str) -> Result<()> {
+        require_fixed_base(&self.desc, what)
+    }
+
+    /// nq, the entries of a configuration: N for a fixed or mobile base, 7 + N for a floating
+    /// one (base position, quaternion x y z w, joints).
+    #[inline]
+    pub fn nq(&self) -> usize {
+        self.dof() + if self.is_floating() { 7 } else { 0 }
+    }
+
+    /// nv, the entries of a velocity, acceleration or generalized-force vector: N for a fixed
+    /// or mobile base, 6 + N for a floating one (base linear and angular velocity in R_0,
+    /// joints).
+    #[inline]
+    pub fn nv(&self) -> usize {
+        self.dof() + if self.is_floating() { 6 } else { 0 }
+    }
+
+    /// Names of the nq configuration entries ([`BASE_CONFIGURATION_NAMES`] first for a
+    /// floating base, then the joint names).
+    pub fn configuration_names(&self) -> Vec<String> {
+        self.names_after_base(&BASE_CONFIGURATION_NAMES)
+    }
+
+    /// Names of the nv velocity entries ([`BASE_VELOCITY_NAMES`] first for a floating base,
+    /// then the joint names).
+    pub fn velocity_names(&self) -> Vec<String> {
+        self.names_after_base(&BASE_VELOCITY_NAMES)
+    }
+
+    /// `base` (for a floating base only), then the joint names.
+    fn names_after_base(&self, base: &[&str]) -> Vec<String> {
+        let base = if self.is_floating() { base } else { &[] };
+        base.iter()
+            .map(|s| s.to_string())
+            .chain(self.coords.names().iter().cloned())
+            .collect()
     }
 
     /// The coordinate map of joint vectors: the movable joints (fixed frames carry no

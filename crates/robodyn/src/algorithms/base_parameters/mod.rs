@@ -67,7 +67,7 @@ use robodyn_symbolic::Expr;
 /// the grouping then hold for generic geometry, the values of the base parameters are unknown.
 pub fn geometry_robot(desc: &RobotDescription) -> Result<(Robot, Vec<(String, f64)>)> {
     let mut d = desc.clone();
-    for l in d.links.iter_mut() {
+    for l in d.links.iter_mut().chain(d.floating_base.as_mut()) {
         for e in l.params.iter_mut().chain(l.wrench.iter_mut()) {
             *e = Expr::zero();
         }

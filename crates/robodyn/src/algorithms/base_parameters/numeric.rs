@@ -492,6 +492,7 @@ pub fn numeric_base_parameters(
     sampler: &mut dyn Sampler,
     opt: &NumericOptions,
 ) -> Result<NumericBase> {
+    robot.require_fixed_base("the numerical base parameters")?;
     let sel = &opt.selection;
     let nl = robot.nl();
     if sel.rotor.len() != nl || sel.friction.len() != nl {

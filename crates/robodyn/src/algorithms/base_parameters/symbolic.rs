@@ -740,6 +740,7 @@ pub fn symbolic_base_parameters(
     desc: &RobotDescription,
     sel: &ParameterSelection,
 ) -> Result<SymbolicBase> {
+    crate::model::require_fixed_base(desc, "the symbolic base parameters")?;
     let nl = desc.nl;
     if sel.rotor.len() != nl || sel.friction.len() != nl {
         return Err(Error::Input(format!(

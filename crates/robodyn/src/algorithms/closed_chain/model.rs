@@ -95,6 +95,7 @@ impl ClosedChain {
     /// loop by rank (see [`crate::algorithms::loop_closure`]) and checks that they are as many as
     /// the passive joints. Error for a tree or a wrong number of actuators.
     pub fn new(robot: &Robot) -> Result<ClosedChain> {
+        robot.require_fixed_base("the closed-chain model")?;
         let closure = LoopClosure::new(robot)?;
         let coords_of = |js: &[usize]| {
             Coordinates::new(

@@ -195,10 +195,12 @@ fn is_ancestor_or_self(robot: &Robot, j: usize, r: usize) -> bool {
 pub fn total_mass(robot: &Robot) -> f64 {
     let mut moving = vec![false; robot.nl() + 1];
     moving_links(robot, &mut moving);
-    (1..=robot.nl())
+    // a floating base's body (link 0 and the links fixed on it) moves too
+    let base = robot.floating_base().map_or(0.0, |b| b.body.mass);
+    base + (1..=robot.nl())
         .filter(|&j| moving[j])
         .map(|j| robot.numeric().link(j).mass)
-        .sum()
+        .sum::<f64>()
 }
 
 /// The mass of the subtree of links carried by frame `root` (its link and every link after it
