@@ -57,6 +57,8 @@ mod finite_results;
 mod fixed_frames;
 #[path = "floating_pinocchio.rs"]
 mod floating_pinocchio;
+#[path = "floating_simulation.rs"]
+mod floating_simulation;
 #[path = "fuzz_regressions.rs"]
 mod fuzz_regressions;
 #[path = "geometry.rs"]
