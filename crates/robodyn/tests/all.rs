@@ -59,6 +59,8 @@ mod fixed_frames;
 mod floating_base;
 #[path = "floating_pinocchio.rs"]
 mod floating_pinocchio;
+#[path = "floating_simulation.rs"]
+mod floating_simulation;
 #[path = "fuzz_regressions.rs"]
 mod fuzz_regressions;
 #[path = "geometry.rs"]

@@ -49,6 +49,13 @@ pub struct Args {
     /// Initial joint velocities (default zeros).
     #[arg(long, allow_hyphen_values = true)]
     pub qd0: Option<String>,
+    /// Floating base: its initial pose x,y,z,qx,qy,qz,qw (position in the world, unit
+    /// quaternion; default the origin, identity).
+    #[arg(long, allow_hyphen_values = true)]
+    pub base_pose: Option<String>,
+    /// Floating base: its initial twist vx,vy,vz,wx,wy,wz in the base frame (default zeros).
+    #[arg(long, allow_hyphen_values = true)]
+    pub base_twist: Option<String>,
     /// Constant joint torques (default zeros).
     #[arg(long, allow_hyphen_values = true, conflicts_with_all = ["torque_csv", "track"])]
     pub torque: Option<String>,
@@ -113,8 +120,34 @@ impl Dynamics for Labelled<'_> {
     fn dof(&self) -> usize {
         self.inner.dof()
     }
+    fn nq(&self) -> usize {
+        self.inner.nq()
+    }
     fn labels(&self) -> Vec<String> {
         self.labels.clone()
+    }
+    /// The inner system's names (a floating base's columns) with the joints' relabelled.
+    fn column_names(&self) -> [Vec<String>; 4] {
+        let mut names = self.inner.column_names();
+        for (names, p) in names.iter_mut().zip(["q", "qd", "qdd", "tau"]) {
+            let base = names.len() - self.labels.len();
+            for (k, l) in self.labels.iter().enumerate() {
+                names[base + k] = format!("{p}{l}");
+            }
+        }
+        names
+    }
+    fn anchor(&mut self, q: &[f64], x: &mut [f64]) -> robodyn::Result<()> {
+        self.inner.anchor(q, x)
+    }
+    fn configuration(&self, x: &[f64], q: &mut [f64]) {
+        self.inner.configuration(x, q)
+    }
+    fn chart_rate(&self, x: &[f64], qd: &[f64], dx: &mut [f64]) {
+        self.inner.chart_rate(x, qd, dx)
+    }
+    fn reanchor(&mut self, x: &mut [f64]) -> bool {
+        self.inner.reanchor(x)
     }
     fn accel(
         &mut self,
@@ -423,6 +456,75 @@ fn torque_input(
     })
 }
 
+/// A floating robot's state and input: the base pose and twist before the joints' values, and
+/// a free base (zero wrench on it). Refused for a robot whose base does not float.
+fn with_base(
+    robot: &robodyn::Robot,
+    a: &Args,
+    q0: Vec<f64>,
+    qd0: Vec<f64>,
+    input: TorqueInput,
+) -> CliResult<(Vec<f64>, Vec<f64>, TorqueInput)> {
+    if !robot.is_floating() {
+        if let Some(flag) = [
+            ("--base-pose", &a.base_pose),
+            ("--base-twist", &a.base_twist),
+        ]
+        .iter()
+        .find_map(|(f, v)| v.is_some().then_some(f))
+        {
+            return Err(format!(
+                "{flag}: the robot's base is {} (a floating base is `base = \"floating\"` in \
+                 TOML, `is_floating = 1` in .par)",
+                robot.base_kind().name()
+            )
+            .into());
+        }
+        return Ok((q0, qd0, input));
+    }
+    let values = |name: &str, s: &Option<String>, default: &[f64]| -> CliResult<Vec<f64>> {
+        let Some(s) = s else {
+            return Ok(default.to_vec());
+        };
+        let v = parse_list(name, s)?;
+        if v.len() != default.len() {
+            return Err(format!(
+                "--{name} has {} values, {} expected",
+                v.len(),
+                default.len()
+            )
+            .into());
+        }
+        Ok(v)
+    };
+    let pose = values(
+        "base-pose",
+        &a.base_pose,
+        &[0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0],
+    )?;
+    let twist = values("base-twist", &a.base_twist, &[0.0; 6])?;
+    let norm = pose[3..].iter().map(|x| x * x).sum::<f64>().sqrt();
+    if (norm - 1.0).abs() > robodyn::model::QUATERNION_TOLERANCE {
+        return Err(format!(
+            "--base-pose: the quaternion ({}, {}, {}, {}) has norm {norm}, not 1",
+            pose[3], pose[4], pose[5], pose[6]
+        )
+        .into());
+    }
+    if matches!(input, TorqueInput::Pd { .. }) {
+        return Err(
+            "--track: a PD input acts on joint positions and needs a fixed base; give \
+                    --torque or --torque-csv for a floating robot"
+                .into(),
+        );
+    }
+    Ok((
+        pose.into_iter().chain(q0).collect(),
+        twist.into_iter().chain(qd0).collect(),
+        input.with_free_base(6),
+    ))
+}
+
 /// A progress bar on a terminal's standard error (hidden otherwise).
 fn progress_bar() -> CliResult<ProgressBar> {
     let bar = if std::io::stderr().is_terminal() {
@@ -490,6 +592,8 @@ pub fn run(a: Args) -> CliResult {
     let qd0 = joint_values("qd0", a.qd0.as_deref(), &joints, what, None)?;
     let all_labels: Vec<String> = label.values().cloned().collect();
     let input = torque_input(&a, &joints, what, &labels, &all_labels)?;
+    let (q0, qd0, input) = with_base(&robot, &a, q0, qd0, input)?;
+    let n = if robot.is_floating() { robot.nv() } else { n };
     let integrator = Integrator::fixed_or_adaptive(a.dt, a.rtol, a.atol);
     let opts = SimOptions {
         duration: a.duration,

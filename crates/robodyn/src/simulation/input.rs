@@ -126,6 +126,27 @@ pub enum TorqueInput {
 }
 
 impl TorqueInput {
+    /// The input of a floating robot whose base is free, from joint torques: `base` zero
+    /// entries (the wrench applied on the base, 6) before the joints' (constants and series;
+    /// a PD input acts on joint positions and is refused by [`super::simulate`] for a floating
+    /// base).
+    pub fn with_free_base(self, base: usize) -> TorqueInput {
+        let widen = |v: &[f64]| -> Vec<f64> {
+            std::iter::repeat_n(0.0, base)
+                .chain(v.iter().copied())
+                .collect()
+        };
+        match self {
+            TorqueInput::Constant(v) => TorqueInput::Constant(widen(&v)),
+            TorqueInput::Series(s) => TorqueInput::Series(TimeSeries {
+                width: s.width + base,
+                values: s.values.iter().map(|r| widen(r)).collect(),
+                times: s.times,
+            }),
+            pd => pd,
+        }
+    }
+
     /// Check the sizes against `dof` coordinates.
     pub fn validate(&self, dof: usize) -> Result<()> {
         let bad = |what: String| Err(Error::Input(what));

@@ -11,6 +11,12 @@ pub trait Ode {
     fn dim(&self) -> usize;
     /// Write f(t, y) into `dy`.
     fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<()>;
+    /// Called after every accepted step with the new state: an ODE written in local
+    /// coordinates of a manifold may move its chart and rewrite `y` there (returning true, so
+    /// that the integrator does not reuse f of the old coordinates).
+    fn accepted(&mut self, _y: &mut [f64]) -> bool {
+        false
+    }
 }
 
 /// Integration scheme.
@@ -215,6 +221,7 @@ impl Stepper {
             y[i] +=
                 h / 6.0 * (self.k[0][i] + 2.0 * self.k[1][i] + 2.0 * self.k[2][i] + self.k[3][i]);
         }
+        ode.accepted(y);
         self.fsal = false;
         self.stats.accepted += 1;
         Ok(())
@@ -367,9 +374,9 @@ impl Stepper {
             if ok {
                 y.copy_from_slice(&self.y1);
                 *t = if last { t_end } else { *t + h };
-                // FSAL: the last stage is f(t + h, y1)
+                // FSAL: the last stage is f(t + h, y1), unless the ODE moved its chart
                 self.k.swap(0, 6);
-                self.fsal = true;
+                self.fsal = !ode.accepted(y);
                 self.stats.accepted += 1;
                 let fac = if rejected_last { fac.min(1.0) } else { fac };
                 // keep the controller's step when the last step was shortened to hit t_end

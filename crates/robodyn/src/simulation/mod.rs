@@ -58,6 +58,7 @@
 
 pub mod closed;
 pub(crate) mod energy;
+pub mod floating;
 pub mod input;
 pub mod integrators;
 pub mod output;
@@ -78,12 +79,45 @@ use crate::model::{Environment, Robot};
 use crate::scalar::DynScalar;
 use energy::mechanical_energy;
 
-/// A mechanical system with `dof` coordinates as the simulator sees it.
+/// A mechanical system with `dof` velocity coordinates as the simulator sees it.
+///
+/// The integrators work on y = [x; qd] where x are coordinates of a chart of the configuration
+/// space (dof entries): x = q for joints; a floating base's pose is carried in local
+/// coordinates ([`floating`]), so that its quaternion is integrated on the group.
 pub trait Dynamics {
-    /// Number of simulated coordinates (length of q, qd, qdd, tau).
+    /// Number of velocity coordinates (length of qd, qdd, tau; of q too unless the base
+    /// floats).
     fn dof(&self) -> usize;
+    /// Length of a configuration q (dof, or 7 + joints with a floating base).
+    fn nq(&self) -> usize {
+        self.dof()
+    }
     /// Label of each coordinate in the column names (`q<label>`); joint frame numbers.
     fn labels(&self) -> Vec<String>;
+    /// Column names of q, qd, qdd and tau (default: `q<label>`, `qd<label>`, ...).
+    fn column_names(&self) -> [Vec<String>; 4] {
+        let labels = self.labels();
+        ["q", "qd", "qdd", "tau"].map(|p| labels.iter().map(|l| format!("{p}{l}")).collect())
+    }
+    /// Anchor the chart at the configuration q (nq entries) and write its chart coordinates
+    /// into x (dof entries); default x = q.
+    fn anchor(&mut self, q: &[f64], x: &mut [f64]) -> Result<()> {
+        x.copy_from_slice(q);
+        Ok(())
+    }
+    /// The configuration q (nq) at chart coordinates x (dof); default q = x.
+    fn configuration(&self, x: &[f64], q: &mut [f64]) {
+        q.copy_from_slice(x);
+    }
+    /// dx/dt at chart coordinates x for the velocity qd; default qd.
+    fn chart_rate(&self, _x: &[f64], qd: &[f64], dx: &mut [f64]) {
+        dx.copy_from_slice(qd);
+    }
+    /// After an accepted step: move the chart if x has gone far from its origin (rewriting x);
+    /// true when x changed.
+    fn reanchor(&mut self, _x: &mut [f64]) -> bool {
+        false
+    }
     /// qdd for the state (q, qd) under tau at time t (allocation-free in hot loops).
     fn accel(&mut self, t: f64, q: &[f64], qd: &[f64], tau: &[f64], qdd: &mut [f64]) -> Result<()>;
     /// Total (kinetic + potential) energy.
@@ -109,6 +143,10 @@ pub struct TreeDynamics<'a> {
     /// The torque given to the direct model (smoothed Coulomb friction added), movable joints.
     tau: Vec<f64>,
     coulomb_smoothing: Option<f64>,
+    /// The chart of a floating base's pose (None for a fixed or mobile base).
+    chart: Option<floating::BaseChart>,
+    /// Energy and momenta of a floating robot.
+    balance: Option<floating::FloatingBalance>,
 }
 
 impl<'a> TreeDynamics<'a> {
@@ -120,8 +158,12 @@ impl<'a> TreeDynamics<'a> {
             method,
             ws: Data::new(robot),
             env: robot.environment().clone(),
-            tau: vec![0.0; robot.dof()],
+            tau: vec![0.0; robot.nv()],
             coulomb_smoothing: None,
+            chart: None,
+            balance: robot
+                .is_floating()
+                .then(|| floating::FloatingBalance::new(robot)),
         }
     }
 
@@ -140,12 +182,81 @@ impl<'a> TreeDynamics<'a> {
     }
 }
 
+impl TreeDynamics<'_> {
+    /// `tau` with the smoothed Coulomb friction: Fs (sign(qd) - tanh(qd / v)) added on every
+    /// movable joint (after the 6 base entries of a floating robot).
+    fn smooth_into_tau(&mut self, qd: &[f64], tau: &[f64], v: f64) -> Result<()> {
+        let nv = self.robot.nv();
+        for (what, x) in [("qd", qd), ("tau", tau)] {
+            if x.len() != nv {
+                return Err(Error::dimension(
+                    what,
+                    nv,
+                    x.len(),
+                    format!("the robot's {nv} velocity coordinates"),
+                ));
+            }
+        }
+        let off = nv - self.robot.dof();
+        let model = self.robot.numeric();
+        self.tau.copy_from_slice(tau);
+        for (k, &j) in self.robot.coordinates().frames().iter().enumerate() {
+            let (fs, s) = (model.link(j).fs, qd[off + k]);
+            self.tau[off + k] += fs * (s.sign() - (s / v).tanh());
+        }
+        Ok(())
+    }
+}
+
 impl Dynamics for TreeDynamics<'_> {
     fn dof(&self) -> usize {
-        self.robot.dof()
+        self.robot.nv()
+    }
+    fn nq(&self) -> usize {
+        self.robot.nq()
     }
     fn labels(&self) -> Vec<String> {
         self.joints().iter().map(|j| j.to_string()).collect()
+    }
+    fn column_names(&self) -> [Vec<String>; 4] {
+        let labels = self.labels();
+        let base = self.robot.is_floating();
+        let mut names = [Vec::new(), Vec::new(), Vec::new(), Vec::new()];
+        for (k, p) in ["q", "qd", "qdd", "tau"].iter().enumerate() {
+            if base {
+                let count = if k == 0 { 7 } else { 6 };
+                names[k].extend(
+                    floating::BASE_COLUMNS[k][..count]
+                        .iter()
+                        .map(|s| s.to_string()),
+                );
+            }
+            names[k].extend(labels.iter().map(|l| format!("{p}{l}")));
+        }
+        names
+    }
+    fn anchor(&mut self, q: &[f64], x: &mut [f64]) -> Result<()> {
+        if !self.robot.is_floating() {
+            x.copy_from_slice(q);
+            return Ok(());
+        }
+        self.chart = Some(floating::BaseChart::anchored(q, x)?);
+        Ok(())
+    }
+    fn configuration(&self, x: &[f64], q: &mut [f64]) {
+        match &self.chart {
+            Some(c) => c.configuration(x, q),
+            None => q.copy_from_slice(x),
+        }
+    }
+    fn chart_rate(&self, x: &[f64], qd: &[f64], dx: &mut [f64]) {
+        match &self.chart {
+            Some(c) => c.rate(x, qd, dx),
+            None => dx.copy_from_slice(qd),
+        }
+    }
+    fn reanchor(&mut self, x: &mut [f64]) -> bool {
+        self.chart.as_mut().is_some_and(|c| c.reanchor(x))
     }
     fn accel(
         &mut self,
@@ -158,14 +269,7 @@ impl Dynamics for TreeDynamics<'_> {
         let tau = match self.coulomb_smoothing {
             None => tau,
             Some(v) => {
-                let c = self.robot.coordinates();
-                c.check("qd", qd, "movable joints")?;
-                c.check("tau", tau, "movable joints")?;
-                let model = self.robot.numeric();
-                for (k, &j) in c.frames().iter().enumerate() {
-                    let (fs, s) = (model.link(j).fs, qd[k]);
-                    self.tau[k] = tau[k] + fs * (s.sign() - (s / v).tanh());
-                }
+                self.smooth_into_tau(qd, tau, v)?;
                 &self.tau
             }
         };
@@ -181,7 +285,24 @@ impl Dynamics for TreeDynamics<'_> {
         )
     }
     fn energy(&mut self, q: &[f64], qd: &[f64]) -> Result<f64> {
-        mechanical_energy(self.robot, &mut self.ws, q, qd)
+        match &mut self.balance {
+            Some(b) => b.evaluate(self.robot, &mut self.ws, q, qd, &mut [0.0; 9]),
+            None => mechanical_energy(self.robot, &mut self.ws, q, qd),
+        }
+    }
+    fn extra_columns(&self) -> Vec<String> {
+        match self.balance {
+            Some(_) => floating::MOMENTUM_COLUMNS.map(String::from).to_vec(),
+            None => Vec::new(),
+        }
+    }
+    fn extra_values(&mut self, q: &[f64], qd: &[f64], out: &mut [f64]) -> Result<()> {
+        if let Some(b) = &mut self.balance {
+            let mut m = [0.0; 9];
+            b.evaluate(self.robot, &mut self.ws, q, qd, &mut m)?;
+            out.copy_from_slice(&m);
+        }
+        Ok(())
     }
 }
 
@@ -214,11 +335,14 @@ pub struct SimSummary {
     pub stats: Stats,
 }
 
-/// y = [q; qd], y' = [qd; qdd(t, q, qd, tau(t, q, qd))].
+/// y = [x; qd] (x the chart coordinates of q), y' = [dx/dt(x, qd); qdd(t, q, qd, tau(t, x,
+/// qd))].
 struct StateOde<'d, 'i> {
     dynamics: &'d mut dyn Dynamics,
     input: &'i TorqueInput,
     tau: Vec<f64>,
+    /// The configuration q (nq) of the current x.
+    q: Vec<f64>,
 }
 
 impl Ode for StateOde<'_, '_> {
@@ -227,20 +351,25 @@ impl Ode for StateOde<'_, '_> {
     }
     fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<()> {
         let n = self.dynamics.dof();
-        let (q, qd) = y.split_at(n);
-        self.input.torque(t, q, qd, &mut self.tau);
-        let (dq, dqd) = dy.split_at_mut(n);
-        dq.copy_from_slice(qd);
-        self.dynamics.accel(t, q, qd, &self.tau, dqd)
+        let (x, qd) = y.split_at(n);
+        self.dynamics.configuration(x, &mut self.q);
+        self.input.torque(t, x, qd, &mut self.tau);
+        let (dx, dqd) = dy.split_at_mut(n);
+        self.dynamics.chart_rate(x, qd, dx);
+        self.dynamics.accel(t, &self.q, qd, &self.tau, dqd)
+    }
+    fn accepted(&mut self, y: &mut [f64]) -> bool {
+        let n = self.dynamics.dof();
+        self.dynamics.reanchor(&mut y[..n])
     }
 }
 
-/// Column names of the trajectory: `t, q<l>, qd<l>, qdd<l>, tau<l>`, energy, extras.
+/// Column names of the trajectory: `t, q<l>, qd<l>, qdd<l>, tau<l>` (a floating base's
+/// columns first, [`floating::BASE_COLUMNS`]), energy, extras.
 pub fn trajectory_headers(dynamics: &dyn Dynamics) -> Vec<String> {
-    let labels = dynamics.labels();
     let mut h = vec!["t".to_string()];
-    for p in ["q", "qd", "qdd", "tau"] {
-        h.extend(labels.iter().map(|l| format!("{p}{l}")));
+    for names in dynamics.column_names() {
+        h.extend(names);
     }
     h.push("energy".into());
     h.extend(dynamics.extra_columns());
@@ -261,12 +390,17 @@ pub fn simulate(
     sink: &mut dyn TrajectorySink,
     progress: &mut dyn FnMut(f64),
 ) -> Result<SimSummary> {
-    let n = dynamics.dof();
-    for (name, v) in [("q0", q0), ("qd0", qd0)] {
-        if v.len() != n {
+    let (n, nq) = (dynamics.dof(), dynamics.nq());
+    for (name, v, len) in [("q0", q0, nq), ("qd0", qd0, n)] {
+        if v.len() != len {
             return Err(Error::Input(format!(
-                "{name} has {} values, the system has {n} coordinates",
-                v.len()
+                "{name} has {} values, the system has {len} {} coordinates",
+                v.len(),
+                if name == "q0" {
+                    "configuration"
+                } else {
+                    "velocity"
+                }
             )));
         }
         if v.iter().any(|x| !x.is_finite()) {
@@ -283,6 +417,13 @@ pub fn simulate(
     opts.integrator.validate()?;
     check_step_budget(opts)?;
     input.validate(n)?;
+    if nq != n && matches!(input, TorqueInput::Pd { .. }) {
+        return Err(Error::Input(
+            "a PD torque input acts on joint positions: with a floating base give torques \
+             (constant or a series over the velocity coordinates) instead"
+                .into(),
+        ));
+    }
     sink.begin(&trajectory_headers(dynamics))?;
     let result = run(dynamics, input, q0, qd0, opts, sink, progress);
     let flushed = sink.finish();
@@ -330,52 +471,25 @@ fn run(
     sink: &mut dyn TrajectorySink,
     progress: &mut dyn FnMut(f64),
 ) -> Result<SimSummary> {
-    let n = dynamics.dof();
+    let (n, nq) = (dynamics.dof(), dynamics.nq());
     let n_extra = dynamics.extra_columns().len();
-    let mut y: Vec<f64> = q0.iter().chain(qd0).copied().collect();
-    let mut row = vec![0.0; 1 + 4 * n + 1 + n_extra];
+    let mut y = vec![0.0; 2 * n];
+    dynamics.anchor(q0, &mut y[..n])?;
+    y[n..].copy_from_slice(qd0);
+    let mut row = vec![0.0; 1 + nq + 3 * n + 1 + n_extra];
     let mut stepper = Stepper::new(opts.integrator, 2 * n);
     stepper.max_steps = opts.max_steps;
     let mut ode = StateOde {
         dynamics,
         input,
         tau: vec![0.0; n],
+        q: vec![0.0; nq],
     };
     let mut t = 0.0;
     let mut k = 0usize;
     let mut summary = SimSummary::default();
-    let stop = |t: f64, e: Error| -> Error {
-        match e {
-            Error::Io { .. } | Error::Input(_) | Error::Dimension { .. } => e,
-            other => Error::Numerical(format!(
-                "simulation stopped at t = {}: {other}",
-                output::Number(t)
-            )),
-        }
-    };
     loop {
-        // output row at (t, y)
-        let (q, qd) = y.split_at(n);
-        row[0] = t;
-        row[1..1 + n].copy_from_slice(q);
-        row[1 + n..1 + 2 * n].copy_from_slice(qd);
-        let (head, rest) = row.split_at_mut(1 + 3 * n);
-        let tau = &mut rest[..n];
-        ode.input.torque(t, q, qd, tau);
-        ode.dynamics
-            .accel(t, q, qd, tau, &mut head[1 + 2 * n..])
-            .map_err(|e| stop(t, e))?;
-        let e = ode.dynamics.energy(q, qd).map_err(|e| stop(t, e))?;
-        rest[n] = e;
-        ode.dynamics
-            .extra_values(q, qd, &mut rest[n + 1..])
-            .map_err(|e| stop(t, e))?;
-        if row.iter().any(|x| !x.is_finite()) {
-            return Err(stop(
-                t,
-                Error::Numerical("an output value is not finite".into()),
-            ));
-        }
+        write_row(&mut ode, t, &y, &mut row)?;
         sink.row(&row)?;
         summary.rows += 1;
         summary.t_end = t;
@@ -393,7 +507,45 @@ fn run(
         };
         stepper
             .advance(&mut ode, &mut t, &mut y, t_next)
-            .map_err(|e| stop(t, e))?;
+            .map_err(|e| stopped(t, e))?;
     }
     Ok(summary)
+}
+
+/// A model error during the run, said with the time it happened.
+fn stopped(t: f64, e: Error) -> Error {
+    match e {
+        Error::Io { .. } | Error::Input(_) | Error::Dimension { .. } => e,
+        other => Error::Numerical(format!(
+            "simulation stopped at t = {}: {other}",
+            output::Number(t)
+        )),
+    }
+}
+
+/// The output row at (t, y): t, q (nq), qd, qdd, tau, energy, extras; every value finite.
+fn write_row(ode: &mut StateOde, t: f64, y: &[f64], row: &mut [f64]) -> Result<()> {
+    let (n, nq) = (ode.dynamics.dof(), ode.q.len());
+    let (x, qd) = y.split_at(n);
+    ode.dynamics.configuration(x, &mut ode.q);
+    row[0] = t;
+    row[1..1 + nq].copy_from_slice(&ode.q);
+    row[1 + nq..1 + nq + n].copy_from_slice(qd);
+    let (head, rest) = row.split_at_mut(1 + nq + 2 * n);
+    let tau = &mut rest[..n];
+    ode.input.torque(t, x, qd, tau);
+    ode.dynamics
+        .accel(t, &ode.q, qd, tau, &mut head[1 + nq + n..])
+        .map_err(|e| stopped(t, e))?;
+    rest[n] = ode.dynamics.energy(&ode.q, qd).map_err(|e| stopped(t, e))?;
+    ode.dynamics
+        .extra_values(&ode.q, qd, &mut rest[n + 1..])
+        .map_err(|e| stopped(t, e))?;
+    if row.iter().any(|x| !x.is_finite()) {
+        return Err(stopped(
+            t,
+            Error::Numerical("an output value is not finite".into()),
+        ));
+    }
+    Ok(())
 }
