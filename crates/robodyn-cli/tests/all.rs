@@ -23,6 +23,8 @@ mod cli_closed_rows;
 mod cli_columns;
 #[path = "cli_conventions.rs"]
 mod cli_conventions;
+#[path = "cli_derivatives.rs"]
+mod cli_derivatives;
 #[path = "cli_generate.rs"]
 mod cli_generate;
 #[path = "cli_generate_names.rs"]
