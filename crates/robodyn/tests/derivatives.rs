@@ -13,6 +13,7 @@
 
 use nalgebra::DMatrix;
 use num_dual::HyperDual64;
+use robodyn::algorithms::derivatives::regressor_derivatives;
 use robodyn::algorithms::energy::convert_model;
 use robodyn::algorithms::inverse_dynamics::rnea;
 use robodyn::{
@@ -327,4 +328,54 @@ fn batch_matches_single_states() {
     qd[200 * n] = f64::INFINITY;
     let e = inverse_dynamics_derivatives_batch(&robot, env, &q, &qd, &qdd, &mut out);
     assert!(matches!(e, Err(Error::Row { row: 201, .. })), "{e:?}");
+}
+
+/// dPhi/dq_k and dPhi/dqd_k against central differences of the recursive regressor
+/// (`regressor`, its own recursion: an independent route), on random trees (fixed frames, a
+/// moving base) and two bundled robots.
+#[test]
+fn regressor_derivatives_match_finite_differences_of_the_regressor() {
+    let mut r = rng(2820);
+    let mut cases: Vec<(String, Robot)> = (0..6)
+        .map(|c| {
+            (
+                format!("random {c}"),
+                random_robot(&mut r, 2 + c, c % 3 == 2),
+            )
+        })
+        .collect();
+    for (name, robot) in bundled() {
+        if ["rx90.toml", "scara.toml"].contains(&name.as_str()) {
+            cases.push((name, robot));
+        }
+    }
+    let mut worst = 0.0f64;
+    for (label, robot) in &cases {
+        let n = robot.dof();
+        let [q, mut qd, qdd] = random_state(&mut r, n);
+        away_from_zero(&mut qd);
+        let d = regressor_derivatives(robot, &q, &qd, &qdd).unwrap();
+        let phi = |q: &[f64], qd: &[f64]| robodyn::regressor(robot, q, qd, &qdd).unwrap();
+        let scale = phi(&q, &qd).amax().max(1.0);
+        for k in 0..n {
+            let (mut a, mut b) = (q.clone(), q.clone());
+            a[k] += H;
+            b[k] -= H;
+            let fq = (phi(&a, &qd) - phi(&b, &qd)) / (2.0 * H);
+            let (mut a, mut b) = (qd.clone(), qd.clone());
+            a[k] += H;
+            b[k] -= H;
+            let fv = (phi(&q, &a) - phi(&q, &b)) / (2.0 * H);
+            let e = (&d.dphi_dq[k] - &fq)
+                .amax()
+                .max((&d.dphi_dqd[k] - &fv).amax())
+                / scale;
+            worst = worst.max(e);
+            assert!(
+                e <= 1e-6,
+                "{label}: dPhi/dq_{k} or dPhi/dqd_{k} vs FD {e:e}"
+            );
+        }
+    }
+    eprintln!("regressor derivatives: worst relative gap to FD {worst:e}");
 }

@@ -8,6 +8,8 @@
 //! - [`direct_dynamics_derivatives_into`]: dqdd/dq, dqdd/dqd and dqdd/dGamma = A^-1 of the
 //!   direct model, -A^-1 dGamma/d(q, qd) at qdd = ddm(Gamma), from the one L'DL factorization
 //!   of A the direct model computes ([`direct`]);
+//! - [`regressor_derivatives_into`]: dPhi/dq_k and dPhi/dqd_k of the regressor, by the same
+//!   analytical kernel on each unit standard parameter (Phi is linear in K) ([`regressor`]).
 //!
 //! Coulomb friction Fs sign(qd) contributes nothing (its derivative is zero away from qd = 0,
 //! and it is not differentiable at 0); viscous friction Fv qd adds Fv on the diagonal of
@@ -19,11 +21,16 @@
 
 pub mod direct;
 pub mod inverse;
+pub mod regressor;
 
 pub use direct::{direct_dynamics_derivatives, direct_dynamics_derivatives_into, DdmDerivatives};
 pub use inverse::{
     inverse_dynamics_derivatives, inverse_dynamics_derivatives_batch,
     inverse_dynamics_derivatives_into, IdmDerivatives,
+};
+pub use regressor::{
+    regressor_derivatives, regressor_derivatives_into, RegressorDerivatives,
+    RegressorDerivativesData,
 };
 
 use crate::data::Data;
