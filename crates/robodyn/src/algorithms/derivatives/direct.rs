@@ -2,10 +2,10 @@
 //! differentiating A(q) qdd + H(q, qd) = Gamma at qdd = ddm(q, qd, Gamma) gives
 //! dqdd/dq = -A^-1 dGamma/dq, dqdd/dqd = -A^-1 dGamma/dqd (the inverse model's derivatives at
 //! that qdd) and dqdd/dGamma = A^-1, in four named steps:
-//! 1. [`accelerations`]: A by composite links, its L'DL factorization (the direct model's own,
+//! 1. `accelerations`: A by composite links, its L'DL factorization (the direct model's own,
 //!    [`ltdl_factor`]) and qdd = A^-1 (Gamma - H);
-//! 2. the inverse model's derivatives at (q, qd, qdd) ([`idm_derivative_columns`]);
-//! 3. [`solve_columns`]: each column replaced by -A^-1 times it, from the same factors;
+//! 2. the inverse model's derivatives at (q, qd, qdd) (`idm_derivative_columns`);
+//! 3. `solve_columns`: each column replaced by -A^-1 times it, from the same factors;
 //! 4. A^-1 column by column from the same factors.
 
 use super::inverse::idm_derivative_columns;

@@ -3,14 +3,14 @@
 //! eqs D1–D14), and A = dGamma/dqdd by composite links.
 //!
 //! Column k (joint k, position and velocity together) in four named steps:
-//! 1. [`seed`]: the tangents of link k itself, the only link whose placement iA_k, iP_k moves
+//! 1. `seed`: the tangents of link k itself, the only link whose placement iA_k, iP_k moves
 //!    with q_k and whose joint rate is qd_k (D4–D7 with the seed terms);
-//! 2. [`propagate`]: the tangents of k's successors, in preorder over k's subtree (nothing
+//! 2. `propagate`: the tangents of k's successors, in preorder over k's subtree (nothing
 //!    outside the subtree moves in the forward recursion), and the tangents of the links'
 //!    wrenches (D8–D9);
-//! 3. [`accumulate`]: the backward recursion of the tangents over the subtree (D10), whose
+//! 3. `accumulate`: the backward recursion of the tangents over the subtree (D10), whose
 //!    projections on the joint axes are the rows of k's subtree (D12);
-//! 4. [`transmit`]: the tangent of the wrench that k exerts on its antecedent carried down to
+//! 4. `transmit`: the tangent of the wrench that k exerts on its antecedent carried down to
 //!    the base (D11, D13), whose projections are the rows of k's ancestors.
 //!
 //! Rows of joints that are neither ancestors nor successors of k are zero. The cost is that of
