@@ -23,6 +23,8 @@ mod cli_closed_rows;
 mod cli_columns;
 #[path = "cli_conventions.rs"]
 mod cli_conventions;
+#[path = "cli_derivatives.rs"]
+mod cli_derivatives;
 #[path = "cli_floating_simulate.rs"]
 mod cli_floating_simulate;
 #[path = "cli_generate.rs"]

@@ -14,7 +14,9 @@ use robodyn::algorithms::regressor::{
 use robodyn::batch::for_each_row;
 use robodyn::KinematicsData;
 use robodyn::{
-    direct_dynamics_into, h_vector_into, inertia_matrix_into, inverse_dynamics_into, Data, Method,
+    direct_dynamics_derivatives_into, direct_dynamics_into, h_vector_into, inertia_matrix_into,
+    inverse_dynamics_derivatives_into, inverse_dynamics_into, Data, DdmDerivatives,
+    DerivativesData, IdmDerivatives, Method,
 };
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -26,6 +28,8 @@ pub struct Work {
     pub data: Data,
     pub kin: KinematicsData,
     pub m: DMatrix<f64>,
+    /// The derivatives' buffers and outputs, made at the first derivatives call.
+    pub deriv: Option<Box<(DerivativesData, IdmDerivatives, DdmDerivatives)>>,
 }
 
 impl Work {
@@ -34,7 +38,22 @@ impl Work {
             data: Data::new(robot),
             kin: KinematicsData::new(robot),
             m: DMatrix::zeros(0, 0),
+            deriv: None,
         }
+    }
+
+    /// The derivatives' buffers for `robot` (made once).
+    pub fn deriv(
+        &mut self,
+        robot: &robodyn::Robot,
+    ) -> &mut (DerivativesData, IdmDerivatives, DdmDerivatives) {
+        self.deriv.get_or_insert_with(|| {
+            Box::new((
+                DerivativesData::new(robot),
+                IdmDerivatives::new(robot),
+                DdmDerivatives::new(robot),
+            ))
+        })
     }
 
     /// The library's `Data` and the matrix buffer with shape (r, c), borrowed together.
@@ -62,6 +81,33 @@ pub fn copy_rows(m: &DMatrix<f64>, cols: &[usize], out: &mut [f64]) {
             out[r * w + k] = m[(r, c)];
         }
     }
+}
+
+/// The N x N matrices `m` one after the other into `out`, each row-major.
+fn copy_matrices(m: &[&DMatrix<f64>], out: &mut [f64]) {
+    let mut k = 0;
+    for a in m {
+        for r in 0..a.nrows() {
+            for c in 0..a.ncols() {
+                out[k] = a[(r, c)];
+                k += 1;
+            }
+        }
+    }
+}
+
+/// An array of shape (3, n, n) or (N, 3, n, n) as a tuple of three C-contiguous arrays of
+/// shape (n, n) or (N, n, n).
+fn split_three<'py>(py: Python<'py>, r: Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+    let np = py.import("numpy")?;
+    let moved = np.getattr("moveaxis")?.call1((r, -3, 0))?;
+    let parts: Vec<Bound<'py, PyAny>> = (0..3)
+        .map(|i| {
+            np.getattr("ascontiguousarray")?
+                .call1((moved.get_item(i)?,))
+        })
+        .collect::<PyResult<_>>()?;
+    Ok(pyo3::types::PyTuple::new(py, parts)?.into_any())
 }
 
 /// `x` or its alias `y` (Pinocchio's spelling: `v` for `qd`, `a` for `qdd`), not both.
@@ -659,6 +705,77 @@ impl Robot {
         self.eval(py, &models, robot, call, move |r, w, x, o| {
             direct_dynamics_into(r, &mut w.data, r.environment(), x[0], x[1], x[2], m, o)
         })
+    }
+
+    /// Derivatives of the inverse dynamic model (analytical, docs/models/derivatives.md):
+    /// (dtau_dq, dtau_dqd, A) with A = dtau/dqdd the inertia matrix, each (nq, nq) for one
+    /// state, (N, nq, nq) for N states (q, qd, qdd of shape (N, nq)); entry [j, k] is the
+    /// derivative of tau_j with respect to joint k. Arguments as idm (Coulomb friction has a
+    /// zero derivative, viscous friction adds Fv on dtau_dqd's diagonal; friction=False leaves
+    /// both out: Pinocchio's computeRNEADerivatives).
+    #[pyo3(signature = (q, qd=None, qdd=None, *, v=None, a=None, friction=true))]
+    #[allow(clippy::too_many_arguments)]
+    fn idm_derivatives<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        qd: Option<&Bound<'py, PyAny>>,
+        qdd: Option<&Bound<'py, PyAny>>,
+        v: Option<&Bound<'py, PyAny>>,
+        a: Option<&Bound<'py, PyAny>>,
+        friction: bool,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let qd = alias("qd", qd, "v", v)?;
+        let qdd = alias("qdd", qdd, "a", a)?;
+        let models = self.models();
+        let robot = models.select(friction)?;
+        let n = robot.dof();
+        let call = Call {
+            inputs: &[("q", Some(q)), ("qd", qd), ("qdd", qdd)],
+            one: &[3, n, n],
+            stacked: false,
+            out: None,
+        };
+        let r = self.eval(py, &models, robot, call, |r, w, x, o| {
+            let (data, d, _) = w.deriv(r);
+            inverse_dynamics_derivatives_into(r, data, r.environment(), x[0], x[1], x[2], d)?;
+            copy_matrices(&[&d.dtau_dq, &d.dtau_dqd, &d.a], o);
+            Ok(())
+        })?;
+        split_three(py, r)
+    }
+
+    /// Derivatives of the direct dynamic model at qdd = ddm(q, qd, tau) (composite method):
+    /// (dqdd_dq, dqdd_dqd, Ainv) with Ainv = dqdd/dtau = A^-1, from the one L'DL factorization
+    /// of A. Shapes as idm_derivatives; arguments as ddm (friction=False: Pinocchio's
+    /// computeABADerivatives). Raises SingularConfiguration for a singular A.
+    #[pyo3(signature = (q, qd=None, tau=None, *, v=None, friction=true))]
+    fn ddm_derivatives<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        qd: Option<&Bound<'py, PyAny>>,
+        tau: Option<&Bound<'py, PyAny>>,
+        v: Option<&Bound<'py, PyAny>>,
+        friction: bool,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let qd = alias("qd", qd, "v", v)?;
+        let models = self.models();
+        let robot = models.select(friction)?;
+        let n = robot.dof();
+        let call = Call {
+            inputs: &[("q", Some(q)), ("qd", qd), ("tau", tau)],
+            one: &[3, n, n],
+            stacked: false,
+            out: None,
+        };
+        let r = self.eval(py, &models, robot, call, |r, w, x, o| {
+            let (data, _, d) = w.deriv(r);
+            direct_dynamics_derivatives_into(r, data, r.environment(), x[0], x[1], x[2], d)?;
+            copy_matrices(&[&d.dqdd_dq, &d.dqdd_dqd, &d.ainv], o);
+            Ok(())
+        })?;
+        split_three(py, r)
     }
 
     /// Geometric model: 0T_j (4 x 4 homogeneous matrices, metres) of the frames 1..NF

@@ -100,6 +100,12 @@ pub use algorithms::closed_chain::{
     loop_closure, loop_closure_into, Branch, ClosedChain, ClosedData, Conditioning,
     ConditioningLimits,
 };
+pub use algorithms::derivatives::{
+    direct_dynamics_derivatives, direct_dynamics_derivatives_into, inverse_dynamics_derivatives,
+    inverse_dynamics_derivatives_batch, inverse_dynamics_derivatives_into, regressor_derivatives,
+    regressor_derivatives_into, DdmDerivatives, DerivativesData, IdmDerivatives,
+    RegressorDerivatives, RegressorDerivativesData,
+};
 pub use algorithms::direct_dynamics::{
     direct_dynamics, direct_dynamics_into, direct_dynamics_state_into, DirectState, Method,
 };

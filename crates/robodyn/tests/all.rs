@@ -49,6 +49,10 @@ mod codegen_opcount;
 mod codegen_parameters;
 #[path = "continuation.rs"]
 mod continuation;
+#[path = "derivatives.rs"]
+mod derivatives;
+#[path = "derivatives_pinocchio.rs"]
+mod derivatives_pinocchio;
 #[path = "direct_dynamics.rs"]
 mod direct_dynamics;
 #[path = "finite_results.rs"]

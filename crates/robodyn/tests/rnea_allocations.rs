@@ -332,3 +332,40 @@ fn batch_runner_allocates_nothing_per_row() {
         );
     }
 }
+
+/// The derivatives of the inverse, direct and regressor models allocate nothing once their
+/// data and outputs are made (robodyn::algorithms::derivatives).
+#[test]
+fn derivatives_allocate_nothing() {
+    use robodyn::algorithms::derivatives::{
+        direct_dynamics_derivatives_into, inverse_dynamics_derivatives_into,
+        regressor_derivatives_into, DdmDerivatives, DerivativesData, IdmDerivatives,
+        RegressorDerivatives, RegressorDerivativesData,
+    };
+    let mut rng = testing::rng(7);
+    for robot in &robots() {
+        let m = robot.dof();
+        let states: Vec<_> = (0..5).map(|_| random_state(&mut rng, m)).collect();
+        let env = robot.environment();
+        let mut data = DerivativesData::new(robot);
+        let (mut idm, mut ddm) = (IdmDerivatives::new(robot), DdmDerivatives::new(robot));
+        let mut rdata = RegressorDerivativesData::new(robot).unwrap();
+        let mut reg = RegressorDerivatives::new(robot);
+        counter_counts();
+        let before = allocations();
+        let mut checksum = 0.0;
+        for s in &states {
+            let (q, qd, x) = (&s[0], &s[1], &s[2]);
+            inverse_dynamics_derivatives_into(robot, &mut data, env, q, qd, x, &mut idm).unwrap();
+            // a tree whose A is singular (sr400's cut links) reports it without allocating
+            if direct_dynamics_derivatives_into(robot, &mut data, env, q, qd, x, &mut ddm).is_ok() {
+                checksum += ddm.ainv[(0, 0)];
+            }
+            regressor_derivatives_into(robot, &mut rdata, env, q, qd, x, &mut reg).unwrap();
+            checksum += idm.dtau_dq[(0, 0)] + reg.dphi_dq[0][(0, 0)];
+        }
+        let after = allocations();
+        assert!(checksum.is_finite());
+        assert_eq!(after - before, 0, "{}: derivatives allocated", robot.name());
+    }
+}

@@ -6,9 +6,12 @@
 //! (the library's branch tracker: each row continued from the previous one, the first from the
 //! robot's `assembly` or `--guess`); rows near a singularity are flagged on stderr and in JSON.
 
-use crate::common::{CliResult, RobotArgs};
+use crate::common::{format_number, parse_list, write_text, CliResult, RobotArgs, TableFormat};
 use crate::rows::{evaluate, EvaluationArgs};
-use robodyn::{closed_inverse_dynamics_into, inverse_dynamics_batch};
+use robodyn::{
+    closed_inverse_dynamics_into, inverse_dynamics, inverse_dynamics_batch,
+    inverse_dynamics_derivatives,
+};
 use std::path::PathBuf;
 
 #[derive(clap::Args, Debug)]
@@ -29,11 +32,20 @@ pub struct Args {
     /// Joint accelerations (default zeros).
     #[arg(long, allow_hyphen_values = true)]
     pub qdd: Option<String>,
+    /// Instead of the torques, write the derivatives of the model at the one state of
+    /// --q/--qd/--qdd: dtau_dq, dtau_dqd and A = dtau/dqdd (N x N over the movable joints; row j
+    /// is the derivative of tau_j; trees only). csv: columns matrix, joint, then one per joint;
+    /// json: {"joints", "q", "qd", "qdd", "tau", "dtau_dq", "dtau_dqd", "A"}.
+    #[arg(long, conflicts_with_all = ["input", "guess", "carry"])]
+    pub derivatives: bool,
     #[command(flatten)]
     pub eval: EvaluationArgs,
 }
 
 pub fn run(a: Args) -> CliResult {
+    if a.derivatives {
+        return derivatives(&a);
+    }
     evaluate(
         &a.robot,
         &a.eval,
@@ -57,4 +69,60 @@ pub fn run(a: Args) -> CliResult {
             )
         },
     )
+}
+
+/// `idm --derivatives`: the three matrices at one state, in the table format of `--format`.
+fn derivatives(a: &Args) -> CliResult {
+    let robot = a.robot.load()?;
+    if !robot.is_tree() {
+        return Err(
+            "idm --derivatives: the derivatives of a closed chain's model are not \
+                    available yet (trees only); drop --derivatives for the torques"
+                .into(),
+        );
+    }
+    let n = robot.dof();
+    let list = |name: &str, s: &Option<String>| match s {
+        Some(s) => parse_list(name, s),
+        None => Ok(vec![0.0; n]),
+    };
+    let (q, qd, qdd) = (list("q", &a.q)?, list("qd", &a.qd)?, list("qdd", &a.qdd)?);
+    let d = inverse_dynamics_derivatives(&robot, &q, &qd, &qdd)?;
+    let tau = inverse_dynamics(&robot, &q, &qd, &qdd)?;
+    let joints = robot.coordinates().frames().to_vec();
+    let mats = [
+        ("dtau_dq", &d.dtau_dq),
+        ("dtau_dqd", &d.dtau_dqd),
+        ("A", &d.a),
+    ];
+    let rows = |m: &robodyn::nalgebra::DMatrix<f64>| -> Vec<Vec<f64>> {
+        (0..n).map(|i| m.row(i).iter().copied().collect()).collect()
+    };
+    let text = match a.eval.out.format {
+        TableFormat::Csv => {
+            let mut t = String::from("matrix,joint");
+            for j in &joints {
+                t += &format!(",{j}");
+            }
+            t.push('\n');
+            for (name, m) in mats {
+                for (i, j) in joints.iter().enumerate() {
+                    t += &format!("{name},{j}");
+                    for x in m.row(i).iter() {
+                        t += &format!(",{}", format_number(*x));
+                    }
+                    t.push('\n');
+                }
+            }
+            t
+        }
+        TableFormat::Json => {
+            let v = serde_json::json!({
+                "joints": joints, "q": q, "qd": qd, "qdd": qdd, "tau": tau.as_slice(),
+                "dtau_dq": rows(&d.dtau_dq), "dtau_dqd": rows(&d.dtau_dqd), "A": rows(&d.a),
+            });
+            serde_json::to_string_pretty(&v)? + "\n"
+        }
+    };
+    write_text(a.eval.out.output.as_deref(), &text)
 }

@@ -185,6 +185,18 @@ class Robot:
         or "aba" (articulated bodies). Shapes as idm; v is Pinocchio's name for qd.
         friction=False leaves out Fv and Fs (Pinocchio's aba). Raises SingularConfiguration for
         a singular A. out: as for idm."""
+    def idm_derivatives(self, q: ArrayLike, qd: Optional[ArrayLike] = None, qdd: Optional[ArrayLike] = None, *, v: Optional[ArrayLike] = None, a: Optional[ArrayLike] = None, friction: bool = True) -> Tuple[Array, Array, Array]:
+        """Derivatives of the inverse dynamic model (analytical, docs/models/derivatives.md):
+        (dtau_dq, dtau_dqd, A) with A = dtau/dqdd the inertia matrix, each (nq, nq) for one
+        state, (N, nq, nq) for N states (q, qd, qdd of shape (N, nq)); entry [j, k] is the
+        derivative of tau_j with respect to joint k. Arguments as idm (Coulomb friction has a
+        zero derivative, viscous friction adds Fv on dtau_dqd's diagonal; friction=False leaves
+        both out: Pinocchio's computeRNEADerivatives)."""
+    def ddm_derivatives(self, q: ArrayLike, qd: Optional[ArrayLike] = None, tau: Optional[ArrayLike] = None, *, v: Optional[ArrayLike] = None, friction: bool = True) -> Tuple[Array, Array, Array]:
+        """Derivatives of the direct dynamic model at qdd = ddm(q, qd, tau) (composite method):
+        (dqdd_dq, dqdd_dqd, Ainv) with Ainv = dqdd/dtau = A^-1, from the one L'DL factorization
+        of A. Shapes as idm_derivatives; arguments as ddm (friction=False: Pinocchio's
+        computeABADerivatives). Raises SingularConfiguration for a singular A."""
     def forward_kinematics(self, q: ArrayLike, *, out: Optional[Array] = None) -> Array:
         """Geometric model: 0T_j (4 x 4 homogeneous matrices, metres) of the frames 1..NF
         (description_frame_names) for the movable joints' values q (rad, m; cut-joint variables taken as

@@ -2,6 +2,7 @@
 
 pub mod base_parameters;
 pub mod closed_chain;
+pub mod derivatives;
 pub mod direct_dynamics;
 pub mod energy;
 pub mod floating_base;
