@@ -65,6 +65,8 @@ mod identification_conic;
 mod identification_consistency;
 #[path = "identification_hostile.rs"]
 mod identification_hostile;
+#[path = "identification_statistics.rs"]
+mod identification_statistics;
 #[path = "identification_synthetic.rs"]
 mod identification_synthetic;
 #[path = "identification_tx40.rs"]
