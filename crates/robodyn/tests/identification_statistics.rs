@@ -276,7 +276,7 @@ fn merges_of_other_robots_or_options_are_refused() {
     .unwrap();
     desc.frames[1].d = robodyn_symbolic::Expr::from(0.123456);
     let mut longer = ModelAccess::new(desc).unwrap();
-    let e = identify_from_statistics(&mut longer, &[a.clone()], &opt)
+    let e = identify_from_statistics(&mut longer, std::slice::from_ref(&a), &opt)
         .unwrap_err()
         .to_string();
     assert!(e.contains("geometry"), "{e}");
@@ -292,7 +292,7 @@ fn merges_of_other_robots_or_options_are_refused() {
         e.contains("bandwidth = 5") && e.contains("bandwidth = 10"),
         "{e}"
     );
-    let e = identify_from_statistics(&mut scara, &[a.clone()], &other)
+    let e = identify_from_statistics(&mut scara, std::slice::from_ref(&a), &other)
         .unwrap_err()
         .to_string();
     assert!(e.contains("bandwidth"), "{e}");
@@ -300,7 +300,7 @@ fn merges_of_other_robots_or_options_are_refused() {
         estimator: Estimator::Iv,
         ..Options::default()
     };
-    let e = identify_from_statistics(&mut scara, &[a.clone()], &iv)
+    let e = identify_from_statistics(&mut scara, std::slice::from_ref(&a), &iv)
         .unwrap_err()
         .to_string();
     assert!(e.contains("IDIM-IV"), "{e}");
