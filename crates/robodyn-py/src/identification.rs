@@ -369,6 +369,13 @@ pub struct Identification {
     desc: RobotDescription,
 }
 
+/// t, measured and predicted torques of the validation segment.
+type Prediction<'py> = (
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyAny>,
+    Bound<'py, PyAny>,
+);
+
 /// A JSON value as a Python object.
 fn py_json<'py>(py: Python<'py>, v: &serde_json::Value) -> PyResult<Bound<'py, PyAny>> {
     py.import("json")?.call_method1("loads", (v.to_string(),))
@@ -467,11 +474,7 @@ impl Identification {
     fn validation_prediction<'py>(
         &self,
         py: Python<'py>,
-    ) -> PyResult<(
-        Bound<'py, PyArray1<f64>>,
-        Bound<'py, PyAny>,
-        Bound<'py, PyAny>,
-    )> {
+    ) -> PyResult<Prediction<'py>> {
         let rows = &self.id.validation_rows;
         let to2d = |v: &[Vec<f64>]| -> PyResult<Bound<'py, PyAny>> {
             let n = self.id.joints.len();
