@@ -471,10 +471,7 @@ impl Identification {
 
     /// The decimated samples of the validation segment for a plot: (t (M,), measured (M, N),
     /// predicted (M, N)) torques, at most 20,000 samples evenly spaced.
-    fn validation_prediction<'py>(
-        &self,
-        py: Python<'py>,
-    ) -> PyResult<Prediction<'py>> {
+    fn validation_prediction<'py>(&self, py: Python<'py>) -> PyResult<Prediction<'py>> {
         let rows = &self.id.validation_rows;
         let to2d = |v: &[Vec<f64>]| -> PyResult<Bound<'py, PyAny>> {
             let n = self.id.joints.len();
