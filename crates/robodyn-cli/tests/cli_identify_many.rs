@@ -141,6 +141,17 @@ fn tx40_halves_merged_equal_the_two_logs_together() {
         "0.6:0.8",
     ]);
     assert!(e.contains("offsets"), "{e}");
+    // the same log twice: its rows would count twice
+    let e = fails(&[
+        "identify",
+        &tx40,
+        "--data",
+        s(&halves[0]),
+        "--data",
+        s(&halves[0]),
+        "--offsets",
+    ]);
+    assert!(e.contains("the same log twice"), "{e}");
 }
 
 /// A noise-free simulated RX-90 log (excite, simulate) cut into three logs, each written as

@@ -287,6 +287,13 @@ fn merges_of_other_robots_or_options_are_refused() {
     };
     let lc = log(&scara, 3, 2.0);
     let c = statistics(&mut scara, &lc, &other).unwrap();
+    let e = Statistics::merged(&[a.clone(), a.clone()])
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("the same log twice") && e.contains("sim1"),
+        "{e}"
+    );
     let e = Statistics::merged(&[a.clone(), c]).unwrap_err().to_string();
     assert!(
         e.contains("bandwidth = 5") && e.contains("bandwidth = 10"),

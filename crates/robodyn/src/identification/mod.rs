@@ -860,12 +860,21 @@ fn pass_statistics(
     preport.fit_samples = pass.fit_samples;
     preport.validation_samples = pass.validation_samples;
     preport.slow_rows = pass.slow_rows.clone();
+    let digest = pass
+        .fit
+        .iter_mut()
+        .flat_map(|f| {
+            let t = f.factor();
+            (0..t.ncols()).map(|i| t[(i, i)]).collect::<Vec<_>>()
+        })
+        .collect();
     let stats = Statistics {
         format: statistics::FORMAT.into(),
         version: statistics::VERSION,
         fingerprint: statistics::Fingerprint::of(access, model),
         options: statistics::RowOptions::of(opt),
         logs: vec![preport],
+        digests: vec![digest],
         fit: std::mem::take(&mut pass.fit),
         validation: std::mem::take(&mut pass.validation),
         validation_raw: std::mem::take(&mut pass.validation_raw),

@@ -241,6 +241,9 @@ pub struct Statistics {
     pub options: RowOptions,
     /// The processing of each log, in merge order.
     pub logs: Vec<ProcessingReport>,
+    /// Per log (same order), the diagonals of its fit factors: the same log merged twice (its
+    /// rows counted twice, standard deviations too small by sqrt 2) is recognized and refused.
+    pub digests: Vec<Vec<f64>>,
     /// One factor per actuated joint of the fit rows.
     pub fit: Vec<TriangularFactor>,
     /// The same for the validation segments' rows.
@@ -264,6 +267,15 @@ impl Statistics {
         let what = format!("the statistics of {}", sources(&other.logs));
         self.options.check(&other.options, &what)?;
         self.fingerprint.check(&other.fingerprint, &what)?;
+        for (k, d) in other.digests.iter().enumerate() {
+            if let Some(m) = self.digests.iter().position(|e| e == d) {
+                return Err(Error::Input(format!(
+                    "{what}: log {} has the rows of {}, already merged: the same log twice \
+                     would count its rows twice (standard deviations too small)",
+                    other.logs[k].source, self.logs[m].source
+                )));
+            }
+        }
         let pairs = [
             (&mut self.fit, &other.fit),
             (&mut self.validation, &other.validation),
@@ -275,6 +287,7 @@ impl Statistics {
             }
         }
         self.logs.extend(other.logs.iter().cloned());
+        self.digests.extend(other.digests.iter().cloned());
         let (rows, more) = (&mut self.validation_rows, &other.validation_rows);
         rows.t.extend_from_slice(&more.t);
         rows.y.extend_from_slice(&more.y);
