@@ -106,13 +106,13 @@ impl TriangularFactor {
 }
 
 /// The serialized form of a [`TriangularFactor`]: its rows and the upper triangle of T, row i
-/// holding T[i][i..=p] (T^T T = [W y]^T [W y]: W^T W, W^T y and y^T y of the rows, carried as
+/// holding `T[i][i..=p]` (T^T T = [W y]^T [W y]: W^T W, W^T y and y^T y of the rows, carried as
 /// their Cholesky factor).
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct FactorData {
     /// Rows (equations) folded into the factor.
     pub rows: usize,
-    /// Row i: T[i][i], ..., T[i][p] (p + 1 - i numbers).
+    /// Row i: `T[i][i], ..., T[i][p]` (p + 1 - i numbers).
     pub upper: Vec<Vec<f64>>,
 }
 
