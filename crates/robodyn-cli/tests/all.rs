@@ -35,6 +35,8 @@ mod cli_generate_names;
 mod cli_identify;
 #[path = "cli_identify_hostile.rs"]
 mod cli_identify_hostile;
+#[path = "cli_identify_many.rs"]
+mod cli_identify_many;
 #[path = "cli_info.rs"]
 mod cli_info;
 #[path = "cli_info_assembly.rs"]

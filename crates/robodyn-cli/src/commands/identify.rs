@@ -8,8 +8,11 @@ use robodyn::algorithms::regressor::RotorMode;
 use robodyn::identification::data::{CsvLog, Effort, JointLabels, LogSource};
 use robodyn::identification::model_access::ModelAccess;
 use robodyn::identification::parameters::ParameterOptions;
-use robodyn::identification::{identify, report, EssentialOptions, Estimator, Options};
-use std::path::PathBuf;
+use robodyn::identification::{
+    identify_from_statistics, identify_logs, report, statistics::statistics, EssentialOptions,
+    Estimator, Identification, Options, Statistics,
+};
+use std::path::{Path, PathBuf};
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Format {
@@ -28,8 +31,18 @@ pub struct Args {
     pub robot: RobotArgs,
     /// Log (CSV): t, q<j>, tau<j> (or i<j> with --gains), optionally qd<j>, qdd<j>; j the frame
     /// number of each actuated joint, or `_<name>` with the joint's name; `-`: standard input.
-    #[arg(long)]
-    pub data: PathBuf,
+    /// Repeated (`--data a.csv --data b.csv`): several logs of the robot, identified together
+    /// (each processed on its own, one least-squares problem).
+    #[arg(long, required_unless_present = "merge")]
+    pub data: Vec<PathBuf>,
+    /// Write the sufficient statistics of the logs (JSON) to this file instead of identifying:
+    /// `identify --merge` identifies from the statistics of many logs, computed anywhere.
+    #[arg(long, value_name = "FILE.json", conflicts_with_all = ["merge", "output", "plot", "write_robot", "strict"])]
+    pub partial: Option<PathBuf>,
+    /// Identify from statistics files written by `--partial` (of this robot, with the same
+    /// parameter and processing options), merged: the numbers of `--data` with all their logs.
+    #[arg(long, value_name = "FILE.json", num_args = 1.., conflicts_with_all = ["data", "plot"])]
+    pub merge: Vec<PathBuf>,
     /// Estimator of the parameters.
     #[arg(long, default_value = "wls",
           value_parser = choices(&Estimator::ALL, Estimator::key, Estimator::describe))]
@@ -181,22 +194,42 @@ pub fn run(a: Args) -> CliResult {
         ("--output", a.output.as_deref()),
         ("--plot", a.plot.as_deref()),
         ("--write-robot", a.write_robot.as_deref()),
+        ("--partial", a.partial.as_deref()),
     ])?;
     let desc = a.robot.description()?.0;
     let mut access = ModelAccess::new(desc)?;
-    let labels = JointLabels {
-        numbers: access.actuated_joints().to_vec(),
-        names: access.joint_names(),
-    };
-    let log = CsvLog::open(&a.data, &labels)?;
     let gains = a
         .gains
         .as_deref()
         .map(|g| parse_list("gains", g))
         .transpose()?;
-    check_gains(gains.as_deref(), &log, labels.numbers.len())?;
-    let opt = options(&a, gains)?;
-    let id = identify(&mut access, &log, &opt)?;
+    let opt = options(&a, gains.clone())?;
+    let id = if a.merge.is_empty() {
+        let labels = JointLabels {
+            numbers: access.actuated_joints().to_vec(),
+            names: access.joint_names(),
+        };
+        let logs = a
+            .data
+            .iter()
+            .map(|d| CsvLog::open(d, &labels))
+            .collect::<Result<Vec<_>, _>>()?;
+        for log in &logs {
+            check_gains(gains.as_deref(), log, labels.numbers.len())?;
+        }
+        if let Some(p) = &a.partial {
+            return write_partial(p, &mut access, &logs, &opt);
+        }
+        let refs: Vec<&dyn LogSource> = logs.iter().map(|l| l as &dyn LogSource).collect();
+        identify_logs(&mut access, &refs, &opt)?
+    } else {
+        let parts = a
+            .merge
+            .iter()
+            .map(|p| read_statistics(p))
+            .collect::<CliResult<Vec<_>>>()?;
+        identify_from_statistics(&mut access, &parts, &opt)?
+    };
     let text = match a.format {
         Format::Text => report::to_text(&id),
         Format::Json => format!("{}\n", serde_json::to_string_pretty(&report::to_json(&id))?),
@@ -226,6 +259,35 @@ pub fn run(a: Args) -> CliResult {
         .into());
     }
     Ok(())
+}
+
+/// `--partial`: the statistics of the logs, merged, written as JSON (all or nothing).
+fn write_partial(
+    path: &Path,
+    access: &mut ModelAccess,
+    logs: &[CsvLog],
+    opt: &Options,
+) -> CliResult {
+    let parts = logs
+        .iter()
+        .map(|log| statistics(access, log, opt))
+        .collect::<Result<Vec<_>, _>>()?;
+    let stats = Statistics::merged(&parts)?;
+    crate::output::write_text(Some(path), &format!("{}\n", stats.to_json()))?;
+    eprintln!(
+        "wrote {}: the statistics of {} ({} rows of the fit)",
+        path.display(),
+        robodyn::identification::statistics::sources(&stats.logs),
+        stats.rows()
+    );
+    Ok(())
+}
+
+/// A statistics file of `--merge`.
+fn read_statistics(path: &Path) -> CliResult<Statistics> {
+    let text =
+        std::fs::read_to_string(path).map_err(|e| format!("--merge {}: {e}", path.display()))?;
+    Ok(Statistics::from_json(&text, &path.display().to_string())?)
 }
 
 /// The identification's options of the command line.
@@ -263,12 +325,7 @@ fn options(a: &Args, gains: Option<Vec<f64>>) -> CliResult<Options> {
 
 /// The report, the fit plot and the identified robot file: all or nothing, the files put in
 /// place once all are written.
-fn write_files(
-    a: &Args,
-    access: &ModelAccess,
-    id: &robodyn::identification::Identification,
-    text: &str,
-) -> CliResult {
+fn write_files(a: &Args, access: &ModelAccess, id: &Identification, text: &str) -> CliResult {
     let mut files = vec![crate::output::Output::create(a.output.as_deref())?];
     files[0].write_all(text.as_bytes())?;
     if let Some(p) = &a.plot {
@@ -284,7 +341,7 @@ fn write_files(
              parameters (pseudo-inertia PSD per link, drive parameters >= 0), the constrained \
              least-squares fit, at squared Mahalanobis distance {:.3} from the unconstrained \
              estimate.",
-            a.data.display(),
+            robodyn::identification::statistics::sources(&id.logs),
             id.estimator,
             id.consistent.as_ref().map_or(0.0, |c| c.distance2)
         ));

@@ -16,6 +16,8 @@ from ._robodyn import (
     DimensionError,
     Error,
     Generated,
+    IdentStatistics,
+    Identification,
     InputError,
     LoopClosureError,
     NotFiniteError,
@@ -29,6 +31,9 @@ from ._robodyn import (
     View,
     __version__,
     base_parameters,
+    ident_statistics,
+    identify,
+    identify_from_statistics,
     load,
 )
 
@@ -39,6 +44,8 @@ __all__ = [
     "DimensionError",
     "Error",
     "Generated",
+    "IdentStatistics",
+    "Identification",
     "InputError",
     "LoopClosureError",
     "NotFiniteError",
@@ -52,5 +59,8 @@ __all__ = [
     "View",
     "__version__",
     "base_parameters",
+    "ident_statistics",
+    "identify",
+    "identify_from_statistics",
     "load",
 ]

@@ -363,3 +363,77 @@ class Generated:
     multiplications: int
     additions: int
     functions: int
+
+# Identification (robodyn identify): docs/python.md, docs/models/identification.md
+
+Log = Union[str, PathLike, Dict[str, ArrayLike], Any]
+"""A CSV path, a dict of 1-D arrays named as the CSV's columns (t, q<j>, tau<j> or i<j>, optionally
+qd<j>, qdd<j>), or a pandas DataFrame with those columns."""
+
+def identify(robot: Union[Robot, str, PathLike], logs: Union[Log, Sequence[Log]], **options: Any) -> Identification:
+    """Identify the base parameters (friction, rotor inertias, offsets, drive parameters of a
+    transmission) of ``robot`` from one log or a list of logs of it (the CLI's repeated ``--data``):
+    the same numbers as ``robodyn identify``. Options (the library's identification Options, the
+    CLI's flags): estimator ("ols", "wls", "iv"), consistent, standard (compute consistent standard
+    parameters for ``robot()``/``write_robot``), rotor, friction, offsets, seed, essential,
+    essential_max_std, essential_tolerance, bandwidth, cutoff, filter_order, decimation, border,
+    validation ((from, to) fractions or None; default (0.8, 1.0)), use_log_derivatives, gains,
+    min_speed, coulomb_band, iv_iterations, iv_bandwidth. An unknown option raises InputError."""
+
+def ident_statistics(robot: Union[Robot, str, PathLike], log: Log, **options: Any) -> IdentStatistics:
+    """The sufficient statistics of one log (options as ``identify``): picklable, merged by
+    ``identify_from_statistics`` into the numbers of ``identify`` of all the logs (map-reduce)."""
+
+def identify_from_statistics(robot: Union[Robot, str, PathLike], statistics: Sequence[IdentStatistics], **options: Any) -> Identification:
+    """Identify from merged statistics (of this robot, computed with the same row-shaping options:
+    checked, InputError otherwise). IDIM-IV needs the logs themselves (InputError)."""
+
+class IdentStatistics:
+    """Per joint, the triangular factor of [W y] of the fit and validation rows of one or more logs,
+    with the robot's fingerprint and the options that shaped the rows. Picklable (as JSON)."""
+    def __init__(self, json: str) -> None:
+        """Statistics from their JSON text (``to_json``, ``robodyn identify --partial``)."""
+    def to_json(self) -> str:
+        """The JSON text (``robodyn identify --merge`` reads it)."""
+    def merge(self, other: IdentStatistics) -> IdentStatistics:
+        """These statistics with ``other``'s rows (same robot and row options)."""
+    rows: int
+    """Rows of the fit (all joints)."""
+    logs: List[str]
+    """The logs' names."""
+
+class Identification:
+    """The result of ``identify``."""
+    report: Dict[str, Any]
+    """The JSON report of ``robodyn identify --format json``."""
+    parameters: List[Dict[str, Any]]
+    """name, unit, equation, value, std, relative_std (%, None when infinite)."""
+    names: List[str]
+    values: Array
+    std: Array
+    relative_std: Array
+    estimator: str
+    condition_number: float
+    """Condition number of W with unit-norm columns."""
+    condition_number_unscaled: float
+    relative_error: float
+    """||Y - W X|| / ||Y|| over the fit rows."""
+    per_joint: List[Dict[str, Any]]
+    """joint, name, rows, rms, relative_error, sigma (the WLS weight is 1/sigma)."""
+    validation: Optional[Dict[str, Any]]
+    """The validation segment's errors (decimated and raw torques), None without a segment."""
+    warnings: List[Dict[str, Any]]
+    """kind, parameters, message."""
+    notes: List[str]
+    def validation_prediction(self) -> Tuple[Array, Array, Array]:
+        """(t (M,), measured (M, N), predicted (M, N)) torques of the validation segment's decimated
+        samples, for a plot."""
+    def text(self) -> str:
+        """The report as ``robodyn identify`` prints it."""
+    def to_pandas(self) -> Any:
+        """The parameters as a pandas DataFrame (ImportError without pandas)."""
+    def robot(self) -> Robot:
+        """The identified robot (consistent standard parameters; identify with standard=True or
+        consistent=True)."""
+    def write_robot(self, path: Union[str, PathLike]) -> None:
+        """Write the identified robot (.toml or .par)."""

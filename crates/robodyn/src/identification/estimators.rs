@@ -18,7 +18,10 @@ use faer::Mat;
 const BLOCK_ROWS: usize = 256;
 
 /// Streaming triangular factor of [W y] for one group of rows (see the module documentation).
-#[derive(Clone, Debug)]
+/// Serialized as its row count and the upper triangle of T with every row folded in
+/// ([`FactorData`]).
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+#[serde(into = "FactorData", try_from = "FactorData")]
 pub struct TriangularFactor {
     /// Number of parameters p.
     p: usize,
@@ -99,6 +102,59 @@ impl TriangularFactor {
         other.flush();
         self.t = combine(&[(&self.t, 1.0), (&other.t, 1.0)]);
         self.rows += other.rows;
+    }
+}
+
+/// The serialized form of a [`TriangularFactor`]: its rows and the upper triangle of T, row i
+/// holding `T[i][i..=p]` (T^T T = [W y]^T [W y]: W^T W, W^T y and y^T y of the rows, carried as
+/// their Cholesky factor).
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct FactorData {
+    /// Rows (equations) folded into the factor.
+    pub rows: usize,
+    /// Row i: `T[i][i], ..., T[i][p]` (p + 1 - i numbers).
+    pub upper: Vec<Vec<f64>>,
+}
+
+impl From<TriangularFactor> for FactorData {
+    fn from(mut f: TriangularFactor) -> FactorData {
+        let p1 = f.p + 1;
+        let rows = f.rows;
+        let t = f.factor();
+        FactorData {
+            rows,
+            upper: (0..p1)
+                .map(|i| (i..p1).map(|c| t[(i, c)]).collect())
+                .collect(),
+        }
+    }
+}
+
+impl TryFrom<FactorData> for TriangularFactor {
+    type Error = String;
+    fn try_from(d: FactorData) -> std::result::Result<TriangularFactor, String> {
+        let p1 = d.upper.len();
+        if p1 == 0 {
+            return Err("a factor with no row of T".into());
+        }
+        let mut f = TriangularFactor::new(p1 - 1);
+        for (i, row) in d.upper.iter().enumerate() {
+            if row.len() != p1 - i {
+                return Err(format!(
+                    "row {i} of a factor's upper triangle has {} numbers, {} expected",
+                    row.len(),
+                    p1 - i
+                ));
+            }
+            for (k, &v) in row.iter().enumerate() {
+                if !v.is_finite() {
+                    return Err(format!("a factor holds a non-finite number ({v})"));
+                }
+                f.t[(i, i + k)] = v;
+            }
+        }
+        f.rows = d.rows;
+        Ok(f)
     }
 }
 
@@ -424,6 +480,24 @@ impl IvAccumulator {
             self.zy[i] += zi * y;
         }
         self.rows += 1;
+    }
+
+    /// Add the rows of another group (another log of the same robot).
+    pub fn add(&mut self, other: &IvAccumulator) {
+        assert_eq!(
+            self.p, other.p,
+            "accumulators of different parameter counts"
+        );
+        for (a, b) in self.zw.iter_mut().zip(&other.zw) {
+            *a += b;
+        }
+        for (a, b) in self.zz.iter_mut().zip(&other.zz) {
+            *a += b;
+        }
+        for (a, b) in self.zy.iter_mut().zip(&other.zy) {
+            *a += b;
+        }
+        self.rows += other.rows;
     }
 }
 

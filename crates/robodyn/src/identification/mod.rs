@@ -14,6 +14,8 @@
 //! - [`excitation`]: finite Fourier series minimizing the condition number;
 //! - [`signs`]: the signs physics fixes (friction, rotor inertias, sums of masses and moments
 //!   of inertia), checked on the estimate;
+//! - [`statistics`]: the sufficient statistics of one log, merged over a set of logs
+//!   (map-reduce; serialized as JSON);
 //! - [`report`]: table (text, JSON, CSV) and SVG plots;
 //! - [`model_access`]: the only calls into the rest of the library;
 //! - [`fuzz_checks`]: the properties the fuzz targets check (`fuzz/`).
@@ -30,6 +32,7 @@ pub mod parameters;
 pub mod report;
 pub mod signal;
 pub mod signs;
+pub mod statistics;
 
 use crate::error::{Error, Result};
 use data::{record, summarize, Effort, LogSource, LogSummary};
@@ -41,6 +44,7 @@ use model_access::ModelAccess;
 use observation::{run_pass, Instruments, PassResult, Processing, ValidationRows};
 use parameters::{Kind, Parameter, ParameterModel, ParameterOptions};
 use signal::Butterworth;
+pub use statistics::Statistics;
 
 pub use model_access::Rotors;
 
@@ -297,7 +301,7 @@ pub struct JointFit {
 }
 
 /// The processing applied, with every value used (printed by the report).
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ProcessingReport {
     /// The log (file name).
     pub source: String,
@@ -507,8 +511,11 @@ pub struct Identification {
     pub per_joint: Vec<JointFit>,
     /// Prediction of the validation segment, if one was kept out.
     pub validation: Option<Validation>,
-    /// The processing applied, with every value used.
+    /// The processing applied, with every value used (of the first log, with the counts
+    /// summed, when there are several).
     pub processing: ProcessingReport,
+    /// The processing of each log, in order.
+    pub logs: Vec<ProcessingReport>,
     /// The essential parameters, when asked for.
     pub essential: Option<Essential>,
     /// IDIM-IV iterations, for that estimator.
@@ -761,44 +768,171 @@ pub fn identify(
     log: &dyn LogSource,
     opt: &Options,
 ) -> Result<Identification> {
+    identify_logs(access, &[log], opt)
+}
+
+/// Identify the parameters of `access`'s robot from several logs of it (a fleet of identical
+/// robots, campaigns): one least-squares problem over the rows of every log, each log
+/// processed (filtered, decimated, its borders and validation segment taken) on its own. The
+/// same as [`identify_from_statistics`] of the logs' [`statistics::statistics`], with IDIM-IV
+/// as well (it simulates each log again).
+pub fn identify_logs(
+    access: &mut ModelAccess,
+    logs: &[&dyn LogSource],
+    opt: &Options,
+) -> Result<Identification> {
     opt.validate()?;
+    if logs.is_empty() {
+        return Err(Error::Input(
+            "no log to identify from: give at least one".into(),
+        ));
+    }
     let mut model = ParameterModel::build(access, &opt.parameters)?;
-    let n = model.joints_count();
-    let p = model.count();
-    let names = model.names();
-    check_gain_count(opt, n)?;
-    // the log is read once (recorded unless it is repeatable): every pass sees the same samples,
-    // whatever happens to the source (a file still being written, a pipe)
-    let recording;
-    let (summary, log): (LogSummary, &dyn LogSource) = if log.repeatable() {
-        (summarize(log, n)?, log)
+    check_gain_count(opt, model.joints_count())?;
+    // each log is read once (recorded unless it is repeatable): every pass sees the same
+    // samples, whatever happens to the source (a file still being written, a pipe)
+    let read = logs
+        .iter()
+        .map(|log| read_once(*log, model.joints_count()))
+        .collect::<Result<Vec<_>>>()?;
+    let mut parts = Vec::with_capacity(logs.len());
+    let mut passes = Vec::with_capacity(logs.len());
+    for (log, (summary, recording)) in logs.iter().zip(&read) {
+        let source: &dyn LogSource = match recording {
+            Some(r) => r,
+            None => *log,
+        };
+        let (stats, proc) = pass_statistics(access, &mut model, (source, summary), opt)?;
+        parts.push(stats);
+        passes.push((source, proc));
+    }
+    let stats = if parts.len() == 1 {
+        parts.pop().expect("one part")
+    } else {
+        Statistics::merged(&parts)?
+    };
+    finish(access, model, stats, opt, Some(&passes))
+}
+
+/// Identify the parameters of `access`'s robot from the statistics of logs
+/// ([`statistics::statistics`], possibly computed elsewhere and read back with
+/// [`Statistics::from_json`]), merged: the same numbers as [`identify_logs`] of the logs. The
+/// statistics must be of this robot, with these parameters and the row options of `opt`
+/// (checked); IDIM-IV, which simulates the logs again, needs the logs themselves.
+pub fn identify_from_statistics(
+    access: &mut ModelAccess,
+    parts: &[Statistics],
+    opt: &Options,
+) -> Result<Identification> {
+    opt.validate()?;
+    if opt.estimator == Estimator::Iv {
+        return Err(Error::Input(
+            "IDIM-IV simulates every log again at each iteration: it needs the logs, not their \
+             statistics (use WLS or OLS, or identify from the logs)"
+                .into(),
+        ));
+    }
+    let model = ParameterModel::build(access, &opt.parameters)?;
+    check_gain_count(opt, model.joints_count())?;
+    let stats = Statistics::merged(parts)?;
+    stats.check_against(access, &model, opt)?;
+    finish(access, model, stats, opt, None)
+}
+
+/// Read a log once: its summary, and its recording unless it is repeatable.
+fn read_once(log: &dyn LogSource, n: usize) -> Result<(LogSummary, Option<data::RecordedLog>)> {
+    if log.repeatable() {
+        Ok((summarize(log, n)?, None))
     } else {
         let (summary, r) = record(log, n)?;
-        recording = r;
-        (summary, &recording)
-    };
-    let (proc, mut preport) = processing(&summary, opt)?;
+        Ok((summary, Some(r)))
+    }
+}
+
+/// The statistics of one log read once (`source` repeatable, `summary` its first read): the
+/// pass of the fit, with the processing it used.
+fn pass_statistics(
+    access: &mut ModelAccess,
+    model: &mut ParameterModel,
+    (source, summary): (&dyn LogSource, &LogSummary),
+    opt: &Options,
+) -> Result<(Statistics, Processing)> {
+    let (proc, mut preport) = processing(summary, opt)?;
     model.coulomb_band = proc.coulomb_band;
-    let mut warnings = Vec::new();
-    let mut notes = Vec::new();
-    let mut pass = run_pass(log, &mut model, access, &proc, None)?;
-    let rows = check_pass(&mut pass, &summary, &proc, p)?;
+    let mut pass = run_pass(source, model, access, &proc, None)?;
+    if pass.samples_read != summary.samples {
+        return Err(Error::Input(format!(
+            "{}: the log changed while it was read ({} samples, then {})",
+            summary.source, summary.samples, pass.samples_read
+        )));
+    }
     preport.fit_samples = pass.fit_samples;
     preport.validation_samples = pass.validation_samples;
     preport.slow_rows = pass.slow_rows.clone();
-    let ts: Vec<Mat<f64>> = pass.fit.iter_mut().map(|f| f.factor().clone()).collect();
-    let (mut sol, sigma) = first_estimate(opt.estimator, &mut pass, &ts, rows, (&names, access))?;
+    let digest = pass
+        .fit
+        .iter_mut()
+        .flat_map(|f| {
+            let t = f.factor();
+            (0..t.ncols()).map(|i| t[(i, i)]).collect::<Vec<_>>()
+        })
+        .collect();
+    let stats = Statistics {
+        format: statistics::FORMAT.into(),
+        version: statistics::VERSION,
+        fingerprint: statistics::Fingerprint::of(access, model),
+        options: statistics::RowOptions::of(opt),
+        logs: vec![preport],
+        digests: vec![digest],
+        fit: std::mem::take(&mut pass.fit),
+        validation: std::mem::take(&mut pass.validation),
+        validation_raw: std::mem::take(&mut pass.validation_raw),
+        validation_rows: std::mem::take(&mut pass.validation_rows),
+    };
+    Ok((stats, proc))
+}
+
+/// The statistics of one log (see [`statistics::statistics`]).
+fn log_statistics(
+    access: &mut ModelAccess,
+    model: &mut ParameterModel,
+    log: &dyn LogSource,
+    opt: &Options,
+) -> Result<(Statistics, Processing)> {
+    check_gain_count(opt, model.joints_count())?;
+    let (summary, recording) = read_once(log, model.joints_count())?;
+    let source: &dyn LogSource = match &recording {
+        Some(r) => r,
+        None => log,
+    };
+    pass_statistics(access, model, (source, &summary), opt)
+}
+
+/// The identification from merged statistics; `logs` (each log with its processing) for
+/// IDIM-IV.
+fn finish(
+    access: &mut ModelAccess,
+    mut model: ParameterModel,
+    mut stats: Statistics,
+    opt: &Options,
+    logs: Option<&[(&dyn LogSource, Processing)]>,
+) -> Result<Identification> {
+    let p = model.count();
+    let names = model.names();
+    let rows = check_rows(&mut stats, p)?;
+    let preport = merged_report(&stats.logs);
+    let mut warnings = Vec::new();
+    let mut notes = Vec::new();
+    let ts: Vec<Mat<f64>> = stats.fit.iter_mut().map(|f| f.factor().clone()).collect();
+    let (mut sol, sigma) =
+        first_estimate(opt.estimator, &mut stats.fit, &ts, rows, (&names, access))?;
     let mut estimator = opt.estimator.name().to_string();
     let mut iv_report = None;
     if opt.estimator == Estimator::Iv {
         let sig = sigma.as_deref().expect("weights");
-        let (report, warning) = idim_iv(
-            log,
-            (&mut model, access),
-            (&proc, opt),
-            (&ts, sig, rows),
-            &mut sol,
-        )?;
+        let logs = logs.expect("IDIM-IV is refused without the logs");
+        let (report, warning) =
+            idim_iv(logs, (&mut model, access), opt, (&ts, sig, rows), &mut sol)?;
         warnings.extend(warning);
         iv_report = Some(report);
     }
@@ -835,8 +969,8 @@ pub fn identify(
         None => None,
     };
     let relative_std = sol.relative_std();
-    let (per_joint, relative_error) = joint_fits(access, &mut pass.fit, &sol.x, sigma.as_deref());
-    let validation = validation(access, &mut pass, &sol.x, &preport);
+    let (per_joint, relative_error) = joint_fits(access, &mut stats.fit, &sol.x, sigma.as_deref());
+    let validation = validation(access, &mut stats, &sol.x, &preport);
     let quality = quality_warnings(&sol, &names, &relative_std, relative_error, &validation);
     warnings.extend(quality);
     warnings.extend(signs::warnings(
@@ -851,6 +985,7 @@ pub fn identify(
         opt,
         model.transmission.is_some(),
     ));
+    notes.extend(logs_note(&stats.logs));
     Ok(Identification {
         robot: access.name().to_string(),
         joints: access.actuated_joints().to_vec(),
@@ -867,13 +1002,53 @@ pub fn identify(
         per_joint,
         validation: validation.ok(),
         processing: preport,
+        logs: std::mem::take(&mut stats.logs),
         essential,
         iv: iv_report,
         consistent,
         warnings,
         notes,
-        validation_rows: std::mem::take(&mut pass.validation_rows),
+        validation_rows: std::mem::take(&mut stats.validation_rows),
         model,
+    })
+}
+
+/// The processing of a set of logs: that of the first, with the counts (samples, duration,
+/// decimated samples, slow rows) summed over the logs and the source naming them all.
+fn merged_report(logs: &[ProcessingReport]) -> ProcessingReport {
+    let mut r = logs[0].clone();
+    if logs.len() == 1 {
+        return r;
+    }
+    r.source = statistics::sources(logs);
+    for l in &logs[1..] {
+        r.samples += l.samples;
+        r.duration += l.duration;
+        r.fit_samples += l.fit_samples;
+        r.validation_samples += l.validation_samples;
+        for (a, b) in r.slow_rows.iter_mut().zip(&l.slow_rows) {
+            *a += b;
+        }
+    }
+    r
+}
+
+/// The note of an identification from several logs: how the processing is reported.
+fn logs_note(logs: &[ProcessingReport]) -> Option<String> {
+    (logs.len() > 1).then(|| {
+        let rates: Vec<f64> = logs.iter().map(|l| l.sample_rate).collect();
+        let same = rates.iter().all(|&r| r == rates[0]);
+        format!(
+            "identified from {} logs, each processed on its own (the processing printed is the \
+             first's{}; samples, duration and decimated samples are the sums; the validation \
+             segment is the same fraction of each log, its times those of the first)",
+            logs.len(),
+            if same {
+                String::new()
+            } else {
+                ", sample rates differ".into()
+            }
+        )
     })
 }
 
@@ -932,7 +1107,7 @@ fn weighted(ts: &[Mat<f64>], sigma: Option<&[f64]>) -> Mat<f64> {
 /// the WLS estimate.
 fn first_estimate(
     estimator: Estimator,
-    pass: &mut PassResult,
+    fit: &mut [estimators::TriangularFactor],
     ts: &[Mat<f64>],
     rows: usize,
     (names, access): (&[String], &ModelAccess),
@@ -943,8 +1118,7 @@ fn first_estimate(
     if estimator == Estimator::Ols {
         return Ok((ols, None));
     }
-    let sig = pass
-        .fit
+    let sig = fit
         .iter_mut()
         .map(|f| {
             let r = f.rows();
@@ -994,33 +1168,29 @@ fn processing_notes(preport: &ProcessingReport, opt: &Options, transmission: boo
     notes
 }
 
-/// The pass read every sample of the first read (the log did not change between reads), left
-/// enough rows, and the torques are not all zero (nothing to fit): the rows of the fit.
-fn check_pass(
-    pass: &mut PassResult,
-    summary: &LogSummary,
-    proc: &Processing,
-    p: usize,
-) -> Result<usize> {
-    if pass.samples_read != summary.samples {
-        return Err(Error::Input(format!(
-            "{}: the log changed while it was read ({} samples, then {})",
-            summary.source, summary.samples, pass.samples_read
-        )));
-    }
-    let rows: usize = pass.fit.iter().map(|f| f.rows()).sum();
+/// The rows of the fit (enough for the parameters) and torques that are not all zero (nothing
+/// to fit).
+fn check_rows(stats: &mut Statistics, p: usize) -> Result<usize> {
+    let rows = stats.rows();
     if rows <= p {
+        let l = &stats.logs[0];
+        let what = match stats.logs.len() {
+            1 => "the log".to_string(),
+            n => format!("the {n} logs"),
+        };
         return Err(Error::Input(format!(
             "{rows} equations for {p} parameters after decimation (by {}) and border removal \
-             ({} samples at each end): the log ({} samples) is too short",
-            proc.decimation, proc.border, summary.samples
+             ({} samples at each end): {what} ({} samples) is too short",
+            l.decimation,
+            l.border,
+            stats.logs.iter().map(|l| l.samples).sum::<usize>(),
         )));
     }
-    let zero = pass.fit.iter_mut().all(|f| output_sq(f.factor()) == 0.0);
+    let zero = stats.fit.iter_mut().all(|f| output_sq(f.factor()) == 0.0);
     if zero {
         return Err(Error::Input(format!(
             "{}: the torques are zero on every row of the fit: there is nothing to identify",
-            summary.source
+            statistics::sources(&stats.logs)
         )));
     }
     Ok(rows)
@@ -1030,9 +1200,9 @@ fn check_pass(
 /// iterated from the weighted least-squares estimate `sol` until no parameter moves by more
 /// than 0.02 standard deviations; `sol` becomes the IV estimate.
 fn idim_iv(
-    log: &dyn LogSource,
+    logs: &[(&dyn LogSource, Processing)],
     (model, access): (&mut ParameterModel, &mut ModelAccess),
-    (proc, opt): (&Processing, &Options),
+    opt: &Options,
     (ts, sig, rows): (&[Mat<f64>], &[f64], usize),
     sol: &mut LsSolution,
 ) -> Result<(IvReport, Option<Warning>)> {
@@ -1043,26 +1213,20 @@ fn idim_iv(
     let mut last_change = f64::INFINITY;
     let mut deviation = 0.0;
     let mut it = 0;
-    let f_iv = opt.iv_bandwidth.unwrap_or(opt.bandwidth / 4.0);
-    let omega = 2.0 * std::f64::consts::PI * f_iv;
-    let substeps = ((proc.dt / 2e-4).ceil() as usize).max(1);
     while it < opt.iv_iterations {
         it += 1;
-        let k = model.joint_side_drives(&model.base_robot_parameters(&x));
-        let mut tracking = access.tracking_model(&k, 0.05)?;
-        let a = tracking.inertia_diagonal(&access.reference_actuated()?)?;
-        let kp: Vec<f64> = a
-            .iter()
-            .map(|a| a.abs().max(1e-6) * omega * omega)
-            .collect();
-        let kd: Vec<f64> = a
-            .iter()
-            .map(|a| a.abs().max(1e-6) * 2.0 * 0.8 * omega)
-            .collect();
-        let mut ins = Instruments::new(tracking, kp, kd, model.offsets(&x), substeps);
-        let ivpass: PassResult = run_pass(log, model, access, proc, Some(&mut ins))?;
-        deviation = ivpass.instrument_deviation;
-        let acc = ivpass.iv.expect("instrument accumulators");
+        let mut acc: Option<Vec<estimators::IvAccumulator>> = None;
+        deviation = 0.0f64;
+        for (log, proc) in logs {
+            let ivpass = instrument_pass(*log, (model, access), (proc, opt), &x)?;
+            deviation = deviation.max(ivpass.instrument_deviation);
+            let part = ivpass.iv.expect("instrument accumulators");
+            match &mut acc {
+                None => acc = Some(part),
+                Some(a) => a.iter_mut().zip(&part).for_each(|(a, b)| a.add(b)),
+            }
+        }
+        let acc = acc.expect("at least one log");
         let (x_new, m) = iv_solve(
             &acc.iter()
                 .zip(sig)
@@ -1114,17 +1278,44 @@ fn idim_iv(
     Ok((report, warning))
 }
 
+/// One pass of IDIM-IV over a log: the instruments from a simulation of the estimate `x`
+/// tracking the log's motion.
+fn instrument_pass(
+    log: &dyn LogSource,
+    (model, access): (&mut ParameterModel, &mut ModelAccess),
+    (proc, opt): (&Processing, &Options),
+    x: &[f64],
+) -> Result<PassResult> {
+    let f_iv = opt.iv_bandwidth.unwrap_or(opt.bandwidth / 4.0);
+    let omega = 2.0 * std::f64::consts::PI * f_iv;
+    let substeps = ((proc.dt / 2e-4).ceil() as usize).max(1);
+    let k = model.joint_side_drives(&model.base_robot_parameters(x));
+    let mut tracking = access.tracking_model(&k, 0.05)?;
+    let a = tracking.inertia_diagonal(&access.reference_actuated()?)?;
+    let kp: Vec<f64> = a
+        .iter()
+        .map(|a| a.abs().max(1e-6) * omega * omega)
+        .collect();
+    let kd: Vec<f64> = a
+        .iter()
+        .map(|a| a.abs().max(1e-6) * 2.0 * 0.8 * omega)
+        .collect();
+    let mut ins = Instruments::new(tracking, kp, kd, model.offsets(x), substeps);
+    model.coulomb_band = proc.coulomb_band;
+    run_pass(log, model, access, proc, Some(&mut ins))
+}
+
 /// The prediction of the validation segment with the estimate `x` (decimated rows as fitted,
 /// and the raw torques at the log's rate); Err(Some(warning)) when the segment has no sample,
 /// Err(None) when there is no segment.
 fn validation(
     access: &ModelAccess,
-    pass: &mut PassResult,
+    stats: &mut Statistics,
     x: &[f64],
     preport: &ProcessingReport,
 ) -> std::result::Result<Validation, Option<Warning>> {
     let (a, b) = preport.validation.ok_or(None)?;
-    if pass.validation_samples == 0 {
+    if preport.validation_samples == 0 {
         return Err(Some(Warning::new(
             WarningKind::Validation,
             Vec::new(),
@@ -1133,8 +1324,9 @@ fn validation(
             ),
         )));
     }
-    let (per_joint, relative_error) = joint_fits(access, &mut pass.validation, x, None);
-    let (raw_per_joint, raw_relative_error) = joint_fits(access, &mut pass.validation_raw, x, None);
+    let (per_joint, relative_error) = joint_fits(access, &mut stats.validation, x, None);
+    let (raw_per_joint, raw_relative_error) =
+        joint_fits(access, &mut stats.validation_raw, x, None);
     Ok(Validation {
         from: a,
         to: b,
