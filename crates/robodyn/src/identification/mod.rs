@@ -1021,6 +1021,16 @@ fn merged_report(logs: &[ProcessingReport]) -> ProcessingReport {
         return r;
     }
     r.source = statistics::sources(logs);
+    // the covariance's inflation for correlated residuals: each log's weighted by its rows
+    // (the logs' decimation filters differ only with their sample rates)
+    let rows: usize = logs.iter().map(|l| l.fit_samples).sum();
+    if rows > 0 {
+        r.std_inflation = logs
+            .iter()
+            .map(|l| l.std_inflation * l.fit_samples as f64)
+            .sum::<f64>()
+            / rows as f64;
+    }
     for l in &logs[1..] {
         r.samples += l.samples;
         r.duration += l.duration;
