@@ -88,6 +88,7 @@ fn to_json(d: &RobotDescription, s: &robodyn::model::Structure) -> serde_json::V
         "nj": d.nj,
         "nf": d.nf(),
         "gravity": d.gravity.iter().map(|e| e.decimal().to_string()).collect::<Vec<_>>(),
+        "base": base_kind(d),
         "symbols": d.symbols,
         "frames": frames,
         "links": links,
@@ -148,6 +149,32 @@ fn role(d: &RobotDescription, j: usize) -> &'static str {
     }
 }
 
+/// `fixed`, `mobile` (its motion imposed) or `floating` (its motion from the dynamics).
+fn base_kind(d: &RobotDescription) -> &'static str {
+    if d.floating_base.is_some() {
+        "floating"
+    } else if d.mobile_base {
+        "mobile"
+    } else {
+        "fixed"
+    }
+}
+
+/// The base line of the text report: its kind, and for a floating base the state layout and
+/// link 0's mass.
+fn base_text(d: &RobotDescription) -> String {
+    match &d.floating_base {
+        Some(l) => format!(
+            "floating (link 0 `{}`, M0 = {}; q = [x, y, z, qx, qy, qz, qw, joints], v = [base \
+             linear and angular velocity in R_0, joint rates]: docs/models/floating_base.md)",
+            l.name,
+            expr(&l.params[robodyn::model::param::M])
+        ),
+        None if d.mobile_base => "mobile (W0, WP0, V0, VP0 imposed)".into(),
+        None => "fixed".into(),
+    }
+}
+
 fn text(d: &RobotDescription, s: &robodyn::model::Structure) -> String {
     let mut out = String::new();
     outln!(
@@ -164,6 +191,7 @@ fn text(d: &RobotDescription, s: &robodyn::model::Structure) -> String {
     }
     let g: Vec<String> = d.gravity.iter().map(expr).collect();
     outln!(out, "gravity: [{}]", g.join(", "));
+    outln!(out, "base: {}", base_text(d));
     outln!(out);
     print_rows(&mut out, &frame_rows(d));
     outln!(out);

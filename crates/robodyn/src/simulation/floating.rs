@@ -9,16 +9,15 @@
 //! the current pose (phi = 0 again): the quaternion of every output row is exp of a rotation
 //! vector, unit to rounding, and never renormalized after the fact.
 //!
-//! Energy and momenta come from the inertia matrix alone: T = 1/2 v' A v; the base block of A
-//! is the composite inertia of the whole robot about O_0 in R_0, [[M I, -M c^], [M c^, I_0]],
-//! which gives the mass M and the centre of mass c (R_0); the base rows A_b v are the robot's
-//! momentum (linear, angular about O_0) in R_0.
+//! Energy and momenta: T = 1/2 v' A v, U = -M g' c with the mass, the centre of mass and the
+//! momenta of [`centroidal_momentum`] (the base rows of A).
 
+use crate::algorithms::floating_base::centroidal_momentum;
 use crate::algorithms::inertia_matrix::inertia_matrix_into;
 use crate::data::Data;
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::model::Robot;
-use nalgebra::{DMatrix, Matrix3, Quaternion, UnitQuaternion, Vector3};
+use nalgebra::{DMatrix, Matrix3, UnitQuaternion, Vector3};
 
 /// Largest rotation (rad) of the chart's coordinates before the chart moves to the current
 /// pose (J_r^-1 is singular at 2 pi; well conditioned below 1 rad).
@@ -143,7 +142,8 @@ impl FloatingBalance {
         }
     }
 
-    /// T + U and the 9 momentum columns ([`MOMENTUM_COLUMNS`]) at (q, v).
+    /// T + U and the 9 momentum columns ([`MOMENTUM_COLUMNS`]) at (q, v): T = 1/2 v' A v,
+    /// U = -M g' c, the momenta from [`centroidal_momentum`].
     pub(crate) fn evaluate(
         &mut self,
         robot: &Robot,
@@ -152,34 +152,15 @@ impl FloatingBalance {
         v: &[f64],
         out: &mut [f64; 9],
     ) -> Result<f64> {
+        let m = centroidal_momentum(robot, data, q, v)?;
         inertia_matrix_into(robot, data, q, &mut self.a)?;
-        let a = &self.a;
         let nv = v.len();
-        let mass = a[(0, 0)];
-        if !(mass > 0.0) {
-            return Err(Error::Numerical(format!(
-                "the floating robot's total mass is {mass}: no momentum or potential energy"
-            )));
-        }
-        // M c^ is the lower-left block: c = (A[5,1], A[3,2], A[4,0]) / M
-        let c0 = Vector3::new(a[(5, 1)], a[(3, 2)], a[(4, 0)]) / mass;
-        let h: Vec<f64> = (0..6)
-            .map(|r| (0..nv).map(|k| a[(r, k)] * v[k]).sum())
-            .collect();
         let kinetic = 0.5
             * (0..nv)
-                .map(|r| v[r] * (0..nv).map(|k| a[(r, k)] * v[k]).sum::<f64>())
+                .map(|r| v[r] * (0..nv).map(|k| self.a[(r, k)] * v[k]).sum::<f64>())
                 .sum::<f64>();
-        let rot = UnitQuaternion::from_quaternion(Quaternion::new(q[6], q[3], q[4], q[5]));
-        let p = Vector3::new(q[0], q[1], q[2]);
-        let com = p + rot * c0;
-        let lin = rot * Vector3::new(h[0], h[1], h[2]);
-        // angular momentum about O_0 (R_0) to world axes, then about the centre of mass
-        let ang_o = rot * Vector3::new(h[3], h[4], h[5]);
-        let ang_c = ang_o - (com - p).cross(&lin);
-        let g = robot.environment().gravity;
-        let potential = -mass * g.dot(&com);
-        for (k, x) in com.iter().chain(lin.iter()).chain(ang_c.iter()).enumerate() {
+        let potential = -m.mass * robot.environment().gravity.dot(&m.com);
+        for (k, x) in m.com.iter().chain(&m.linear).chain(&m.angular).enumerate() {
             out[k] = *x;
         }
         Ok(kinetic + potential)
@@ -189,6 +170,7 @@ impl FloatingBalance {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use nalgebra::Quaternion;
 
     /// The chart's rate equals the derivative of the configuration along the motion: finite
     /// differences of exp through the chart, against R v and the body angular velocity.
