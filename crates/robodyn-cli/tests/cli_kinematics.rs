@@ -247,7 +247,7 @@ fn state_tables_equal_the_single_states() {
     }
     std::fs::write(&file, text).unwrap();
     let input = file.to_str().unwrap();
-    let qd_arg = format!("--qd={}", list(&qd)[4..].to_string());
+    let qd_arg = format!("--qd={}", &list(&qd)[4..]);
     let nums = |line: &str, skip: usize| -> Vec<f64> {
         line.split(',')
             .skip(skip)
