@@ -1,16 +1,30 @@
-//! The state the kinematic commands (`fk`, `jacobian`, `com`) share: the robot and one state
-//! from `--q/--qd/--qdd` (a closed chain's actuated joints, completed on the assembly branch),
-//! and the frames named by `--frame`.
+//! The states the kinematic commands (`fk`, `jacobian`, `com`) share: the robot and one state
+//! from `--q/--qd/--qdd`, or every state of an `--input` table (columns as `idm` reads them);
+//! a closed chain's actuated joints completed on the assembly branch (a table's rows one after
+//! the other on the branch tracker); and the frames named by `--frame`.
 
-use crate::common::{parse_list, start_branch, warn_conditioning, CliResult, RobotArgs};
+use crate::common::{
+    format_number, parse_list, start_branch, warn_conditioning, CliResult, NamesArg, RobotArgs,
+};
+use crate::states::{Chunk, StateInput, StateRequest};
 use nalgebra::DMatrix;
-use robodyn::{closed_state, forward_kinematics_into, ClosedChain, FrameId, KinematicsData, Robot};
+use robodyn::{
+    closed_state, forward_kinematics_into, Branch, ClosedChain, FrameId, KinematicsData, Robot,
+};
+use std::path::{Path, PathBuf};
 
-/// `--q`, `--qd`, `--qdd` and `--guess` of the kinematic commands.
+/// `--input`, `--q`, `--qd`, `--qdd` and `--guess` of the kinematic commands.
 #[derive(clap::Args, Debug)]
 pub struct StateArgs {
     #[command(flatten)]
     pub robot: RobotArgs,
+    /// CSV of states with columns q<j> (required), qd<j>, qdd<j> (optional: zeros) for the
+    /// movable joints (closed chains: the actuated joints), as `idm` reads them; the output is
+    /// a CSV table with the state's row number (and the table's other columns) on every line.
+    #[arg(long, conflicts_with_all = ["q", "qd", "qdd"])]
+    pub input: Option<PathBuf>,
+    #[command(flatten)]
+    pub names: NamesArg,
     /// Joint positions, comma separated (movable joints in frame order; closed chains: the
     /// actuated joints; default zeros).
     #[arg(long, allow_hyphen_values = true)]
@@ -40,12 +54,18 @@ pub struct Evaluated {
 }
 
 impl StateArgs {
-    /// Load the robot and compute the kinematics at the state.
-    pub fn evaluate(&self) -> CliResult<Evaluated> {
+    /// The robot and, when it has loops, its closed chain.
+    fn load(&self) -> CliResult<(Robot, Option<ClosedChain>)> {
         let robot = self.robot.load()?;
         let chain = (!robot.is_tree())
             .then(|| ClosedChain::new(&robot))
             .transpose()?;
+        Ok((robot, chain))
+    }
+
+    /// Load the robot and compute the kinematics at the state of `--q/--qd/--qdd`.
+    pub fn evaluate(&self) -> CliResult<Evaluated> {
+        let (robot, chain) = self.load()?;
         let n = match &chain {
             Some(c) => c.dof(),
             None => robot.dof(),
@@ -56,33 +76,166 @@ impl StateArgs {
                 None => Ok(vec![0.0; n]),
             }
         };
-        let (q, qd, qdd) = (
+        let x = [
             list("q", &self.q)?,
             list("qd", &self.qd)?,
             list("qdd", &self.qdd)?,
-        );
-        let mut data = KinematicsData::new(&robot);
-        let closed = match chain {
-            None => {
-                forward_kinematics_into(&robot, &mut data, &q, &qd, &qdd)?;
-                None
-            }
-            Some(c) => {
-                let mut branch = start_branch(&c, &q, self.guess.as_deref())?;
-                let s = closed_state(&c, &mut branch, &q, &qd, &qdd)?;
-                // near a singular configuration the results are sensitive to their inputs
-                warn_conditioning(&c, None, &s.conditioning);
-                let tree = [&s.q, &s.qd, &s.qdd].map(|v| v.as_slice());
-                forward_kinematics_into(&robot, &mut data, tree[0], tree[1], tree[2])?;
-                Some((c, s.g))
-            }
+        ];
+        let mut e = Evaluated::new(robot, chain);
+        let mut branch = None;
+        e.at(
+            &mut branch,
+            self.guess.as_deref(),
+            [&x[0], &x[1], &x[2]],
+            None,
+        )?;
+        Ok(e)
+    }
+
+    /// Every state of the `--input` table `input`: `setup` once on the robot, then
+    /// `each(&setup's value, row, carried values, the kinematics at the row)` per row (1-based;
+    /// a closed chain's rows continued on the branch tracker). Returns the carried columns'
+    /// names (the table's other columns, written in front of each output line).
+    pub fn each_state<T>(
+        &self,
+        input: &Path,
+        setup: impl FnOnce(&Robot, &[String]) -> CliResult<T>,
+        mut each: impl FnMut(&mut T, usize, &[f64], &mut Evaluated) -> CliResult,
+    ) -> CliResult<T> {
+        let (robot, chain) = self.load()?;
+        let (coords, what) = match &chain {
+            Some(c) => (c.coordinates().clone(), "actuated joints (closed chain)"),
+            None => (robot.coordinates().clone(), "movable joints"),
         };
-        Ok(Evaluated {
+        let mut states = StateInput::open(&StateRequest {
+            input: Some(input),
+            prefixes: ["q", "qd", "qdd"],
+            lists: [None; 3],
+            coords: &coords,
+            tree: robot.coordinates(),
+            names: self.names,
+            what,
+            carry: &[],
+        })?;
+        let carried = states.carried_headers().to_vec();
+        let mut value = setup(&robot, &carried)?;
+        let (n, nc) = (coords.len(), carried.len());
+        let mut e = Evaluated::new(robot, chain);
+        let (mut chunk, mut branch) = (Chunk::default(), None);
+        while states.next_chunk(crate::common::chunk_states(3 * n + nc), &mut chunk)? {
+            for s in 0..chunk.count {
+                let row = chunk.first + s;
+                e.at(
+                    &mut branch,
+                    self.guess.as_deref(),
+                    chunk.state(s, n),
+                    Some(row),
+                )?;
+                each(&mut value, row, chunk.carried(s, nc), &mut e)?;
+            }
+        }
+        Ok(value)
+    }
+}
+
+impl Evaluated {
+    fn new(robot: Robot, chain: Option<ClosedChain>) -> Evaluated {
+        Evaluated {
+            data: KinematicsData::new(&robot),
             robot,
-            data,
-            q,
-            closed,
-        })
+            q: Vec::new(),
+            closed: chain.map(|c| (c, DMatrix::zeros(0, 0))),
+        }
+    }
+
+    /// The kinematics at state `x` (q, q̇, q̈; a closed chain's actuated joints completed on
+    /// `branch`, started from `guess` or the assembly at the first state); `row` names a
+    /// table's row in errors and warnings.
+    fn at(
+        &mut self,
+        branch: &mut Option<Branch>,
+        guess: Option<&str>,
+        x: [&[f64]; 3],
+        row: Option<usize>,
+    ) -> CliResult {
+        let in_row = |e: robodyn::Error| match row {
+            Some(r) => e.in_row(r),
+            None => e,
+        };
+        self.q = x[0].to_vec();
+        match &mut self.closed {
+            None => forward_kinematics_into(&self.robot, &mut self.data, x[0], x[1], x[2])
+                .map_err(in_row)?,
+            Some((c, g)) => {
+                let b = match branch {
+                    Some(b) => b,
+                    None => branch.insert(start_branch(c, x[0], guess)?),
+                };
+                let s = closed_state(c, b, x[0], x[1], x[2]).map_err(in_row)?;
+                // near a singular configuration the results are sensitive to their inputs
+                warn_conditioning(c, row, &s.conditioning);
+                let tree = [&s.q, &s.qd, &s.qdd].map(|v| v.as_slice());
+                forward_kinematics_into(&self.robot, &mut self.data, tree[0], tree[1], tree[2])
+                    .map_err(in_row)?;
+                *g = s.g;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The names of the joints of a state table's results: the movable joints (closed chains: the
+/// actuated ones).
+pub fn joint_names(robot: &Robot) -> CliResult<Vec<String>> {
+    Ok(if robot.is_tree() {
+        robot.coordinates().names().to_vec()
+    } else {
+        ClosedChain::new(robot)?.coordinates().names().to_vec()
+    })
+}
+
+/// A CSV table built line by line: the carried columns, `row`, then the command's.
+pub struct CsvTable {
+    pub text: String,
+}
+
+impl CsvTable {
+    /// The header line: `carried`, `row`, `columns`.
+    pub fn new(carried: &[String], columns: &[&str]) -> CsvTable {
+        let mut h: Vec<String> = carried.iter().map(|c| csv_field(c)).collect();
+        h.push("row".into());
+        h.extend(columns.iter().map(|c| csv_field(c)));
+        CsvTable {
+            text: h.join(",") + "\n",
+        }
+    }
+
+    /// One line: the carried values, the row number, the labels, the values.
+    pub fn line(&mut self, carried: &[f64], row: usize, labels: &[&str], values: &[f64]) {
+        let mut f: Vec<String> = carried.iter().map(|x| format_number(*x)).collect();
+        f.push(row.to_string());
+        f.extend(labels.iter().map(|l| csv_field(l)));
+        f.extend(values.iter().map(|x| format_number(*x)));
+        self.text += &(f.join(",") + "\n");
+    }
+}
+
+/// A CSV field, quoted when it holds a comma or a quote.
+pub fn csv_field(s: &str) -> String {
+    if s.contains([',', '"', '\n']) {
+        format!("\"{}\"", s.replace('"', "\"\""))
+    } else {
+        s.to_string()
+    }
+}
+
+/// `--format json` is the single state's: a table is CSV.
+pub fn table_format(format: crate::common::TableFormat) -> CliResult {
+    match format {
+        crate::common::TableFormat::Csv => Ok(()),
+        _ => Err(
+            "--input writes a CSV table: drop --format json (or give one state with --q)".into(),
+        ),
     }
 }
 

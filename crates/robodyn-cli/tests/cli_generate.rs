@@ -316,3 +316,42 @@ fn frame_flags_are_checked() {
     ]);
     assert!(e.contains("`local`"), "{e}");
 }
+
+/// `--frame` by name: a URDF joint or link names the frame of that number (the same generated
+/// text); an unknown name and a tool are clear errors.
+#[test]
+fn generate_frame_by_name_is_the_frame_number() {
+    let rx90 = robot("rx90.urdf");
+    let gen = |f: &str| {
+        Command::new(env!("CARGO_BIN_EXE_robodyn"))
+            .args([
+                "generate",
+                &rx90,
+                "--numeric",
+                "--model",
+                "dgm",
+                "--frame",
+                f,
+            ])
+            .output()
+            .unwrap()
+    };
+    let text = |f: &str| {
+        let out = gen(f);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        String::from_utf8(out.stdout).unwrap()
+    };
+    let three = text("3");
+    assert!(!three.is_empty());
+    assert_eq!(text("elbow"), three, "joint name");
+    assert_eq!(text("link3"), three, "link name");
+    assert_ne!(text("link4"), three);
+    let out = gen("elbw");
+    assert_eq!(out.status.code(), Some(1));
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert!(e.contains("elbw") && e.contains("link3"), "{e}");
+}

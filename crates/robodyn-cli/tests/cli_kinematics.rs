@@ -225,3 +225,103 @@ fn kinematic_commands_refuse_bad_input() {
     let e = fails(&["ik", &robot("scara.toml"), "--pose=0.5,0,0,0,0,0"]);
     assert!(e.contains("numeric") || e.contains("class"), "{e}");
 }
+
+/// `--input` state tables: every row of `fk`, `jacobian` and `com --jacobian` equals the same
+/// command on that row's state given with --q/--qd (the state-table path against the
+/// single-state one, itself checked against differences above); the table's other columns are
+/// carried; a table without q columns is refused.
+#[test]
+fn state_tables_equal_the_single_states() {
+    let rx90 = robot("rx90.urdf");
+    let states = [
+        [0.1, -0.4, 0.9, 0.3, -0.7, 1.2],
+        [-1.0, 0.5, 0.2, -0.6, 1.1, 0.0],
+        [0.7, 0.2, -1.3, 1.4, 0.4, -0.9],
+    ];
+    let qd = [0.3, -0.2, 0.5, 0.1, -0.4, 0.6];
+    let file = common::tmp("kin_table", "states.csv");
+    let mut text = String::from("t,q1,q2,q3,q4,q5,q6,qd1,qd2,qd3,qd4,qd5,qd6\n");
+    for (i, q) in states.iter().enumerate() {
+        let v: Vec<String> = q.iter().chain(&qd).map(|x| format!("{x:e}")).collect();
+        text += &format!("{},{}\n", i as f64 * 0.01, v.join(","));
+    }
+    std::fs::write(&file, text).unwrap();
+    let input = file.to_str().unwrap();
+    let qd_arg = format!("--qd={}", &list(&qd)[4..]);
+    let nums = |line: &str, skip: usize| -> Vec<f64> {
+        line.split(',')
+            .skip(skip)
+            .map(|x| x.parse().unwrap())
+            .collect()
+    };
+    let close = |a: &[f64], b: &[f64], what: &str| {
+        assert_eq!(a.len(), b.len(), "{what}");
+        for (x, y) in a.iter().zip(b) {
+            assert!(
+                (x - y).abs() <= 1e-12 * y.abs().max(1.0),
+                "{what}: {a:?} vs {b:?}"
+            );
+        }
+    };
+    // fk: t, row, frame, then the single state's columns
+    let table = run(&[
+        "fk", &rx90, "--input", input, "--frame", "link6", "--frame", "elbow",
+    ]);
+    let lines: Vec<&str> = table.lines().collect();
+    assert!(
+        lines[0].starts_with("t,row,frame,x,y,z,roll,pitch,yaw,vx"),
+        "{}",
+        lines[0]
+    );
+    assert_eq!(lines.len(), 1 + 2 * states.len());
+    for (i, q) in states.iter().enumerate() {
+        for (k, frame) in ["link6", "elbow"].iter().enumerate() {
+            let line = lines[1 + 2 * i + k];
+            assert!(line.contains(&format!(",{},{frame},", i + 1)), "{line}");
+            let one = run(&["fk", &rx90, &list(q), &qd_arg, "--frame", frame]);
+            let expected = nums(one.lines().nth(1).unwrap(), 1);
+            close(
+                &nums(line, 3),
+                &expected,
+                &format!("fk row {} {frame}", i + 1),
+            );
+        }
+    }
+    // jacobian: six lines per state
+    let table = run(&["jacobian", &rx90, "--input", input, "--frame", "link6"]);
+    let lines: Vec<&str> = table.lines().collect();
+    assert_eq!(lines.len(), 1 + 6 * states.len());
+    for (i, q) in states.iter().enumerate() {
+        let one = jacobian(&rx90, q, "link6", "local_world_aligned");
+        for r in 0..6 {
+            let got = nums(lines[1 + 6 * i + r], 3);
+            let expected: Vec<f64> = one.row(r).iter().copied().collect();
+            close(&got, &expected, &format!("J row {} line {r}", i + 1));
+        }
+    }
+    // com --jacobian: one line per state, J's rows after the centre of mass
+    let table = run(&["com", &rx90, "--input", input, "--jacobian"]);
+    let lines: Vec<&str> = table.lines().collect();
+    assert_eq!(lines.len(), 1 + states.len());
+    for (i, q) in states.iter().enumerate() {
+        let one = run(&["com", &rx90, &list(q), &qd_arg, "--jacobian"]);
+        let mut expected = nums(one.lines().nth(1).unwrap(), 0);
+        for l in one.lines().skip(4) {
+            expected.extend(nums(l, 1));
+        }
+        close(
+            &nums(lines[1 + i], 2),
+            &expected,
+            &format!("com row {}", i + 1),
+        );
+    }
+    // no q columns: refused with the file named
+    let bad = common::tmp("kin_table", "bad.csv");
+    std::fs::write(&bad, "t,x\n0,1\n").unwrap();
+    let e = fails(&["fk", &rx90, "--input", bad.to_str().unwrap()]);
+    assert!(e.contains("bad.csv") && e.contains("q1"), "{e}");
+    let e = fails(&[
+        "jacobian", &rx90, "--input", input, "--frame", "6", "--format", "json",
+    ]);
+    assert!(e.contains("--input"), "{e}");
+}

@@ -10,7 +10,9 @@ use numpy::{PyArray1, PyArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use robodyn::algorithms::inverse_geometry::ClosedFormIgm;
+use robodyn::algorithms::inverse_geometry::{
+    numeric_igm_batch, ClosedFormIgm, NumericIgm, NumericOptions, NumericSolution,
+};
 use robodyn::algorithms::kinematics::{
     center_of_mass, center_of_mass_jacobian_into, forward_kinematics_into,
     frame_classical_acceleration, frame_jacobian_into, frame_placement, frame_velocity,
@@ -54,6 +56,71 @@ fn matrix4(what: &str, obj: &Bound<'_, PyAny>) -> PyResult<Matrix4<f64>> {
 }
 
 impl Robot {
+    /// `ik(frame, target, q0)`: the numeric inverse geometric model from q0, one target (4, 4)
+    /// with q0 (nq,), or N targets (N, 4, 4) with q0 (N, nq) over the cores.
+    fn numeric_ik<'py>(
+        &self,
+        py: Python<'py>,
+        frame: &str,
+        target: &Bound<'py, PyAny>,
+        q0: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let robot = self.model();
+        let f = robot.frame_id(frame).py()?;
+        let igm = NumericIgm::new(&robot, f, NumericOptions::default()).py()?;
+        let n = robot.dof();
+        let (t, t_shape) = values(target)?;
+        let (start, s_shape) = values(q0)?;
+        let rows = match (t_shape.as_slice(), s_shape.as_slice()) {
+            ([4, 4], [k]) if *k == n => None,
+            ([m, 4, 4], [r, k]) if *k == n && m == r => Some(*m),
+            _ => {
+                return Err(DimensionError::new_err(format!(
+                    "target has shape {t_shape:?} and q0 {s_shape:?}: expected (4, 4) with \
+                     ({n},), or (N, 4, 4) with (N, {n}) ({n} movable joints)"
+                )))
+            }
+        };
+        let targets: Vec<Matrix4<f64>> = t.chunks(16).map(Matrix4::from_row_slice).collect();
+        let sols = py
+            .detach(|| numeric_igm_batch(&robot, &igm, &targets, &start))
+            .py()?;
+        let d = PyDict::new(py);
+        let q: Vec<f64> = sols.iter().flat_map(|s| s.q.iter().copied()).collect();
+        let col = |g: &dyn Fn(&NumericSolution) -> f64| sols.iter().map(g).collect::<Vec<f64>>();
+        let converged: Vec<bool> = sols.iter().map(|s| s.converged).collect();
+        let counts = |g: &dyn Fn(&NumericSolution) -> usize| sols.iter().map(g).collect::<Vec<_>>();
+        match rows {
+            None => {
+                let s = &sols[0];
+                d.set_item("q", PyArray1::from_vec(py, q))?;
+                d.set_item("converged", s.converged)?;
+                d.set_item("position_error", s.position_error)?;
+                d.set_item("rotation_error", s.rotation_error)?;
+                d.set_item("iterations", s.iterations)?;
+                d.set_item("starts", s.starts)?;
+            }
+            Some(m) => {
+                d.set_item("q", PyArray1::from_vec(py, q).reshape([m, n])?)?;
+                d.set_item("converged", PyArray1::from_vec(py, converged))?;
+                d.set_item(
+                    "position_error",
+                    PyArray1::from_vec(py, col(&|s| s.position_error)),
+                )?;
+                d.set_item(
+                    "rotation_error",
+                    PyArray1::from_vec(py, col(&|s| s.rotation_error)),
+                )?;
+                d.set_item(
+                    "iterations",
+                    PyArray1::from_vec(py, counts(&|s| s.iterations)),
+                )?;
+                d.set_item("starts", PyArray1::from_vec(py, counts(&|s| s.starts)))?;
+            }
+        }
+        Ok(d)
+    }
+
     /// `f` on the model over one state or N states of `inputs` (up to three), `one` the
     /// result's shape for one state: the call every kinematic function makes.
     fn kinematics<'py, F>(
@@ -247,22 +314,35 @@ impl Robot {
         })
     }
 
-    /// Closed-form inverse geometric model (Paul's method; 6R chains with a spherical wrist or
-    /// axes 2, 3, 4 parallel): every q placing the frame named `frame` (as `placement`) at
-    /// `target` (4 x 4 homogeneous matrix in the base frame, m). Returns a dict: "q" (S, nq),
-    /// one row per solution (S <= 8, 0 when out of reach; joints off the chain to the frame
-    /// are 0), "within_limits" (S,) bool (every joint within the description's limits),
-    /// "singular" (S,) bool (any singular case), "shoulder", "elbow", "wrist" (S,) bool (which
-    /// case), "joints" (the 6 indices of the chain's joints in q) and "class". Raises
-    /// InputError when the chain has no closed form, NotFiniteError / InputError for a target
-    /// that is not a placement.
-    #[pyo3(signature = (frame, target))]
+    /// Inverse geometric model of the frame named `frame` (as `placement`) for `target` (4 x 4
+    /// homogeneous placement in the base frame, m).
+    ///
+    /// Without `q0`: the closed form (Paul's method; 6R chains with a spherical wrist or axes
+    /// 2, 3, 4 parallel), every solution. Returns a dict: "q" (S, nq), one row per solution
+    /// (S <= 8, 0 when out of reach; joints off the chain to the frame are 0),
+    /// "within_limits" (S,) bool (every joint within the description's limits), "singular"
+    /// (S,) bool (any singular case), "shoulder", "elbow", "wrist" (S,) bool (which case),
+    /// "joints" (the 6 indices of the chain's joints in q) and "class". Raises InputError when
+    /// the chain has no closed form.
+    ///
+    /// With `q0` (nq,): the numeric model (Levenberg-Marquardt on the placement error, joint
+    /// limits kept, from q0 then seeded random starts), any robot. Returns a dict: "q" (nq,),
+    /// "converged" bool, "position_error" (m), "rotation_error" (rad), "iterations",
+    /// "starts". Batched: `target` (N, 4, 4) with `q0` (N, nq) gives arrays with a leading N
+    /// (the targets over the cores).
+    ///
+    /// NotFiniteError / InputError for a target that is not a placement.
+    #[pyo3(signature = (frame, target, q0=None))]
     fn ik<'py>(
         &self,
         py: Python<'py>,
         frame: &str,
         target: &Bound<'py, PyAny>,
+        q0: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyDict>> {
+        if let Some(q0) = q0 {
+            return self.numeric_ik(py, frame, target, q0);
+        }
         let robot = self.model();
         let t = matrix4("target", target)?;
         let f = robot.frame_id(frame).py()?;

@@ -224,6 +224,34 @@ def test_ik_without_closed_form_raises():
         robot.ik(frame, target)
 
 
+def test_numeric_ik_with_q0_places_the_frame():
+    """ik(frame, T, q0): the numeric model on a robot without a closed form (the SCARA) and on
+    the RX-90, each solution placed at the target by placement (a round trip); a batch of
+    targets equals the calls one by one."""
+    rng = np.random.default_rng(11)
+    for name in ["scara.toml", "rx90.urdf"]:
+        robot = robodyn.load(robot_path(name))
+        frame = robot.description_frame_names[-1]
+        qs = rng.uniform(-1.0, 1.0, (3, robot.nq))
+        targets = np.array([robot.placement(q, frame) for q in qs])
+        starts = qs + rng.uniform(-0.3, 0.3, qs.shape)
+        for t, q0 in zip(targets, starts):
+            r = robot.ik(frame, t, q0=q0)
+            assert r["converged"], (name, r)
+            assert r["q"].shape == (robot.nq,)
+            assert r["position_error"] <= 1e-10 and r["rotation_error"] <= 1e-10
+            np.testing.assert_allclose(robot.placement(r["q"], frame), t, rtol=0, atol=1e-9)
+        batch = robot.ik(frame, targets, q0=starts)
+        assert batch["q"].shape == (3, robot.nq) and batch["converged"].all()
+        for k in range(3):
+            one = robot.ik(frame, targets[k], q0=starts[k])
+            np.testing.assert_array_equal(batch["q"][k], one["q"])
+        with pytest.raises(robodyn.DimensionError, match="q0"):
+            robot.ik(frame, targets[0], q0=np.zeros(robot.nq + 1))
+        with pytest.raises(robodyn.DimensionError):
+            robot.ik(frame, targets, q0=starts[:2])
+
+
 def test_closed_chain_jacobian_is_the_derivative_of_the_placement():
     robot = robodyn.load(robot_path("sr400.toml"))
     chain = robodyn.ClosedChain(robot)

@@ -19,8 +19,9 @@ use nalgebra::DMatrix;
 use robodyn::algorithms::kinematics::center_of_mass_jacobian_into;
 use robodyn::model::param;
 use robodyn::{
-    direct_dynamics_into, frame_jacobian_into, inertia_matrix_into, inverse_dynamics_into,
-    placements_into, Data, FrameId, KinematicsData, Method, Reference, Robot,
+    direct_dynamics_into, frame_jacobian_from_q_into, frame_jacobian_into, inertia_matrix_into,
+    inverse_dynamics_into, placements_into, Data, FrameId, KinematicsData, Method, Reference,
+    Robot,
 };
 use std::fmt::Write as _;
 use std::hint::black_box;
@@ -221,9 +222,9 @@ fn main() -> Result<(), Error> {
         put(&mut text, "aba", &out);
         direct_dynamics_into(&robot, &mut data, &env, &s.q, &s.qd, &s.tau, cmp, &mut out)?;
         put(&mut text, "composite", &out);
-        placements_into(&robot, &mut kin, &s.q)?;
-        frame_jacobian_into(&robot, &kin, &tip, Reference::Local, &mut jac)?;
+        frame_jacobian_from_q_into(&robot, &mut kin, &s.q, &tip, Reference::Local, &mut jac)?;
         put_matrix(&mut text, "jac", &jac, &idx, &[]);
+        placements_into(&robot, &mut kin, &s.q)?;
         let g = robodyn::algorithms::kinematics::center_of_mass(
             &robot,
             &mut kin_motion(&robot, s)?,
@@ -273,8 +274,8 @@ fn main() -> Result<(), Error> {
         }
     });
     time("frame_jacobian", &states, samples, target_us, |s| {
-        placements_into(&robot, &mut kin, black_box(&s.q)).unwrap();
-        frame_jacobian_into(&robot, &kin, &tip, Reference::Local, &mut jac).unwrap();
+        let q = black_box(&s.q);
+        frame_jacobian_from_q_into(&robot, &mut kin, q, &tip, Reference::Local, &mut jac).unwrap();
         black_box(&jac);
     });
     time("com_jacobian", &states, samples, target_us, |s| {

@@ -20,9 +20,9 @@ use robodyn::algorithms::kinematics::{
 use robodyn::geometry::Transform;
 use robodyn::{
     forward_kinematics_into, frame_acceleration, frame_classical_acceleration,
-    frame_classical_drift, frame_jacobian, frame_jacobian_into, frame_jacobian_time_variation_into,
-    frame_placement, frame_velocity, placements_into, relative_placement, Error, FrameId,
-    KinematicsData, Motion, Reference, Robot,
+    frame_classical_drift, frame_jacobian, frame_jacobian_from_q_into, frame_jacobian_into,
+    frame_jacobian_time_variation_into, frame_placement, frame_velocity, placements_into,
+    relative_placement, Error, FrameId, KinematicsData, Motion, Reference, Robot,
 };
 use robodyn_testing as testing;
 
@@ -113,6 +113,9 @@ fn check_robot(label: &str, robot: &Robot, s: &[Vec<f64>; 3], rng: &mut impl ran
     let (dp, dm) = (fk(robot, &at(s, H)), fk(robot, &at(s, -H)));
     let mut jac = DMatrix::zeros(6, n);
     let mut jd = DMatrix::zeros(6, n);
+    let mut js = DMatrix::zeros(6, n);
+    // a data holding another state: the support-only pass must not read its other links
+    let mut stale = fk(robot, &at(s, 0.3));
     let qd = nalgebra::DVector::from_column_slice(&s[1]);
     let qdd = nalgebra::DVector::from_column_slice(&s[2]);
     for (fi, f) in frames(robot, rng).iter().enumerate() {
@@ -120,6 +123,17 @@ fn check_robot(label: &str, robot: &Robot, s: &[Vec<f64>; 3], rng: &mut impl ran
             let ctx = format!("{label}, frame #{fi} (on {}), {}", f.parent(), r.name());
             // J q̇ = the velocity (recursion) = the derivative of the placement
             frame_jacobian_into(robot, &d0, f, r, &mut jac).unwrap();
+            // from q on the frame's support only: the same Jacobian (the same products on
+            // the support's placements), and the data then holds no full pass
+            frame_jacobian_from_q_into(robot, &mut stale, &s[0], f, r, &mut js).unwrap();
+            assert!(
+                (&js - &jac).amax() <= 1e-15 * jac.amax().max(1.0),
+                "{ctx}: support-only J"
+            );
+            assert!(
+                frame_placement(robot, &stale, f).is_err(),
+                "{ctx}: level reset"
+            );
             let v = frame_velocity(robot, &d0, f, r).unwrap();
             let fd = velocity_by_differences(robot, s, f, r);
             close(

@@ -4,7 +4,7 @@
 //! actuated joints; the passive ones come from the assembly branch.
 
 use crate::common::{format_number, write_text, CliResult, TableFormat};
-use crate::kinematic_state::{frames, StateArgs};
+use crate::kinematic_state::{csv_field, frames, table_format, CsvTable, StateArgs};
 use robodyn::algorithms::kinematics::rpy;
 use robodyn::{frame_classical_acceleration, frame_placement, frame_velocity, Reference};
 use std::path::PathBuf;
@@ -31,6 +31,9 @@ const VELOCITY: [&str; 6] = ["vx", "vy", "vz", "wx", "wy", "wz"];
 const ACCELERATION: [&str; 6] = ["ax", "ay", "az", "dwx", "dwy", "dwz"];
 
 pub fn run(a: Args) -> CliResult {
+    if let Some(input) = &a.state.input {
+        return table(&a, input);
+    }
     let e = a.state.evaluate()?;
     let motion = a.state.qd.is_some() || a.state.qdd.is_some();
     let lwa = Reference::LocalWorldAligned;
@@ -81,11 +84,36 @@ pub fn run(a: Args) -> CliResult {
     write_text(a.output.as_deref(), &text)
 }
 
-/// A CSV field, quoted when it holds a comma or a quote.
-pub fn csv_field(s: &str) -> String {
-    if s.contains([',', '"', '\n']) {
-        format!("\"{}\"", s.replace('"', "\"\""))
-    } else {
-        s.to_string()
-    }
+/// `--input`: a line per state and frame, the pose, velocity and classical acceleration columns
+/// (zero velocities for a table without qd columns).
+fn table(a: &Args, input: &std::path::Path) -> CliResult {
+    table_format(a.format)?;
+    let lwa = Reference::LocalWorldAligned;
+    let columns: Vec<&str> = ["frame"]
+        .iter()
+        .chain(&POSE)
+        .chain(&VELOCITY)
+        .chain(&ACCELERATION)
+        .copied()
+        .collect();
+    let setup = |robot: &robodyn::Robot, carried: &[String]| {
+        Ok((frames(robot, &a.frame)?, CsvTable::new(carried, &columns)))
+    };
+    let (_, out) = a
+        .state
+        .each_state(input, setup, |(fr, out), row, carried, e| {
+            for (name, f) in fr.iter() {
+                let t = frame_placement(&e.robot, &e.data, f)?;
+                let v = frame_velocity(&e.robot, &e.data, f, lwa)?;
+                let acc = frame_classical_acceleration(&e.robot, &e.data, f, lwa)?;
+                let values: Vec<f64> = (t.pos.iter().copied().chain(rpy(&t.rot)))
+                    .chain(v.to_vector().iter().copied())
+                    .chain(acc.to_vector().iter().copied())
+                    .collect();
+                crate::common::check_finite(&format!("row {row}, {name}"), &values)?;
+                out.line(carried, row, &[name.as_str()], &values);
+            }
+            Ok(())
+        })?;
+    write_text(a.output.as_deref(), &out.text)
 }

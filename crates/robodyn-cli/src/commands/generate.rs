@@ -4,6 +4,7 @@
 use crate::common::{choices, CliResult};
 use robodyn::algorithms::regressor::ZeroParameters;
 use robodyn::codegen::{generate_with_progress, BaseParameters, Frames, GenOptions, ModelKind};
+use robodyn::model::RobotDescription;
 use robodyn_symbolic::{check_function_name, emit, Lang};
 use std::path::PathBuf;
 
@@ -46,9 +47,10 @@ pub struct Args {
     /// The model to generate.
     #[arg(long, value_enum, default_value = "idm")]
     pub model: Model,
-    /// Frame j of --model dgm and jacobian, 1..NL (default: the terminal link's frame).
-    #[arg(long, value_name = "J")]
-    pub frame: Option<usize>,
+    /// Frame j of --model dgm and jacobian: a number 1..NL or a name as the robot file gives
+    /// it (URDF link or joint, frame name); default the terminal link's frame.
+    #[arg(long, value_name = "J|NAME")]
+    pub frame: Option<String>,
     /// Reference frame i of --model dgm and jacobian: the DGM is iT_j, the Jacobian is
     /// expressed in frame i; 0 the base (world axes at O_j, the default), `local` frame j itself.
     #[arg(long, value_name = "I|local", value_parser = reference)]
@@ -101,13 +103,50 @@ fn reference(s: &str) -> Result<Reference, String> {
 }
 
 /// The frames of --model dgm and jacobian; --frame and --reference belong to those models only.
-fn frames(a: &Args) -> Frames {
+fn frames(a: &Args, desc: &RobotDescription) -> CliResult<Frames> {
     let mut f = Frames::TERMINAL;
-    f.frame = a.frame;
+    f.frame = a
+        .frame
+        .as_deref()
+        .map(|s| frame_number(desc, s))
+        .transpose()?;
     if let Some(Reference(i)) = a.reference {
         f.reference = i;
     }
-    f
+    Ok(f)
+}
+
+/// `--frame`: a frame number, else a name resolved as `Robot::frame_id` does (a URDF link,
+/// then a frame or joint name); a `[[tool]]` is a frame fixed on another one, which the
+/// generated models do not place: its frame is named in the error.
+fn frame_number(desc: &RobotDescription, s: &str) -> CliResult<usize> {
+    if let Ok(j) = s.parse::<usize>() {
+        return Ok(j);
+    }
+    if let Some(t) = desc.tools.iter().find(|t| t.name == s) {
+        return Err(format!(
+            "--frame {s}: a [[tool]] (an offset on frame {}), not a frame of the description:              generate frame {} and compose the tool's constant placement",
+            t.frame, t.frame
+        )
+        .into());
+    }
+    let j = desc
+        .links
+        .iter()
+        .position(|l| l.name == s)
+        .or_else(|| desc.frames.iter().position(|f| f.name == s));
+    match j {
+        Some(i) => Ok(i + 1),
+        None => {
+            let names: Vec<&str> = desc.links.iter().map(|l| l.name.as_str()).collect();
+            Err(format!(
+                "--frame {s}: no frame, link or joint of `{}` has this name (links: {})",
+                desc.name,
+                names.join(", ")
+            )
+            .into())
+        }
+    }
 }
 
 pub fn run(a: Args) -> CliResult {
@@ -159,8 +198,8 @@ pub fn run(a: Args) -> CliResult {
             Model::Ddm => ModelKind::Ddm,
             Model::Closed => ModelKind::Closed,
             Model::W => ModelKind::W,
-            Model::Dgm => ModelKind::Dgm(frames(&a)),
-            Model::Jacobian => ModelKind::Jacobian(frames(&a)),
+            Model::Dgm => ModelKind::Dgm(frames(&a, &desc)?),
+            Model::Jacobian => ModelKind::Jacobian(frames(&a, &desc)?),
         },
         numeric: a.numeric,
         symmetric: a.symmetric,

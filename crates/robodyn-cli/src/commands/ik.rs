@@ -64,7 +64,7 @@ pub fn run(a: Args) -> CliResult {
         TableFormat::Csv => {
             let h: Vec<String> = joints
                 .iter()
-                .map(|n| crate::commands::fk::csv_field(n))
+                .map(|n| crate::kinematic_state::csv_field(n))
                 .collect();
             let mut s = format!("{},within_limits,singular\n", h.join(","));
             for sol in solutions.as_slice() {
@@ -116,7 +116,7 @@ fn numeric(a: &Args, robot: &robodyn::Robot) -> CliResult {
         TableFormat::Csv => {
             let h: Vec<String> = names
                 .iter()
-                .map(|n| crate::commands::fk::csv_field(n))
+                .map(|n| crate::kinematic_state::csv_field(n))
                 .collect();
             let v: Vec<String> = s.q.iter().map(|x| format_number(*x)).collect();
             format!(

@@ -4,7 +4,9 @@
 //! J_a = J_tr G on the assembly branch.
 
 use crate::common::{choices, format_number, write_text, CliResult, TableFormat};
-use crate::kinematic_state::{rows, StateArgs};
+use crate::kinematic_state::{
+    csv_field, joint_names, rows, table_format, CsvTable, Evaluated, StateArgs,
+};
 use robodyn::{frame_jacobian_into, Reference};
 use std::path::PathBuf;
 
@@ -32,23 +34,17 @@ pub struct Args {
 const ROWS: [&str; 6] = ["vx", "vy", "vz", "wx", "wy", "wz"];
 
 pub fn run(a: Args) -> CliResult {
+    if let Some(input) = &a.state.input {
+        return table(&a, input);
+    }
     let e = a.state.evaluate()?;
     let f = e.robot.frame_id(&a.frame)?;
-    let mut j = nalgebra::DMatrix::zeros(6, e.robot.dof());
-    frame_jacobian_into(&e.robot, &e.data, &f, a.reference, &mut j)?;
-    // closed chains: J_a = J_tr G at the state evaluate() reached on the branch
-    let (j, joints) = match &e.closed {
-        None => (j, e.robot.coordinates().names().to_vec()),
-        Some((chain, g)) => (j * g, chain.coordinates().names().to_vec()),
-    };
+    let (j, joints) = jacobian(&e, &f, a.reference)?;
     let rows = rows(&j);
     crate::common::check_finite("J", &rows.concat())?;
     let text = match a.format {
         TableFormat::Csv => {
-            let names: Vec<String> = joints
-                .iter()
-                .map(|n| crate::commands::fk::csv_field(n))
-                .collect();
+            let names: Vec<String> = joints.iter().map(|n| csv_field(n)).collect();
             let mut s = format!("row,{}\n", names.join(","));
             for (label, r) in ROWS.iter().zip(&rows) {
                 let v: Vec<String> = r.iter().map(|x| format_number(*x)).collect();
@@ -65,4 +61,42 @@ pub fn run(a: Args) -> CliResult {
         }
     };
     write_text(a.output.as_deref(), &text)
+}
+
+/// The frame's Jacobian at the evaluated state and the names of its columns: a closed chain's
+/// J_a = J_tr G (G at the state reached on the branch).
+fn jacobian(
+    e: &Evaluated,
+    f: &robodyn::FrameId,
+    reference: Reference,
+) -> CliResult<(nalgebra::DMatrix<f64>, Vec<String>)> {
+    let mut j = nalgebra::DMatrix::zeros(6, e.robot.dof());
+    frame_jacobian_into(&e.robot, &e.data, f, reference, &mut j)?;
+    Ok(match &e.closed {
+        None => (j, e.robot.coordinates().names().to_vec()),
+        Some((chain, g)) => (j * g, chain.coordinates().names().to_vec()),
+    })
+}
+
+/// `--input`: six lines per state (vx .. wz), a column per joint.
+fn table(a: &Args, input: &std::path::Path) -> CliResult {
+    table_format(a.format)?;
+    let setup = |robot: &robodyn::Robot, carried: &[String]| {
+        let f = robot.frame_id(&a.frame)?;
+        let names = joint_names(robot)?;
+        let mut columns = vec!["component"];
+        columns.extend(names.iter().map(String::as_str));
+        Ok((f, CsvTable::new(carried, &columns)))
+    };
+    let (_, out) = a
+        .state
+        .each_state(input, setup, |(f, out), row, carried, e| {
+            let (j, _) = jacobian(e, f, a.reference)?;
+            for (label, r) in ROWS.iter().zip(rows(&j)) {
+                crate::common::check_finite(&format!("row {row}, J"), &r)?;
+                out.line(carried, row, &[label], &r);
+            }
+            Ok(())
+        })?;
+    write_text(a.output.as_deref(), &out.text)
 }

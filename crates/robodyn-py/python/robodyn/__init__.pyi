@@ -225,12 +225,15 @@ class Robot:
     def com_jacobian(self, q: ArrayLike, *, out: Optional[Array] = None) -> Array:
         """Jacobian of the centre of mass: shape (3, nq) for q of shape (nq,), (N, 3, nq) for
         (N, nq). out: as for idm."""
-    def ik(self, frame: str, target: ArrayLike) -> Dict[str, Any]:
-        """Closed-form inverse geometric model (6R, spherical wrist or axes 2, 3, 4 parallel):
-        every q placing the frame named ``frame`` at ``target`` (4 x 4). A dict: "q" (S, nq)
-        (joints off the chain are 0), "within_limits", "singular", "shoulder", "elbow", "wrist"
-        (S,) bool, "joints" (the chain's 6 indices in q), "class". Raises InputError when the
-        chain has no closed form."""
+    def ik(self, frame: str, target: ArrayLike, q0: Optional[ArrayLike] = None) -> Dict[str, Any]:
+        """Inverse geometric model of the frame named ``frame`` for ``target`` (4 x 4).
+        Without ``q0``: the closed form (6R, spherical wrist or axes 2, 3, 4 parallel), every
+        solution: a dict "q" (S, nq) (joints off the chain are 0), "within_limits", "singular",
+        "shoulder", "elbow", "wrist" (S,) bool, "joints" (the chain's 6 indices in q), "class";
+        InputError when the chain has no closed form. With ``q0`` (nq,): the numeric model
+        (Levenberg-Marquardt from q0, then seeded random starts; any robot): a dict "q" (nq,),
+        "converged", "position_error" (m), "rotation_error" (rad), "iterations", "starts";
+        batched with ``target`` (N, 4, 4) and ``q0`` (N, nq) (arrays with a leading N)."""
     def regressor_columns(self, columns: str = "standard", friction: bool = True, rotor: str = "actuated", seed: int = 1) -> List[str]:
         """Names of the regressor's columns for ``columns`` ("standard" or "base")."""
     def regressor(self, q: ArrayLike, qd: Optional[ArrayLike] = None, qdd: Optional[ArrayLike] = None, columns: str = "standard", friction: bool = True, rotor: str = "actuated", seed: int = 1, *, v: Optional[ArrayLike] = None, a: Optional[ArrayLike] = None, out: Optional[Array] = None) -> Array:

@@ -81,20 +81,6 @@ pub(crate) fn terminal_frame(robot: &Robot) -> Result<usize> {
     }
 }
 
-/// Rz(theta) as a rotation matrix.
-pub(crate) fn rot_z(theta: f64) -> Matrix3<f64> {
-    let (s, c) = theta.sin_cos();
-    Matrix3::new(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0)
-}
-
-/// T * Rz(theta) without a full product.
-pub(crate) fn then_rot_z(t: &Transform, theta: f64) -> Transform {
-    Transform {
-        rot: t.rot * rot_z(theta),
-        pos: t.pos,
-    }
-}
-
 impl Chain {
     /// The chain from the base to `frame`: every joint on the path revolute, the movable joints
     /// that are not on the path ignored.

@@ -14,12 +14,12 @@
 //! canonical chain T = C0 Rz(theta1) C1 ... Rz(theta6) C6 (`chain.rs`); the page
 //! docs/models/inverse_geometry.md derives them.
 
-use super::chain::{rot_z, then_rot_z, Chain};
+use super::chain::Chain;
 use super::transform_of;
 use crate::error::{Error, Result};
 use crate::geometry::Transform;
 use crate::model::Robot;
-use nalgebra::{Matrix4, Vector3};
+use nalgebra::{Matrix3, Matrix4, Vector3};
 
 /// Relative tolerance of the class detection (parallel axes, concurrent axes) and of the
 /// singularity markers (a root whose equation's discriminant is within it of zero).
@@ -106,11 +106,45 @@ impl IgmSolutions {
     }
 }
 
+/// An angle carried with its cosine and sine, so that no sine or cosine is computed again
+/// from it: the roots of Paul's equations come with theirs (algebraically), and each is an
+/// atan2 or an acos once.
+#[derive(Clone, Copy, Debug)]
+struct Angle {
+    th: f64,
+    c: f64,
+    s: f64,
+}
+
+impl Angle {
+    fn new(th: f64) -> Angle {
+        let (s, c) = th.sin_cos();
+        Angle { th, c, s }
+    }
+
+    /// Rz(theta).
+    #[inline]
+    fn rot(&self) -> Matrix3<f64> {
+        Matrix3::new(self.c, -self.s, 0.0, self.s, self.c, 0.0, 0.0, 0.0, 1.0)
+    }
+
+    /// m Rz(theta) (12 products: [c x + s y, c y - s x, z] for the columns x, y, z of m).
+    #[inline]
+    fn right_of(&self, m: &Matrix3<f64>) -> Matrix3<f64> {
+        let (x, y) = (m.column(0), m.column(1));
+        Matrix3::from_columns(&[
+            x * self.c + y * self.s,
+            y * self.c - x * self.s,
+            m.column(2).into_owned(),
+        ])
+    }
+}
+
 /// Roots of the type-2 equation X sin(theta) + Y cos(theta) = Z.
 #[derive(Clone, Copy, Debug)]
 enum Roots {
     /// Two roots (equal when `singular`: a double root, within the tolerance).
-    Two(f64, f64, bool),
+    Two(Angle, Angle, bool),
     /// X = Y = Z = 0: any theta.
     Any,
     /// |Z| > sqrt(X^2 + Y^2): no root.
@@ -119,12 +153,13 @@ enum Roots {
 
 /// theta with a . Rz(theta) b = k (a type-2 equation of Paul's method): X = a_y b_x - a_x b_y,
 /// Y = a_x b_x + a_y b_y, Z = k - a_z b_z; `tol` is the tolerance on Z (units of k) for
-/// X = Y = 0 and for |Z| beyond sqrt(X^2 + Y^2).
+/// X = Y = 0 and for |Z| beyond sqrt(X^2 + Y^2). theta = phi ± delta with phi = atan2(X, Y)
+/// and cos(delta) = Z / rho, their cosines and sines from X / rho, Y / rho and cos(delta).
 fn solve_dot(a: &Vector3<f64>, b: &Vector3<f64>, k: f64, tol: f64) -> Roots {
     let x = a.y * b.x - a.x * b.y;
     let y = a.x * b.x + a.y * b.y;
     let z = k - a.z * b.z;
-    let rho = x.hypot(y);
+    let rho = (x * x + y * y).sqrt();
     if rho <= tol {
         return if z.abs() <= tol {
             Roots::Any
@@ -135,22 +170,50 @@ fn solve_dot(a: &Vector3<f64>, b: &Vector3<f64>, k: f64, tol: f64) -> Roots {
     if z.abs() > rho + tol {
         return Roots::None;
     }
-    let cos = (z / rho).clamp(-1.0, 1.0);
+    let mut cd = (z / rho).clamp(-1.0, 1.0);
+    // a double root: cos(delta) within a few roundings of ±1 is ±1 (acos would turn that
+    // rounding into delta ~ 1e-8, and the pose error with it)
+    if 1.0 - cd.abs() <= 4.0 * f64::EPSILON {
+        cd = cd.signum();
+    }
     let phi = x.atan2(y);
-    let delta = cos.acos();
+    let delta = cd.acos();
     // rounding in Z / rho moves a double root by ~sqrt(eps): the roots count as one when
     // they are within sqrt(CLOSED_FORM_TOLERANCE) of each other (or of a half turn apart)
     let singular = delta.min(std::f64::consts::PI - delta) <= CLOSED_FORM_TOLERANCE.sqrt();
-    Roots::Two(phi + delta, phi - delta, singular)
+    let (cp, sp) = (y / rho, x / rho);
+    // (1 - c)(1 + c): exact factors near c = ±1, where 1 - c² loses its digits
+    let sd = ((1.0 - cd) * (1.0 + cd)).sqrt();
+    let plus = Angle {
+        th: phi + delta,
+        c: cp * cd - sp * sd,
+        s: sp * cd + cp * sd,
+    };
+    let minus = Angle {
+        th: phi - delta,
+        c: cp * cd + sp * sd,
+        s: sp * cd - cp * sd,
+    };
+    Roots::Two(plus, minus, singular)
 }
 
 /// The angle theta of Rz(theta) u = v in the xy plane; None when u or v lies on the z axis.
-fn angle_between(u: &Vector3<f64>, v: &Vector3<f64>, tol: f64) -> Option<f64> {
-    (u.xy().norm() > tol && v.xy().norm() > tol).then(|| v.y.atan2(v.x) - u.y.atan2(u.x))
+fn angle_between(u: &Vector3<f64>, v: &Vector3<f64>, tol: f64) -> Option<Angle> {
+    let (nu, nv) = (u.x * u.x + u.y * u.y, v.x * v.x + v.y * v.y);
+    if nu.sqrt() <= tol || nv.sqrt() <= tol {
+        return None;
+    }
+    let (c, s) = (u.x * v.x + u.y * v.y, u.x * v.y - u.y * v.x);
+    let r = (nu * nv).sqrt();
+    Some(Angle {
+        th: s.atan2(c),
+        c: c / r,
+        s: s / r,
+    })
 }
 
 /// A root pair, a free angle given as `free` (twice), or none.
-fn roots_or(r: Roots, free: f64) -> Option<([f64; 2], bool)> {
+fn roots_or(r: Roots, free: Angle) -> Option<([Angle; 2], bool)> {
     match r {
         Roots::Two(a, b, s) => Some(([a, b], s)),
         Roots::Any => Some(([free; 2], true)),
@@ -179,8 +242,15 @@ pub struct ClosedFormIgm {
     point0: Vector3<f64>,
     point6: Vector3<f64>,
     point3: Vector3<f64>,
-    /// Axis 2's direction in frame A4 (offset wrist).
-    e4: Vector3<f64>,
+    /// The representative value of each joint in an infinite family (its theta0).
+    free: [Angle; 6],
+    /// The planar arm's constants: C2's origin in C2's axes, |C2 origin|² + |point3|².
+    arm_a: Vector3<f64>,
+    arm_k: f64,
+    /// The theta5 equation g . Rz(theta5) p6 = ... : g = C4^T e_z (spherical wrist) or
+    /// C4^T e4 (offset wrist), p6 = C5 e_z.
+    g: Vector3<f64>,
+    p6: Vector3<f64>,
 }
 
 /// A geometric line: a point and a unit direction.
@@ -279,6 +349,12 @@ impl ClosedFormIgm {
             IgmClass::SphericalWrist => inv(&frames[2], &point0),
             IgmClass::OffsetWrist => chain.c[3].pos,
         };
+        let e4 = frames[3].rot.tr_mul(&u2);
+        let (c2, c4) = (&chain.c[2], &chain.c[4]);
+        let g = match class {
+            IgmClass::SphericalWrist => c4.rot.tr_mul(&Vector3::z()),
+            IgmClass::OffsetWrist => c4.rot.tr_mul(&e4),
+        };
         Ok(ClosedFormIgm {
             class,
             frame,
@@ -287,9 +363,13 @@ impl ClosedFormIgm {
             c6_inv: chain.c[6].inverse(),
             u2,
             point6: inv(&frames[5], &point0),
-            point3,
             point0,
-            e4: frames[3].rot.tr_mul(&u2),
+            free: std::array::from_fn(|k| Angle::new(chain.theta0[k])),
+            arm_a: c2.rot.tr_mul(&c2.pos),
+            arm_k: c2.pos.norm_squared() + point3.norm_squared(),
+            point3,
+            g,
+            p6: chain.c[5].rot * Vector3::z(),
             chain,
         })
     }
@@ -346,45 +426,38 @@ impl ClosedFormIgm {
 
     /// theta1 from the point's component along axis 2, invariant under joints 2, 3 (and 4):
     /// u2 . Rz(theta1)^T x_M = u2 . x(0).
-    fn theta1(&self, x_m: &Vector3<f64>) -> Option<([f64; 2], bool)> {
+    fn theta1(&self, x_m: &Vector3<f64>) -> Option<([Angle; 2], bool)> {
         let r = solve_dot(x_m, &self.u2, self.u2.dot(&self.point0), self.tol());
-        roots_or(r, self.chain.theta0[0])
+        roots_or(r, self.free[0])
     }
 
     /// theta2, theta3 of the planar arm placing the point `point3` (fixed in A3) at `x_m`:
     /// theta3 from its distance to O2 (type 2), theta2 from atan2.
-    fn planar(&self, theta1: f64, x_m: &Vector3<f64>) -> Option<[(f64, f64, Singularity); 2]> {
+    fn planar(&self, th1: &Angle, x_m: &Vector3<f64>) -> Option<[(Angle, Angle, Singularity); 2]> {
         let (c1, c2) = (&self.chain.c[1], &self.chain.c[2]);
-        let x2 = c1.rot.tr_mul(&(rot_z(theta1).tr_mul(x_m) - c1.pos));
-        let a = c2.rot.tr_mul(&c2.pos);
+        let x2 = c1.rot.tr_mul(&(th1.rot().tr_mul(x_m) - c1.pos));
         let b = &self.point3;
-        let k = (x2.norm_squared() - c2.pos.norm_squared() - b.norm_squared()) / 2.0;
+        let k = (x2.norm_squared() - self.arm_k) / 2.0;
         let tol2 = self.tol() * self.chain.scale;
-        let (t3, elbow) = roots_or(solve_dot(&a, b, k, tol2), self.chain.theta0[2])?;
+        let (t3, elbow) = roots_or(solve_dot(&self.arm_a, b, k, tol2), self.free[2])?;
         Some(t3.map(|th3| {
-            let v = c2.compose(&Transform {
-                rot: rot_z(th3),
-                pos: Vector3::zeros(),
-            });
-            let v = v.rot * b + v.pos;
+            let v = c2.rot * (th3.rot() * b) + c2.pos;
             let th2 = angle_between(&v, &x2, self.tol());
             let singular = Singularity {
                 shoulder: th2.is_none(),
                 elbow,
                 wrist: false,
             };
-            (th2.unwrap_or(self.chain.theta0[1]), th3, singular)
+            (th2.unwrap_or(self.free[1]), th3, singular)
         }))
     }
 
-    /// A3 = Rz(theta1) C1 Rz(theta2) C2 Rz(theta3) (the frame of C0 removed).
-    fn a3(&self, th: &[f64; 6]) -> Transform {
+    /// The rotation of A3 C3 = Rz(theta1) C1 Rz(theta2) C2 Rz(theta3) C3 (C0 removed): the
+    /// axes of the wrist's first frame.
+    fn a3c3(&self, th: &[Angle; 3]) -> Matrix3<f64> {
         let c = &self.chain.c;
-        let a1 = Transform {
-            rot: rot_z(th[0]),
-            pos: Vector3::zeros(),
-        };
-        then_rot_z(&then_rot_z(&a1.compose(&c[1]), th[1]).compose(&c[2]), th[2])
+        let r = th[1].right_of(&(th[0].rot() * c[1].rot));
+        th[2].right_of(&(r * c[2].rot)) * c[3].rot
     }
 
     fn push(&self, th: &[f64; 6], singular: Singularity, out: &mut IgmSolutions) {
@@ -407,40 +480,37 @@ impl ClosedFormIgm {
         let Some((t1, shoulder)) = self.theta1(&c_m) else {
             return;
         };
-        let (c3, c4, c5) = (&self.chain.c[3], &self.chain.c[4], &self.chain.c[5]);
+        let (c4, c5) = (&self.chain.c[4], &self.chain.c[5]);
         for th1 in t1 {
-            let Some(arm) = self.planar(th1, &c_m) else {
+            let Some(arm) = self.planar(&th1, &c_m) else {
                 continue;
             };
             for (th2, th3, s) in arm {
-                let mut th = [th1, th2, th3, 0.0, 0.0, 0.0];
-                // R = 3A4'^T A3^T M: Rz(theta4) C4 Rz(theta5) C5 Rz(theta6)
-                let r = c3.rot.tr_mul(&self.a3(&th).rot.tr_mul(&m.rot));
+                // R = (A3 C3)^T M = Rz(theta4) C4 Rz(theta5) C5 Rz(theta6)
+                let r = self.a3c3(&[th1, th2, th3]).tr_mul(&m.rot);
                 let b: Vector3<f64> = r.column(2).into();
-                let z = Vector3::z();
-                let g = c4.rot.tr_mul(&z);
-                let p6 = c5.rot * z;
                 let Some((t5, _)) = roots_or(
-                    solve_dot(&g, &p6, b.z, CLOSED_FORM_TOLERANCE),
-                    self.chain.theta0[4],
+                    solve_dot(&self.g, &self.p6, b.z, CLOSED_FORM_TOLERANCE),
+                    self.free[4],
                 ) else {
                     continue;
                 };
                 for th5 in t5 {
-                    let c4r5 = c4.rot * rot_z(th5);
-                    let m5 = c4r5 * p6;
+                    let c4r5 = th5.right_of(&c4.rot);
+                    let m5 = c4r5 * self.p6;
                     let th4 = angle_between(&m5, &b, CLOSED_FORM_TOLERANCE);
-                    th[3] = th4.unwrap_or(self.chain.theta0[3]);
-                    th[4] = th5;
+                    let wrist = th4.is_none();
+                    let th4 = th4.unwrap_or(self.free[3]);
                     // Rz(theta6) = Q^T R, Q = Rz(theta4) C4 Rz(theta5) C5: its first column
-                    let q = rot_z(th[3]) * c4r5 * c5.rot;
+                    let q = th4.rot() * c4r5 * c5.rot;
                     let r0 = r.column(0);
-                    th[5] = q.column(1).dot(&r0).atan2(q.column(0).dot(&r0));
+                    let th6 = q.column(1).dot(&r0).atan2(q.column(0).dot(&r0));
                     let singular = Singularity {
                         shoulder: shoulder || s.shoulder,
                         elbow: s.elbow,
-                        wrist: th4.is_none(),
+                        wrist,
                     };
+                    let th = [th1.th, th2.th, th3.th, th4.th, th5.th, th6];
                     self.push(&th, singular, out);
                 }
             }
@@ -452,42 +522,42 @@ impl ClosedFormIgm {
         let Some((t1, shoulder)) = self.theta1(&w_m) else {
             return;
         };
-        let (c3, c4, c5) = (&self.chain.c[3], &self.chain.c[4], &self.chain.c[5]);
+        let (c4, c5) = (&self.chain.c[4], &self.chain.c[5]);
         let z6: Vector3<f64> = m.rot.column(2).into();
-        let z = Vector3::z();
         for th1 in t1 {
-            let z2 = rot_z(th1) * self.u2;
+            let z2 = th1.rot() * self.u2;
             // axis 6 against axis 2: e4 . C4 Rz(theta5) C5 e_z = z2 . z6
-            let g = c4.rot.tr_mul(&self.e4);
-            let p6 = c5.rot * z;
             let Some((t5, _)) = roots_or(
-                solve_dot(&g, &p6, z2.dot(&z6), CLOSED_FORM_TOLERANCE),
-                self.chain.theta0[4],
+                solve_dot(&self.g, &self.p6, z2.dot(&z6), CLOSED_FORM_TOLERANCE),
+                self.free[4],
             ) else {
                 continue;
             };
+            // axis 2 seen from frame 6: Rz(theta6) n = m6
+            let n = m.rot.tr_mul(&z2);
             for th5 in t5 {
-                // axis 2 seen from frame 6: Rz(theta6) n = m6
-                let n = m.rot.tr_mul(&z2);
-                let m6 = c5.rot.tr_mul(&rot_z(th5).tr_mul(&g));
+                let m6 = c5.rot.tr_mul(&th5.rot().tr_mul(&self.g));
                 let th6 = angle_between(&n, &m6, CLOSED_FORM_TOLERANCE);
                 let wrist = th6.is_none();
-                let th6 = th6.unwrap_or(self.chain.theta0[5]);
+                let th6 = th6.unwrap_or(self.free[5]);
                 // A4 = M (C4 Rz5 C5 Rz6)^-1
-                let tail = then_rot_z(&then_rot_z(c4, th5).compose(c5), th6);
+                let tail = Transform {
+                    rot: th6.right_of(&(th5.right_of(&c4.rot) * c5.rot)),
+                    pos: c4.pos + th5.right_of(&c4.rot) * c5.pos,
+                };
                 let a4 = m.compose(&tail.inverse());
-                let Some(arm) = self.planar(th1, &a4.pos) else {
+                let Some(arm) = self.planar(&th1, &a4.pos) else {
                     continue;
                 };
                 for (th2, th3, s) in arm {
-                    let mut th = [th1, th2, th3, 0.0, th5, th6];
-                    let n4 = (self.a3(&th).rot * c3.rot).tr_mul(&a4.rot);
-                    th[3] = n4[(1, 0)].atan2(n4[(0, 0)]);
+                    let n4 = self.a3c3(&[th1, th2, th3]).tr_mul(&a4.rot);
+                    let th4 = n4[(1, 0)].atan2(n4[(0, 0)]);
                     let singular = Singularity {
                         shoulder: shoulder || s.shoulder,
                         elbow: s.elbow,
                         wrist,
                     };
+                    let th = [th1.th, th2.th, th3.th, th4, th5.th, th6.th];
                     self.push(&th, singular, out);
                 }
             }

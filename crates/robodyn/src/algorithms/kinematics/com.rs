@@ -5,7 +5,7 @@
 
 use super::forward::{KinematicsData, Level};
 use super::frames::FrameId;
-use super::jacobian::{check_matrix, for_each_support_joint};
+use super::jacobian::check_matrix;
 use crate::error::{Error, Result};
 use crate::model::{JointType, Robot};
 use nalgebra::{DMatrix, Vector3};
@@ -41,9 +41,22 @@ fn carrying_link(robot: &Robot, frame: usize) -> usize {
     j
 }
 
-/// Mark in `data.member` the links of the subtree rooted at `root`'s carrying link that a
-/// joint moves (all moving links for `None` or a frame on the base); returns that link.
-fn mark_subtree(robot: &Robot, data: &mut KinematicsData, root: Option<&FrameId>) -> Result<usize> {
+/// Mark in `member` (description links 0..NL) the subtree of links rooted at link `r`.
+fn mark_subtree(robot: &Robot, r: usize, member: &mut [bool]) {
+    member[0] = r == 0;
+    for j in 1..=robot.nl() {
+        member[j] = j == r || member[robot.ant(j)];
+    }
+}
+
+/// The bodies counted for `root`: the whole robot (no root, or a frame carried by the base) is
+/// the moving tree's own bodies; a subtree's are gathered into `data.body_m`, `data.body_ms`.
+/// Returns the root's carrying link and whether it is the whole robot.
+fn select_bodies(
+    robot: &Robot,
+    data: &mut KinematicsData,
+    root: Option<&FrameId>,
+) -> Result<(usize, bool)> {
     let r = match root {
         Some(f) => {
             f.check(robot)?;
@@ -51,37 +64,14 @@ fn mark_subtree(robot: &Robot, data: &mut KinematicsData, root: Option<&FrameId>
         }
         None => 0,
     };
-    moving_links(robot, &mut data.moving);
-    data.member[0] = r == 0;
-    for j in 1..=robot.nl() {
-        data.member[j] = j == r || data.member[robot.ant(j)];
+    if r == 0 {
+        return Ok((0, true));
     }
-    for j in 0..=robot.nl() {
-        data.member[j] &= data.moving[j];
-    }
-    Ok(r)
-}
-
-/// Per link j in the subtree: m_j 0P_Gj = m_j 0P_j + 0A_j jMS_j into `data.sub_ms`, m_j into
-/// `data.sub_m`, then summed towards the base (each link then holds its subtree's sums).
-fn accumulate_first_moments(robot: &Robot, data: &mut KinematicsData) {
-    let m = robot.numeric();
-    for j in 0..=robot.nl() {
-        let (ms, mass) = if j > 0 && data.member[j] {
-            let l = m.link(j);
-            (l.mass * data.pos[j] + data.rot[j] * l.ms, l.mass)
-        } else {
-            (Vector3::zeros(), 0.0)
-        };
-        data.sub_ms[j] = ms;
-        data.sub_m[j] = mass;
-    }
-    for j in (1..=robot.nl()).rev() {
-        let a = robot.ant(j);
-        let (ms, mass) = (data.sub_ms[j], data.sub_m[j]);
-        data.sub_ms[a] += ms;
-        data.sub_m[a] += mass;
-    }
+    mark_subtree(robot, r, &mut data.member);
+    let member = &data.member;
+    data.tree
+        .bodies(robot, |j| member[j], &mut data.body_m, &mut data.body_ms);
+    Ok((r, false))
 }
 
 fn no_mass(robot: &Robot, r: usize) -> Error {
@@ -111,21 +101,22 @@ pub fn center_of_mass(
     root: Option<&FrameId>,
 ) -> Result<CenterOfMass> {
     data.ready(robot, Level::Motion)?;
-    let r = mark_subtree(robot, data, root)?;
-    let m = robot.numeric();
+    let (r, whole) = select_bodies(robot, data, root)?;
+    let (bm, bms) = if whole {
+        (&data.tree.mass, &data.tree.ms)
+    } else {
+        (&data.body_m, &data.body_ms)
+    };
     let (mut mass, mut first, mut vel, mut acc) =
         (0.0, Vector3::zeros(), Vector3::zeros(), Vector3::zeros());
-    for j in 1..=robot.nl() {
-        if !data.member[j] {
-            continue;
-        }
-        let l = m.link(j);
-        let c = data.rot[j] * l.ms; // m_j (G_j - O_j) in R_0
-        let (w, wd) = (data.w[j], data.wd[j]);
-        mass += l.mass;
-        first += l.mass * data.pos[j] + c;
-        vel += l.mass * data.v[j] + w.cross(&c);
-        acc += l.mass * data.a[j] + wd.cross(&c) + w.cross(&w.cross(&c));
+    for k in 1..bm.len() {
+        let m = bm[k];
+        let c = data.rot[k] * bms[k]; // sum m_j (G_j - O_k) in R_0
+        let (w, wd) = (data.w[k], data.wd[k]);
+        mass += m;
+        first += m * data.pos[k] + c;
+        vel += m * data.v[k] + w.cross(&c);
+        acc += m * data.a[k] + wd.cross(&c) + w.cross(&w.cross(&c));
     }
     if mass <= 0.0 {
         return Err(no_mass(robot, r));
@@ -155,40 +146,42 @@ pub fn center_of_mass_jacobian_into(
 ) -> Result<()> {
     data.ready(robot, Level::Placements)?;
     check_matrix(robot, "Jcom", out, 3)?;
-    let r = mark_subtree(robot, data, root)?;
-    accumulate_first_moments(robot, data);
-    let mass = data.sub_m[r];
+    let (r, whole) = select_bodies(robot, data, root)?;
+    let (bm, bms) = if whole {
+        (&data.tree.mass, &data.tree.ms)
+    } else {
+        (&data.body_m, &data.body_ms)
+    };
+    // per moving link: its counted bodies' mass and first moment sum m_j 0P_Gj, then summed
+    // towards the base (each link then holds its subtree's)
+    let n = bm.len() - 1;
+    data.sub_m[0] = 0.0;
+    data.sub_ms[0] = Vector3::zeros();
+    for k in 1..=n {
+        data.sub_m[k] = bm[k];
+        data.sub_ms[k] = bm[k] * data.pos[k] + data.rot[k] * bms[k];
+    }
+    for k in (1..=n).rev() {
+        let a = data.tree.frame(k).ant;
+        let (m, ms) = (data.sub_m[k], data.sub_ms[k]);
+        data.sub_m[a] += m;
+        data.sub_ms[a] += ms;
+    }
+    let mass = data.sub_m[0];
     if mass <= 0.0 {
         return Err(no_mass(robot, r));
     }
-    out.fill(0.0);
-    let c = robot.coordinates();
-    for (k, &j) in c.frames().iter().enumerate() {
-        let z: Vector3<f64> = data.rot[j].column(2).into_owned();
-        // the counted links moved by joint j: its subtree, cut to the root's
-        let (s, mj) = if data.member[j] {
-            (data.sub_ms[j], data.sub_m[j])
-        } else if is_ancestor_or_self(robot, j, r) {
-            (data.sub_ms[r], data.sub_m[r])
-        } else {
-            continue;
-        };
-        let col = match robot.frame(j).joint {
-            JointType::Prismatic => mj * z,
-            _ => z.cross(&(s - mj * data.pos[j])),
+    let o = out.as_mut_slice();
+    for k in 1..=n {
+        let z: Vector3<f64> = data.rot[k].column(2).into_owned();
+        let (mk, sk) = (data.sub_m[k], data.sub_ms[k]);
+        let col = match data.tree.frame(k).joint {
+            JointType::Prismatic => mk * z,
+            _ => z.cross(&(sk - mk * data.pos[k])),
         } / mass;
-        out.fixed_view_mut::<3, 1>(0, k).copy_from(&col);
+        o[3 * (k - 1)..3 * k].copy_from_slice(col.as_slice());
     }
     Ok(())
-}
-
-/// Whether frame `j` is `r` or one of its ancestors.
-fn is_ancestor_or_self(robot: &Robot, j: usize, r: usize) -> bool {
-    let mut found = false;
-    if r > 0 {
-        for_each_support_joint(robot, r, |_, jj, _| found |= jj == j);
-    }
-    found
 }
 
 /// The mass of the links a joint moves (kg): what [`center_of_mass`] weighs.
@@ -209,11 +202,12 @@ pub fn total_mass(robot: &Robot) -> f64 {
 /// Errors: [`Error::Input`] for a frame of another robot.
 pub fn subtree_mass(robot: &Robot, root: &FrameId) -> Result<f64> {
     root.check(robot)?;
-    let mut data = KinematicsData::new(robot);
-    let r = mark_subtree(robot, &mut data, Some(root))?;
-    let _ = r;
+    let mut moving = vec![false; robot.nl() + 1];
+    let mut member = vec![false; robot.nl() + 1];
+    moving_links(robot, &mut moving);
+    mark_subtree(robot, carrying_link(robot, root.parent()), &mut member);
     Ok((1..=robot.nl())
-        .filter(|&j| data.member[j])
+        .filter(|&j| member[j] && moving[j])
         .map(|j| robot.numeric().link(j).mass)
         .sum())
 }

@@ -2,6 +2,7 @@
 //! the description, in R_0, into a [`KinematicsData`]; and the frame quantities read from it.
 
 use super::frames::FrameId;
+use super::tree::{mul_form, MovingTree};
 use super::{Motion, Reference};
 use crate::error::{Error, Result};
 use crate::geometry::Transform;
@@ -20,62 +21,72 @@ pub(crate) enum Level {
 }
 
 /// Buffers and results of the kinematic functions for one robot (Pinocchio's `Data` for
-/// `forwardKinematics`, `computeJointJacobians`, `centerOfMass`): per frame j = 0..NF of the
-/// description (0 the base), all in R_0, at the origin O_j: the placement 0T_j, the angular
-/// velocity and acceleration, the linear velocity and (classical) acceleration of O_j. Made once
-/// per thread with [`KinematicsData::new`]; [`forward_kinematics_into`] or [`placements_into`]
-/// fill it, and the frame functions (placements, velocities, Jacobians, centre of mass) read it
-/// without allocating. Cut-joint frames (NL+1..NJ) are placed at cut variable 0 and never
-/// read (see [`Robot::frame_id_of`]).
+/// `forwardKinematics`, `computeJointJacobians`, `centerOfMass`). The passes run over the
+/// movable joints only, as Pinocchio's model: per movable joint k (0 the base), all in R_0 at
+/// the origin of its frame, the placement, the angular velocity and acceleration, the linear
+/// velocity and (classical) acceleration; every other frame of the description is fixed on its
+/// nearest movable ancestor and read from it. Made once per thread with
+/// [`KinematicsData::new`]; [`forward_kinematics_into`] or [`placements_into`] fill it, and the
+/// frame functions (placements, velocities, Jacobians, centre of mass) read it without
+/// allocating. Cut-joint frames (NL+1..NJ) are placed at cut variable 0 and never read (see
+/// [`Robot::frame_id_of`]).
 #[derive(Clone, Debug)]
 pub struct KinematicsData {
     pub(crate) nf: usize,
     pub(crate) level: Level,
+    pub(crate) tree: MovingTree,
+    /// Per moving link 0..N (0 the base).
     pub(crate) rot: Vec<Matrix3<f64>>,
     pub(crate) pos: Vec<Vector3<f64>>,
     pub(crate) w: Vec<Vector3<f64>>,
     pub(crate) v: Vec<Vector3<f64>>,
     pub(crate) wd: Vec<Vector3<f64>>,
     pub(crate) a: Vec<Vector3<f64>>,
-    /// Tree arrays (NL entries) of q, qd, qdd.
-    pub(crate) q: Vec<f64>,
-    pub(crate) qd: Vec<f64>,
+    /// The q̈ of the last [`forward_kinematics_into`] (movable joints).
     pub(crate) qdd: Vec<f64>,
-    /// Per link (0..NL): sum over its subtree of m_j 0P_Gj, its mass (centre of mass pass).
-    pub(crate) sub_ms: Vec<Vector3<f64>>,
+    /// The moving links from a frame to the base (scratch of the support-only pass).
+    pub(crate) chain: Vec<usize>,
+    /// Per moving link 0..N: the counted bodies of the last centre of mass call (mass, first
+    /// moment in the link's axes), then its subtree's sums m, sum m_j 0P_Gj (in R_0).
+    pub(crate) body_m: Vec<f64>,
+    pub(crate) body_ms: Vec<Vector3<f64>>,
     pub(crate) sub_m: Vec<f64>,
-    /// Per link (0..NL): moved by a joint; in the subtree of the last centre of mass call.
-    pub(crate) moving: Vec<bool>,
+    pub(crate) sub_ms: Vec<Vector3<f64>>,
+    /// Per description link 0..NL: in the subtree of the last centre of mass call.
     pub(crate) member: Vec<bool>,
 }
 
 impl KinematicsData {
     /// The buffers of `robot`'s kinematic functions.
     pub fn new(robot: &Robot) -> KinematicsData {
-        let nf = robot.nf();
-        let v = || vec![Vector3::zeros(); nf + 1];
+        let n = robot.dof();
+        let v = || vec![Vector3::zeros(); n + 1];
         KinematicsData {
-            nf,
+            nf: robot.nf(),
             level: Level::None,
-            rot: vec![Matrix3::identity(); nf + 1],
+            tree: MovingTree::new(robot),
+            rot: vec![Matrix3::identity(); n + 1],
             pos: v(),
             w: v(),
             v: v(),
             wd: v(),
             a: v(),
-            q: vec![0.0; robot.nl()],
-            qd: vec![0.0; robot.nl()],
-            qdd: vec![0.0; robot.nl()],
-            sub_ms: vec![Vector3::zeros(); robot.nl() + 1],
-            sub_m: vec![0.0; robot.nl() + 1],
-            moving: vec![false; robot.nl() + 1],
+            qdd: vec![0.0; n],
+            chain: Vec::with_capacity(n + 1),
+            body_m: vec![0.0; n + 1],
+            body_ms: v(),
+            sub_m: vec![0.0; n + 1],
+            sub_ms: v(),
             member: vec![false; robot.nl() + 1],
         }
     }
 
     /// Error unless this data was made for a robot of `robot`'s size ([`Error::Dimension`]).
     pub fn check(&self, robot: &Robot) -> Result<()> {
-        if self.nf != robot.nf() || self.q.len() != robot.nl() {
+        if self.nf != robot.nf()
+            || self.qdd.len() != robot.dof()
+            || self.member.len() != robot.nl() + 1
+        {
             return Err(Error::dimension(
                 "kinematics data",
                 robot.nf(),
@@ -113,25 +124,41 @@ impl KinematicsData {
 /// [`Error::NotFinite`] for a NaN or infinite entry.
 pub fn placements_into(robot: &Robot, data: &mut KinematicsData, q: &[f64]) -> Result<()> {
     data.check(robot)?;
-    let c = robot.coordinates();
-    c.check("q", q, "movable joints")?;
-    c.scatter(q, &mut data.q);
+    robot.coordinates().check("q", q, "movable joints")?;
     data.level = Level::None;
-    for j in 1..=robot.nf() {
-        place(robot, data, j);
+    for k in 1..=data.tree.n() {
+        place(data, k, q[k - 1]);
     }
     data.level = Level::Placements;
     Ok(())
 }
 
-/// 0T_j = 0T_a(j) a(j)T_j (cut variables 0).
-#[inline]
-fn place(robot: &Robot, data: &mut KinematicsData, j: usize) {
-    let qj = if j <= robot.nl() { data.q[j - 1] } else { 0.0 };
-    let (r, p) = robot.numeric().frame(j).transform(&qj);
-    let a = robot.ant(j);
-    data.pos[j] = data.pos[a] + data.rot[a] * p;
-    data.rot[j] = data.rot[a] * r;
+/// The placements of the moving links from the base to the one frame `f` is fixed on (its
+/// support: Pinocchio's `computeFrameJacobian` pass), into `data`. The other links keep older
+/// values, so `data` holds no full pass afterwards (its level is reset).
+pub(crate) fn place_support(data: &mut KinematicsData, q: &[f64], f: &FrameId) {
+    data.level = Level::None;
+    data.chain.clear();
+    let mut k = data.tree.anchor[f.parent()].link;
+    while k != 0 {
+        data.chain.push(k);
+        k = data.tree.frame(k).ant;
+    }
+    for i in (0..data.chain.len()).rev() {
+        let k = data.chain[i];
+        place(data, k, q[k - 1]);
+    }
+}
+
+/// 0T_k = 0T_a(k) a(k)T_k for moving link k at joint value `qk`.
+#[inline(always)]
+fn place(data: &mut KinematicsData, k: usize, qk: f64) {
+    let fc = data.tree.frame(k);
+    let (r, p) = fc.placement(&qk);
+    let a = fc.ant;
+    let ra = data.rot[a];
+    data.pos[k] = data.pos[a] + ra * p;
+    data.rot[k] = mul_form(&ra, &r, fc.form());
 }
 
 /// The forward kinematic model of every frame for a state over the movable joints (frame
@@ -175,13 +202,11 @@ pub fn forward_kinematics_into(
     c.check("q", q, "movable joints")?;
     c.check("qd", qd, "movable joints")?;
     c.check("qdd", qdd, "movable joints")?;
-    c.scatter(q, &mut data.q);
-    c.scatter(qd, &mut data.qd);
-    c.scatter(qdd, &mut data.qdd);
     data.level = Level::None;
-    for j in 1..=robot.nf() {
-        place(robot, data, j);
-        propagate(robot, data, j);
+    data.qdd.copy_from_slice(qdd);
+    for k in 1..=data.tree.n() {
+        place(data, k, q[k - 1]);
+        propagate(data, k, qd[k - 1], qdd[k - 1]);
     }
     let finite = |v: &[Vector3<f64>]| v.iter().all(|x| x.iter().all(|e| e.is_finite()));
     if !(finite(&data.w) && finite(&data.v) && finite(&data.wd) && finite(&data.a)) {
@@ -193,37 +218,50 @@ pub fn forward_kinematics_into(
     Ok(())
 }
 
-/// Velocity and acceleration of frame j from its antecedent's (after [`place`]).
+/// Velocity and acceleration of moving link k from its antecedent's (after [`place`]).
 #[inline]
-fn propagate(robot: &Robot, data: &mut KinematicsData, j: usize) {
-    let i = robot.ant(j);
-    let (qd, qdd) = if j <= robot.nl() {
-        (data.qd[j - 1], data.qdd[j - 1])
-    } else {
-        (0.0, 0.0)
-    };
-    let p = data.pos[j] - data.pos[i];
-    let z: Vector3<f64> = data.rot[j].column(2).into_owned();
+fn propagate(data: &mut KinematicsData, k: usize, qd: f64, qdd: f64) {
+    let fc = data.tree.frame(k);
+    let i = fc.ant;
+    let p = data.pos[k] - data.pos[i];
+    let z: Vector3<f64> = data.rot[k].column(2).into_owned();
     let (wi, wdi) = (data.w[i], data.wd[i]);
     let mut w = wi;
     let mut v = data.v[i] + wi.cross(&p);
     let mut wd = wdi;
     let mut a = data.a[i] + wdi.cross(&p) + wi.cross(&wi.cross(&p));
-    match robot.numeric().frame(j).joint {
-        JointType::Revolute if j <= robot.nl() => {
+    match fc.joint {
+        JointType::Revolute => {
             w += qd * z;
             wd += wi.cross(&(qd * z)) + qdd * z;
         }
-        JointType::Prismatic if j <= robot.nl() => {
+        JointType::Prismatic => {
             v += qd * z;
             a += 2.0 * wi.cross(&(qd * z)) + qdd * z;
         }
-        _ => {}
+        JointType::Fixed => {}
     }
-    data.w[j] = w;
-    data.v[j] = v;
-    data.wd[j] = wd;
-    data.a[j] = a;
+    data.w[k] = w;
+    data.v[k] = v;
+    data.wd[k] = wd;
+    data.a[k] = a;
+}
+
+/// 0T_f, the placement of frame `f` (its anchor's placement, its offsets composed).
+#[inline]
+pub(crate) fn placement_of(data: &KinematicsData, f: &FrameId) -> Transform {
+    let an = &data.tree.anchor[f.parent()];
+    let mut t = Transform {
+        rot: data.rot[an.link],
+        pos: data.pos[an.link],
+    };
+    if !an.identity {
+        t = t.compose(&an.t);
+    }
+    if !f.is_identity() {
+        t = t.compose(f.offset());
+    }
+    t
 }
 
 /// The frame's placement 0T_f and, in R_0 at its origin, w, v, wd, a (a the classical
@@ -236,22 +274,18 @@ pub(crate) struct FrameState {
     pub a: Vector3<f64>,
 }
 
-/// The state of frame `f` from its parent's (a rigid offset: same w, wd; v and a of the point).
+/// The state of frame `f` from its anchor's (a rigid offset: same w, wd; v and a of the point).
 pub(crate) fn frame_state(data: &KinematicsData, f: &FrameId) -> FrameState {
-    let j = f.parent();
-    let parent = Transform {
-        rot: data.rot[j],
-        pos: data.pos[j],
-    };
-    let t = parent.compose(f.offset());
-    let r = t.pos - parent.pos;
-    let (w, wd) = (data.w[j], data.wd[j]);
+    let k = data.tree.anchor[f.parent()].link;
+    let t = placement_of(data, f);
+    let r = t.pos - data.pos[k];
+    let (w, wd) = (data.w[k], data.wd[k]);
     FrameState {
         t,
         w,
-        v: data.v[j] + w.cross(&r),
+        v: data.v[k] + w.cross(&r),
         wd,
-        a: data.a[j] + wd.cross(&r) + w.cross(&w.cross(&r)),
+        a: data.a[k] + wd.cross(&r) + w.cross(&w.cross(&r)),
     }
 }
 
@@ -263,7 +297,7 @@ pub(crate) fn frame_state(data: &KinematicsData, f: &FrameId) -> FrameState {
 pub fn frame_placement(robot: &Robot, data: &KinematicsData, f: &FrameId) -> Result<Transform> {
     data.ready(robot, Level::Placements)?;
     f.check(robot)?;
-    Ok(frame_state(data, f).t)
+    Ok(placement_of(data, f))
 }
 
 /// jT_k = (0T_j)^-1 0T_k, the placement of frame `k` in frame `j`.

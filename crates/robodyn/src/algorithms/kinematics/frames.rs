@@ -15,6 +15,8 @@ use nalgebra::{Matrix3, Rotation3, Vector3};
 pub struct FrameId {
     frame: usize,
     offset: Transform,
+    /// `offset` is the identity (the frame is its parent frame): no product to read it.
+    identity: bool,
     nf: usize,
 }
 
@@ -29,6 +31,11 @@ impl FrameId {
         &self.offset
     }
 
+    /// Whether the offset is the identity (the frame is its parent frame).
+    pub(crate) fn is_identity(&self) -> bool {
+        self.identity
+    }
+
     /// The frame translated to the point `p` (m, in this frame's coordinates), same
     /// orientation: the Jacobian of a point on a frame is the Jacobian of this frame.
     pub fn at_point(&self, p: Vector3<f64>) -> FrameId {
@@ -40,9 +47,11 @@ impl FrameId {
 
     /// The frame placed at `t` in this frame (a frame fixed on this one).
     pub fn with_offset(&self, t: &Transform) -> FrameId {
+        let offset = self.offset.compose(t);
         FrameId {
             frame: self.frame,
-            offset: self.offset.compose(t),
+            identity: offset == Transform::identity(),
+            offset,
             nf: self.nf,
         }
     }
@@ -161,6 +170,7 @@ impl Robot {
     fn frame_at(&self, frame: usize, offset: Transform) -> FrameId {
         FrameId {
             frame,
+            identity: offset == Transform::identity(),
             offset,
             nf: self.nf(),
         }

@@ -2,30 +2,28 @@
 //! order) in the three references, their time derivative J̇ and the classical drift J̇ q̇,
 //! read from the placements (and velocities) of a [`KinematicsData`].
 
-use super::forward::{frame_state, placements_into, FrameState, KinematicsData, Level};
+use super::forward::{frame_state, place_support, placement_of, FrameState, KinematicsData, Level};
 use super::frames::FrameId;
 use super::{Motion, Reference};
 use crate::error::{Error, Result};
+use crate::geometry::Transform;
 use crate::model::{JointType, Robot};
 use nalgebra::{DMatrix, Vector3};
 
-/// Call `f(k, j, revolute)` for each movable tree joint j on the path from the base to frame
-/// `parent` (its ancestors and itself), k its entry in the joint vectors.
+/// Call `f(k, j, revolute)` for each movable joint on the path from the base to the
+/// description frame `frame` (its moving link j and the moving links before it; k = j - 1 its
+/// entry in the joint vectors).
+#[inline]
 pub(crate) fn for_each_support_joint(
-    robot: &Robot,
-    parent: usize,
+    data: &KinematicsData,
+    frame: usize,
     mut f: impl FnMut(usize, usize, bool),
 ) {
-    let c = robot.coordinates();
-    let mut j = parent;
+    let mut j = data.tree.anchor[frame].link;
     while j != 0 {
-        if j <= robot.nl() {
-            let joint = robot.numeric().frame(j).joint;
-            if let Some(k) = c.index_of_frame(j) {
-                f(k, j, joint == JointType::Revolute);
-            }
-        }
-        j = robot.ant(j);
+        let fc = data.tree.frame(j);
+        f(j - 1, j, fc.joint == JointType::Revolute);
+        j = fc.ant;
     }
 }
 
@@ -52,6 +50,14 @@ pub(crate) fn check_matrix(
     Ok(())
 }
 
+/// Write the 6-row column k of `out` (column-major: one slice).
+#[inline(always)]
+fn put(out: &mut DMatrix<f64>, k: usize, m: &Motion) {
+    let c = &mut out.as_mut_slice()[6 * k..6 * k + 6];
+    c[..3].copy_from_slice(m.linear.as_slice());
+    c[3..].copy_from_slice(m.angular.as_slice());
+}
+
 /// Column of the LocalWorldAligned Jacobian of the point `p` (R_0) for joint j: revolute
 /// [z_j x (p - O_j); z_j], prismatic [z_j; 0].
 #[inline]
@@ -66,18 +72,18 @@ fn lwa_column(data: &KinematicsData, j: usize, revolute: bool, p: &Vector3<f64>)
 
 /// A motion given in LocalWorldAligned (at the frame's origin O_f, R_0 axes) in `reference`.
 #[inline]
-fn from_lwa(s: &FrameState, m: Motion, reference: Reference) -> Motion {
+fn from_lwa(t: &Transform, m: Motion, reference: Reference) -> Motion {
     match reference {
         Reference::LocalWorldAligned => m,
-        Reference::Local => Motion::new(s.t.rot.tr_mul(&m.linear), s.t.rot.tr_mul(&m.angular)),
+        Reference::Local => Motion::new(t.rot.tr_mul(&m.linear), t.rot.tr_mul(&m.angular)),
         // the velocity of the body point at O_0: v - w x O_f
-        Reference::World => Motion::new(m.linear + s.t.pos.cross(&m.angular), m.angular),
+        Reference::World => Motion::new(m.linear + t.pos.cross(&m.angular), m.angular),
     }
 }
 
 /// The Jacobian of frame `f` in `reference` into `out` (6 x N, rows [linear; angular], one
 /// column per movable joint, zero for joints not between the base and the frame), after
-/// [`placements_into`] or [`forward_kinematics_into`](super::forward_kinematics_into): J q̇ is
+/// [`placements_into`](super::placements_into) or [`forward_kinematics_into`](super::forward_kinematics_into): J q̇ is
 /// [`frame_velocity`](super::frame_velocity) in the same reference. Computing the placements
 /// once and reading several frames' Jacobians is Pinocchio's `computeJointJacobians` then
 /// `getFrameJacobian`. Allocation-free.
@@ -99,19 +105,53 @@ pub fn frame_jacobian_into(
     data.ready(robot, Level::Placements)?;
     f.check(robot)?;
     check_matrix(robot, "J", out, 6)?;
+    write_jacobian(data, f, reference, out);
+    Ok(())
+}
+
+/// The columns of the frame Jacobian from the placements of its support.
+fn write_jacobian(
+    data: &KinematicsData,
+    f: &FrameId,
+    reference: Reference,
+    out: &mut DMatrix<f64>,
+) {
     out.fill(0.0);
-    let s = frame_state(data, f);
-    for_each_support_joint(robot, f.parent(), |k, j, revolute| {
-        let col = from_lwa(&s, lwa_column(data, j, revolute, &s.t.pos), reference);
-        col.write_column(out, k);
+    let t = placement_of(data, f);
+    for_each_support_joint(data, f.parent(), |k, j, revolute| {
+        let col = from_lwa(&t, lwa_column(data, j, revolute, &t.pos), reference);
+        put(out, k, &col);
     });
+}
+
+/// The Jacobian of frame `f` in `reference` at joint positions `q` into `out` (6 x N), from
+/// the placements of the frame's support only (the movable joints between the base and the
+/// frame): Pinocchio's `computeFrameJacobian`. Cheaper than [`placements_into`](super::placements_into) then
+/// [`frame_jacobian_into`] for one frame of a large tree; `data` is left without a full pass
+/// (the frame functions ask for one again). Allocation-free.
+///
+/// Errors: as [`placements_into`](super::placements_into) and [`frame_jacobian_into`].
+pub fn frame_jacobian_from_q_into(
+    robot: &Robot,
+    data: &mut KinematicsData,
+    q: &[f64],
+    f: &FrameId,
+    reference: Reference,
+    out: &mut DMatrix<f64>,
+) -> Result<()> {
+    data.check(robot)?;
+    robot.coordinates().check("q", q, "movable joints")?;
+    f.check(robot)?;
+    check_matrix(robot, "J", out, 6)?;
+    place_support(data, q, f);
+    write_jacobian(data, f, reference, out);
     Ok(())
 }
 
 /// The Jacobian of frame `f` in `reference` at joint positions `q` (movable joints, frame
 /// order): 6 x N, rows [linear; angular]. Allocates; use [`frame_jacobian_into`] in loops.
 ///
-/// Errors: as [`placements_into`] and [`frame_jacobian_into`].
+/// Errors: as [`placements_into`](super::placements_into) and [`frame_jacobian_into`].
 ///
 /// # Example
 ///
@@ -134,9 +174,8 @@ pub fn frame_jacobian(
     reference: Reference,
 ) -> Result<DMatrix<f64>> {
     let mut data = KinematicsData::new(robot);
-    placements_into(robot, &mut data, q)?;
     let mut out = DMatrix::zeros(6, robot.dof());
-    frame_jacobian_into(robot, &data, f, reference, &mut out)?;
+    frame_jacobian_from_q_into(robot, &mut data, q, f, reference, &mut out)?;
     Ok(out)
 }
 
@@ -162,7 +201,7 @@ pub fn frame_jacobian_time_variation_into(
     check_matrix(robot, "dJ", out, 6)?;
     out.fill(0.0);
     let s = frame_state(data, f);
-    for_each_support_joint(robot, f.parent(), |k, j, revolute| {
+    for_each_support_joint(data, f.parent(), |k, j, revolute| {
         let z: Vector3<f64> = data.rot[j].column(2).into_owned();
         let zd = data.w[j].cross(&z);
         let col = match (reference, revolute) {
@@ -180,7 +219,7 @@ pub fn frame_jacobian_time_variation_into(
                 local_derivative(&s, lwa, Motion::new(z.cross(&r), z), reference)
             }
         };
-        col.write_column(out, k);
+        put(out, k, &col);
     });
     Ok(())
 }
@@ -216,9 +255,9 @@ pub fn frame_classical_drift(
     let acc = super::frame_classical_acceleration(robot, data, f, reference)?;
     let s = frame_state(data, f);
     let mut jqdd = Motion::new(Vector3::zeros(), Vector3::zeros());
-    for_each_support_joint(robot, f.parent(), |_, j, revolute| {
-        let col = from_lwa(&s, lwa_column(data, j, revolute, &s.t.pos), reference);
-        let qdd = data.qdd[j - 1];
+    for_each_support_joint(data, f.parent(), |k, j, revolute| {
+        let col = from_lwa(&s.t, lwa_column(data, j, revolute, &s.t.pos), reference);
+        let qdd = data.qdd[k];
         jqdd.linear += qdd * col.linear;
         jqdd.angular += qdd * col.angular;
     });

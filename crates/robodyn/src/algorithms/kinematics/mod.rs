@@ -15,6 +15,7 @@ mod forward;
 mod frames;
 mod jacobian;
 mod newton_euler;
+mod tree;
 
 pub use closed::{closed_frame_jacobian, ClosedJacobian};
 pub use com::{
@@ -26,11 +27,12 @@ pub use forward::{
 };
 pub use frames::{rpy, tool_transform, FrameId};
 pub use jacobian::{
-    frame_classical_drift, frame_jacobian, frame_jacobian_into, frame_jacobian_time_variation_into,
+    frame_classical_drift, frame_jacobian, frame_jacobian_from_q_into, frame_jacobian_into,
+    frame_jacobian_time_variation_into,
 };
 pub use newton_euler::{frame_motion_from_newton_euler, NewtonEulerFrame};
 
-use nalgebra::{DMatrix, Vector3, Vector6};
+use nalgebra::{Vector3, Vector6};
 
 /// Where a velocity, an acceleration or a Jacobian is expressed, named as Pinocchio's
 /// `ReferenceFrame`. Rows are [linear; angular] in every reference.
@@ -97,13 +99,5 @@ impl Motion {
         let l = &self.linear;
         let a = &self.angular;
         Vector6::new(l.x, l.y, l.z, a.x, a.y, a.z)
-    }
-
-    /// Write [linear; angular] into column `k` of a 6-row matrix.
-    pub(crate) fn write_column(&self, out: &mut DMatrix<f64>, k: usize) {
-        for r in 0..3 {
-            out[(r, k)] = self.linear[r];
-            out[(r + 3, k)] = self.angular[r];
-        }
     }
 }

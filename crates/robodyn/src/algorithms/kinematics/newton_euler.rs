@@ -4,8 +4,9 @@
 //! without another pass.
 
 use super::frames::FrameId;
+use super::tree::anchor_of;
 use crate::data::Data;
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::geometry::Transform;
 use crate::model::{Environment, Robot};
 use nalgebra::{Matrix3, Vector3};
@@ -33,8 +34,8 @@ pub struct NewtonEulerFrame {
 /// placement is the product of the pass's iT_j. With a moving base (`env.base`) the motion is
 /// relative to R_0's origin as the pass makes it. Allocation-free; O(depth).
 ///
-/// Errors: [`Error::Dimension`] for a `data` of another robot, [`Error::Input`] for a frame of
-/// another robot.
+/// Errors: [`Error::Dimension`](crate::Error::Dimension) for a `data` of another robot,
+/// [`Error::Input`](crate::Error::Input) for a frame of another robot.
 pub fn frame_motion_from_newton_euler(
     robot: &Robot,
     data: &Data,
@@ -43,15 +44,9 @@ pub fn frame_motion_from_newton_euler(
 ) -> Result<NewtonEulerFrame> {
     data.check(robot)?;
     f.check(robot)?;
-    let (host, h_t_f) = host_of(robot, f);
-    let k = match host {
-        0 => 0,
-        h => robot
-            .coordinates()
-            .index_of_frame(h)
-            .map(|k| k + 1)
-            .ok_or_else(|| Error::Input(format!("frame {h} is not a movable joint's frame")))?,
-    };
+    // the frame's nearest movable joint k (its link in the pass) and kT_f
+    let anchor = anchor_of(robot, f.parent());
+    let (k, h_t_f) = (anchor.link, anchor.t.compose(f.offset()));
     let (rots, poss) = data.local_placements();
     let dynamic = robot.dynamic();
     // 0T_h: the product of the pass's iT_j from the base
@@ -75,17 +70,4 @@ pub fn frame_motion_from_newton_euler(
         angular_acceleration: rot * wd,
         linear_acceleration: rot * a + env.gravity,
     })
-}
-
-/// The nearest movable tree joint h at or before the frame (0 the base) and hT_f through the
-/// fixed frames between them.
-fn host_of(robot: &Robot, f: &FrameId) -> (usize, Transform) {
-    let mut t = *f.offset();
-    let mut j = f.parent();
-    while j != 0 && !(j <= robot.nl() && robot.frame(j).joint.is_movable()) {
-        let (r, p) = robot.numeric().frame(j).transform(&0.0);
-        t = Transform { rot: r, pos: p }.compose(&t);
-        j = robot.ant(j);
-    }
-    (j, t)
 }
