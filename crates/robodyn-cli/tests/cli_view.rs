@@ -181,6 +181,15 @@ fn bundled_cases(dir: &Path, rng: &mut Rng) -> (Vec<Case>, Vec<PathBuf>) {
     for f in files {
         let file = f.file_name().unwrap().to_string_lossy().into_owned();
         let r = robodyn::io::load(&f).unwrap();
+        // a floating robot is drawn with its base frame R_0 at the origin: its frames are
+        // those of the same robot on a fixed base
+        let r = if r.is_floating() {
+            let mut d = r.description().clone();
+            d.floating_base = None;
+            robodyn::Robot::new(d).unwrap()
+        } else {
+            r
+        };
         pages.push(make_page(dir, &file, &[f.to_str().unwrap()]));
         let closes = !r.is_tree()
             && ClosedChain::new(&r)

@@ -43,12 +43,25 @@ fn bundled() -> Vec<(String, Robot)> {
         .map(|e| e.unwrap().path())
         .collect();
     v.sort();
-    v.iter()
+    let all: Vec<(String, Robot)> = v
+        .iter()
         .map(|p| {
             let name = p.file_name().unwrap().to_string_lossy().into_owned();
             (name, robodyn::io::load(p).unwrap())
         })
-        .collect()
+        .collect();
+    // derivatives of floating-base robots are not there yet: they are refused, never a
+    // fixed-base number (issue 28 / 27)
+    for (name, robot) in all.iter().filter(|(_, r)| r.is_floating()) {
+        let n = robot.dof();
+        let z = vec![0.0; n];
+        let got = inverse_dynamics_derivatives(robot, &z, &z, &z);
+        assert!(
+            got.is_err(),
+            "{name}: a floating robot's derivatives: {got:?}"
+        );
+    }
+    all.into_iter().filter(|(_, r)| !r.is_floating()).collect()
 }
 
 /// dGamma/dq and dGamma/dqd by the hyper-dual route: `rnea` of the model of the dynamic

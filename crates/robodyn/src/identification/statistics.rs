@@ -334,7 +334,7 @@ impl Statistics {
         if value.get("format").and_then(|f| f.as_str()) != Some(FORMAT) {
             return Err(Error::Input(format!(
                 "{source}: not identification statistics (no \"format\": \"{FORMAT}\"; they are \
-                 written by `identify --partial` or `robodyn.ident_statistics`)"
+                 written by `Statistics::to_json`)"
             )));
         }
         let version = value.get("version").and_then(|v| v.as_u64());
