@@ -4,17 +4,7 @@
 //! is refused with a reason.
 
 mod common;
-use common::{robot, run, tmp};
-use std::process::Command;
-
-fn fails(args: &[&str]) -> String {
-    let out = Command::new(env!("CARGO_BIN_EXE_robodyn"))
-        .args(args)
-        .output()
-        .unwrap();
-    assert!(!out.status.success(), "robodyn {args:?} should fail");
-    String::from_utf8_lossy(&out.stderr).to_string()
-}
+use common::{assert_identified_base_params, fails, robot, run, tmp};
 
 #[test]
 fn excite_simulate_identify_round_trip() {
@@ -95,30 +85,8 @@ fn excite_simulate_identify_round_trip() {
     );
     assert!(v["relative_error"].as_f64().unwrap() < 1e-9);
     // the same base parameters from the robot file, by base-params
-    let bp: serde_json::Value = serde_json::from_str(&run(&[
-        "base-params",
-        &rx90,
-        "--method",
-        "numeric",
-        "--format",
-        "json",
-    ]))
-    .unwrap();
-    let base = bp["base"].as_array().unwrap();
-    let params = v["parameters"].as_array().unwrap();
-    assert_eq!(base.len(), params.len());
-    let scale = base
-        .iter()
-        .map(|b| b["value"].as_f64().unwrap().abs())
-        .fold(0.0, f64::max);
-    for (b, p) in base.iter().zip(params) {
-        assert_eq!(b["name"], p["name"]);
-        let (x, t) = (p["value"].as_f64().unwrap(), b["value"].as_f64().unwrap());
-        assert!(
-            (x - t).abs() <= 1e-8 * t.abs().max(1e-3 * scale),
-            "{}: {x} vs {t}",
-            b["name"]
-        );
+    assert_identified_base_params(&rx90, &v);
+    for p in v["parameters"].as_array().unwrap() {
         assert!(p.get("relative_std").is_some());
     }
     // CSV table and the consistent robot file, which simulates

@@ -5,18 +5,8 @@
 //! robot or other options are refused.
 
 mod common;
-use common::{robot, run, tmp};
+use common::{assert_identified_base_params, fails, robot, run, tmp};
 use std::path::{Path, PathBuf};
-use std::process::Command;
-
-fn fails(args: &[&str]) -> String {
-    let out = Command::new(env!("CARGO_BIN_EXE_robodyn"))
-        .args(args)
-        .output()
-        .unwrap();
-    assert!(!out.status.success(), "robodyn {args:?} should fail");
-    String::from_utf8_lossy(&out.stderr).to_string()
-}
 
 /// The CSV `src` cut into `parts` files of consecutive rows (each with the header).
 fn split(src: &Path, parts: usize, tag: &str) -> Vec<PathBuf> {
@@ -205,64 +195,24 @@ fn rx90_statistics_of_three_logs_give_the_true_base_parameters() {
     ]);
     let parts = split(&traj, 3, "many_rx90");
     let (a, bc) = (tmp("many_rx90", "a.json"), tmp("many_rx90", "bc.json"));
-    let opt = ["--estimator", "ols", "--validation", "none"];
-    let mut args = vec![
-        "identify",
-        &rx90,
-        "--data",
-        s(&parts[0]),
-        "--partial",
-        s(&a),
-    ];
-    args.extend(opt);
-    run(&args);
-    let mut args = vec![
-        "identify",
-        &rx90,
+    // every run with the same options: OLS, no validation segment
+    let identify = |extra: &[&str]| {
+        let mut args = vec!["identify", rx90.as_str()];
+        args.extend(extra);
+        args.extend(["--estimator", "ols", "--validation", "none"]);
+        run(&args)
+    };
+    identify(&["--data", s(&parts[0]), "--partial", s(&a)]);
+    identify(&[
         "--data",
         s(&parts[1]),
         "--data",
         s(&parts[2]),
         "--partial",
         s(&bc),
-    ];
-    args.extend(opt);
-    run(&args);
-    let mut args = vec![
-        "identify",
-        &rx90,
-        "--merge",
-        s(&a),
-        s(&bc),
-        "--format",
-        "json",
-    ];
-    args.extend(opt);
-    let v = json(&run(&args));
-    let bp = json(&run(&[
-        "base-params",
-        &rx90,
-        "--method",
-        "numeric",
-        "--format",
-        "json",
-    ]));
-    let base = bp["base"].as_array().unwrap();
-    let params = v["parameters"].as_array().unwrap();
-    assert_eq!(base.len(), params.len());
-    let scale = base
-        .iter()
-        .map(|b| b["value"].as_f64().unwrap().abs())
-        .fold(0.0, f64::max);
-    for (b, p) in base.iter().zip(params) {
-        assert_eq!(b["name"], p["name"]);
-        let (x, t) = (p["value"].as_f64().unwrap(), b["value"].as_f64().unwrap());
-        assert!(
-            (x - t).abs() <= 1e-8 * t.abs().max(1e-3 * scale),
-            "{}: {x} vs {t}",
-            b["name"]
-        );
-    }
+    ]);
+    let v = json(&identify(&["--merge", s(&a), s(&bc), "--format", "json"]));
+    assert_identified_base_params(&rx90, &v);
     assert!(v["processing"]["source"]
         .as_str()
         .unwrap()

@@ -72,3 +72,44 @@ pub fn octave_eval(dir: &std::path::Path, code: &str) -> String {
     );
     String::from_utf8(out.stdout).unwrap()
 }
+
+/// Run `robodyn ARGS`, assert failure, return standard error.
+pub fn fails(args: &[&str]) -> String {
+    let out = Command::new(env!("CARGO_BIN_EXE_robodyn"))
+        .args(args)
+        .output()
+        .unwrap();
+    assert!(!out.status.success(), "robodyn {args:?} should fail");
+    String::from_utf8_lossy(&out.stderr).to_string()
+}
+
+/// The parameters of an `identify --format json` report equal the numeric base parameters of
+/// the robot file `robot` (`base-params --method numeric`), by name and to 1e-8 relative (1e-3
+/// of the largest for the small ones): the arbiter of a noise-free identification.
+pub fn assert_identified_base_params(robot: &str, report: &serde_json::Value) {
+    let bp: serde_json::Value = serde_json::from_str(&run(&[
+        "base-params",
+        robot,
+        "--method",
+        "numeric",
+        "--format",
+        "json",
+    ]))
+    .unwrap();
+    let base = bp["base"].as_array().unwrap();
+    let params = report["parameters"].as_array().unwrap();
+    assert_eq!(base.len(), params.len());
+    let scale = base
+        .iter()
+        .map(|b| b["value"].as_f64().unwrap().abs())
+        .fold(0.0, f64::max);
+    for (b, p) in base.iter().zip(params) {
+        assert_eq!(b["name"], p["name"]);
+        let (x, t) = (p["value"].as_f64().unwrap(), b["value"].as_f64().unwrap());
+        assert!(
+            (x - t).abs() <= 1e-8 * t.abs().max(1e-3 * scale),
+            "{}: {x} vs {t}",
+            b["name"]
+        );
+    }
+}

@@ -133,12 +133,20 @@ impl BaseChart {
 /// momentum and the angular momentum about the centre of mass (world).
 pub(crate) struct FloatingBalance {
     a: DMatrix<f64>,
+    /// The last state evaluated (q then v) and its results: an output row asks for the energy
+    /// and for the momenta at the same state, so the second request is a copy.
+    state: Vec<f64>,
+    energy: f64,
+    momenta: Option<[f64; 9]>,
 }
 
 impl FloatingBalance {
     pub(crate) fn new(robot: &Robot) -> Self {
         FloatingBalance {
             a: DMatrix::zeros(robot.nv(), robot.nv()),
+            state: Vec::with_capacity(robot.nq() + robot.nv()),
+            energy: 0.0,
+            momenta: None,
         }
     }
 
@@ -152,6 +160,14 @@ impl FloatingBalance {
         v: &[f64],
         out: &mut [f64; 9],
     ) -> Result<f64> {
+        let same = self.state.len() == q.len() + v.len()
+            && self.state[..q.len()] == *q
+            && self.state[q.len()..] == *v;
+        if let (true, Some(m)) = (same, self.momenta) {
+            *out = m;
+            return Ok(self.energy);
+        }
+        self.momenta = None;
         let m = centroidal_momentum(robot, data, q, v)?;
         inertia_matrix_into(robot, data, q, &mut self.a)?;
         let nv = v.len();
@@ -163,7 +179,12 @@ impl FloatingBalance {
         for (k, x) in m.com.iter().chain(&m.linear).chain(&m.angular).enumerate() {
             out[k] = *x;
         }
-        Ok(kinetic + potential)
+        self.state.clear();
+        self.state.extend_from_slice(q);
+        self.state.extend_from_slice(v);
+        self.energy = kinetic + potential;
+        self.momenta = Some(*out);
+        Ok(self.energy)
     }
 }
 
