@@ -16,6 +16,10 @@
 //! pool of 1 and of 2 threads, 15 pairs run back to back, and prints the median ratio.
 
 use nalgebra::DMatrix;
+use robodyn::algorithms::derivatives::{
+    direct_dynamics_derivatives_into, inverse_dynamics_derivatives_into, DdmDerivatives,
+    DerivativesData, IdmDerivatives,
+};
 use robodyn::algorithms::kinematics::center_of_mass_jacobian_into;
 use robodyn::model::param;
 use robodyn::{
@@ -198,6 +202,8 @@ fn main() -> Result<(), Error> {
     };
     let mut kin = KinematicsData::new(&robot);
     let (mut jac, mut jcom) = (DMatrix::zeros(6, n), DMatrix::zeros(3, n));
+    let mut dd = DerivativesData::new(&robot);
+    let (mut di, mut da) = (IdmDerivatives::new(&robot), DdmDerivatives::new(&robot));
 
     let mut text = String::new();
     let put = |text: &mut String, tag: &str, v: &[f64]| {
@@ -232,6 +238,10 @@ fn main() -> Result<(), Error> {
         )?;
         center_of_mass_jacobian_into(&robot, &mut kin, None, &mut jcom)?;
         put_matrix(&mut text, "com", &jcom, &idx, g.position.as_slice());
+        inverse_dynamics_derivatives_into(&robot, &mut dd, &env, &s.q, &s.qd, &s.qdd, &mut di)?;
+        put_squares(&mut text, "drnea", &[&di.dtau_dq, &di.dtau_dqd], &idx);
+        direct_dynamics_derivatives_into(&robot, &mut dd, &env, &s.q, &s.qd, &s.tau, &mut da)?;
+        put_squares(&mut text, "daba", &[&da.dqdd_dq, &da.dqdd_dqd], &idx);
     }
     std::fs::write(&args[3], text)?;
 
@@ -283,7 +293,31 @@ fn main() -> Result<(), Error> {
         center_of_mass_jacobian_into(&robot, &mut kin, None, &mut jcom).unwrap();
         black_box(&jcom);
     });
+    time("rnea_derivatives", &states, samples, target_us, |s| {
+        let q = black_box(&s.q);
+        inverse_dynamics_derivatives_into(&robot, &mut dd, &env, q, &s.qd, &s.qdd, &mut di)
+            .unwrap();
+        black_box(&di);
+    });
+    time("aba_derivatives", &states, samples, target_us, |s| {
+        let q = black_box(&s.q);
+        direct_dynamics_derivatives_into(&robot, &mut dd, &env, q, &s.qd, &s.tau, &mut da).unwrap();
+        black_box(&da);
+    });
     Ok(())
+}
+
+/// `tag`, then each N x N matrix row by row, rows and columns in the states' order.
+fn put_squares(text: &mut String, tag: &str, ms: &[&DMatrix<f64>], idx: &[usize]) {
+    text.push_str(tag);
+    for m in ms {
+        for &r in idx {
+            for &c in idx {
+                write!(text, " {:e}", m[(r, c)]).unwrap();
+            }
+        }
+    }
+    text.push('\n');
 }
 
 /// The kinematics at a state with velocities (the centre of mass's position is read there).

@@ -16,12 +16,14 @@
 #include "peer_model.hpp"
 
 #include <pinocchio/algorithm/aba.hpp>
+#include <pinocchio/algorithm/aba-derivatives.hpp>
 #include <pinocchio/algorithm/center-of-mass.hpp>
 #include <pinocchio/algorithm/frames.hpp>
 #include <pinocchio/algorithm/jacobian.hpp>
 #include <pinocchio/algorithm/cholesky.hpp>
 #include <pinocchio/algorithm/crba.hpp>
 #include <pinocchio/algorithm/rnea.hpp>
+#include <pinocchio/algorithm/rnea-derivatives.hpp>
 
 #include <algorithm>
 #include <chrono>
@@ -129,6 +131,17 @@ int main(int argc, char** argv) {
       for (int r = 0; r < 3; ++r) out << ' ' << data.com[0][r];
       for (int r = 0; r < 3; ++r)
         for (int c = 0; c < nv; ++c) out << ' ' << data.Jcom(r, c);
+      // derivatives (issue 28): dtau/dq then dtau/dv; ddq/dq then ddq/dv
+      out << "\ndrnea";
+      pinocchio::computeRNEADerivatives(model, data, s.q, s.v, s.a);
+      for (const auto* m : {&data.dtau_dq, &data.dtau_dv})
+        for (int r = 0; r < nv; ++r)
+          for (int c = 0; c < nv; ++c) out << ' ' << (*m)(r, c);
+      out << "\ndaba";
+      pinocchio::computeABADerivatives(model, data, s.q, s.v, s.tau);
+      for (const auto* m : {&data.ddq_dq, &data.ddq_dv})
+        for (int r = 0; r < nv; ++r)
+          for (int c = 0; c < nv; ++c) out << ' ' << (*m)(r, c);
       out << '\n';
     }
   }
@@ -195,6 +208,14 @@ int main(int argc, char** argv) {
   });
   time("com_jacobian", [&](const State& s) {
     sink += pinocchio::jacobianCenterOfMass(model, data, s.q)(0, 0) + data.com[0][0];
+  });
+  time("rnea_derivatives", [&](const State& s) {
+    pinocchio::computeRNEADerivatives(model, data, s.q, s.v, s.a);
+    sink += data.dtau_dq(0, 0);
+  });
+  time("aba_derivatives", [&](const State& s) {
+    pinocchio::computeABADerivatives(model, data, s.q, s.v, s.tau);
+    sink += data.ddq_dq(0, 0);
   });
   std::fprintf(stderr, "sink %g\n", sink);
   return 0;

@@ -189,7 +189,7 @@ def read_results(path):
 def agreement(pin_res, rd_res):
     """Max abs and relative differences per algorithm."""
     rows = {}
-    for alg in ("rnea", "crba", "aba", "composite", "jac", "com"):
+    for alg in ("rnea", "crba", "aba", "composite", "jac", "com", "drnea", "daba"):
         p, r = pin_res[alg], rd_res[alg]
         diff = np.abs(p - r).max()
         rel = diff / max(1.0, np.abs(p).max())
@@ -313,6 +313,10 @@ def main():
              "all_frame_jacobians", ["all_frame_jacobians"]),
             ("a frame Jacobian, LOCAL, from q (computeFrameJacobian)", "frame_jacobian", ["frame_jacobian"]),
             ("centre of mass + its Jacobian from q (jacobianCenterOfMass)", "com_jacobian", ["com_jacobian"]),
+            ("IDM derivatives dtau/dq, dtau/dv, A (computeRNEADerivatives)", "rnea_derivatives",
+             ["rnea_derivatives"]),
+            ("DDM derivatives dqdd/dq, dqdd/dv, A^-1 (computeABADerivatives)", "aba_derivatives",
+             ["aba_derivatives"]),
         ]:
             rm, rs = stat(rd, rname)
             best = min(pnames, key=lambda n: stat(pn, n)[0])

@@ -158,6 +158,10 @@ pub fn ltdl_solve(model: &DynModel<f64>, a: &DMatrix<f64>, x: &mut [f64]) {
             continue;
         }
         let xi = x[i - 1];
+        if xi == 0.0 {
+            // nothing to carry (the unit columns of A^-1 start mostly at zero)
+            continue;
+        }
         let mut j = lambda[i];
         while j != 0 {
             x[j - 1] -= h[at(j, i)] * xi;

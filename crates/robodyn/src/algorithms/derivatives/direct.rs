@@ -4,11 +4,11 @@
 //! that qdd) and dqdd/dGamma = A^-1, in four named steps:
 //! 1. `accelerations`: A by composite links, its L'DL factorization (the direct model's own,
 //!    [`ltdl_factor`]) and qdd = A^-1 (Gamma - H);
-//! 2. the inverse model's derivatives at (q, qd, qdd) (`idm_derivative_columns`);
-//! 3. `solve_columns`: each column replaced by -A^-1 times it, from the same factors;
-//! 4. A^-1 column by column from the same factors.
+//! 2. the inverse model's derivatives at (q, qd, qdd) (`world::idm_derivatives_world`);
+//! 3. `solve_columns`: A^-1 column by column from the same factors;
+//! 4. dqdd/dq = -A^-1 dGamma/dq and dqdd/dqd = -A^-1 dGamma/dqd as two matrix products.
 
-use super::inverse::idm_derivative_columns;
+use super::world::idm_derivatives_world;
 use super::{check_square, DerivativesData};
 use crate::algorithms::direct_dynamics::{ltdl_factor, ltdl_solve};
 use crate::algorithms::inertia_matrix::composite_inertia_matrix;
@@ -73,16 +73,35 @@ fn accelerations(
     check_finite_result("qdd", qdd)
 }
 
-/// Step 3: every column c of `m` replaced by `scale` A^-1 c, from the L'DL factors.
-fn solve_columns(model: &DynModel<f64>, factor: &DMatrix<f64>, m: &mut DMatrix<f64>, scale: f64) {
+/// Step 3: every column c of `m` replaced by A^-1 c, from the L'DL factors.
+fn solve_columns(model: &DynModel<f64>, factor: &DMatrix<f64>, m: &mut DMatrix<f64>) {
     let n = model.nl;
     if n == 0 {
         return;
     }
     for col in m.as_mut_slice().chunks_exact_mut(n) {
         ltdl_solve(model, factor, col);
-        if scale != 1.0 {
-            col.iter_mut().for_each(|x| *x *= scale);
+    }
+}
+
+/// Step 4: `out` = -A^-1 `b`, column by column, skipping the zeros of `b` (a tree's
+/// dGamma/dq has none only between ancestors and descendants). Allocation-free.
+fn neg_product(ainv: &DMatrix<f64>, b: &DMatrix<f64>, out: &mut DMatrix<f64>) {
+    let n = ainv.nrows();
+    if n == 0 {
+        return;
+    }
+    let a = ainv.as_slice();
+    for (oc, bc) in out
+        .as_mut_slice()
+        .chunks_exact_mut(n)
+        .zip(b.as_slice().chunks_exact(n))
+    {
+        oc.fill(0.0);
+        for (ak, &x) in a.chunks_exact(n).zip(bc) {
+            if x != 0.0 {
+                oc.iter_mut().zip(ak).for_each(|(o, y)| *o -= y * x);
+            }
         }
     }
 }
@@ -146,26 +165,19 @@ pub fn direct_dynamics_derivatives_into(
     accelerations(model, data, env, q, qd, tau, out.qdd.as_mut_slice())?;
     let DerivativesData {
         data: ws,
-        dir,
+        world,
+        dtau,
         factor,
         h,
         ..
     } = data;
     let state = (q, qd, out.qdd.as_slice());
-    idm_derivative_columns(
-        model,
-        ws,
-        dir,
-        env,
-        state,
-        h,
-        &mut out.dqdd_dq,
-        &mut out.dqdd_dqd,
-    );
-    solve_columns(model, factor, &mut out.dqdd_dq, -1.0);
-    solve_columns(model, factor, &mut out.dqdd_dqd, -1.0);
+    let [dq, dqd] = dtau;
+    idm_derivatives_world(model, ws, world, env, state, h, [dq, dqd], None);
     out.ainv.fill_with_identity();
-    solve_columns(model, factor, &mut out.ainv, 1.0);
+    solve_columns(model, factor, &mut out.ainv);
+    neg_product(&out.ainv, dq, &mut out.dqdd_dq);
+    neg_product(&out.ainv, dqd, &mut out.dqdd_dqd);
     check_finite_matrix("dqdd_dq", &out.dqdd_dq)?;
     check_finite_matrix("dqdd_dqd", &out.dqdd_dqd)?;
     check_finite_matrix("Ainv", &out.ainv)

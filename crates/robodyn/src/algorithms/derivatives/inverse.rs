@@ -17,8 +17,8 @@
 //! N restricted recursions: O(N d) link steps for N joints at depth at most d, O(N^2) for a
 //! chain.
 
+use super::world::idm_derivatives_world;
 use super::{check_square, DerivativesData, Tangent};
-use crate::algorithms::inertia_matrix::composite_inertia_matrix;
 use crate::algorithms::inverse_dynamics::{check_state, rnea_with_environment};
 use crate::batch::{count_rows, for_each_row};
 use crate::data::Data;
@@ -349,19 +349,18 @@ pub fn inverse_dynamics_derivatives_into(
     )?;
     let model = robot.dynamic();
     let DerivativesData {
-        data: ws, dir, h, ..
+        data: ws, world, h, ..
     } = data;
-    idm_derivative_columns(
+    idm_derivatives_world(
         model,
         ws,
-        dir,
+        world,
         env,
         (q, qd, qdd),
         h,
-        &mut out.dtau_dq,
-        &mut out.dtau_dqd,
+        [&mut out.dtau_dq, &mut out.dtau_dqd],
+        Some(&mut out.a),
     );
-    composite_inertia_matrix(model, ws, q, &mut out.a);
     check_finite_matrix("dtau_dq", &out.dtau_dq)?;
     check_finite_matrix("dtau_dqd", &out.dtau_dqd)?;
     check_finite_matrix("A", &out.a)

@@ -22,6 +22,7 @@
 pub mod direct;
 pub mod inverse;
 pub mod regressor;
+mod world;
 
 pub use direct::{direct_dynamics_derivatives, direct_dynamics_derivatives_into, DdmDerivatives};
 pub use inverse::{
@@ -73,6 +74,10 @@ pub struct DerivativesData {
     pub(crate) data: Data,
     /// Tangents along q_k ([0]) and qd_k ([1]) of the column k in progress.
     pub(crate) dir: [Tangent; 2],
+    /// The world-frame terms of [`world`], the kernel of the inverse and direct derivatives.
+    pub(crate) world: world::WorldTerms,
+    /// dGamma/dq and dGamma/dqd of the direct model's derivatives (N x N each).
+    pub(crate) dtau: [DMatrix<f64>; 2],
     /// A, then its L'DL factors (N x N).
     pub(crate) factor: DMatrix<f64>,
     /// N-vectors: the torques with qdd = 0 (H), a right-hand side.
@@ -88,6 +93,8 @@ impl DerivativesData {
         DerivativesData {
             data: Data::new(robot),
             dir: [Tangent::new(nl), Tangent::new(nl)],
+            world: world::WorldTerms::new(nl),
+            dtau: [DMatrix::zeros(n, n), DMatrix::zeros(n, n)],
             factor: DMatrix::zeros(n, n),
             h: vec![0.0; n],
             zeros: vec![0.0; n],
