@@ -42,6 +42,10 @@ pub struct KinematicsData {
     pub(crate) v: Vec<Vector3<f64>>,
     pub(crate) wd: Vec<Vector3<f64>>,
     pub(crate) a: Vec<Vector3<f64>>,
+    /// Per moving link 0..N: its joint's column of the World Jacobian, [O_k x z_k; z_k]
+    /// (revolute) or [z_k; 0] (prismatic), written with its placement (Pinocchio's `data.J` of
+    /// `computeJointJacobians`): every frame Jacobian is read from these.
+    pub(crate) col: Vec<[f64; 6]>,
     /// The q̈ of the last [`forward_kinematics_into`] (movable joints).
     pub(crate) qdd: Vec<f64>,
     /// The moving links from a frame to the base (scratch of the support-only pass).
@@ -71,6 +75,7 @@ impl KinematicsData {
             v: v(),
             wd: v(),
             a: v(),
+            col: vec![[0.0; 6]; n + 1],
             qdd: vec![0.0; n],
             chain: Vec::with_capacity(n + 1),
             body_m: vec![0.0; n + 1],
@@ -150,15 +155,25 @@ pub(crate) fn place_support(data: &mut KinematicsData, q: &[f64], f: &FrameId) {
     }
 }
 
-/// 0T_k = 0T_a(k) a(k)T_k for moving link k at joint value `qk`.
+/// 0T_k = 0T_a(k) a(k)T_k for moving link k at joint value `qk`, and its joint's World
+/// Jacobian column.
 #[inline(always)]
 fn place(data: &mut KinematicsData, k: usize, qk: f64) {
     let fc = data.tree.frame(k);
     let (r, p) = fc.placement(&qk);
     let a = fc.ant;
     let ra = data.rot[a];
-    data.pos[k] = data.pos[a] + ra * p;
-    data.rot[k] = mul_form(&ra, &r, fc.form());
+    let pos = data.pos[a] + ra * p;
+    let rot = mul_form(&ra, &r, fc.form());
+    let z = rot.column(2);
+    data.col[k] = if fc.joint == JointType::Revolute {
+        let l = pos.cross(&z);
+        [l.x, l.y, l.z, z.x, z.y, z.z]
+    } else {
+        [z.x, z.y, z.z, 0.0, 0.0, 0.0]
+    };
+    data.pos[k] = pos;
+    data.rot[k] = rot;
 }
 
 /// The forward kinematic model of every frame for a state over the movable joints (frame
