@@ -312,7 +312,7 @@ def main():
             ("inertia matrix vs crba upper only", "crba_full", ["crba_upper_local", "crba_upper_world"]),
             ("direct dynamics O(n) (aba)", "aba", ["aba_local", "aba_world"]),
             ("direct dynamics A^-1(tau - H)", "composite", ["composite_local", "composite_world"]),
-            ("all joints' Jacobians (robodyn: placements; Pinocchio: computeJointJacobians)",
+            ("all joints' Jacobians (robodyn: joint_jacobians_into; Pinocchio: computeJointJacobians)",
              "joint_jacobians", ["joint_jacobians"]),
             ("every joint's Jacobian read, WORLD (the above + one read per joint)",
              "all_frame_jacobians", ["all_frame_jacobians"]),

@@ -16,9 +16,10 @@
 
 use super::chain::Chain;
 use super::transform_of;
+use crate::algorithms::kinematics::mul_form;
 use crate::error::{Error, Result};
 use crate::geometry::Transform;
-use crate::model::Robot;
+use crate::model::{Robot, RotationForm};
 use nalgebra::{Matrix3, Matrix4, Vector3};
 
 /// Relative tolerance of the class detection (parallel axes, concurrent axes) and of the
@@ -165,6 +166,13 @@ impl Angle {
     }
 }
 
+/// atan2(y, x) of the `libm` crate (musl's, within an ulp): the solve's ~20 calls to glibc's
+/// correctly rounded atan2 (and its rounding-mode guards) were a third of its time.
+#[inline]
+fn atan2(y: f64, x: f64) -> f64 {
+    libm::atan2(y, x)
+}
+
 /// Roots of the type-2 equation X sin(theta) + Y cos(theta) = Z.
 #[derive(Clone, Copy, Debug)]
 enum Roots {
@@ -196,7 +204,7 @@ impl DotEquation {
         let rho = (x * x + y * y).sqrt();
         DotEquation {
             rho,
-            phi: x.atan2(y),
+            phi: atan2(x, y),
             cp: y / rho,
             sp: x / rho,
             azbz: a.z * b.z,
@@ -224,7 +232,7 @@ impl DotEquation {
         if 1.0 - cd.abs() <= 4.0 * f64::EPSILON {
             cd = cd.signum();
         }
-        let delta = cd.acos();
+        let delta = libm::acos(cd);
         // rounding in Z / rho moves a double root by ~sqrt(eps): the roots count as one when
         // they are within sqrt(CLOSED_FORM_TOLERANCE) of each other (or of a half turn apart)
         let singular = delta.min(std::f64::consts::PI - delta) <= CLOSED_FORM_TOLERANCE.sqrt();
@@ -254,7 +262,7 @@ fn angle_between(u: &Vector3<f64>, v: &Vector3<f64>, tol: f64) -> Option<Angle> 
     let (c, s) = (u.x * v.x + u.y * v.y, u.x * v.y - u.y * v.x);
     let r = (nu * nv).sqrt();
     Some(Angle {
-        th: s.atan2(c),
+        th: atan2(s, c),
         c: c / r,
         s: s / r,
     })
@@ -302,6 +310,8 @@ pub struct ClosedFormIgm {
     g: Vector3<f64>,
     p6: Vector3<f64>,
     wrist: DotEquation,
+    /// The sparsity of the rotations of C2 and C3 (their zeros skipped in the products).
+    forms: [RotationForm; 2],
 }
 
 /// A geometric line: a point and a unit direction.
@@ -422,6 +432,7 @@ impl ClosedFormIgm {
             arm: DotEquation::new(&c2.rot.tr_mul(&c2.pos), &point3),
             point3,
             wrist: DotEquation::new(&g, &p6),
+            forms: [RotationForm::of(&c2.rot), RotationForm::of(&chain.c[3].rot)],
             g,
             p6,
             chain,
@@ -511,7 +522,8 @@ impl ClosedFormIgm {
     fn a3c3(&self, th: &[Angle; 3]) -> Matrix3<f64> {
         let c = &self.chain.c;
         let r = th[1].right_of(&th[0].left_of(&c[1].rot));
-        th[2].right_of(&(r * c[2].rot)) * c[3].rot
+        let r = th[2].right_of(&mul_form(&r, &c[2].rot, self.forms[0]));
+        mul_form(&r, &c[3].rot, self.forms[1])
     }
 
     fn push(&self, th: &[f64; 6], singular: Singularity, out: &mut IgmSolutions) {
@@ -558,7 +570,7 @@ impl ClosedFormIgm {
                     // (Q^T r0 = C5^T (C4 Rz5)^T Rz4^T r0)
                     let r0 = r.column(0);
                     let u = c4r5.tr_mul(&th4.unturn(&r0.into_owned()));
-                    let th6 = c5.rot.column(1).dot(&u).atan2(c5.rot.column(0).dot(&u));
+                    let th6 = atan2(c5.rot.column(1).dot(&u), c5.rot.column(0).dot(&u));
                     let singular = Singularity {
                         shoulder: shoulder || s.shoulder,
                         elbow: s.elbow,
@@ -605,7 +617,7 @@ impl ClosedFormIgm {
                 };
                 for (th2, th3, s) in arm {
                     let n4 = self.a3c3(&[th1, th2, th3]).tr_mul(&a4.rot);
-                    let th4 = n4[(1, 0)].atan2(n4[(0, 0)]);
+                    let th4 = atan2(n4[(1, 0)], n4[(0, 0)]);
                     let singular = Singularity {
                         shoulder: shoulder || s.shoulder,
                         elbow: s.elbow,

@@ -43,9 +43,11 @@ pub struct KinematicsData {
     pub(crate) wd: Vec<Vector3<f64>>,
     pub(crate) a: Vec<Vector3<f64>>,
     /// Per moving link 0..N: its joint's column of the World Jacobian, [O_k x z_k; z_k]
-    /// (revolute) or [z_k; 0] (prismatic), written with its placement (Pinocchio's `data.J` of
-    /// `computeJointJacobians`): every frame Jacobian is read from these.
+    /// (revolute) or [z_k; 0] (prismatic), stored by [`joint_jacobians_into`] (Pinocchio's
+    /// `data.J` of `computeJointJacobians`), valid when `columns` holds; the frame Jacobians
+    /// read them then, and compute them from the placements otherwise.
     pub(crate) col: Vec<[f64; 6]>,
+    pub(crate) columns: bool,
     /// The q̈ of the last [`forward_kinematics_into`] (movable joints).
     pub(crate) qdd: Vec<f64>,
     /// The moving links from a frame to the base (scratch of the support-only pass).
@@ -76,6 +78,7 @@ impl KinematicsData {
             wd: v(),
             a: v(),
             col: vec![[0.0; 6]; n + 1],
+            columns: false,
             qdd: vec![0.0; n],
             chain: Vec::with_capacity(n + 1),
             body_m: vec![0.0; n + 1],
@@ -131,6 +134,7 @@ pub fn placements_into(robot: &Robot, data: &mut KinematicsData, q: &[f64]) -> R
     data.check(robot)?;
     robot.coordinates().check("q", q, "movable joints")?;
     data.level = Level::None;
+    data.columns = false;
     for k in 1..=data.tree.n() {
         place(data, k, q[k - 1]);
     }
@@ -138,11 +142,46 @@ pub fn placements_into(robot: &Robot, data: &mut KinematicsData, q: &[f64]) -> R
     Ok(())
 }
 
+/// [`placements_into`] that also stores every joint's column of the `World` Jacobian in the
+/// same pass (Pinocchio's `computeJointJacobians`): the frame Jacobians
+/// ([`frame_jacobian_into`](super::frame_jacobian_into)) are then copies of their support's
+/// columns (`World`) or these moved to the frame. After [`placements_into`] or
+/// [`forward_kinematics_into`] they compute the columns from the placements instead (same
+/// numbers). Allocation-free.
+///
+/// Errors: as [`placements_into`].
+pub fn joint_jacobians_into(robot: &Robot, data: &mut KinematicsData, q: &[f64]) -> Result<()> {
+    data.check(robot)?;
+    robot.coordinates().check("q", q, "movable joints")?;
+    data.level = Level::None;
+    for k in 1..=data.tree.n() {
+        place(data, k, q[k - 1]);
+        data.col[k] = world_column(data, k);
+    }
+    data.columns = true;
+    data.level = Level::Placements;
+    Ok(())
+}
+
+/// Joint k's column of the `World` Jacobian from its placement: [O_k x z_k; z_k] (revolute),
+/// [z_k; 0] (prismatic).
+#[inline(always)]
+pub(crate) fn world_column(data: &KinematicsData, k: usize) -> [f64; 6] {
+    let z = data.rot[k].column(2);
+    if data.tree.revolute[k] {
+        let l = data.pos[k].cross(&z);
+        [l.x, l.y, l.z, z.x, z.y, z.z]
+    } else {
+        [z.x, z.y, z.z, 0.0, 0.0, 0.0]
+    }
+}
+
 /// The placements of the moving links from the base to the one frame `f` is fixed on (its
 /// support: Pinocchio's `computeFrameJacobian` pass), into `data`. The other links keep older
 /// values, so `data` holds no full pass afterwards (its level is reset).
 pub(crate) fn place_support(data: &mut KinematicsData, q: &[f64], f: &FrameId) {
     data.level = Level::None;
+    data.columns = false;
     data.chain.clear();
     let mut k = data.tree.anchor[f.parent()].link;
     while k != 0 {
@@ -155,25 +194,15 @@ pub(crate) fn place_support(data: &mut KinematicsData, q: &[f64], f: &FrameId) {
     }
 }
 
-/// 0T_k = 0T_a(k) a(k)T_k for moving link k at joint value `qk`, and its joint's World
-/// Jacobian column.
+/// 0T_k = 0T_a(k) a(k)T_k for moving link k at joint value `qk`.
 #[inline(always)]
 fn place(data: &mut KinematicsData, k: usize, qk: f64) {
     let fc = data.tree.frame(k);
     let (r, p) = fc.placement(&qk);
     let a = fc.ant;
     let ra = data.rot[a];
-    let pos = data.pos[a] + ra * p;
-    let rot = mul_form(&ra, &r, fc.form());
-    let z = rot.column(2);
-    data.col[k] = if fc.joint == JointType::Revolute {
-        let l = pos.cross(&z);
-        [l.x, l.y, l.z, z.x, z.y, z.z]
-    } else {
-        [z.x, z.y, z.z, 0.0, 0.0, 0.0]
-    };
-    data.pos[k] = pos;
-    data.rot[k] = rot;
+    data.pos[k] = data.pos[a] + ra * p;
+    data.rot[k] = mul_form(&ra, &r, fc.form());
 }
 
 /// The forward kinematic model of every frame for a state over the movable joints (frame
@@ -218,6 +247,7 @@ pub fn forward_kinematics_into(
     c.check("qd", qd, "movable joints")?;
     c.check("qdd", qdd, "movable joints")?;
     data.level = Level::None;
+    data.columns = false;
     data.qdd.copy_from_slice(qdd);
     for k in 1..=data.tree.n() {
         place(data, k, q[k - 1]);

@@ -2,7 +2,9 @@
 //! order) in the three references, their time derivative J̇ and the classical drift J̇ q̇,
 //! read from the placements (and velocities) of a [`KinematicsData`].
 
-use super::forward::{frame_state, place_support, placement_of, FrameState, KinematicsData, Level};
+use super::forward::{
+    frame_state, place_support, placement_of, world_column, FrameState, KinematicsData, Level,
+};
 use super::frames::FrameId;
 use super::tree::{form_mul, form_mul_vector};
 use super::{Motion, Reference};
@@ -110,6 +112,16 @@ pub fn frame_jacobian_into(
     Ok(())
 }
 
+/// Joint j's column of the World Jacobian: stored by `joint_jacobians_into`, else computed.
+#[inline(always)]
+fn column(data: &KinematicsData, j: usize) -> [f64; 6] {
+    if data.columns {
+        data.col[j]
+    } else {
+        world_column(data, j)
+    }
+}
+
 /// The columns of the frame Jacobian from the World columns of its support (a copy in
 /// `World`; moved to the frame's origin, and turned into its axes for `Local`).
 fn write_jacobian(
@@ -124,14 +136,14 @@ fn write_jacobian(
     let mut j = data.tree.anchor[f.parent()].link;
     if reference == Reference::World {
         while j != 0 {
-            o[6 * (j - 1)..6 * j].copy_from_slice(&data.col[j]);
+            o[6 * (j - 1)..6 * j].copy_from_slice(&column(data, j));
             j = data.tree.parent[j];
         }
         return;
     }
     let t = placement_of(data, f);
     while j != 0 {
-        let c = &data.col[j];
+        let c = &column(data, j);
         let w = Vector3::new(c[3], c[4], c[5]);
         // the velocity of the body point at O_f from that at O_0: v + w x O_f
         let v = Vector3::new(c[0], c[1], c[2]) + w.cross(&t.pos);

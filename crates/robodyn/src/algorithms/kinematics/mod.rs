@@ -23,7 +23,7 @@ pub use com::{
 };
 pub use forward::{
     forward_kinematics_into, frame_acceleration, frame_classical_acceleration, frame_placement,
-    frame_velocity, placements_into, relative_placement, KinematicsData,
+    frame_velocity, joint_jacobians_into, placements_into, relative_placement, KinematicsData,
 };
 pub use frames::{rpy, tool_transform, FrameId};
 pub use jacobian::{
@@ -31,6 +31,8 @@ pub use jacobian::{
     frame_jacobian_time_variation_into,
 };
 pub use newton_euler::{frame_motion_from_newton_euler, NewtonEulerFrame};
+
+pub(crate) use tree::mul_form;
 
 use nalgebra::{Vector3, Vector6};
 

@@ -5,7 +5,7 @@
 //! [`KinematicsData`](super::KinematicsData) from the robot's constants.
 
 use crate::geometry::Transform;
-use crate::model::{FrameConstants, Robot, RotationForm};
+use crate::model::{FrameConstants, JointType, Robot, RotationForm};
 use nalgebra::{Matrix3, Vector3};
 
 /// Where a description frame is: on link `link` of the moving tree (0 the base) at the
@@ -28,6 +28,8 @@ pub(crate) struct MovingTree {
     /// Per link 0..N its antecedent (0 for the base itself): the support walks read this
     /// compact array, not the frame constants.
     pub parent: Vec<usize>,
+    /// Per link 0..N whether its joint is revolute (false for the base).
+    pub revolute: Vec<bool>,
     pub anchor: Vec<Anchor>,
     pub mass: Vec<f64>,
     pub ms: Vec<Vector3<f64>>,
@@ -54,9 +56,13 @@ impl MovingTree {
         let parent: Vec<usize> = std::iter::once(0)
             .chain(frames.iter().map(|fc| fc.ant))
             .collect();
+        let revolute: Vec<bool> = std::iter::once(false)
+            .chain(frames.iter().map(|fc| fc.joint == JointType::Revolute))
+            .collect();
         let mut tree = MovingTree {
             frames,
             parent,
+            revolute,
             anchor,
             mass: vec![0.0; c.len() + 1],
             ms: vec![Vector3::zeros(); c.len() + 1],
