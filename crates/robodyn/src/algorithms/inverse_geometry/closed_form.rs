@@ -16,10 +16,9 @@
 
 use super::chain::Chain;
 use super::transform_of;
-use crate::algorithms::kinematics::mul_form;
 use crate::error::{Error, Result};
 use crate::geometry::Transform;
-use crate::model::{Robot, RotationForm};
+use crate::model::Robot;
 use nalgebra::{Matrix3, Matrix4, Vector3};
 
 /// Relative tolerance of the class detection (parallel axes, concurrent axes) and of the
@@ -310,8 +309,6 @@ pub struct ClosedFormIgm {
     g: Vector3<f64>,
     p6: Vector3<f64>,
     wrist: DotEquation,
-    /// The sparsity of the rotations of C2 and C3 (their zeros skipped in the products).
-    forms: [RotationForm; 2],
 }
 
 /// A geometric line: a point and a unit direction.
@@ -432,7 +429,6 @@ impl ClosedFormIgm {
             arm: DotEquation::new(&c2.rot.tr_mul(&c2.pos), &point3),
             point3,
             wrist: DotEquation::new(&g, &p6),
-            forms: [RotationForm::of(&c2.rot), RotationForm::of(&chain.c[3].rot)],
             g,
             p6,
             chain,
@@ -522,8 +518,7 @@ impl ClosedFormIgm {
     fn a3c3(&self, th: &[Angle; 3]) -> Matrix3<f64> {
         let c = &self.chain.c;
         let r = th[1].right_of(&th[0].left_of(&c[1].rot));
-        let r = th[2].right_of(&mul_form(&r, &c[2].rot, self.forms[0]));
-        mul_form(&r, &c[3].rot, self.forms[1])
+        th[2].right_of(&(r * c[2].rot)) * c[3].rot
     }
 
     fn push(&self, th: &[f64; 6], singular: Singularity, out: &mut IgmSolutions) {

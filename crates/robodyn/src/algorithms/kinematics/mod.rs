@@ -32,8 +32,6 @@ pub use jacobian::{
 };
 pub use newton_euler::{frame_motion_from_newton_euler, NewtonEulerFrame};
 
-pub(crate) use tree::mul_form;
-
 use nalgebra::{Vector3, Vector6};
 
 /// Where a velocity, an acceleration or a Jacobian is expressed, named as Pinocchio's
