@@ -24,8 +24,8 @@ use robodyn::algorithms::kinematics::center_of_mass_jacobian_into;
 use robodyn::model::param;
 use robodyn::{
     direct_dynamics_into, frame_jacobian_from_q_into, frame_jacobian_into, inertia_matrix_into,
-    inverse_dynamics_into, placements_into, Data, FrameId, KinematicsData, Method, Reference,
-    Robot,
+    inverse_dynamics_into, joint_jacobians_into, placements_into, Data, FrameId, KinematicsData,
+    Method, Reference, Robot,
 };
 use std::fmt::Write as _;
 use std::hint::black_box;
@@ -273,11 +273,11 @@ fn main() -> Result<(), Error> {
         black_box(&out);
     });
     time("joint_jacobians", &states, samples, target_us, |s| {
-        placements_into(&robot, &mut kin, black_box(&s.q)).unwrap();
+        joint_jacobians_into(&robot, &mut kin, black_box(&s.q)).unwrap();
         black_box(&kin);
     });
     time("all_frame_jacobians", &states, samples, target_us, |s| {
-        placements_into(&robot, &mut kin, black_box(&s.q)).unwrap();
+        joint_jacobians_into(&robot, &mut kin, black_box(&s.q)).unwrap();
         for f in &frames {
             frame_jacobian_into(&robot, &kin, f, Reference::World, &mut jac).unwrap();
             black_box(&jac);

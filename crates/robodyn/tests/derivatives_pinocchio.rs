@@ -23,10 +23,10 @@ use robodyn::{
 use robodyn_testing as testing;
 use serde_json::{json, Value};
 use std::path::Path;
-use std::process::Command;
 
 mod common;
-use common::{example_robot_data, find_file, python};
+use common::pinocchio::{by_name, joint_indices, robot_entry, run_script};
+use common::{example_robot_data, find_file};
 
 const ROBOTS: [(&str, usize); 3] = [
     ("ur5_robot.urdf", 100),
@@ -52,43 +52,23 @@ fn friction(robot: &Robot, qd: &[f64]) -> (Vec<f64>, Vec<f64>) {
 }
 
 fn reference(cases: &[Case], dir: &Path) -> Value {
-    let mut spec = Vec::new();
-    for c in cases {
-        let coords = c.robot.coordinates();
-        let by_name = |v: &[f64]| -> Value {
-            (0..coords.len())
-                .map(|k| (coords.name(k).to_string(), json!(v[k])))
-                .collect::<serde_json::Map<_, _>>()
-                .into()
-        };
-        let states: Vec<Value> = c
-            .states
-            .iter()
-            .map(|[q, qd, qdd, tau]| {
-                let (fr, _) = friction(&c.robot, qd);
-                let pin_tau: Vec<f64> = tau.iter().zip(&fr).map(|(t, f)| t - f).collect();
-                json!({"q": by_name(q), "qd": by_name(qd), "qdd": by_name(qdd),
-                       "tau": by_name(&pin_tau)})
-            })
-            .collect();
-        let path = find_file(dir, c.name).unwrap_or_else(|| panic!("{} not found", c.name));
-        spec.push(json!({"urdf": path, "states": states}));
-    }
-    let tmp = std::env::temp_dir().join(format!("robodyn_pin_deriv_{}", std::process::id()));
-    std::fs::create_dir_all(&tmp).unwrap();
-    let (inp, outp) = (tmp.join("in.json"), tmp.join("out.json"));
-    std::fs::write(&inp, json!({ "robots": spec }).to_string()).unwrap();
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/pinocchio_derivatives.py");
-    let st = Command::new(python())
-        .arg(&script)
-        .arg(&inp)
-        .arg(&outp)
-        .status()
-        .unwrap();
-    assert!(st.success(), "pinocchio script failed");
-    let res: Value = serde_json::from_str(&std::fs::read_to_string(&outp).unwrap()).unwrap();
-    let _ = std::fs::remove_dir_all(&tmp);
-    res
+    let robots = cases
+        .iter()
+        .map(|c| {
+            let pin = |v: &[f64]| by_name(&c.robot, v);
+            let states = c
+                .states
+                .iter()
+                .map(|[q, qd, qdd, tau]| {
+                    let (fr, _) = friction(&c.robot, qd);
+                    let pin_tau: Vec<f64> = tau.iter().zip(&fr).map(|(t, f)| t - f).collect();
+                    json!({"q": pin(q), "qd": pin(qd), "qdd": pin(qdd), "tau": pin(&pin_tau)})
+                })
+                .collect();
+            robot_entry(dir, c.name, states)
+        })
+        .collect();
+    run_script("pinocchio_derivatives.py", robots)
 }
 
 /// A JSON matrix in Pinocchio's v order, rows and columns moved to the robot's joint order.
@@ -160,12 +140,7 @@ fn derivatives_match_pinocchio_on_ur5_panda_talos() {
             "{}",
             c.name
         );
-        let perm: Vec<usize> = r["joints"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|j| robot.coordinates().index_of(j.as_str().unwrap()).unwrap())
-            .collect();
+        let perm = joint_indices(robot, &r["joints"]);
         let env = robot.environment();
         let mut data = DerivativesData::new(robot);
         let mut idm = IdmDerivatives::new(robot);

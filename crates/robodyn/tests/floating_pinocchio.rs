@@ -21,10 +21,10 @@ use robodyn::{Robot, State};
 use robodyn_testing as testing;
 use serde_json::{json, Value};
 use std::path::Path;
-use std::process::Command;
 
 mod common;
-use common::{example_robot_data, find_file, python};
+use common::pinocchio::{by_name, joint_indices, numbers, robot_entry, run_script};
+use common::{example_robot_data, find_file};
 
 const ROBOTS: [&str; 3] = ["talos_full_v2.urdf", "hyq_no_sensors.urdf", "solo12.urdf"];
 const STATES: usize = 1000;
@@ -62,49 +62,22 @@ fn random_state<R: Rng>(rng: &mut R, robot: &Robot) -> [Vec<f64>; 4] {
 type Case = (&'static str, Robot, Vec<[Vec<f64>; 4]>);
 
 fn pinocchio_reference(cases: &[Case], dir: &Path) -> Value {
-    let mut spec = Vec::new();
-    for (name, robot, states) in cases {
-        let coords = robot.coordinates();
-        let by_name = |v: &[f64]| -> Value {
-            (0..coords.len())
-                .map(|k| (coords.name(k).to_string(), json!(v[k])))
-                .collect::<serde_json::Map<_, _>>()
-                .into()
-        };
-        let states: Vec<Value> = states
-            .iter()
-            .map(|[q, v, a, t]| {
-                json!({"base_q": &q[..7], "base_v": &v[..6], "base_a": &a[..6],
-                       "base_tau": &t[..6], "q": by_name(&q[7..]), "v": by_name(&v[6..]),
-                       "a": by_name(&a[6..]), "tau": by_name(&t[6..])})
-            })
-            .collect();
-        let path = find_file(dir, name).unwrap_or_else(|| panic!("{name} not found"));
-        spec.push(json!({"urdf": path, "states": states}));
-    }
-    let tmp = std::env::temp_dir().join(format!("robodyn_pin_float_{}", std::process::id()));
-    std::fs::create_dir_all(&tmp).unwrap();
-    let (inp, outp) = (tmp.join("in.json"), tmp.join("out.json"));
-    std::fs::write(&inp, json!({ "robots": spec }).to_string()).unwrap();
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/pinocchio_floating.py");
-    let st = Command::new(python())
-        .arg(&script)
-        .arg(&inp)
-        .arg(&outp)
-        .status()
-        .unwrap();
-    assert!(st.success(), "pinocchio script failed");
-    let res: Value = serde_json::from_str(&std::fs::read_to_string(&outp).unwrap()).unwrap();
-    let _ = std::fs::remove_dir_all(&tmp);
-    res
-}
-
-fn vector(v: &Value) -> Vec<f64> {
-    v.as_array()
-        .unwrap()
+    let robots = cases
         .iter()
-        .map(|x| x.as_f64().unwrap())
-        .collect()
+        .map(|(name, robot, states)| {
+            let pin = |v: &[f64]| by_name(robot, v);
+            let states = states
+                .iter()
+                .map(|[q, v, a, t]| {
+                    json!({"base_q": &q[..7], "base_v": &v[..6], "base_a": &a[..6],
+                           "base_tau": &t[..6], "q": pin(&q[7..]), "v": pin(&v[6..]),
+                           "a": pin(&a[6..]), "tau": pin(&t[6..])})
+                })
+                .collect();
+            robot_entry(dir, name, states)
+        })
+        .collect();
+    run_script("pinocchio_floating.py", robots)
 }
 
 /// Pinocchio's nv vector in robodyn's order (`perm[p]`: robodyn index of Pinocchio entry p).
@@ -163,9 +136,7 @@ fn floating_dynamics_match_pinocchio_free_flyer() {
         let nv = robot.nv();
         assert_eq!(r["nv"].as_u64().unwrap() as usize, nv, "{name}: nv");
         let mut perm: Vec<usize> = (0..6).collect();
-        for j in r["joints"].as_array().unwrap() {
-            perm.push(6 + robot.coordinates().index_of(j.as_str().unwrap()).unwrap());
-        }
+        perm.extend(joint_indices(robot, &r["joints"]).iter().map(|k| 6 + k));
         let mass: f64 = robot.floating_base().unwrap().body.mass
             + (1..=robot.dof())
                 .map(|k| robot.dynamic().link(k).mass)
@@ -192,7 +163,7 @@ fn floating_dynamics_match_pinocchio_free_flyer() {
             // inverse dynamics
             let state = State { q, qd: v, qdd: a };
             robodyn::inverse_dynamics_state_into(robot, &mut data, env, state, &mut tau).unwrap();
-            let pin_tau: Vec<f64> = reorder(&vector(&p["rnea"]), &perm)
+            let pin_tau: Vec<f64> = reorder(&numbers(&p["rnea"]), &perm)
                 .iter()
                 .zip(&fr)
                 .map(|(x, f)| x + f)
@@ -205,7 +176,7 @@ fn floating_dynamics_match_pinocchio_free_flyer() {
             let rows = p["crba"].as_array().unwrap();
             let mut pin_m = DMatrix::zeros(nv, nv);
             for (pr, row) in rows.iter().enumerate() {
-                for (pc, x) in vector(row).into_iter().enumerate() {
+                for (pc, x) in numbers(row).into_iter().enumerate() {
                     pin_m[(perm[pr], perm[pc])] = x;
                 }
             }
@@ -213,7 +184,7 @@ fn floating_dynamics_match_pinocchio_free_flyer() {
             worst[1] = worst[1].max(e);
             assert!(e <= TOL, "{ctx}: crba differs by {e:e}");
             // direct dynamics, both methods, torques with our joint friction added
-            let pin_a = reorder(&vector(&p["aba"]), &perm);
+            let pin_a = reorder(&numbers(&p["aba"]), &perm);
             let tr: Vec<f64> = t.iter().zip(&fr).map(|(x, f)| x + f).collect();
             for (m, w) in [(Method::Composite, 2), (Method::ArticulatedBody, 3)] {
                 direct_dynamics_into(robot, &mut data, env, q, v, &tr, m, &mut qdd).unwrap();
@@ -224,15 +195,15 @@ fn floating_dynamics_match_pinocchio_free_flyer() {
             // centroidal momentum and centre of mass (world frame)
             let c = centroidal_momentum(robot, &mut data, q, v).unwrap();
             let ours: Vec<f64> = c.linear.iter().chain(c.angular.iter()).copied().collect();
-            let e = rel_gap(&ours, &vector(&p["hg"]));
+            let e = rel_gap(&ours, &numbers(&p["hg"]));
             worst[4] = worst[4].max(e);
             assert!(e <= TOL, "{ctx}: centroidal momentum differs by {e:e}");
-            let e = rel_gap(c.com.as_slice(), &vector(&p["com"]));
+            let e = rel_gap(c.com.as_slice(), &numbers(&p["com"]));
             assert!(e <= TOL, "{ctx}: centre of mass differs by {e:e}");
             assert!((c.mass - mass).abs() < 1e-9 * mass);
             // integration on SE(3): the base pose after 0.01 s at v (quaternion up to sign)
             let next = integrate(robot, q, v, 0.01).unwrap();
-            let pin_next = vector(&p["integrate"]);
+            let pin_next = numbers(&p["integrate"]);
             let sign = if next[6] * pin_next[6] < 0.0 {
                 -1.0
             } else {

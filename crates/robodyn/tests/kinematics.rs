@@ -21,8 +21,8 @@ use robodyn::geometry::Transform;
 use robodyn::{
     forward_kinematics_into, frame_acceleration, frame_classical_acceleration,
     frame_classical_drift, frame_jacobian, frame_jacobian_from_q_into, frame_jacobian_into,
-    frame_jacobian_time_variation_into, frame_placement, frame_velocity, placements_into,
-    relative_placement, Error, FrameId, KinematicsData, Motion, Reference, Robot,
+    frame_jacobian_time_variation_into, frame_placement, frame_velocity, joint_jacobians_into,
+    placements_into, relative_placement, Error, FrameId, KinematicsData, Motion, Reference, Robot,
 };
 use robodyn_testing as testing;
 
@@ -116,6 +116,13 @@ fn check_robot(label: &str, robot: &Robot, s: &[Vec<f64>; 3], rng: &mut impl ran
     let mut js = DMatrix::zeros(6, n);
     // a data holding another state: the support-only pass must not read its other links
     let mut stale = fk(robot, &at(s, 0.3));
+    // the World columns stored by joint_jacobians_into (read as copies), and a data whose
+    // stored columns are of another state, then placed at this one (they must not be read)
+    let mut dj = KinematicsData::new(robot);
+    joint_jacobians_into(robot, &mut dj, &s[0]).unwrap();
+    let mut old_columns = KinematicsData::new(robot);
+    joint_jacobians_into(robot, &mut old_columns, &at(s, 0.3)[0]).unwrap();
+    placements_into(robot, &mut old_columns, &s[0]).unwrap();
     let qd = nalgebra::DVector::from_column_slice(&s[1]);
     let qdd = nalgebra::DVector::from_column_slice(&s[2]);
     for (fi, f) in frames(robot, rng).iter().enumerate() {
@@ -130,6 +137,13 @@ fn check_robot(label: &str, robot: &Robot, s: &[Vec<f64>; 3], rng: &mut impl ran
                 (&js - &jac).amax() <= 1e-15 * jac.amax().max(1.0),
                 "{ctx}: support-only J"
             );
+            for (what, d) in [
+                ("stored columns", &dj),
+                ("columns of another state", &old_columns),
+            ] {
+                frame_jacobian_into(robot, d, f, r, &mut js).unwrap();
+                assert_eq!(js, jac, "{ctx}: J after {what}");
+            }
             assert!(
                 frame_placement(robot, &stale, f).is_err(),
                 "{ctx}: level reset"

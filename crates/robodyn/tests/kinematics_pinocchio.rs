@@ -23,17 +23,17 @@ use robodyn::{
 use robodyn_testing as testing;
 use serde_json::{json, Value};
 use std::path::Path;
-use std::process::Command;
 
 mod common;
-use common::{example_robot_data, find_file, python};
+use common::pinocchio::{by_name, joint_indices, numbers, robot_entry, run_script};
+use common::{example_robot_data, find_file};
 
-/// States per robot: 1000 on UR5 and Panda, 300 on Talos (44 joints, 60 links: its JSON
-/// reference is the largest part of the test's time).
+/// States per robot: 1000 on each (Talos's JSON reference, 44 joints and 60 links, is the
+/// largest part of the test's time).
 const ROBOTS: [(&str, usize); 3] = [
     ("ur5_robot.urdf", 1000),
     ("panda.urdf", 1000),
-    ("talos_full_v2.urdf", 300),
+    ("talos_full_v2.urdf", 1000),
 ];
 
 /// The URDF link names of a robot loaded by robodyn: its links (auxiliary frames' excepted)
@@ -63,41 +63,20 @@ struct Case {
 }
 
 fn pinocchio_reference(cases: &[Case], dir: &Path) -> Value {
-    let mut spec = Vec::new();
-    for c in cases {
-        let coords = c.robot.coordinates();
-        let by_name = |v: &[f64]| -> Value {
-            (0..coords.len())
-                .map(|k| (coords.name(k).to_string(), json!(v[k])))
-                .collect::<serde_json::Map<_, _>>()
-                .into()
-        };
-        let states: Vec<Value> = c
-            .states
-            .iter()
-            .zip(&c.frames)
-            .map(|([q, qd, qdd], f)| {
-                json!({"q": by_name(q), "qd": by_name(qd), "qdd": by_name(qdd), "frame": f})
-            })
-            .collect();
-        let path = find_file(dir, c.name).unwrap_or_else(|| panic!("{} not found", c.name));
-        spec.push(json!({"urdf": path, "states": states}));
-    }
-    let tmp = std::env::temp_dir().join(format!("robodyn_pin_kin_{}", std::process::id()));
-    std::fs::create_dir_all(&tmp).unwrap();
-    let (inp, outp) = (tmp.join("in.json"), tmp.join("out.json"));
-    std::fs::write(&inp, json!({ "robots": spec }).to_string()).unwrap();
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/pinocchio_kinematics.py");
-    let st = Command::new(python())
-        .arg(&script)
-        .arg(&inp)
-        .arg(&outp)
-        .status()
-        .unwrap();
-    assert!(st.success(), "pinocchio script failed");
-    let res: Value = serde_json::from_str(&std::fs::read_to_string(&outp).unwrap()).unwrap();
-    let _ = std::fs::remove_dir_all(&tmp);
-    res
+    let robots = cases
+        .iter()
+        .map(|c| {
+            let pin = |v: &[f64]| by_name(&c.robot, v);
+            let states = c
+                .states
+                .iter()
+                .zip(&c.frames)
+                .map(|([q, qd, qdd], f)| json!({"q": pin(q), "qd": pin(qd), "qdd": pin(qdd), "frame": f}))
+                .collect();
+            robot_entry(dir, c.name, states)
+        })
+        .collect();
+    run_script("pinocchio_kinematics.py", robots)
 }
 
 /// A JSON matrix (rows of numbers) with its columns reordered from Pinocchio's v order to the
@@ -112,14 +91,6 @@ fn matrix(v: &Value, cols: &[usize]) -> DMatrix<f64> {
         }
     }
     m
-}
-
-fn vector(v: &Value) -> Vec<f64> {
-    v.as_array()
-        .unwrap()
-        .iter()
-        .map(|x| x.as_f64().unwrap())
-        .collect()
 }
 
 /// The largest |a - b| over the entries, with the scale max(1, max |b|).
@@ -181,12 +152,7 @@ fn frames_jacobians_accelerations_and_com_match_pinocchio() {
         let robot = &c.robot;
         let n = robot.dof();
         assert_eq!(r["nv"].as_u64().unwrap() as usize, n, "{}: nv", c.name);
-        let cols: Vec<usize> = r["joints"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|j| robot.coordinates().index_of(j.as_str().unwrap()).unwrap())
-            .collect();
+        let cols = joint_indices(robot, &r["joints"]);
         let mass = total_mass(robot);
         assert!(mass > 1.0, "{}: mass {mass}", c.name);
         worst.check(
@@ -228,7 +194,7 @@ fn frames_jacobians_accelerations_and_com_match_pinocchio() {
                     &format!("{ctx}, {key}"),
                 );
                 let a = frame_classical_acceleration(robot, &data, &f, rf).unwrap();
-                let pa = vector(&p["acc"][key]);
+                let pa = numbers(&p["acc"][key]);
                 worst.check(
                     "acc",
                     a.to_vector().as_slice(),
@@ -241,21 +207,21 @@ fn frames_jacobians_accelerations_and_com_match_pinocchio() {
             worst.check(
                 "com",
                 com.position.as_slice(),
-                &vector(&p["com"]),
+                &numbers(&p["com"]),
                 false,
                 &ctx,
             );
             worst.check(
                 "vcom",
                 com.velocity.as_slice(),
-                &vector(&p["vcom"]),
+                &numbers(&p["vcom"]),
                 true,
                 &ctx,
             );
             worst.check(
                 "acom",
                 com.acceleration.as_slice(),
-                &vector(&p["acom"]),
+                &numbers(&p["acom"]),
                 true,
                 &ctx,
             );

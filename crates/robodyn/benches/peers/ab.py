@@ -2,11 +2,13 @@
 """Paired A/B timing of robodyn's kernels: this tree against another commit. NOT run by CI.
 
     python3 crates/robodyn/benches/peers/ab.py --base <commit> [--rounds 21] [--robots ur5,panda,talos]
+                                               [--base-exe <peer_timing built at that commit>]
 
 Why: a refactoring must not slow the kernels, and on a shared VM whose speed changes by up to 2x
 within seconds only back-to-back pairs can show it. What it does:
 1. `git worktree add` of <commit> under target/peers/ab-base (kept for the next run), and the
-   same `peer_timing` example built in both trees (--release, target-cpu=native).
+   same `peer_timing` example built in both trees (--release, target-cpu=native); `--base-exe`
+   names a binary built at <commit> instead (no second build on a busy machine).
 2. The states of run.py (Pinocchio's URDF parser, seed 1) for each robot; both builds must give
    the same results on them (max relative difference 1e-12), else no timing.
 3. Rounds pinned to one core (`taskset -c 1`): per robot, base then this tree (order swapped every
@@ -25,7 +27,8 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 import run as peers  # noqa: E402
 
-ALGORITHMS = ["rnea", "crba_full", "aba", "composite"]
+ALGORITHMS = ["rnea", "crba_full", "aba", "composite", "joint_jacobians", "all_frame_jacobians",
+              "frame_jacobian", "com_jacobian"]
 
 
 def build(root, target):
@@ -47,6 +50,7 @@ def base_tree(commit):
 def main():
     ap = peers.arg_parser(__doc__, "ur5,panda,talos")
     ap.add_argument("--base", required=True, help="the commit to compare against")
+    ap.add_argument("--base-exe", help="a peer_timing binary already built at --base (skips its build)")
     args = ap.parse_args()
     import pinocchio as pin
     import numpy as np
@@ -56,7 +60,7 @@ def main():
     robots = [r.strip() for r in args.robots.split(",")]
     print(f"building peer_timing at {args.base} and in this tree...", flush=True)
     exes = {
-        "base": build(base_tree(args.base), os.path.join(peers.BUILD, "ab-base-target")),
+        "base": args.base_exe or build(base_tree(args.base), os.path.join(peers.BUILD, "ab-base-target")),
         "this": build(peers.ROOT, os.path.join(peers.BUILD, "cargo")),
     }
     files = {}
@@ -65,13 +69,15 @@ def main():
         model = pin.buildModelFromUrdf(urdf)
         sfile = os.path.join(peers.BUILD, f"{key}.states")
         peers.write_states(pin, model, sfile)
-        files[key] = (urdf, sfile)
+        tip = peers.tip_name(model)
+        files[key] = (urdf, sfile, tip)
         res = {}
         for side, exe in exes.items():
             out = os.path.join(peers.BUILD, f"{key}.ab-{side}.results")
-            peers.run([exe, urdf, sfile, out, "--samples", "1", "--target-us", "1"], capture_output=True)
+            peers.run([exe, urdf, sfile, out, "--samples", "1", "--target-us", "1", "--tip", tip],
+                      capture_output=True)
             res[side] = peers.read_results(out)
-        for alg in ("rnea", "crba", "aba", "composite"):
+        for alg in ("rnea", "crba", "aba", "composite", "jac", "com"):
             a, b = res["this"][alg], res["base"][alg]
             rel = np.abs(a - b).max() / max(1.0, np.abs(b).max())
             if rel > 1e-12:
@@ -79,8 +85,8 @@ def main():
     opts = ["--samples", str(args.samples)]
 
     def sides(key):
-        urdf, sfile = files[key]
-        return [(side, [exe, urdf, sfile, os.devnull, *opts]) for side, exe in exes.items()]
+        urdf, sfile, tip = files[key]
+        return [(side, [exe, urdf, sfile, os.devnull, *opts, "--tip", tip]) for side, exe in exes.items()]
 
     times = peers.interleaved(args.rounds, robots, sides)
     print()

@@ -177,6 +177,13 @@ def build_robodyn():
     return os.path.join(BUILD, "cargo", "release", "examples", "peer_timing")
 
 
+def tip_name(model):
+    """The frame of the one-frame Jacobian: the last joint's child link (its frame is that
+    joint's frame, Pinocchio's joint frame)."""
+    return next(f.name for f in model.frames
+                if f.parentJoint == model.njoints - 1 and str(f.type) == "BODY")
+
+
 def read_results(path):
     out = {}
     with open(path) as fh:
@@ -258,9 +265,7 @@ def main():
         dump_model(model, mfile)
         write_states(pin, model, sfile)
         merged_urdf(pin, model, merged)
-        # the last joint's child link: its frame is that joint's frame (Pinocchio's joint frame)
-        tip = next(f.name for f in model.frames
-                   if f.parentJoint == model.njoints - 1 and str(f.type) == "BODY")
+        tip = tip_name(model)
         files[key] = (urdf, mfile, sfile, model.nv, merged)
         tips[key] = tip
 
@@ -307,7 +312,7 @@ def main():
             ("inertia matrix vs crba upper only", "crba_full", ["crba_upper_local", "crba_upper_world"]),
             ("direct dynamics O(n) (aba)", "aba", ["aba_local", "aba_world"]),
             ("direct dynamics A^-1(tau - H)", "composite", ["composite_local", "composite_world"]),
-            ("all joints' Jacobians (robodyn: placements; Pinocchio: computeJointJacobians)",
+            ("all joints' Jacobians (robodyn: joint_jacobians_into; Pinocchio: computeJointJacobians)",
              "joint_jacobians", ["joint_jacobians"]),
             ("every joint's Jacobian read, WORLD (the above + one read per joint)",
              "all_frame_jacobians", ["all_frame_jacobians"]),

@@ -6,6 +6,8 @@ use robodyn::Robot;
 use std::f64::consts::{FRAC_PI_2, PI};
 use std::path::PathBuf;
 
+pub mod pinocchio;
+
 /// Largest gap between each cut frame and its twin (rotation and position) at a solution, from
 /// the geometric model 0T_j (frames 1..NJ with the cut-joint variables).
 pub fn closure_gap(

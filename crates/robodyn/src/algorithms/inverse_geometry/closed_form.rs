@@ -122,10 +122,35 @@ impl Angle {
         Angle { th, c, s }
     }
 
-    /// Rz(theta).
+    /// Rz(theta) v.
     #[inline]
-    fn rot(&self) -> Matrix3<f64> {
-        Matrix3::new(self.c, -self.s, 0.0, self.s, self.c, 0.0, 0.0, 0.0, 1.0)
+    fn turn(&self, v: &Vector3<f64>) -> Vector3<f64> {
+        Vector3::new(
+            self.c * v.x - self.s * v.y,
+            self.s * v.x + self.c * v.y,
+            v.z,
+        )
+    }
+
+    /// Rz(theta)^T v.
+    #[inline]
+    fn unturn(&self, v: &Vector3<f64>) -> Vector3<f64> {
+        Vector3::new(
+            self.c * v.x + self.s * v.y,
+            self.c * v.y - self.s * v.x,
+            v.z,
+        )
+    }
+
+    /// Rz(theta) m (12 products: rows [c x - s y, s x + c y, z] for the rows x, y, z of m).
+    #[inline]
+    fn left_of(&self, m: &Matrix3<f64>) -> Matrix3<f64> {
+        let (x, y) = (m.row(0), m.row(1));
+        Matrix3::from_rows(&[
+            x * self.c - y * self.s,
+            x * self.s + y * self.c,
+            m.row(2).into_owned(),
+        ])
     }
 
     /// m Rz(theta) (12 products: [c x + s y, c y - s x, z] for the columns x, y, z of m).
@@ -140,6 +165,13 @@ impl Angle {
     }
 }
 
+/// atan2(y, x) of the `libm` crate (musl's, within an ulp): the solve's ~20 calls to glibc's
+/// correctly rounded atan2 (and its rounding-mode guards) were a third of its time.
+#[inline]
+fn atan2(y: f64, x: f64) -> f64 {
+    libm::atan2(y, x)
+}
+
 /// Roots of the type-2 equation X sin(theta) + Y cos(theta) = Z.
 #[derive(Clone, Copy, Debug)]
 enum Roots {
@@ -151,50 +183,73 @@ enum Roots {
     None,
 }
 
-/// theta with a . Rz(theta) b = k (a type-2 equation of Paul's method): X = a_y b_x - a_x b_y,
-/// Y = a_x b_x + a_y b_y, Z = k - a_z b_z; `tol` is the tolerance on Z (units of k) for
-/// X = Y = 0 and for |Z| beyond sqrt(X^2 + Y^2). theta = phi ± delta with phi = atan2(X, Y)
-/// and cos(delta) = Z / rho, their cosines and sines from X / rho, Y / rho and cos(delta).
-fn solve_dot(a: &Vector3<f64>, b: &Vector3<f64>, k: f64, tol: f64) -> Roots {
-    let x = a.y * b.x - a.x * b.y;
-    let y = a.x * b.x + a.y * b.y;
-    let z = k - a.z * b.z;
-    let rho = (x * x + y * y).sqrt();
-    if rho <= tol {
-        return if z.abs() <= tol {
-            Roots::Any
-        } else {
-            Roots::None
+/// The type-2 equation a . Rz(theta) b = k of Paul's method for fixed a, b: X = a_y b_x -
+/// a_x b_y, Y = a_x b_x + a_y b_y and Z = k - a_z b_z, so that rho = sqrt(X^2 + Y^2), phi =
+/// atan2(X, Y) and its cosine and sine are found once (at model build when a and b are
+/// constants) and each k costs one acos.
+#[derive(Clone, Copy, Debug)]
+struct DotEquation {
+    rho: f64,
+    phi: f64,
+    cp: f64,
+    sp: f64,
+    azbz: f64,
+}
+
+impl DotEquation {
+    fn new(a: &Vector3<f64>, b: &Vector3<f64>) -> DotEquation {
+        let x = a.y * b.x - a.x * b.y;
+        let y = a.x * b.x + a.y * b.y;
+        let rho = (x * x + y * y).sqrt();
+        DotEquation {
+            rho,
+            phi: atan2(x, y),
+            cp: y / rho,
+            sp: x / rho,
+            azbz: a.z * b.z,
+        }
+    }
+
+    /// theta with a . Rz(theta) b = k; `tol` is the tolerance on Z (units of k) for X = Y = 0
+    /// and for |Z| beyond rho. theta = phi ± delta with cos(delta) = Z / rho, their cosines and
+    /// sines from X / rho, Y / rho and cos(delta).
+    fn roots(&self, k: f64, tol: f64) -> Roots {
+        let (rho, z) = (self.rho, k - self.azbz);
+        if rho <= tol {
+            return if z.abs() <= tol {
+                Roots::Any
+            } else {
+                Roots::None
+            };
+        }
+        if z.abs() > rho + tol {
+            return Roots::None;
+        }
+        let mut cd = (z / rho).clamp(-1.0, 1.0);
+        // a double root: cos(delta) within a few roundings of ±1 is ±1 (acos would turn that
+        // rounding into delta ~ 1e-8, and the pose error with it)
+        if 1.0 - cd.abs() <= 4.0 * f64::EPSILON {
+            cd = cd.signum();
+        }
+        let delta = libm::acos(cd);
+        // rounding in Z / rho moves a double root by ~sqrt(eps): the roots count as one when
+        // they are within sqrt(CLOSED_FORM_TOLERANCE) of each other (or of a half turn apart)
+        let singular = delta.min(std::f64::consts::PI - delta) <= CLOSED_FORM_TOLERANCE.sqrt();
+        let (cp, sp, phi) = (self.cp, self.sp, self.phi);
+        // (1 - c)(1 + c): exact factors near c = ±1, where 1 - c² loses its digits
+        let sd = ((1.0 - cd) * (1.0 + cd)).sqrt();
+        let plus = Angle {
+            th: phi + delta,
+            c: cp * cd - sp * sd,
+            s: sp * cd + cp * sd,
         };
+        let minus = Angle {
+            th: phi - delta,
+            c: cp * cd + sp * sd,
+            s: sp * cd - cp * sd,
+        };
+        Roots::Two(plus, minus, singular)
     }
-    if z.abs() > rho + tol {
-        return Roots::None;
-    }
-    let mut cd = (z / rho).clamp(-1.0, 1.0);
-    // a double root: cos(delta) within a few roundings of ±1 is ±1 (acos would turn that
-    // rounding into delta ~ 1e-8, and the pose error with it)
-    if 1.0 - cd.abs() <= 4.0 * f64::EPSILON {
-        cd = cd.signum();
-    }
-    let phi = x.atan2(y);
-    let delta = cd.acos();
-    // rounding in Z / rho moves a double root by ~sqrt(eps): the roots count as one when
-    // they are within sqrt(CLOSED_FORM_TOLERANCE) of each other (or of a half turn apart)
-    let singular = delta.min(std::f64::consts::PI - delta) <= CLOSED_FORM_TOLERANCE.sqrt();
-    let (cp, sp) = (y / rho, x / rho);
-    // (1 - c)(1 + c): exact factors near c = ±1, where 1 - c² loses its digits
-    let sd = ((1.0 - cd) * (1.0 + cd)).sqrt();
-    let plus = Angle {
-        th: phi + delta,
-        c: cp * cd - sp * sd,
-        s: sp * cd + cp * sd,
-    };
-    let minus = Angle {
-        th: phi - delta,
-        c: cp * cd + sp * sd,
-        s: sp * cd - cp * sd,
-    };
-    Roots::Two(plus, minus, singular)
 }
 
 /// The angle theta of Rz(theta) u = v in the xy plane; None when u or v lies on the z axis.
@@ -206,7 +261,7 @@ fn angle_between(u: &Vector3<f64>, v: &Vector3<f64>, tol: f64) -> Option<Angle> 
     let (c, s) = (u.x * v.x + u.y * v.y, u.x * v.y - u.y * v.x);
     let r = (nu * nv).sqrt();
     Some(Angle {
-        th: s.atan2(c),
+        th: atan2(s, c),
         c: c / r,
         s: s / r,
     })
@@ -229,12 +284,13 @@ pub struct ClosedFormIgm {
     class: IgmClass,
     /// The terminal frame.
     frame: usize,
-    /// tool^-1 (identity without a tool).
-    tool_inv: Transform,
     /// C0^-1.
     c0_inv: Transform,
     /// C6^-1.
     c6_inv: Transform,
+    /// tool^-1 C6^-1 (C6^-1 without a tool), and whether C0 is the identity: a target costs one or two products.
+    tail: Transform,
+    c0_identity: bool,
     /// Axis 2's direction in frame A1 (C1 e_z).
     u2: Vector3<f64>,
     /// The class's point (wrist centre, W) in A1 at theta = 0, in A6, and in the link where
@@ -244,13 +300,15 @@ pub struct ClosedFormIgm {
     point3: Vector3<f64>,
     /// The representative value of each joint in an infinite family (its theta0).
     free: [Angle; 6],
-    /// The planar arm's constants: C2's origin in C2's axes, |C2 origin|² + |point3|².
-    arm_a: Vector3<f64>,
+    /// The planar arm's constants: |C2 origin|² + |point3|², and the theta3 equation
+    /// arm_a . Rz(theta3) point3 = k with arm_a C2's origin in C2's axes.
     arm_k: f64,
+    arm: DotEquation,
     /// The theta5 equation g . Rz(theta5) p6 = ... : g = C4^T e_z (spherical wrist) or
     /// C4^T e4 (offset wrist), p6 = C5 e_z.
     g: Vector3<f64>,
     p6: Vector3<f64>,
+    wrist: DotEquation,
 }
 
 /// A geometric line: a point and a unit direction.
@@ -355,21 +413,24 @@ impl ClosedFormIgm {
             IgmClass::SphericalWrist => c4.rot.tr_mul(&Vector3::z()),
             IgmClass::OffsetWrist => c4.rot.tr_mul(&e4),
         };
+        let p6 = chain.c[5].rot * Vector3::z();
         Ok(ClosedFormIgm {
             class,
             frame,
-            tool_inv: Transform::identity(),
             c0_inv: chain.c[0].inverse(),
             c6_inv: chain.c[6].inverse(),
+            tail: chain.c[6].inverse(),
+            c0_identity: chain.c[0] == Transform::identity(),
             u2,
             point6: inv(&frames[5], &point0),
             point0,
             free: std::array::from_fn(|k| Angle::new(chain.theta0[k])),
-            arm_a: c2.rot.tr_mul(&c2.pos),
             arm_k: c2.pos.norm_squared() + point3.norm_squared(),
+            arm: DotEquation::new(&c2.rot.tr_mul(&c2.pos), &point3),
             point3,
+            wrist: DotEquation::new(&g, &p6),
             g,
-            p6: chain.c[5].rot * Vector3::z(),
+            p6,
             chain,
         })
     }
@@ -379,7 +440,7 @@ impl ClosedFormIgm {
     ///
     /// Errors: as a target ([`Self::solve`]).
     pub fn with_tool(mut self, tool: &Matrix4<f64>) -> Result<Self> {
-        self.tool_inv = transform_of("tool", tool)?.inverse();
+        self.tail = transform_of("tool", tool)?.inverse().compose(&self.c6_inv);
         Ok(self)
     }
 
@@ -408,10 +469,10 @@ impl ClosedFormIgm {
     /// (within 1e-9).
     pub fn solve(&self, target: &Matrix4<f64>) -> Result<IgmSolutions> {
         let t = transform_of("target", target)?;
-        let m = self
-            .c0_inv
-            .compose(&t.compose(&self.tool_inv))
-            .compose(&self.c6_inv);
+        let mut m = t.compose(&self.tail);
+        if !self.c0_identity {
+            m = self.c0_inv.compose(&m);
+        }
         let mut out = IgmSolutions::default();
         match self.class {
             IgmClass::SphericalWrist => self.spherical(&m, &mut out),
@@ -427,7 +488,7 @@ impl ClosedFormIgm {
     /// theta1 from the point's component along axis 2, invariant under joints 2, 3 (and 4):
     /// u2 . Rz(theta1)^T x_M = u2 . x(0).
     fn theta1(&self, x_m: &Vector3<f64>) -> Option<([Angle; 2], bool)> {
-        let r = solve_dot(x_m, &self.u2, self.u2.dot(&self.point0), self.tol());
+        let r = DotEquation::new(x_m, &self.u2).roots(self.u2.dot(&self.point0), self.tol());
         roots_or(r, self.free[0])
     }
 
@@ -435,13 +496,13 @@ impl ClosedFormIgm {
     /// theta3 from its distance to O2 (type 2), theta2 from atan2.
     fn planar(&self, th1: &Angle, x_m: &Vector3<f64>) -> Option<[(Angle, Angle, Singularity); 2]> {
         let (c1, c2) = (&self.chain.c[1], &self.chain.c[2]);
-        let x2 = c1.rot.tr_mul(&(th1.rot().tr_mul(x_m) - c1.pos));
+        let x2 = c1.rot.tr_mul(&(th1.unturn(x_m) - c1.pos));
         let b = &self.point3;
         let k = (x2.norm_squared() - self.arm_k) / 2.0;
         let tol2 = self.tol() * self.chain.scale;
-        let (t3, elbow) = roots_or(solve_dot(&self.arm_a, b, k, tol2), self.free[2])?;
+        let (t3, elbow) = roots_or(self.arm.roots(k, tol2), self.free[2])?;
         Some(t3.map(|th3| {
-            let v = c2.rot * (th3.rot() * b) + c2.pos;
+            let v = c2.rot * th3.turn(b) + c2.pos;
             let th2 = angle_between(&v, &x2, self.tol());
             let singular = Singularity {
                 shoulder: th2.is_none(),
@@ -456,7 +517,7 @@ impl ClosedFormIgm {
     /// axes of the wrist's first frame.
     fn a3c3(&self, th: &[Angle; 3]) -> Matrix3<f64> {
         let c = &self.chain.c;
-        let r = th[1].right_of(&(th[0].rot() * c[1].rot));
+        let r = th[1].right_of(&th[0].left_of(&c[1].rot));
         th[2].right_of(&(r * c[2].rot)) * c[3].rot
     }
 
@@ -489,10 +550,9 @@ impl ClosedFormIgm {
                 // R = (A3 C3)^T M = Rz(theta4) C4 Rz(theta5) C5 Rz(theta6)
                 let r = self.a3c3(&[th1, th2, th3]).tr_mul(&m.rot);
                 let b: Vector3<f64> = r.column(2).into();
-                let Some((t5, _)) = roots_or(
-                    solve_dot(&self.g, &self.p6, b.z, CLOSED_FORM_TOLERANCE),
-                    self.free[4],
-                ) else {
+                let Some((t5, _)) =
+                    roots_or(self.wrist.roots(b.z, CLOSED_FORM_TOLERANCE), self.free[4])
+                else {
                     continue;
                 };
                 for th5 in t5 {
@@ -502,9 +562,10 @@ impl ClosedFormIgm {
                     let wrist = th4.is_none();
                     let th4 = th4.unwrap_or(self.free[3]);
                     // Rz(theta6) = Q^T R, Q = Rz(theta4) C4 Rz(theta5) C5: its first column
-                    let q = th4.rot() * c4r5 * c5.rot;
+                    // (Q^T r0 = C5^T (C4 Rz5)^T Rz4^T r0)
                     let r0 = r.column(0);
-                    let th6 = q.column(1).dot(&r0).atan2(q.column(0).dot(&r0));
+                    let u = c4r5.tr_mul(&th4.unturn(&r0.into_owned()));
+                    let th6 = atan2(c5.rot.column(1).dot(&u), c5.rot.column(0).dot(&u));
                     let singular = Singularity {
                         shoulder: shoulder || s.shoulder,
                         elbow: s.elbow,
@@ -525,10 +586,10 @@ impl ClosedFormIgm {
         let (c4, c5) = (&self.chain.c[4], &self.chain.c[5]);
         let z6: Vector3<f64> = m.rot.column(2).into();
         for th1 in t1 {
-            let z2 = th1.rot() * self.u2;
+            let z2 = th1.turn(&self.u2);
             // axis 6 against axis 2: e4 . C4 Rz(theta5) C5 e_z = z2 . z6
             let Some((t5, _)) = roots_or(
-                solve_dot(&self.g, &self.p6, z2.dot(&z6), CLOSED_FORM_TOLERANCE),
+                self.wrist.roots(z2.dot(&z6), CLOSED_FORM_TOLERANCE),
                 self.free[4],
             ) else {
                 continue;
@@ -536,7 +597,7 @@ impl ClosedFormIgm {
             // axis 2 seen from frame 6: Rz(theta6) n = m6
             let n = m.rot.tr_mul(&z2);
             for th5 in t5 {
-                let m6 = c5.rot.tr_mul(&th5.rot().tr_mul(&self.g));
+                let m6 = c5.rot.tr_mul(&th5.unturn(&self.g));
                 let th6 = angle_between(&n, &m6, CLOSED_FORM_TOLERANCE);
                 let wrist = th6.is_none();
                 let th6 = th6.unwrap_or(self.free[5]);
@@ -551,7 +612,7 @@ impl ClosedFormIgm {
                 };
                 for (th2, th3, s) in arm {
                     let n4 = self.a3c3(&[th1, th2, th3]).tr_mul(&a4.rot);
-                    let th4 = n4[(1, 0)].atan2(n4[(0, 0)]);
+                    let th4 = atan2(n4[(1, 0)], n4[(0, 0)]);
                     let singular = Singularity {
                         shoulder: shoulder || s.shoulder,
                         elbow: s.elbow,

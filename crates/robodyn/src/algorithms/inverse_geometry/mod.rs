@@ -61,7 +61,8 @@ pub(crate) fn transform_of(what: &str, m: &Matrix4<f64>) -> Result<Transform> {
 /// The checks of [`transform_of`].
 pub(crate) fn check_target(what: &str, m: &Matrix4<f64>) -> Result<()> {
     // column-major index k = row + 4 column, reported as [row, column]
-    if let Some(k) = m.iter().position(|x| !x.is_finite()) {
+    // the slice, not the matrix's strided iterator (a quarter of the closed form's bookkeeping)
+    if let Some(k) = m.as_slice().iter().position(|x| !x.is_finite()) {
         return Err(Error::NotFinite {
             what: format!("{what}[{}, {}]", k % 4, k / 4),
             index: k,

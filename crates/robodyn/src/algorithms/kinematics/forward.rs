@@ -42,6 +42,12 @@ pub struct KinematicsData {
     pub(crate) v: Vec<Vector3<f64>>,
     pub(crate) wd: Vec<Vector3<f64>>,
     pub(crate) a: Vec<Vector3<f64>>,
+    /// Per moving link 0..N: its joint's column of the World Jacobian, [O_k x z_k; z_k]
+    /// (revolute) or [z_k; 0] (prismatic), stored by [`joint_jacobians_into`] (Pinocchio's
+    /// `data.J` of `computeJointJacobians`), valid when `columns` holds; the frame Jacobians
+    /// read them then, and compute them from the placements otherwise.
+    pub(crate) col: Vec<[f64; 6]>,
+    pub(crate) columns: bool,
     /// The q̈ of the last [`forward_kinematics_into`] (movable joints).
     pub(crate) qdd: Vec<f64>,
     /// The moving links from a frame to the base (scratch of the support-only pass).
@@ -71,6 +77,8 @@ impl KinematicsData {
             v: v(),
             wd: v(),
             a: v(),
+            col: vec![[0.0; 6]; n + 1],
+            columns: false,
             qdd: vec![0.0; n],
             chain: Vec::with_capacity(n + 1),
             body_m: vec![0.0; n + 1],
@@ -126,11 +134,51 @@ pub fn placements_into(robot: &Robot, data: &mut KinematicsData, q: &[f64]) -> R
     data.check(robot)?;
     robot.coordinates().check("q", q, "movable joints")?;
     data.level = Level::None;
+    data.columns = false;
     for k in 1..=data.tree.n() {
-        place(data, k, q[k - 1]);
+        place::<false>(data, k, q[k - 1]);
     }
     data.level = Level::Placements;
     Ok(())
+}
+
+/// [`placements_into`] that also stores every joint's column of the `World` Jacobian in the
+/// same pass (Pinocchio's `computeJointJacobians`): the frame Jacobians
+/// ([`frame_jacobian_into`](super::frame_jacobian_into)) are then copies of their support's
+/// columns (`World`) or these moved to the frame. After [`placements_into`] or
+/// [`forward_kinematics_into`] they compute the columns from the placements instead (same
+/// numbers). Allocation-free.
+///
+/// Errors: as [`placements_into`].
+pub fn joint_jacobians_into(robot: &Robot, data: &mut KinematicsData, q: &[f64]) -> Result<()> {
+    data.check(robot)?;
+    robot.coordinates().check("q", q, "movable joints")?;
+    data.level = Level::None;
+    for k in 1..=data.tree.n() {
+        place::<true>(data, k, q[k - 1]);
+    }
+    data.columns = true;
+    data.level = Level::Placements;
+    Ok(())
+}
+
+/// Joint k's column of the `World` Jacobian from its placement: [O_k x z_k; z_k] (revolute),
+/// [z_k; 0] (prismatic).
+#[inline(always)]
+pub(crate) fn world_column(data: &KinematicsData, k: usize) -> [f64; 6] {
+    column_of(&data.rot[k], &data.pos[k], data.tree.revolute[k])
+}
+
+/// The World column of a joint placed at (`rot`, `pos`).
+#[inline(always)]
+fn column_of(rot: &Matrix3<f64>, pos: &Vector3<f64>, revolute: bool) -> [f64; 6] {
+    let z = rot.column(2);
+    if revolute {
+        let l = pos.cross(&z);
+        [l.x, l.y, l.z, z.x, z.y, z.z]
+    } else {
+        [z.x, z.y, z.z, 0.0, 0.0, 0.0]
+    }
 }
 
 /// The placements of the moving links from the base to the one frame `f` is fixed on (its
@@ -138,6 +186,7 @@ pub fn placements_into(robot: &Robot, data: &mut KinematicsData, q: &[f64]) -> R
 /// values, so `data` holds no full pass afterwards (its level is reset).
 pub(crate) fn place_support(data: &mut KinematicsData, q: &[f64], f: &FrameId) {
     data.level = Level::None;
+    data.columns = false;
     data.chain.clear();
     let mut k = data.tree.anchor[f.parent()].link;
     while k != 0 {
@@ -146,19 +195,25 @@ pub(crate) fn place_support(data: &mut KinematicsData, q: &[f64], f: &FrameId) {
     }
     for i in (0..data.chain.len()).rev() {
         let k = data.chain[i];
-        place(data, k, q[k - 1]);
+        place::<false>(data, k, q[k - 1]);
     }
 }
 
-/// 0T_k = 0T_a(k) a(k)T_k for moving link k at joint value `qk`.
+/// 0T_k = 0T_a(k) a(k)T_k for moving link k at joint value `qk`, and with `COLUMN` its World
+/// column from the placement still in registers (read back from memory it cost a third more).
 #[inline(always)]
-fn place(data: &mut KinematicsData, k: usize, qk: f64) {
+fn place<const COLUMN: bool>(data: &mut KinematicsData, k: usize, qk: f64) {
     let fc = data.tree.frame(k);
     let (r, p) = fc.placement(&qk);
     let a = fc.ant;
     let ra = data.rot[a];
-    data.pos[k] = data.pos[a] + ra * p;
-    data.rot[k] = mul_form(&ra, &r, fc.form());
+    let pos = data.pos[a] + ra * p;
+    let rot = mul_form(&ra, &r, fc.form());
+    if COLUMN {
+        data.col[k] = column_of(&rot, &pos, fc.joint == JointType::Revolute);
+    }
+    data.pos[k] = pos;
+    data.rot[k] = rot;
 }
 
 /// The forward kinematic model of every frame for a state over the movable joints (frame
@@ -203,9 +258,10 @@ pub fn forward_kinematics_into(
     c.check("qd", qd, "movable joints")?;
     c.check("qdd", qdd, "movable joints")?;
     data.level = Level::None;
+    data.columns = false;
     data.qdd.copy_from_slice(qdd);
     for k in 1..=data.tree.n() {
-        place(data, k, q[k - 1]);
+        place::<false>(data, k, q[k - 1]);
         propagate(data, k, qd[k - 1], qdd[k - 1]);
     }
     let finite = |v: &[Vector3<f64>]| v.iter().all(|x| x.iter().all(|e| e.is_finite()));

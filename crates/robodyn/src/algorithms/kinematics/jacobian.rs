@@ -2,8 +2,11 @@
 //! order) in the three references, their time derivative J̇ and the classical drift J̇ q̇,
 //! read from the placements (and velocities) of a [`KinematicsData`].
 
-use super::forward::{frame_state, place_support, placement_of, FrameState, KinematicsData, Level};
+use super::forward::{
+    frame_state, place_support, placement_of, world_column, FrameState, KinematicsData, Level,
+};
 use super::frames::FrameId;
+use super::tree::{form_mul, form_mul_vector};
 use super::{Motion, Reference};
 use crate::error::{Error, Result};
 use crate::geometry::Transform;
@@ -109,19 +112,50 @@ pub fn frame_jacobian_into(
     Ok(())
 }
 
-/// The columns of the frame Jacobian from the placements of its support.
+/// Joint j's column of the World Jacobian: stored by `joint_jacobians_into`, else computed.
+#[inline(always)]
+fn column(data: &KinematicsData, j: usize) -> [f64; 6] {
+    if data.columns {
+        data.col[j]
+    } else {
+        world_column(data, j)
+    }
+}
+
+/// The columns of the frame Jacobian from the World columns of its support (a copy in
+/// `World`; moved to the frame's origin, and turned into its axes for `Local`).
 fn write_jacobian(
     data: &KinematicsData,
     f: &FrameId,
     reference: Reference,
     out: &mut DMatrix<f64>,
 ) {
-    out.fill(0.0);
+    // a slice's fill is a memset; DMatrix::fill walks the matrix by strides (~2 ns an entry)
+    let o = out.as_mut_slice();
+    o.fill(0.0);
+    let mut j = data.tree.anchor[f.parent()].link;
+    if reference == Reference::World {
+        while j != 0 {
+            o[6 * (j - 1)..6 * j].copy_from_slice(&column(data, j));
+            j = data.tree.parent[j];
+        }
+        return;
+    }
     let t = placement_of(data, f);
-    for_each_support_joint(data, f.parent(), |k, j, revolute| {
-        let col = from_lwa(&t, lwa_column(data, j, revolute, &t.pos), reference);
-        put(out, k, &col);
-    });
+    while j != 0 {
+        let c = &column(data, j);
+        let w = Vector3::new(c[3], c[4], c[5]);
+        // the velocity of the body point at O_f from that at O_0: v + w x O_f
+        let v = Vector3::new(c[0], c[1], c[2]) + w.cross(&t.pos);
+        let (v, w) = match reference {
+            Reference::Local => (t.rot.tr_mul(&v), t.rot.tr_mul(&w)),
+            _ => (v, w),
+        };
+        let col = &mut o[6 * (j - 1)..6 * j];
+        col[..3].copy_from_slice(v.as_slice());
+        col[3..].copy_from_slice(w.as_slice());
+        j = data.tree.parent[j];
+    }
 }
 
 /// The Jacobian of frame `f` in `reference` at joint positions `q` into `out` (6 x N), from
@@ -143,9 +177,51 @@ pub fn frame_jacobian_from_q_into(
     robot.coordinates().check("q", q, "movable joints")?;
     f.check(robot)?;
     check_matrix(robot, "J", out, 6)?;
-    place_support(data, q, f);
-    write_jacobian(data, f, reference, out);
+    if reference == Reference::Local {
+        data.level = Level::None;
+        local_jacobian_from_q(data, q, f, out);
+    } else {
+        place_support(data, q, f);
+        write_jacobian(data, f, reference, out);
+    }
     Ok(())
+}
+
+/// The `Local` Jacobian of frame `f` at `q` by one pass from the frame towards the base
+/// (Pinocchio's `computeFrameJacobian` in `LOCAL`), no placement in R_0 formed: with
+/// kT_f = (R, P) the frame's placement in moving link k, joint k's column is
+/// [R^T (z x P); R^T z] (revolute) or [R^T z; 0] (prismatic), z = (0, 0, 1) (R^T z is R's last
+/// row), then a(k)T_f = a(k)T_k kT_f.
+fn local_jacobian_from_q(data: &KinematicsData, q: &[f64], f: &FrameId, out: &mut DMatrix<f64>) {
+    let o = out.as_mut_slice();
+    o.fill(0.0);
+    let an = &data.tree.anchor[f.parent()];
+    let mut t = if an.identity {
+        *f.offset()
+    } else {
+        an.t.compose(f.offset())
+    };
+    let mut k = an.link;
+    while k != 0 {
+        let fc = data.tree.frame(k);
+        let (r, p) = (&t.rot, &t.pos);
+        let z = r.row(2);
+        let col = &mut o[6 * (k - 1)..6 * k];
+        if fc.joint == JointType::Revolute {
+            let lin = r.row(1) * p.x - r.row(0) * p.y;
+            col[..3].copy_from_slice(&[lin[0], lin[1], lin[2]]);
+            col[3..].copy_from_slice(&[z[0], z[1], z[2]]);
+        } else {
+            col[..3].copy_from_slice(&[z[0], z[1], z[2]]);
+        }
+        let (a, pa) = fc.placement(&q[k - 1]);
+        let form = fc.form();
+        t = Transform {
+            pos: form_mul_vector(&a, p, form) + pa,
+            rot: form_mul(&a, r, form),
+        };
+        k = fc.ant;
+    }
 }
 
 /// The Jacobian of frame `f` in `reference` at joint positions `q` (movable joints, frame
@@ -199,7 +275,7 @@ pub fn frame_jacobian_time_variation_into(
     data.ready(robot, Level::Motion)?;
     f.check(robot)?;
     check_matrix(robot, "dJ", out, 6)?;
-    out.fill(0.0);
+    out.as_mut_slice().fill(0.0);
     let s = frame_state(data, f);
     for_each_support_joint(data, f.parent(), |k, j, revolute| {
         let z: Vector3<f64> = data.rot[j].column(2).into_owned();

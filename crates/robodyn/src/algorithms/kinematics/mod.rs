@@ -23,7 +23,7 @@ pub use com::{
 };
 pub use forward::{
     forward_kinematics_into, frame_acceleration, frame_classical_acceleration, frame_placement,
-    frame_velocity, placements_into, relative_placement, KinematicsData,
+    frame_velocity, joint_jacobians_into, placements_into, relative_placement, KinematicsData,
 };
 pub use frames::{rpy, tool_transform, FrameId};
 pub use jacobian::{
