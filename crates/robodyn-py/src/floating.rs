@@ -1,11 +1,11 @@
 //! The functions of `robodyn.Robot` proper to floating robots (docs/models/floating_base.md):
-//! `integrate` on the configuration space (SE(3) for the base) and the centroidal momentum,
-//! each on one state or N states.
+//! `integrate` on the configuration space (SE(3) for the base), the centroidal momentum and
+//! the centroidal momentum matrix, each on one state or N states.
 
 use crate::robot::{Call, Robot};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use robodyn::{centroidal_momentum, integrate_into};
+use robodyn::{centroidal_map_into, centroidal_momentum, integrate_into};
 
 /// The (..., 10) rows [mass, com (3), linear (3), angular (3)] of a centroidal call as a dict
 /// of C-contiguous arrays.
@@ -91,5 +91,35 @@ impl Robot {
             Ok(())
         })?;
         centroidal_dict(py, r)
+    }
+
+    /// The centroidal momentum matrix A_G(q) of a floating robot (Orin's CMM; Pinocchio's
+    /// computeCentroidalMap / ccrba's data.Ag): h_G = A_G v, rows [linear momentum; angular
+    /// momentum about the centre of mass] in world components, columns over v (base linear,
+    /// angular velocity in the base frame, joints). Shape (6, nv) for q of shape (nq,),
+    /// (N, 6, nv) for (N, nq). InputError on a robot that does not float. out: as for idm.
+    #[pyo3(signature = (q, *, out=None))]
+    fn centroidal_map<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        out: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let models = self.models();
+        let nv = models.full.nv();
+        let call = Call {
+            inputs: &[("q", Some(q))],
+            one: &[6, nv],
+            stacked: false,
+            out,
+        };
+        self.eval_state(py, &models, &models.full, call, move |r, w, x, o| {
+            let (data, ag) = w.split(6, nv);
+            centroidal_map_into(r, data, x[0], ag)?;
+            for (k, o) in o.iter_mut().enumerate() {
+                *o = ag[(k / nv, k % nv)];
+            }
+            Ok(())
+        })
     }
 }

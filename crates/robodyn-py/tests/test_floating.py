@@ -4,7 +4,8 @@ functions on nq / nv vectors.
 Cross-checks against Pinocchio with a free-flyer root (`buildModelFromUrdf(path,
 JointModelFreeFlyer())`, the joints matched by name) on example-robot-data's Talos (full), HyQ and
 Solo12: idm = rnea, inertia = crba, ddm (both methods) = aba, h = nonLinearEffects, integrate =
-pin.integrate, centroidal_momentum = computeCentroidalMomentum; those need `pip install pin
+pin.integrate, centroidal_momentum = computeCentroidalMomentum, centroidal_map =
+computeCentroidalMap; those need `pip install pin
 example-robot-data` and are skipped visibly without them unless ROBODYN_REQUIRE names pinocchio
 (tests/pinocchio_ref.py). The hand-derived free fall and the refusals need nothing."""
 
@@ -94,7 +95,7 @@ def test_models_match_pinocchio_free_flyer(name):
 @needs_pinocchio
 @pytest.mark.filterwarnings("ignore::robodyn.RobotFileWarning")
 @pytest.mark.parametrize("name", URDFS)
-def test_integrate_and_centroidal_momentum_match_pinocchio(name):
+def test_integrate_and_centroidal_quantities_match_pinocchio(name):
     path = find(name)
     robot = robodyn.load(path, floating=True)
     p = PinFloating(path, robot.joint_names)
@@ -103,6 +104,8 @@ def test_integrate_and_centroidal_momentum_match_pinocchio(name):
     qs, vs, _ = random_states(rng, robot, 3)
     nexts = robot.integrate(qs, vs, 0.3)
     cm = robot.centroidal_momentum(qs, vs)
+    maps = robot.centroidal_map(qs)
+    assert maps.shape == (3, 6, robot.nv)
     assert cm["com"].shape == (3, 3) and cm["mass"].shape == (3,)
     for r in range(len(qs)):
         pq, pv = p.q(qs[r]), p.v(vs[r])
@@ -117,6 +120,10 @@ def test_integrate_and_centroidal_momentum_match_pinocchio(name):
         close(one["linear"], hg.linear)
         close(one["angular"], hg.angular)
         close(cm["angular"][r], hg.angular)
+        ag = pin.computeCentroidalMap(m, d, pq)[:, p.iv]
+        close(maps[r], ag)
+        close(robot.centroidal_map(qs[r]), ag)
+        close(maps[r] @ vs[r], np.r_[one["linear"], one["angular"]])
 
 
 @needs_pinocchio
@@ -183,6 +190,8 @@ def test_state_sizes_and_names():
     np.testing.assert_allclose(fixed.integrate(np.ones(6), np.arange(6.0), 0.5), 1 + 0.5 * np.arange(6.0))
     with pytest.raises(robodyn.InputError, match="floating base"):
         fixed.centroidal_momentum(np.zeros(6))
+    with pytest.raises(robodyn.InputError, match="centroidal map"):
+        fixed.centroidal_map(np.zeros(6))
 
 
 @pytest.mark.parametrize(

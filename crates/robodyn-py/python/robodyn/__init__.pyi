@@ -225,6 +225,12 @@ class Robot:
         (3,) (kg m^2/s, about the centre of mass), world components (Pinocchio's
         computeCentroidalMomentum: data.com[0], data.hg). N states (N, nq), (N, nv) give arrays
         with a leading N. InputError on a robot that does not float."""
+    def centroidal_map(self, q: ArrayLike, *, out: Optional[Array] = None) -> Array:
+        """The centroidal momentum matrix A_G(q) of a floating robot (Pinocchio's
+        computeCentroidalMap / ccrba's data.Ag): h_G = A_G v, rows [linear momentum; angular
+        momentum about the centre of mass] in world components, columns over v. Shape (6, nv)
+        for q of shape (nq,), (N, 6, nv) for (N, nq). InputError on a robot that does not
+        float. out: as for idm."""
     def idm_derivatives(self, q: ArrayLike, qd: Optional[ArrayLike] = None, qdd: Optional[ArrayLike] = None, *, v: Optional[ArrayLike] = None, a: Optional[ArrayLike] = None, friction: bool = True) -> Tuple[Array, Array, Array]:
         """Derivatives of the inverse dynamic model (analytical, docs/models/derivatives.md):
         (dtau_dq, dtau_dqd, A) with A = dtau/dqdd the inertia matrix, each (nq, nq) for one
