@@ -2,6 +2,7 @@
 //! `integrate` on the configuration space (SE(3) for the base), the centroidal momentum and
 //! the centroidal momentum matrix, each on one state or N states.
 
+use crate::kinematics::write_matrix;
 use crate::robot::{Call, Robot};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -116,9 +117,7 @@ impl Robot {
         self.eval_state(py, &models, &models.full, call, move |r, w, x, o| {
             let (data, ag) = w.split(6, nv);
             centroidal_map_into(r, data, x[0], ag)?;
-            for (k, o) in o.iter_mut().enumerate() {
-                *o = ag[(k / nv, k % nv)];
-            }
+            write_matrix(ag, o);
             Ok(())
         })
     }
