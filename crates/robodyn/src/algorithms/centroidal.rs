@@ -9,7 +9,7 @@
 //! 2. its base block holds the total mass M and the first moment MS = M c (c the centre of mass
 //!    in R_0);
 //! 3. the momentum is moved to the centre of mass and rotated to the world:
-//!    h_G = [R h_lin; R (h_ang - c x h_lin)], i.e. A_G = [[R, 0], [-R [c]x, R]] A_0.
+//!    `h_G = [R h_lin; R (h_ang - c x h_lin)]`, i.e. `A_G = [[R, 0], [-R [c]x, R]] A_0`.
 
 use crate::algorithms::floating_base::{
     check_state, composite_blocks, dot, gather_base_rows, skew, v3,
