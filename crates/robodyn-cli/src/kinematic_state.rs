@@ -57,6 +57,7 @@ impl StateArgs {
     /// The robot and, when it has loops, its closed chain.
     fn load(&self) -> CliResult<(Robot, Option<ClosedChain>)> {
         let robot = self.robot.load()?;
+        crate::common::fixed_base_only(&robot, "the kinematics commands (fk, jacobian, com)")?;
         let chain = (!robot.is_tree())
             .then(|| ClosedChain::new(&robot))
             .transpose()?;
@@ -116,6 +117,7 @@ impl StateArgs {
             names: self.names,
             what,
             carry: &[],
+            base: Default::default(),
         })?;
         let carried = states.carried_headers().to_vec();
         let mut value = setup(&robot, &carried)?;

@@ -6,7 +6,7 @@ use crate::common::{
     chunk_states, conditioning_json, in_table, start_branch, warn_conditioning, CliResult,
     NamesArg, Phases, RobotArgs, TableOutput, TableWriter, TimingsArg,
 };
-use crate::states::{CarryArg, Chunk, StateInput, StateRequest};
+use crate::states::{base_columns, base_columns3, CarryArg, Chunk, StateInput, StateRequest};
 use robodyn::{Branch, ClosedChain, ClosedData, Conditioning};
 use std::path::Path;
 
@@ -118,11 +118,16 @@ impl Evaluation<'_> {
             names: self.names,
             what,
             carry: self.carry,
+            base: base_columns3(robot, self.prefixes),
         })?;
-        let results = self.names.columns(self.result, coords);
+        let results = [
+            base_columns(robot, self.result),
+            self.names.columns(self.result, coords),
+        ]
+        .concat();
         let mut out = self.output.writer(input.headers_with(&results)?)?;
         match &chain {
-            None => tree_rows(&mut input, &mut out, coords.len(), t, tree)?,
+            None => tree_rows(&mut input, &mut out, results.len(), t, tree)?,
             Some(c) => closed_rows(&mut input, &mut out, c, self.guess, t, |b, d, x, r| {
                 closed(c, b, d, x, r)
             })?,

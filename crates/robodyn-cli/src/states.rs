@@ -285,11 +285,18 @@ fn plural(n: usize) -> &'static str {
 }
 
 /// The joint columns of the robot that a command may meet without reading them: `q<j>`,
-/// `qd<j>`, `qdd<j>`, `tau<j>` of every joint (`labels`: `<j>` as `--names` writes it), and `t`.
-pub fn known_columns(labels: &[String]) -> Vec<String> {
+/// `qd<j>`, `qdd<j>`, `tau<j>` of every joint (`labels`: `<j>` as `--names` writes it), and `t`;
+/// with a floating base, every base column `simulate` writes (state, forces, momenta).
+pub fn known_columns(labels: &[String], floating: bool) -> Vec<String> {
     let mut known = vec!["t".to_string()];
     for prefix in ["q", "qd", "qdd", "tau"] {
         known.extend(labels.iter().map(|l| format!("{prefix}{l}")));
+    }
+    if floating {
+        use robodyn::simulation::floating::{BASE_COLUMNS, MOMENTUM_COLUMNS};
+        let base = BASE_COLUMNS.iter().flatten().chain(&MOMENTUM_COLUMNS);
+        known.extend(base.filter(|c| !c.is_empty()).map(|c| c.to_string()));
+        known.push("energy".to_string());
     }
     known
 }
@@ -335,7 +342,8 @@ pub struct StateInput {
     source: Source,
     /// The table (for messages).
     file: String,
-    n: usize,
+    /// Entries of each quantity (a floating base's first: nq, then nv).
+    n: [usize; 3],
     carried_headers: Vec<String>,
     read: usize,
     command_line: bool,
@@ -357,13 +365,36 @@ pub struct StateRequest<'a> {
     pub what: &'a str,
     /// `--carry`.
     pub carry: &'a [String],
+    /// A floating robot's base columns in front of each quantity's joint columns
+    /// ([`base_columns`]); empty for a fixed base.
+    pub base: [Vec<String>; 3],
+}
+
+/// The base columns of a quantity (`q`, `qd`, `qdd`, `tau`) of a floating robot, as `simulate`
+/// writes them (`base_x` .. `base_qw`, `base_vx` .. `base_wz`, `base_ax` .. `base_dwz`,
+/// `base_fx` .. `base_mz`); none for a fixed base.
+pub fn base_columns(robot: &robodyn::Robot, prefix: &str) -> Vec<String> {
+    let k = ["q", "qd", "qdd", "tau"].iter().position(|p| *p == prefix);
+    match k {
+        Some(k) if robot.is_floating() => robodyn::simulation::floating::BASE_COLUMNS[k]
+            .iter()
+            .filter(|c| !c.is_empty())
+            .map(|c| c.to_string())
+            .collect(),
+        _ => Vec::new(),
+    }
+}
+
+/// [`base_columns`] of the three quantities.
+pub fn base_columns3(robot: &robodyn::Robot, prefixes: [&str; 3]) -> [Vec<String>; 3] {
+    prefixes.map(|p| base_columns(robot, p))
 }
 
 impl StateInput {
     /// Open the states: check a table's header (the rule of the module documentation), or
     /// parse the command-line lists.
     pub fn open(r: &StateRequest) -> CliResult<StateInput> {
-        let n = r.coords.len();
+        let n: [usize; 3] = std::array::from_fn(|i| r.base[i].len() + r.coords.len());
         let Some(path) = r.input else {
             return Ok(StateInput {
                 source: Source::Lists(Some(lists(r)?)),
@@ -388,12 +419,12 @@ impl StateInput {
             groups: (0..3)
                 .map(|i| Group {
                     prefix: r.prefixes[i].to_string(),
-                    names: r.names.columns(r.prefixes[i], r.coords),
+                    names: [r.base[i].clone(), r.names.columns(r.prefixes[i], r.coords)].concat(),
                     required: i == 0,
                     absent: "they are taken as zero",
                 })
                 .collect(),
-            known: known_columns(&r.names.columns("", r.tree)),
+            known: known_columns(&r.names.columns("", r.tree), !r.base[0].is_empty()),
             declared: r.carry,
             fate: "carried to the output",
             carry_option: true,
@@ -472,10 +503,10 @@ impl StateInput {
                 row,
             } => {
                 while chunk.count < max && reader.next_row(row)? {
-                    for (x, c) in chunk.x.iter_mut().zip(cols.iter()) {
+                    for ((x, c), &n) in chunk.x.iter_mut().zip(cols.iter()).zip(&self.n) {
                         match c {
                             Some(c) => x.extend(c.iter().map(|&k| row[k])),
-                            None => x.extend(std::iter::repeat_n(0.0, self.n)),
+                            None => x.extend(std::iter::repeat_n(0.0, n)),
                         }
                     }
                     chunk.carried.extend(others.iter().map(|&k| row[k]));
@@ -510,8 +541,8 @@ fn other_naming(headers: &[String], r: &StateRequest) -> Option<String> {
 }
 
 /// The one state of the command-line lists: the first required, the others zeros by default.
+/// A floating robot's lists hold the base entries first (nq for q, nv for the others).
 fn lists(r: &StateRequest) -> CliResult<[Vec<f64>; 3]> {
-    let n = r.coords.len();
     let p = r.prefixes;
     if r.lists[0].is_none() {
         return Err(format!(
@@ -520,17 +551,29 @@ fn lists(r: &StateRequest) -> CliResult<[Vec<f64>; 3]> {
         )
         .into());
     }
-    let mut s = [vec![0.0; n], vec![0.0; n], vec![0.0; n]];
+    let n: [usize; 3] = std::array::from_fn(|k| r.base[k].len() + r.coords.len());
+    let mut s = n.map(|n| vec![0.0; n]);
     for k in 0..3 {
         if let Some(v) = r.lists[k] {
             let vals = parse_list(p[k], v)?;
-            if vals.len() != n {
+            if vals.len() != n[k] {
+                let base = match r.base[k].as_slice() {
+                    [] => String::new(),
+                    b => format!(
+                        "{} base entries ({}, floating base) then ",
+                        b.len(),
+                        b.join(", ")
+                    ),
+                };
                 return Err(format!(
-                    "--{} has {} values, the robot has {n} {} ({:?})",
+                    "--{} has {} values, the robot has {}{} {} ({:?}): {} values",
                     p[k],
                     vals.len(),
+                    base,
+                    r.coords.len(),
                     r.what,
-                    r.coords.frames()
+                    r.coords.frames(),
+                    n[k]
                 )
                 .into());
             }

@@ -25,6 +25,8 @@ mod cli_columns;
 mod cli_conventions;
 #[path = "cli_derivatives.rs"]
 mod cli_derivatives;
+#[path = "cli_floating_models.rs"]
+mod cli_floating_models;
 #[path = "cli_floating_simulate.rs"]
 mod cli_floating_simulate;
 #[path = "cli_generate.rs"]

@@ -41,8 +41,9 @@ pub struct Inputs<'py> {
     arrays: [Option<Bound<'py, PyArrayDyn<f64>>>; 3],
     /// None: one state (1-D inputs, 1-D outputs); Some(N): N rows.
     pub rows: Option<usize>,
-    /// Length of one state vector.
-    pub n: usize,
+    /// Length of one state vector, per input (a floating robot's q has nq entries, its
+    /// velocities nv).
+    pub n: [usize; 3],
 }
 
 /// A float64 array whose memory can be read in place: aligned, strides whole elements.
@@ -100,11 +101,23 @@ pub fn inputs<'py>(
     n: usize,
     what: &dyn Fn() -> String,
 ) -> PyResult<Inputs<'py>> {
+    inputs_sized(given, [n; 3], what)
+}
+
+/// [`inputs`] with a length per input (`lens[k]` for input k: a floating robot's q has nq
+/// entries, its velocities nv).
+pub fn inputs_sized<'py>(
+    given: &[(&str, Option<&Bound<'py, PyAny>>)],
+    lens: [usize; 3],
+    what: &dyn Fn() -> String,
+) -> PyResult<Inputs<'py>> {
     let mut rows: Option<Option<usize>> = None; // decided by the first given input
     let mut first = "";
+    let mut first_n = 0;
     let mut arrays: [Option<Bound<'py, PyArrayDyn<f64>>>; 3] = [None, None, None];
     for (k, (name, obj)) in given.iter().enumerate() {
         let Some(obj) = obj else { continue };
+        let n = lens[k];
         let a = float64(obj)?;
         let shape = a.shape();
         let this = match shape {
@@ -128,15 +141,16 @@ pub fn inputs<'py>(
             None => {
                 rows = Some(this);
                 first = name;
+                first_n = n;
             }
             Some(prev) if prev != this => {
                 return Err(DimensionError::new_err(format!(
                     "{name} has shape {} but {first} has {}: give every input as one state \
-                     ({n},) or all as N states (N, {n}) with the same N",
+                     (1-D) or all as N states (2-D) with the same N",
                     shape_text(shape),
                     match prev {
-                        None => format!("({n},)"),
-                        Some(r) => format!("({r}, {n})"),
+                        None => format!("({first_n},)"),
+                        Some(r) => format!("({r}, {first_n})"),
                     }
                 )));
             }
@@ -147,7 +161,7 @@ pub fn inputs<'py>(
     Ok(Inputs {
         arrays,
         rows: rows.flatten(),
-        n,
+        n: lens,
     })
 }
 
@@ -180,7 +194,7 @@ pub struct States<'a> {
     inputs: [Rows<'a>; 3],
     /// None: one state; Some(N): N rows.
     pub rows: Option<usize>,
-    n: usize,
+    n: [usize; 3],
 }
 
 impl States<'_> {
@@ -191,7 +205,7 @@ impl States<'_> {
 
     /// Row r (< count) of input k.
     pub fn row(&self, k: usize, r: usize) -> &[f64] {
-        let n = self.n;
+        let n = self.n[k];
         match &self.inputs[k] {
             Rows::View(v) => {
                 assert!(r < self.count());
@@ -252,9 +266,9 @@ impl<'py> Inputs<'py> {
     /// The inputs row by row: in place where rows are contiguous and the memory is not that of
     /// `avoid` (the caller's output, a byte span), else copied in C order.
     pub fn states(&self, avoid: Option<(usize, usize)>) -> PyResult<States<'_>> {
-        let n = self.n;
         let mut out: [Rows<'_>; 3] = [Rows::Zeros(None), Rows::Zeros(None), Rows::Zeros(None)];
         for (k, a) in self.arrays.iter().enumerate() {
+            let n = self.n[k];
             out[k] = match a {
                 None if n <= ZERO_ROW.len() => Rows::Zeros(None),
                 None => Rows::Zeros(Some(try_zeros(n)?)),
@@ -283,7 +297,7 @@ impl<'py> Inputs<'py> {
         Ok(States {
             inputs: out,
             rows: self.rows,
-            n,
+            n: self.n,
         })
     }
 }

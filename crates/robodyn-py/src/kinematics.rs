@@ -123,9 +123,11 @@ impl Robot {
 
     /// `f` on the model over one state or N states of `inputs` (up to three), `one` the
     /// result's shape for one state: the call every kinematic function makes.
+    #[allow(clippy::too_many_arguments)]
     fn kinematics<'py, F>(
         &self,
         py: Python<'py>,
+        what: &str,
         inputs: &[(&str, Option<&Bound<'py, PyAny>>)],
         one: &[usize],
         out: Option<&Bound<'py, PyAny>>,
@@ -137,6 +139,7 @@ impl Robot {
             + Send,
     {
         let models = self.models();
+        crate::robot::fixed_base_only(&models.full, what)?;
         let call = Call {
             inputs,
             one,
@@ -170,16 +173,23 @@ impl Robot {
         out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let f = self.model().frame_id(frame).py()?;
-        self.kinematics(py, &[("q", Some(q))], &[4, 4], out, move |r, w, x, o| {
-            placements_into(r, &mut w.kin, x[0])?;
-            let m = frame_placement(r, &w.kin, &f)?.matrix();
-            for a in 0..4 {
-                for b in 0..4 {
-                    o[4 * a + b] = m[(a, b)];
+        self.kinematics(
+            py,
+            "Robot.placement",
+            &[("q", Some(q))],
+            &[4, 4],
+            out,
+            move |r, w, x, o| {
+                placements_into(r, &mut w.kin, x[0])?;
+                let m = frame_placement(r, &w.kin, &f)?.matrix();
+                for a in 0..4 {
+                    for b in 0..4 {
+                        o[4 * a + b] = m[(a, b)];
+                    }
                 }
-            }
-            check_finite_result("placement", o)
-        })
+                check_finite_result("placement", o)
+            },
+        )
     }
 
     /// Jacobian of the frame named `frame` (as `placement`) in `reference`: "world" (spatial
@@ -200,13 +210,20 @@ impl Robot {
         let rf = parse_reference(reference)?;
         let f = self.model().frame_id(frame).py()?;
         let n = self.model().dof();
-        self.kinematics(py, &[("q", Some(q))], &[6, n], out, move |r, w, x, o| {
-            let (kin, j) = w.kin_split(6, n);
-            placements_into(r, kin, x[0])?;
-            frame_jacobian_into(r, kin, &f, rf, j)?;
-            write_matrix(j, o);
-            check_finite_result("J", o)
-        })
+        self.kinematics(
+            py,
+            "Robot.jacobian",
+            &[("q", Some(q))],
+            &[6, n],
+            out,
+            move |r, w, x, o| {
+                let (kin, j) = w.kin_split(6, n);
+                placements_into(r, kin, x[0])?;
+                frame_jacobian_into(r, kin, &f, rf, j)?;
+                write_matrix(j, o);
+                check_finite_result("J", o)
+            },
+        )
     }
 
     /// Velocity of the frame named `frame` in `reference` (as `jacobian`): [linear; angular]
@@ -227,6 +244,7 @@ impl Robot {
         let f = self.model().frame_id(frame).py()?;
         self.kinematics(
             py,
+            "Robot.frame_velocity",
             &[("q", Some(q)), ("qd", Some(qd)), ("qdd", None)],
             &[6],
             out,
@@ -259,6 +277,7 @@ impl Robot {
         let f = self.model().frame_id(frame).py()?;
         self.kinematics(
             py,
+            "Robot.frame_acceleration",
             &[("q", Some(q)), ("qd", Some(qd)), ("qdd", Some(qdd))],
             &[6],
             out,
@@ -282,6 +301,7 @@ impl Robot {
     ) -> PyResult<Bound<'py, PyAny>> {
         self.kinematics(
             py,
+            "Robot.com",
             &[("q", Some(q)), ("qd", None), ("qdd", None)],
             &[3],
             out,
@@ -305,13 +325,20 @@ impl Robot {
         out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let n = self.model().dof();
-        self.kinematics(py, &[("q", Some(q))], &[3, n], out, move |r, w, x, o| {
-            let (kin, j) = w.kin_split(3, n);
-            placements_into(r, kin, x[0])?;
-            center_of_mass_jacobian_into(r, kin, None, j)?;
-            write_matrix(j, o);
-            check_finite_result("Jcom", o)
-        })
+        self.kinematics(
+            py,
+            "Robot.com_jacobian",
+            &[("q", Some(q))],
+            &[3, n],
+            out,
+            move |r, w, x, o| {
+                let (kin, j) = w.kin_split(3, n);
+                placements_into(r, kin, x[0])?;
+                center_of_mass_jacobian_into(r, kin, None, j)?;
+                write_matrix(j, o);
+                check_finite_result("Jcom", o)
+            },
+        )
     }
 
     /// Inverse geometric model of the frame named `frame` (as `placement`) for `target` (4 x 4
@@ -340,6 +367,7 @@ impl Robot {
         target: &Bound<'py, PyAny>,
         q0: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyDict>> {
+        crate::robot::fixed_base_only(&self.model(), "Robot.ik")?;
         if let Some(q0) = q0 {
             return self.numeric_ik(py, frame, target, q0);
         }

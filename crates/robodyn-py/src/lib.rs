@@ -6,6 +6,7 @@
 mod arrays;
 mod closed;
 mod errors;
+mod floating;
 mod identification;
 mod kinematics;
 mod models;
@@ -24,16 +25,27 @@ use std::path::PathBuf;
 /// loaded with a fixed base, ...) is issued as a `robodyn.RobotFileWarning`. A file whose symbols
 /// lack values (a SYMORO file of symbols only) is refused with the list of them and the two
 /// ways on: values as keyword arguments, or `robodyn.base_parameters(path)`, which needs none.
+///
+/// floating=True makes the base floating: a URDF's root link becomes link 0 of a free-flyer
+/// base with its `<inertial>` (Pinocchio's `JointModelFreeFlyer` root); the state vectors then
+/// have nq = 7 + N (q: base position, quaternion x y z w, joints) and nv = 6 + N entries. A
+/// .toml or .par file says it itself (`base = "floating"`, `is_floating = 1`).
 #[pyfunction]
-#[pyo3(signature = (path, **values))]
+#[pyo3(signature = (path, *, floating=false, **values))]
 fn load(
     py: Python<'_>,
     path: PathBuf,
+    floating: bool,
     values: Option<&Bound<'_, pyo3::types::PyDict>>,
 ) -> PyResult<robot::Robot> {
     let overrides = robot::kwargs_values(values)?;
     robot::check_finite(&overrides)?;
-    match robodyn::io::load_with_warnings(&path, &overrides) {
+    let options = if floating {
+        robodyn::io::LoadOptions::floating()
+    } else {
+        robodyn::io::LoadOptions::default()
+    };
+    match robodyn::io::load_with_warnings_options(&path, &overrides, &options) {
         Ok((r, warnings)) => {
             let warn = py.import("warnings")?;
             for w in warnings {

@@ -2,7 +2,7 @@
 //! as methods on one state (1-D arrays) or N states (2-D arrays, evaluated over all cores with
 //! the GIL released).
 
-use crate::arrays::{in_blocks, inputs, shift_row, Output, Shape, States};
+use crate::arrays::{in_blocks, inputs_sized, shift_row, Output, Shape, States};
 use crate::errors::{InputError, IntoPy};
 use nalgebra::DMatrix;
 use pyo3::prelude::*;
@@ -267,9 +267,21 @@ impl Robot {
         )
     }
 
+    /// What the entries of a floating robot's state vectors are, for messages.
+    fn state_text(robot: &robodyn::Robot) -> String {
+        let n = robot.dof();
+        format!(
+            "q: nq = 7 + {n} entries (base position, quaternion x y z w, then the {}); \
+             velocities, accelerations and forces: nv = 6 + {n} (base linear and angular \
+             velocity in the base frame, then the joints)",
+            Self::joint_text(robot)
+        )
+    }
+
     /// Evaluate `f` (on `robot`, one of `models`) on one state or on every row of N states:
     /// one state on this robot's kept buffers, N states over all cores in blocks with the GIL
-    /// released (signals checked between blocks).
+    /// released (signals checked between blocks). Inputs are joint vectors (N entries each):
+    /// a floating robot is refused (its functions go through [`Robot::eval_state`]).
     pub fn eval<'py, F>(
         &self,
         py: Python<'py>,
@@ -283,8 +295,62 @@ impl Robot {
             + Sync
             + Send,
     {
+        fixed_base_only(robot, "this function")?;
         let n = robot.dof();
-        let inp = inputs(call.inputs, n, &|| Self::joint_text(robot))?;
+        self.eval_sized(
+            py,
+            models,
+            robot,
+            call,
+            [n; 3],
+            &|| Self::joint_text(robot),
+            f,
+        )
+    }
+
+    /// [`Robot::eval`] on the state vectors of a floating robot too: the first input is a
+    /// configuration (nq entries), the others velocities, accelerations or forces (nv).
+    pub fn eval_state<'py, F>(
+        &self,
+        py: Python<'py>,
+        models: &Arc<Models>,
+        robot: &robodyn::Robot,
+        call: Call<'_, 'py>,
+        f: F,
+    ) -> PyResult<Bound<'py, PyAny>>
+    where
+        F: Fn(&robodyn::Robot, &mut Work, [&[f64]; 3], &mut [f64]) -> robodyn::Result<()>
+            + Sync
+            + Send,
+    {
+        let lens = [robot.nq(), robot.nv(), robot.nv()];
+        let text = || {
+            if robot.is_floating() {
+                Self::state_text(robot)
+            } else {
+                Self::joint_text(robot)
+            }
+        };
+        self.eval_sized(py, models, robot, call, lens, &text, f)
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn eval_sized<'py, F>(
+        &self,
+        py: Python<'py>,
+        models: &Arc<Models>,
+        robot: &robodyn::Robot,
+        call: Call<'_, 'py>,
+        lens: [usize; 3],
+        what: &dyn Fn() -> String,
+        f: F,
+    ) -> PyResult<Bound<'py, PyAny>>
+    where
+        F: Fn(&robodyn::Robot, &mut Work, [&[f64]; 3], &mut [f64]) -> robodyn::Result<()>
+            + Sync
+            + Send,
+    {
+        let inp = inputs_sized(call.inputs, lens, what)?;
         let shape = Shape::result(inp.rows, call.one, call.stacked);
         let mut out = Output::new(py, call.out, shape, inp.rows.is_some())?;
         let st = inp.states(out.span())?;
@@ -368,6 +434,24 @@ impl Robot {
     }
 }
 
+/// The functions of a `Robot` that take a floating robot's state (nq / nv vectors).
+pub const FLOATING_FUNCTIONS: &str =
+    "idm, h, inertia, ddm, integrate, centroidal_momentum and centroidal_map";
+
+/// The refusal of a function (`what`, e.g. "Robot.jacobian") that does not support floating
+/// robots: InputError naming it and the functions that do; Ok for a fixed or mobile base.
+pub fn fixed_base_only(robot: &robodyn::Robot, what: &str) -> PyResult<()> {
+    if !robot.is_floating() {
+        return Ok(());
+    }
+    let n = robot.dof();
+    Err(InputError::new_err(format!(
+        "{what}: robot `{}` has a floating base (nq = 7 + {n}, nv = 6 + {n}), which {what} \
+         does not support yet; on a floating robot use {FLOATING_FUNCTIONS}",
+        robot.name()
+    )))
+}
+
 /// Values must be finite numbers (NotFiniteError naming the first that is not).
 pub fn check_finite(values: &BTreeMap<String, f64>) -> PyResult<()> {
     for (k, v) in values {
@@ -405,10 +489,53 @@ impl Robot {
         self.model().name().to_string()
     }
 
-    /// Number of movable joints: the length of every joint vector (q, qd, qdd, tau).
+    /// nq, the length of a configuration q: the number of movable joints for a fixed (or
+    /// mobile) base, 7 + that for a floating base (base position, quaternion x y z w, joints).
     #[getter]
     fn nq(&self) -> usize {
+        self.model().nq()
+    }
+
+    /// nv, the length of a velocity, acceleration or generalized-force vector (qd, qdd, tau):
+    /// the number of movable joints, 6 + that for a floating base (base linear and angular
+    /// velocity in the base frame, joints).
+    #[getter]
+    fn nv(&self) -> usize {
+        self.model().nv()
+    }
+
+    /// Number of movable joints (the length of the joint vectors; nq = nv = dof on a fixed
+    /// base).
+    #[getter]
+    fn dof(&self) -> usize {
         self.model().dof()
+    }
+
+    /// Whether the base floats (a free body whose motion results from the dynamics: state
+    /// vectors of nq / nv entries, Pinocchio's free-flyer).
+    #[getter]
+    fn is_floating(&self) -> bool {
+        self.model().is_floating()
+    }
+
+    /// What moves the base: "fixed", "mobile" (its motion imposed) or "floating".
+    #[getter]
+    fn base_kind(&self) -> &'static str {
+        self.model().base_kind().name()
+    }
+
+    /// Names of the nq entries of q (base_x .. base_qw first on a floating base, then the
+    /// joint names).
+    #[getter]
+    fn configuration_names(&self) -> Vec<String> {
+        self.model().configuration_names()
+    }
+
+    /// Names of the nv entries of qd, qdd and tau (base_vx .. base_wz first on a floating
+    /// base, then the joint names).
+    #[getter]
+    fn velocity_names(&self) -> Vec<String> {
+        self.model().velocity_names()
     }
 
     /// NL, number of links (and of tree joints).
@@ -570,10 +697,15 @@ impl Robot {
 
     fn __repr__(&self) -> String {
         let r = self.model();
+        let base = if r.is_floating() {
+            format!(", nv={}, floating", r.nv())
+        } else {
+            String::new()
+        };
         format!(
-            "Robot({:?}, nq={}, NL={}, NJ={}, loops={})",
+            "Robot({:?}, nq={}{base}, NL={}, NJ={}, loops={})",
             r.name(),
-            r.dof(),
+            r.nq(),
             r.nl(),
             r.nj(),
             r.n_loops()
@@ -584,7 +716,10 @@ impl Robot {
     /// tau of the movable joints for positions q (rad, m), velocities qd (rad/s, m/s) and
     /// accelerations qdd (rad/s², m/s²), under the robot's gravity and wrenches.
     ///
-    /// Shapes: (nq,) for one state, (N, nq) for N states (the result likewise). Omitted qd,
+    /// Shapes: (nq,) for one state, (N, nq) for N states (the result likewise). On a floating
+    /// base q has nq entries, qd, qdd and the result nv (the result: the wrench on the base,
+    /// force then moment about its origin in the base frame, then the joint torques;
+    /// Pinocchio's rnea with a free-flyer root). Omitted qd,
     /// qdd are zeros; v and a are Pinocchio's names for qd and qdd. Friction Fv qd + Fs sign(qd)
     /// (URDF <dynamics damping friction>) and rotor inertias Ia qdd are included; friction=False
     /// leaves out Fv and Fs (Pinocchio's rnea). out: a float64 C-contiguous writeable array of
@@ -606,20 +741,22 @@ impl Robot {
         let qdd = alias("qdd", qdd, "a", a)?;
         let models = self.models();
         let robot = models.select(friction)?;
-        let n = robot.dof();
+        let n = robot.nv();
         let call = Call {
             inputs: &[("q", Some(q)), ("qd", qd), ("qdd", qdd)],
             one: &[n],
             stacked: false,
             out,
         };
-        self.eval(py, &models, robot, call, |r, w, x, o| {
+        self.eval_state(py, &models, robot, call, |r, w, x, o| {
             inverse_dynamics_into(r, &mut w.data, r.environment(), x[0], x[1], x[2], o)
         })
     }
 
     /// Inertia matrix A(q) by composite links (kg m², kg, kg m): (nq, nq) for q of shape (nq,),
-    /// (N, nq, nq) for (N, nq); rotor inertias on the diagonal. out: as for idm.
+    /// (N, nq, nq) for (N, nq); rotor inertias on the diagonal. On a floating base (nv, nv)
+    /// for q of nq entries: the base block, the base rows, the joints (Pinocchio's crba).
+    /// out: as for idm.
     #[pyo3(signature = (q, *, out=None))]
     fn inertia<'py>(
         &self,
@@ -628,14 +765,14 @@ impl Robot {
         out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let models = self.models();
-        let n = models.full.dof();
+        let n = models.full.nv();
         let call = Call {
             inputs: &[("q", Some(q))],
             one: &[n, n],
             stacked: false,
             out,
         };
-        self.eval(py, &models, &models.full, call, |r, w, x, o| {
+        self.eval_state(py, &models, &models.full, call, |r, w, x, o| {
             let (data, a) = w.split(n, n);
             inertia_matrix_into(r, data, x[0], a)?;
             for (k, o) in o.iter_mut().enumerate() {
@@ -646,7 +783,7 @@ impl Robot {
     }
 
     /// H(q, qd) (N m, N): centrifugal, Coriolis, gravity, friction and external-wrench torques,
-    /// so that tau = A(q) qdd + H(q, qd). Shapes as idm; v is Pinocchio's name for qd
+    /// so that tau = A(q) qdd + H(q, qd). Shapes as idm (nv entries on a floating base); v is Pinocchio's name for qd
     /// (Pinocchio's nonLinearEffects, plus friction unless friction=False). out: as for idm.
     #[pyo3(signature = (q, qd=None, *, v=None, friction=true, out=None))]
     fn h<'py>(
@@ -661,21 +798,24 @@ impl Robot {
         let qd = alias("qd", qd, "v", v)?;
         let models = self.models();
         let robot = models.select(friction)?;
-        let n = robot.dof();
+        let n = robot.nv();
         let call = Call {
             inputs: &[("q", Some(q)), ("qd", qd)],
             one: &[n],
             stacked: false,
             out,
         };
-        self.eval(py, &models, robot, call, |r, w, x, o| {
+        self.eval_state(py, &models, robot, call, |r, w, x, o| {
             h_vector_into(r, &mut w.data, r.environment(), x[0], x[1], o)
         })
     }
 
     /// Direct dynamic model: accelerations qdd (rad/s², m/s²) = A^-1 (tau - H) for positions q,
     /// velocities qd and torques tau (N m, N); method "composite" (tree L'DL of A) or "aba"
-    /// (articulated bodies). Shapes as idm; v is Pinocchio's name for qd. friction=False
+    /// (articulated bodies). Shapes as idm (on a floating base: q nq entries, qd, tau and the
+    /// result nv, tau's 6 first the wrench applied on the base, zero for a free robot, the
+    /// result's 6 first the derivative of the base twist; Pinocchio's aba); v is Pinocchio's
+    /// name for qd. friction=False
     /// leaves out Fv and Fs (Pinocchio's aba). Raises SingularConfiguration for a singular A.
     /// out: as for idm.
     #[pyo3(signature = (q, qd=None, tau=None, method="composite", *, v=None, friction=true, out=None))]
@@ -695,14 +835,14 @@ impl Robot {
         let qd = alias("qd", qd, "v", v)?;
         let models = self.models();
         let robot = models.select(friction)?;
-        let n = robot.dof();
+        let n = robot.nv();
         let call = Call {
             inputs: &[("q", Some(q)), ("qd", qd), ("tau", tau)],
             one: &[n],
             stacked: false,
             out,
         };
-        self.eval(py, &models, robot, call, move |r, w, x, o| {
+        self.eval_state(py, &models, robot, call, move |r, w, x, o| {
             direct_dynamics_into(r, &mut w.data, r.environment(), x[0], x[1], x[2], m, o)
         })
     }
@@ -729,6 +869,7 @@ impl Robot {
         let qdd = alias("qdd", qdd, "a", a)?;
         let models = self.models();
         let robot = models.select(friction)?;
+        fixed_base_only(robot, "Robot.idm_derivatives")?;
         let n = robot.dof();
         let call = Call {
             inputs: &[("q", Some(q)), ("qd", qd), ("qdd", qdd)],
@@ -762,6 +903,7 @@ impl Robot {
         let qd = alias("qd", qd, "v", v)?;
         let models = self.models();
         let robot = models.select(friction)?;
+        fixed_base_only(robot, "Robot.ddm_derivatives")?;
         let n = robot.dof();
         let call = Call {
             inputs: &[("q", Some(q)), ("qd", qd), ("tau", tau)],
@@ -789,6 +931,7 @@ impl Robot {
         out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let models = self.models();
+        fixed_base_only(&models.full, "Robot.forward_kinematics")?;
         let nf = models.full.nf();
         let call = Call {
             inputs: &[("q", Some(q))],
@@ -821,9 +964,9 @@ impl Robot {
         rotor: &str,
         seed: u64,
     ) -> PyResult<Vec<String>> {
-        Ok(self
-            .columns(&self.model(), columns, friction, rotor, seed)?
-            .1)
+        let robot = self.model();
+        fixed_base_only(&robot, "Robot.regressor_columns")?;
+        Ok(self.columns(&robot, columns, friction, rotor, seed)?.1)
     }
 
     /// Regressor Phi with tau = Phi K (+ external-wrench torques) for q (rad, m), qd, qdd
@@ -851,6 +994,7 @@ impl Robot {
         let qdd = alias("qdd", qdd, "a", a)?;
         let models = self.models();
         let robot = &models.full;
+        fixed_base_only(robot, "Robot.regressor")?;
         let (cols, _) = self.columns(robot, columns, friction, rotor, seed)?;
         let n = robot.dof();
         let nk = PARAMS_PER_LINK * robot.nl();
@@ -883,6 +1027,7 @@ impl Robot {
         zeros: Option<&str>,
         seed: u64,
     ) -> PyResult<crate::models::BaseParameters> {
+        fixed_base_only(&self.model(), "Robot.base_parameters")?;
         crate::models::base_parameters(py, self, method, friction, rotor, zeros, seed)
     }
 
@@ -901,6 +1046,7 @@ impl Robot {
         numeric: bool,
         name: Option<String>,
     ) -> PyResult<crate::models::Generated> {
+        fixed_base_only(&self.model(), "Robot.generate")?;
         crate::models::generate(
             py,
             &self.model(),
@@ -942,6 +1088,7 @@ impl Robot {
         max_steps: usize,
     ) -> PyResult<Bound<'py, PyDict>> {
         let robot = self.model();
+        fixed_base_only(&robot, "Robot.simulate")?;
         let n = robot.dof();
         let mut dynamics = crate::models::tree_dynamics(&robot, method, coulomb_smoothing)?;
         let args = crate::models::SimArgs {

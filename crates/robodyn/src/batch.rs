@@ -173,15 +173,16 @@ where
     }
 }
 
-/// A joint-vector output of N states: N x n.
+/// A joint-vector output of N states: N x n (n = nv on a floating base).
 fn check_states(what: &str, out: &[f64], rows: usize, n: usize) -> Result<()> {
     check_output(what, out, rows * n, || {
-        format!("{rows} states x {n} joints")
+        format!("{rows} states x {n} entries")
     })
 }
 
 /// Inverse dynamic model (eqs 10.3–10.12) of N states: `q`, `qd`, `qdd` and `tau` row-major,
-/// N x n (n = [`Robot::dof`], movable joints in frame order), under `env`. Rows run in parallel
+/// N x n (n = [`Robot::dof`], movable joints in frame order; a floating base's q has
+/// nq = 7 + n entries per state, the others nv = 6 + n), under `env`. Rows run in parallel
 /// on the rayon pool, allocation-free per state.
 ///
 /// Errors: [`Error::Dimension`] for slices of different or wrong lengths; the first state whose
@@ -194,19 +195,47 @@ pub fn inverse_dynamics_batch(
     qdd: &[f64],
     tau: &mut [f64],
 ) -> Result<()> {
-    let n = robot.dof();
-    let rows = count_rows(n, &[("q", q), ("qd", qd), ("qdd", qdd)])?;
-    check_states("tau", tau, rows, n)?;
-    let r = |s: usize| s * n..(s + 1) * n;
+    let rows = count_state_rows(robot, q, &[("qd", qd), ("qdd", qdd)])?;
+    let (nq, nv) = (robot.nq(), robot.nv());
+    check_states("tau", tau, rows, nv)?;
+    let r = |s: usize| s * nq..(s + 1) * nq;
+    let v = |s: usize| s * nv..(s + 1) * nv;
     for_each_row(
         rows,
         tau,
-        n,
+        nv,
         || Data::new(robot),
         |data, s, out| {
-            inverse_dynamics_into(robot, data, env, &q[r(s)], &qd[r(s)], &qdd[r(s)], out)
+            inverse_dynamics_into(robot, data, env, &q[r(s)], &qd[v(s)], &qdd[v(s)], out)
         },
     )
+}
+
+/// The number of states of row-major inputs: `q` of nq entries per state, each of `vs` of nv
+/// (a fixed base: n = [`Robot::dof`] each; a floating one: nq = 7 + n, nv = 6 + n).
+fn count_state_rows(robot: &Robot, q: &[f64], vs: &[(&str, &[f64])]) -> Result<usize> {
+    if !robot.is_floating() {
+        let all: Vec<(&str, &[f64])> = std::iter::once(("q", q))
+            .chain(vs.iter().copied())
+            .collect();
+        return count_rows(robot.dof(), &all);
+    }
+    let rows = count_rows(robot.nq(), &[("q", q)])?;
+    for &(what, v) in vs {
+        if v.len() != rows * robot.nv() {
+            return Err(Error::dimension(
+                what,
+                rows * robot.nv(),
+                v.len(),
+                format!(
+                    "{rows} rows x nv = {} entries, row-major, as many rows as `q` (nq = {})",
+                    robot.nv(),
+                    robot.nq()
+                ),
+            ));
+        }
+    }
+    Ok(rows)
 }
 
 /// Direct dynamic model of N states by `method`: `q`, `qd`, `tau` and `qdd` row-major, N x n,
@@ -222,14 +251,15 @@ pub fn direct_dynamics_batch(
     method: Method,
     qdd: &mut [f64],
 ) -> Result<()> {
-    let n = robot.dof();
-    let rows = count_rows(n, &[("q", q), ("qd", qd), ("tau", tau)])?;
-    check_states("qdd", qdd, rows, n)?;
-    let r = |s: usize| s * n..(s + 1) * n;
+    let rows = count_state_rows(robot, q, &[("qd", qd), ("tau", tau)])?;
+    let (nq, nv) = (robot.nq(), robot.nv());
+    check_states("qdd", qdd, rows, nv)?;
+    let r = |s: usize| s * nq..(s + 1) * nq;
+    let v = |s: usize| s * nv..(s + 1) * nv;
     for_each_row(
         rows,
         qdd,
-        n,
+        nv,
         || Data::new(robot),
         |data, s, out| {
             direct_dynamics_into(
@@ -237,8 +267,8 @@ pub fn direct_dynamics_batch(
                 data,
                 env,
                 &q[r(s)],
-                &qd[r(s)],
-                &tau[r(s)],
+                &qd[v(s)],
+                &tau[v(s)],
                 method,
                 out,
             )

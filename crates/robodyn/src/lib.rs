@@ -94,6 +94,9 @@ pub mod simulation;
 #[cfg(feature = "view")]
 pub mod view;
 
+pub use algorithms::centroidal::{
+    centroidal_map, centroidal_map_into, centroidal_momentum, Centroidal,
+};
 pub use algorithms::closed_chain::{
     closed_direct_dynamics, closed_direct_dynamics_into, closed_inertia_matrix_into,
     closed_inverse_dynamics, closed_inverse_dynamics_into, closed_regressor_into, closed_state,
@@ -109,7 +112,7 @@ pub use algorithms::derivatives::{
 pub use algorithms::direct_dynamics::{
     direct_dynamics, direct_dynamics_into, direct_dynamics_state_into, DirectState, Method,
 };
-pub use algorithms::floating_base::{centroidal_momentum, integrate, integrate_into, Centroidal};
+pub use algorithms::floating_base::{integrate, integrate_into};
 pub use algorithms::inertia_matrix::{
     h_vector, h_vector_into, inertia_matrix, inertia_matrix_into,
 };

@@ -61,6 +61,8 @@ mod finite_results;
 mod fixed_frames;
 #[path = "floating_base.rs"]
 mod floating_base;
+#[path = "floating_centroidal.rs"]
+mod floating_centroidal;
 #[path = "floating_pinocchio.rs"]
 mod floating_pinocchio;
 #[path = "floating_simulation.rs"]

@@ -49,6 +49,7 @@ pub struct Args {
 pub fn run(a: Args) -> CliResult {
     let mut t = Phases::start(a.timings);
     let robot = a.robot.load()?;
+    crate::common::fixed_base_only(&robot, "regressor")?;
     // a literal 0 in a SYMORO file means the parameter does not exist (docs/robot-format.md)
     let friction = if a.no_friction {
         Friction::None
@@ -86,6 +87,7 @@ pub fn run(a: Args) -> CliResult {
         names: a.names,
         what: "joints",
         carry: &a.carry.carry,
+        base: Default::default(),
     })?;
     let headers = input.headers_with(
         &["state", "joint", "tau_e"]

@@ -324,7 +324,7 @@ fn read_series(
                 absent,
             })
             .collect(),
-        known: known_columns(all_labels),
+        known: known_columns(all_labels, false),
         declared: &[],
         fate: "ignored",
         carry_option: false,

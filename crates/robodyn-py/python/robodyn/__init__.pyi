@@ -72,7 +72,7 @@ class RobotFileWarning(UserWarning):
     """What a robot file's reader noticed that is not an error (inertial parameters no rigid body
     has, a legged robot loaded with a fixed base, ...)."""
 
-def load(path: Union[str, PathLike], **values: float) -> Robot:
+def load(path: Union[str, PathLike], *, floating: bool = False, **values: float) -> Robot:
     """Read a robot file (TOML, SYMORO .par or URDF, by extension). ``values`` give or change
     values by name: symbols (``robodyn.load("robots/sr400.toml", d3=0.6)``) or standard
     parameters the file writes as numbers (``load("ur5.urdf", M3=3.2, FV2=0.5)``: mass of link 3
@@ -80,7 +80,12 @@ def load(path: Union[str, PathLike], **values: float) -> Robot:
     unknown name raises InputError listing the known ones. What the reader notices is issued as
     a RobotFileWarning. Raises RobotFileError with the file and line of a bad entry; for a file
     whose symbols lack values (a SYMORO file of symbols only) the message lists them: give them
-    as keyword arguments, or use ``base_parameters(path)``, which needs none."""
+    as keyword arguments, or use ``base_parameters(path)``, which needs none.
+
+    ``floating=True`` makes the base floating: a URDF's root link becomes link 0 of a free-flyer
+    base with its ``<inertial>`` (Pinocchio's ``JointModelFreeFlyer`` root); the state vectors
+    then have nq = 7 + N (q: base position, quaternion x y z w, joints) and nv = 6 + N entries.
+    A .toml or .par file says it itself (``base = "floating"``, ``is_floating = 1``)."""
 
 def base_parameters(path: Union[str, PathLike], method: str = "symbolic", friction: bool = True, rotor: str = "actuated", zeros: Optional[str] = None, seed: int = 1, **values: float) -> BaseParameters:
     """Base inertial parameters of a robot file, with or without numeric values (the CLI's
@@ -99,7 +104,23 @@ class Robot:
     name: str
     """Robot name."""
     nq: int
-    """Number of movable joints: the length of every joint vector (q, qd, qdd, tau)."""
+    """nq, the length of a configuration q: the number of movable joints on a fixed (or mobile)
+    base, 7 + that on a floating base (base position, quaternion x y z w, joints)."""
+    nv: int
+    """nv, the length of qd, qdd and tau: the number of movable joints, 6 + that on a floating
+    base (base linear and angular velocity in the base frame, joints)."""
+    dof: int
+    """Number of movable joints (nq = nv = dof on a fixed base)."""
+    is_floating: bool
+    """Whether the base floats (a free body moved by the dynamics; Pinocchio's free-flyer)."""
+    base_kind: str
+    """What moves the base: "fixed", "mobile" (its motion imposed) or "floating"."""
+    configuration_names: List[str]
+    """Names of the nq entries of q (base_x, base_y, base_z, base_qx .. base_qw first on a
+    floating base, then the joint names)."""
+    velocity_names: List[str]
+    """Names of the nv entries of qd, qdd and tau (base_vx .. base_wz first on a floating base,
+    then the joint names)."""
     nl: int
     """NL, number of links (and of tree joints)."""
     nj: int
@@ -167,24 +188,49 @@ class Robot:
         tau of the movable joints for positions q (rad, m), velocities qd (rad/s, m/s) and
         accelerations qdd (rad/s^2, m/s^2), under the robot's gravity and wrenches.
 
-        Shapes: (nq,) for one state, (N, nq) for N states (the result likewise). Omitted qd,
-        qdd are zeros; v and a are Pinocchio's names for qd and qdd. Friction Fv qd + Fs sign(qd)
+        Shapes: (nq,) for one state, (N, nq) for N states (the result likewise). On a floating
+        base q has nq entries, qd, qdd and the result nv: the result is the wrench on the base
+        (force, then moment about its origin, in the base frame) then the joint torques
+        (Pinocchio's rnea with a free-flyer root). Omitted qd, qdd are zeros; v and a are Pinocchio's names for qd and qdd. Friction Fv qd + Fs sign(qd)
         (URDF <dynamics damping friction>) and rotor inertias Ia qdd are included; friction=False
         leaves out Fv and Fs (Pinocchio's rnea). out: a float64 C-contiguous writeable array of
         the result's shape to write into (returned)."""
     def inertia(self, q: ArrayLike, *, out: Optional[Array] = None) -> Array:
         """Inertia matrix A(q) by composite links (kg m^2, kg, kg m): (nq, nq) for q of shape
-        (nq,), (N, nq, nq) for (N, nq); rotor inertias on the diagonal. out: as for idm."""
+        (nq,), (N, nq, nq) for (N, nq); rotor inertias on the diagonal. On a floating base
+        (nv, nv) for q of nq entries: base block, base rows, joints (Pinocchio's crba). out: as
+        for idm."""
     def h(self, q: ArrayLike, qd: Optional[ArrayLike] = None, *, v: Optional[ArrayLike] = None, friction: bool = True, out: Optional[Array] = None) -> Array:
         """H(q, qd) (N m, N): centrifugal, Coriolis, gravity, friction and external-wrench
-        torques, so that tau = A(q) qdd + H(q, qd). Shapes as idm; v is Pinocchio's name for qd
+        torques, so that tau = A(q) qdd + H(q, qd). Shapes as idm (nv entries on a floating
+        base); v is Pinocchio's name for qd
         (Pinocchio's nonLinearEffects, plus friction unless friction=False). out: as for idm."""
     def ddm(self, q: ArrayLike, qd: Optional[ArrayLike] = None, tau: Optional[ArrayLike] = None, method: str = "composite", *, v: Optional[ArrayLike] = None, friction: bool = True, out: Optional[Array] = None) -> Array:
         """Direct dynamic model: accelerations qdd (rad/s^2, m/s^2) = A^-1 (tau - H) for
         positions q, velocities qd and torques tau (N m, N); method "composite" (tree L'DL of A)
-        or "aba" (articulated bodies). Shapes as idm; v is Pinocchio's name for qd.
+        or "aba" (articulated bodies). Shapes as idm; on a floating base tau's 6 first entries
+        are the wrench applied on the base (zero for a free robot) and the result's 6 first the
+        derivative of the base twist (Pinocchio's aba). v is Pinocchio's name for qd.
         friction=False leaves out Fv and Fs (Pinocchio's aba). Raises SingularConfiguration for
         a singular A. out: as for idm."""
+    def integrate(self, q: ArrayLike, v: ArrayLike, dt: float, *, out: Optional[Array] = None) -> Array:
+        """The configuration reached from q (nq,) moving at the constant velocity v (nv,) for dt
+        seconds (Pinocchio's integrate(model, q, v dt)): a floating base moves on SE(3), its
+        placement M exp(v dt) with the twist in the base frame, so the quaternion stays a unit
+        quaternion; the joints move by v dt (on a fixed base, q + v dt). Shapes (nq,) and (nv,),
+        or (N, nq) and (N, nv); the result has q's shape. out: as for idm."""
+    def centroidal_momentum(self, q: ArrayLike, v: Optional[ArrayLike] = None) -> Dict[str, Any]:
+        """Mass, centre of mass and centroidal momentum of a floating robot at q (nq,) and v
+        (nv,): a dict with "mass" (kg), "com" (3,) (m), "linear" (3,) (kg m/s) and "angular"
+        (3,) (kg m^2/s, about the centre of mass), world components (Pinocchio's
+        computeCentroidalMomentum: data.com[0], data.hg). N states (N, nq), (N, nv) give arrays
+        with a leading N. InputError on a robot that does not float."""
+    def centroidal_map(self, q: ArrayLike, *, out: Optional[Array] = None) -> Array:
+        """The centroidal momentum matrix A_G(q) of a floating robot (Pinocchio's
+        computeCentroidalMap / ccrba's data.Ag): h_G = A_G v, rows [linear momentum; angular
+        momentum about the centre of mass] in world components, columns over v. Shape (6, nv)
+        for q of shape (nq,), (N, 6, nv) for (N, nq). InputError on a robot that does not
+        float. out: as for idm."""
     def idm_derivatives(self, q: ArrayLike, qd: Optional[ArrayLike] = None, qdd: Optional[ArrayLike] = None, *, v: Optional[ArrayLike] = None, a: Optional[ArrayLike] = None, friction: bool = True) -> Tuple[Array, Array, Array]:
         """Derivatives of the inverse dynamic model (analytical, docs/models/derivatives.md):
         (dtau_dq, dtau_dqd, A) with A = dtau/dqdd the inertia matrix, each (nq, nq) for one

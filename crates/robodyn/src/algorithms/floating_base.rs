@@ -53,7 +53,7 @@ pub fn base_rotation(q: &[f64]) -> Result<UnitQuaternion<f64>> {
 
 /// Check a floating state: the data and the environment against the robot, `q` with nq
 /// entries (and a unit quaternion), each of `vs` with nv, the output with nv. Returns wR_0.
-fn check_state(
+pub(crate) fn check_state(
     robot: &Robot,
     data: &Data,
     env: Option<&crate::Environment>,
@@ -81,7 +81,7 @@ fn check_state(
     Ok(base_rotation(q)?.to_rotation_matrix().into_inner())
 }
 
-fn v3(x: &[f64]) -> Vector3<f64> {
+pub(crate) fn v3(x: &[f64]) -> Vector3<f64> {
     Vector3::new(x[0], x[1], x[2])
 }
 
@@ -177,7 +177,7 @@ pub(crate) fn h_vector_into(
 /// The composite links and the base rows of A: the joint block A_jj into `data.a_dyn` (N x N),
 /// the column wrenches of every joint carried to R_0 (`data.col`, by preorder position), and the
 /// base block (the 6 x 6 composite inertia of the whole robot about O_0 in R_0) returned.
-fn composite_blocks(robot: &Robot, data: &mut Data, q: &[f64]) -> Matrix6<f64> {
+pub(crate) fn composite_blocks(robot: &Robot, data: &mut Data, q: &[f64]) -> Matrix6<f64> {
     let model = robot.dynamic();
     let n = model.nl;
     let mut ajj = std::mem::replace(&mut data.a_dyn, DMatrix::zeros(0, 0));
@@ -217,13 +217,13 @@ fn composite_blocks(robot: &Robot, data: &mut Data, q: &[f64]) -> Matrix6<f64> {
     abb
 }
 
-fn skew(v: &Vector3<f64>) -> Matrix3<f64> {
+pub(crate) fn skew(v: &Vector3<f64>) -> Matrix3<f64> {
     Matrix3::new(0.0, -v.z, v.y, v.z, 0.0, -v.x, -v.y, v.x, 0.0)
 }
 
 /// The base rows of A over the joints (after [`composite_blocks`]): row c (c = 0..6) into
 /// `data.base_rows[c N..(c + 1) N]`, joint-vector order.
-fn gather_base_rows(robot: &Robot, data: &mut Data) {
+pub(crate) fn gather_base_rows(robot: &Robot, data: &mut Data) {
     let model = robot.dynamic();
     let n = model.nl;
     for (p, &link) in model.index.preorder.iter().enumerate() {
@@ -401,7 +401,7 @@ fn aba(
     Ok(())
 }
 
-fn dot(a: &[f64], b: &[f64]) -> f64 {
+pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
@@ -457,63 +457,4 @@ fn exp3_left_jacobian(w: &Vector3<f64>) -> Matrix3<f64> {
     };
     let k = skew(w);
     Matrix3::identity() + k * a + k * k * b
-}
-
-/// The centroidal quantities of a floating robot: mass, centre of mass and momentum.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Centroidal {
-    /// Total mass (kg), the base included.
-    pub mass: f64,
-    /// Centre of mass in the world frame (m).
-    pub com: Vector3<f64>,
-    /// Linear momentum (kg m/s), world components.
-    pub linear: Vector3<f64>,
-    /// Angular momentum about the centre of mass (kg m²/s), world components.
-    pub angular: Vector3<f64>,
-}
-
-/// Mass, centre of mass and centroidal momentum (linear, and angular about the centre of mass,
-/// Pinocchio's `computeCentroidalMomentum` hg, world components) of a floating robot at q (nq),
-/// v (nv). The spatial momentum about O_0 in R_0 is the base rows of A times v (the momentum
-/// conjugate to the base twist), moved to the centre of mass and rotated to the world.
-/// Allocation-free.
-pub fn centroidal_momentum(
-    robot: &Robot,
-    data: &mut Data,
-    q: &[f64],
-    v: &[f64],
-) -> Result<Centroidal> {
-    if !robot.is_floating() {
-        return Err(Error::Input(format!(
-            "centroidal momentum: robot `{}` has a {} base; the centroidal momentum is that of \
-             a floating base (nq = 7 + N, nv = 6 + N)",
-            robot.name(),
-            robot.base_kind().name()
-        )));
-    }
-    let rot = check_state(robot, data, None, q, &[("v", v)], ("v", robot.nv()))?;
-    let abb = composite_blocks(robot, data, q);
-    gather_base_rows(robot, data);
-    let n = robot.dof();
-    let base = Vector6::from_column_slice(&v[..6]);
-    let h = Vector6::from_fn(|c, _| {
-        (abb.row(c) * base)[0] + dot(&data.base_rows[c * n..(c + 1) * n], &v[6..])
-    });
-    let mass = abb[(0, 0)];
-    if mass.is_nan() || mass <= 0.0 {
-        return Err(Error::Input(format!(
-            "centroidal momentum: robot `{}` has no mass (total {mass} kg)",
-            robot.name()
-        )));
-    }
-    // skew(MS) sits at rows 3..6, columns 0..3 of the base block
-    let c = Vector3::new(abb[(5, 1)], abb[(3, 2)], abb[(4, 0)]) / mass;
-    let (lin, ang) = (v3(&h.as_slice()[0..3]), v3(&h.as_slice()[3..6]));
-    let r = rot;
-    Ok(Centroidal {
-        mass,
-        com: v3(&q[0..3]) + r * c,
-        linear: r * lin,
-        angular: r * (ang - c.cross(&lin)),
-    })
 }

@@ -1,6 +1,7 @@
 //! One module per algorithm, named as the chapter names it.
 
 pub mod base_parameters;
+pub mod centroidal;
 pub mod closed_chain;
 pub mod derivatives;
 pub mod direct_dynamics;

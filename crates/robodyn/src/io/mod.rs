@@ -251,7 +251,16 @@ pub fn load_with_warnings(
     path: impl AsRef<Path>,
     overrides: &BTreeMap<String, f64>,
 ) -> Result<(Robot, Vec<Warning>)> {
-    let (desc, map) = load_description_with(path, overrides)?;
+    load_with_warnings_options(path, overrides, &LoadOptions::default())
+}
+
+/// [`load_with_warnings`] with [`LoadOptions`] (a URDF with a floating base).
+pub fn load_with_warnings_options(
+    path: impl AsRef<Path>,
+    overrides: &BTreeMap<String, f64>,
+    options: &LoadOptions,
+) -> Result<(Robot, Vec<Warning>)> {
+    let (desc, map) = load_description_with_options(path, overrides, options)?;
     let robot = Robot::new(desc).map_err(|e| map.locate(e))?;
     Ok((robot, map.warnings))
 }
@@ -263,8 +272,7 @@ pub fn load_with_options(
     overrides: &BTreeMap<String, f64>,
     options: &LoadOptions,
 ) -> Result<Robot> {
-    let (desc, map) = load_description_with_options(path, overrides, options)?;
-    Robot::new(desc).map_err(|e| map.locate(e))
+    load_with_warnings_options(path, overrides, options).map(|(r, _)| r)
 }
 
 /// Read a robot description from a file.

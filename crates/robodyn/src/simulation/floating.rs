@@ -12,7 +12,7 @@
 //! Energy and momenta: T = 1/2 v' A v, U = -M g' c with the mass, the centre of mass and the
 //! momenta of [`centroidal_momentum`] (the base rows of A).
 
-use crate::algorithms::floating_base::centroidal_momentum;
+use crate::algorithms::centroidal::centroidal_momentum;
 use crate::algorithms::inertia_matrix::inertia_matrix_into;
 use crate::data::Data;
 use crate::error::Result;
