@@ -81,7 +81,7 @@ def fleet(name, seeds, workers, rebuild):
     with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
         with Client(cluster) as client:
             # warm the workers (import, first load, and the cached model when not rebuilding)
-            client.gather([client.submit(statistics, name, -1 - k, pure=False) for k in range(2 * workers)])
+            client.gather([client.submit(statistics, name, 10**6 + k, pure=False) for k in range(2 * workers)])
             start = time.perf_counter()
             stats = client.gather(client.map(statistics, [name] * len(seeds), seeds, [rebuild] * len(seeds)))
             result = robodyn.identify_from_statistics(path, stats, **options)
