@@ -29,6 +29,8 @@ mod cli_derivatives;
 mod cli_floating_models;
 #[path = "cli_floating_simulate.rs"]
 mod cli_floating_simulate;
+#[path = "cli_gains_payload.rs"]
+mod cli_gains_payload;
 #[path = "cli_generate.rs"]
 mod cli_generate;
 #[path = "cli_generate_names.rs"]

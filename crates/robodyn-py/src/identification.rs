@@ -15,11 +15,13 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyTuple};
 use robodyn::identification::data::{CsvLog, JointLabels, LogSource};
 use robodyn::identification::model_access::ModelAccess;
+use robodyn::identification::statistics::StatisticsBuilder;
 use robodyn::identification::{
     self as ident, report, statistics, EssentialOptions, Estimator, Options, Statistics,
 };
 use robodyn::RobotDescription;
 use std::path::PathBuf;
+use std::sync::Mutex;
 
 /// The option names of `identify` (the fields of the library's `identification::Options`).
 const OPTIONS: [&str; 22] = [
@@ -113,7 +115,7 @@ fn options(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<Options> {
 }
 
 /// The robot's description: a `Robot` or the path of a robot file.
-fn description(robot: &Bound<'_, PyAny>) -> PyResult<RobotDescription> {
+pub(crate) fn description(robot: &Bound<'_, PyAny>) -> PyResult<RobotDescription> {
     if let Ok(r) = robot.extract::<PyRef<'_, Robot>>() {
         return Ok(r.model().description().clone());
     }
@@ -272,12 +274,91 @@ pub fn ident_statistics(
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<IdentStatistics> {
     let opt = self::options(options)?;
-    let mut access = ModelAccess::new(description(robot)?).py()?;
-    let log = one_log(log, &labels(&access), 0)?;
-    let stats = py
-        .detach(|| statistics::statistics(&mut access, &log, &opt))
-        .py()?;
-    Ok(IdentStatistics { stats })
+    let desc = description(robot)?;
+    let key = format!("{desc:?}\n{opt:?}");
+    let mut builder = match take_builder(&key) {
+        Some(b) => b,
+        None => StatisticsBuilder::new(ModelAccess::new(desc).py()?, opt).py()?,
+    };
+    let labels = JointLabels {
+        numbers: builder_joints(&builder),
+        names: builder_names(&builder),
+    };
+    let log = one_log(log, &labels, 0);
+    let stats = log.and_then(|log| py.detach(|| builder.statistics(&log)).py());
+    put_builder(key, builder);
+    Ok(IdentStatistics { stats: stats? })
+}
+
+/// The statistics builders of the robots and options this process has seen (a Dask worker
+/// computes the statistics of many logs of one robot: the parameter model is built once per
+/// process, not per log), at most [`CACHED_BUILDERS`], the oldest dropped.
+static BUILDERS: Mutex<Vec<(String, StatisticsBuilder)>> = Mutex::new(Vec::new());
+
+/// Builders kept by `ident_statistics`.
+const CACHED_BUILDERS: usize = 8;
+
+/// The cached builder of `key` (the robot's description and the options), taken out while in
+/// use: two threads of one process each use their own.
+fn take_builder(key: &str) -> Option<StatisticsBuilder> {
+    let mut b = BUILDERS.lock().unwrap_or_else(|e| e.into_inner());
+    let k = b.iter().position(|(k, _)| k == key)?;
+    Some(b.remove(k).1)
+}
+
+fn put_builder(key: String, builder: StatisticsBuilder) {
+    let mut b = BUILDERS.lock().unwrap_or_else(|e| e.into_inner());
+    b.push((key, builder));
+    if b.len() > CACHED_BUILDERS {
+        b.remove(0);
+    }
+}
+
+fn builder_joints(b: &StatisticsBuilder) -> Vec<usize> {
+    b.access().actuated_joints().to_vec()
+}
+
+fn builder_names(b: &StatisticsBuilder) -> Vec<String> {
+    b.access().joint_names()
+}
+
+/// `robodyn.IdentStatisticsBuilder(robot, **options)`: the statistics of many logs of one
+/// robot with one set of options, the parameter model built once; called with a log (path,
+/// dict of arrays, DataFrame) it returns that log's `IdentStatistics`, the numbers of
+/// `ident_statistics(robot, log, **options)`. Not picklable: make one per worker (or use
+/// `ident_statistics`, which keeps one per robot and options in each process).
+#[pyclass(module = "robodyn", frozen)]
+pub struct IdentStatisticsBuilder {
+    builder: Mutex<StatisticsBuilder>,
+    labels: JointLabels,
+}
+
+#[pymethods]
+impl IdentStatisticsBuilder {
+    #[new]
+    #[pyo3(signature = (robot, **options))]
+    fn new(robot: &Bound<'_, PyAny>, options: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
+        let opt = self::options(options)?;
+        let access = ModelAccess::new(description(robot)?).py()?;
+        let labels = self::labels(&access);
+        let builder = StatisticsBuilder::new(access, opt).py()?;
+        Ok(IdentStatisticsBuilder {
+            builder: Mutex::new(builder),
+            labels,
+        })
+    }
+
+    /// The statistics of one log (runs with the GIL released).
+    fn __call__(&self, py: Python<'_>, log: &Bound<'_, PyAny>) -> PyResult<IdentStatistics> {
+        let log = one_log(log, &self.labels, 0)?;
+        let stats = py
+            .detach(|| {
+                let mut b = self.builder.lock().unwrap_or_else(|e| e.into_inner());
+                b.statistics(&log)
+            })
+            .py()?;
+        Ok(IdentStatistics { stats })
+    }
 }
 
 /// Identify from the statistics of logs (a list of `IdentStatistics`, merged; of this robot,
@@ -541,6 +622,7 @@ impl Identification {
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Identification>()?;
     m.add_class::<IdentStatistics>()?;
+    m.add_class::<IdentStatisticsBuilder>()?;
     m.add_function(wrap_pyfunction!(identify, m)?)?;
     m.add_function(wrap_pyfunction!(ident_statistics, m)?)?;
     m.add_function(wrap_pyfunction!(identify_from_statistics, m)?)?;

@@ -6,6 +6,7 @@
 mod arrays;
 mod closed;
 mod errors;
+mod excitation;
 mod floating;
 mod identification;
 mod kinematics;
@@ -125,6 +126,7 @@ fn _robodyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(load, m)?)?;
     m.add_function(wrap_pyfunction!(models::base_parameters_of_file, m)?)?;
     identification::register(m)?;
+    m.add_function(wrap_pyfunction!(excitation::excite, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -77,8 +77,12 @@ mod identification_conic;
 mod identification_consistency;
 #[path = "identification_coverage.rs"]
 mod identification_coverage;
+#[path = "identification_gains.rs"]
+mod identification_gains;
 #[path = "identification_hostile.rs"]
 mod identification_hostile;
+#[path = "identification_payload.rs"]
+mod identification_payload;
 #[path = "identification_statistics.rs"]
 mod identification_statistics;
 #[path = "identification_synthetic.rs"]

@@ -128,6 +128,33 @@ pub struct Args {
     /// Exit with an error (code 1) when the report has warnings.
     #[arg(long)]
     pub strict: bool,
+    /// Identify the drive gains (torque per unit of current) with the parameters: the --data
+    /// logs have motor currents i<j>; --reference fixes the scale.
+    #[arg(long, requires = "reference",
+          conflicts_with_all = ["gains", "partial", "merge", "plot", "write_robot", "consistent", "essential", "payload"])]
+    pub estimate_gains: bool,
+    /// With --estimate-gains: logs of the same robot fixing the gains' scale, either with joint
+    /// torques tau<j>, or with currents i<j> and the known payload of --known-payload.
+    #[arg(long, value_name = "LOG.csv", requires = "estimate_gains")]
+    pub reference: Vec<PathBuf>,
+    /// With --estimate-gains: the payload carried in the --reference logs of currents,
+    /// LINK:XX,XY,XZ,YY,YZ,ZZ,MX,MY,MZ,M (about O_LINK in R_LINK; kg m^2, kg m, kg).
+    #[arg(
+        long,
+        value_name = "LINK:XX,..,M",
+        requires = "estimate_gains",
+        allow_hyphen_values = true
+    )]
+    pub known_payload: Option<String>,
+    /// Identify the payload carried on link LINK in the --data logs (its 10 standard
+    /// parameters XX..M about O_LINK in R_LINK), the robot's parameters those of the robot file,
+    /// or, with --before, identified from logs without the payload too.
+    #[arg(long, value_name = "LINK",
+          conflicts_with_all = ["gains", "partial", "merge", "plot", "write_robot", "consistent", "essential"])]
+    pub payload: Option<usize>,
+    /// With --payload: logs of the robot without the payload (before/after identification).
+    #[arg(long, value_name = "LOG.csv", requires = "payload")]
+    pub before: Vec<PathBuf>,
 }
 
 /// A finite positive number (a constant expression as every value of the command line).
@@ -198,6 +225,9 @@ pub fn run(a: Args) -> CliResult {
     ])?;
     let desc = a.robot.description()?.0;
     let mut access = ModelAccess::new(desc)?;
+    if a.estimate_gains || a.payload.is_some() {
+        return joint::run(&a, &mut access);
+    }
     let gains = a
         .gains
         .as_deref()
@@ -352,4 +382,300 @@ fn write_files(a: &Args, access: &ModelAccess, id: &Identification, text: &str) 
         files.push(robot);
     }
     crate::output::commit_all(files)
+}
+
+/// `--estimate-gains` and `--payload`: the joint problems of the drive gains and of a payload.
+mod joint {
+    use super::{options, Args, Format};
+    use crate::common::{parse_list, CliResult};
+    use robodyn::identification::data::{CsvLog, Effort, JointLabels, LogSource};
+    use robodyn::identification::gains::{identify_gains, GainIdentification, GainReference};
+    use robodyn::identification::model_access::ModelAccess;
+    use robodyn::identification::payload::{
+        identify_payload, Estimate, PayloadIdentification, PayloadLogs,
+    };
+    use robodyn::model::param::unit;
+    use serde_json::json;
+    use std::fmt::Write;
+    use std::path::PathBuf;
+
+    pub fn run(a: &Args, access: &mut ModelAccess) -> CliResult {
+        if a.format == Format::Csv {
+            return Err(
+                "--estimate-gains and --payload report as text or JSON (--format csv \
+                        is for the parameter table of identify)"
+                    .into(),
+            );
+        }
+        let opt = options(a, None)?;
+        let labels = JointLabels {
+            numbers: access.actuated_joints().to_vec(),
+            names: access.joint_names(),
+        };
+        let open = |paths: &[PathBuf]| -> CliResult<Vec<CsvLog>> {
+            Ok(paths
+                .iter()
+                .map(|d| CsvLog::open(d, &labels))
+                .collect::<Result<Vec<_>, _>>()?)
+        };
+        let data = open(&a.data)?;
+        let text = if a.estimate_gains {
+            let reference = open(&a.reference)?;
+            let id = gains(a, access, (&refs(&data), refs(&reference)), &opt)?;
+            match a.format {
+                Format::Json => gains_json(&id),
+                _ => gains_text(&id),
+            }
+        } else {
+            let link = a.payload.expect("--payload");
+            let before = open(&a.before)?;
+            let logs = if before.is_empty() {
+                PayloadLogs::Known(refs(&data))
+            } else {
+                PayloadLogs::BeforeAfter {
+                    before: refs(&before),
+                    after: refs(&data),
+                }
+            };
+            let id = identify_payload(access, link, &logs, &opt)?;
+            match a.format {
+                Format::Json => payload_json(&id),
+                _ => payload_text(&id, !before.is_empty()),
+            }
+        };
+        crate::output::write_text(a.output.as_deref(), &text)
+    }
+
+    fn refs(logs: &[CsvLog]) -> Vec<&dyn LogSource> {
+        logs.iter().map(|l| l as &dyn LogSource).collect()
+    }
+
+    fn gains(
+        a: &Args,
+        access: &mut ModelAccess,
+        (data, reference): (&[&dyn LogSource], Vec<&dyn LogSource>),
+        opt: &robodyn::identification::Options,
+    ) -> CliResult<GainIdentification> {
+        for log in data {
+            if log.effort() != Effort::Current {
+                return Err(format!(
+                    "{}: --estimate-gains needs logs of motor currents (i<j> columns) as --data",
+                    log.name()
+                )
+                .into());
+            }
+        }
+        let currents = reference.iter().all(|l| l.effort() == Effort::Current);
+        let reference = match (&a.known_payload, currents) {
+            (Some(p), true) => {
+                let (link, values) = p.split_once(':').ok_or_else(|| {
+                    format!("--known-payload {p}: LINK:XX,XY,XZ,YY,YZ,ZZ,MX,MY,MZ,M expected")
+                })?;
+                let link: usize = link
+                    .trim()
+                    .parse()
+                    .map_err(|_| format!("--known-payload {p}: `{link}` is not a link number"))?;
+                let v = parse_list("known-payload", values)?;
+                let parameters: [f64; 10] = v.try_into().map_err(|v: Vec<f64>| {
+                    format!(
+                        "--known-payload {p}: {} values, 10 expected (XX,XY,XZ,YY,YZ,ZZ,MX,MY,MZ,M)",
+                        v.len()
+                    )
+                })?;
+                GainReference::Payload {
+                    link,
+                    parameters,
+                    logs: reference,
+                }
+            }
+            (None, false) if reference.iter().all(|l| l.effort() == Effort::Torque) => {
+                GainReference::Torques(reference)
+            }
+            (None, _) => {
+                return Err(
+                    "--reference: logs of joint torques (tau<j>) expected, or logs of \
+                            currents with --known-payload"
+                        .into(),
+                )
+            }
+            (Some(_), false) => {
+                return Err(
+                    "--known-payload: the --reference logs must have currents (i<j>), \
+                            carrying that payload"
+                        .into(),
+                )
+            }
+        };
+        Ok(identify_gains(access, data, &reference, opt)?)
+    }
+
+    fn rel(v: f64, s: f64) -> String {
+        if v == 0.0 {
+            "inf".into()
+        } else {
+            format!("{:.2}", 100.0 * s / v.abs())
+        }
+    }
+
+    fn gains_text(id: &GainIdentification) -> String {
+        let mut s = format!(
+            "Drive gains of {} identified with its parameters ({}), scale from {}\n\n",
+            id.robot, id.estimator, id.reference
+        );
+        let _ = writeln!(
+            s,
+            "{:<8} {:<14} {:>14} {:>11} {:>9}",
+            "gain", "joint", "value", "std", "rel.std %"
+        );
+        for k in 0..id.gains.len() {
+            let _ = writeln!(
+                s,
+                "{:<8} {:<14} {:>14.6e} {:>11.3e} {:>9}",
+                format!("g{}", id.joints[k]),
+                id.joint_names[k],
+                id.gains[k],
+                id.gains_std[k],
+                rel(id.gains[k], id.gains_std[k])
+            );
+        }
+        let _ = writeln!(
+            s,
+            "\n(torque per unit of current: N m or N per unit of the i<j> columns)\n\
+             condition number {:.4e} (unit columns); residual RMS {:.4e} over {} rows; \
+             std inflation for the decimation {:.3}\n\nparameters:",
+            id.condition_number, id.residual_rms, id.rows, id.std_inflation
+        );
+        let _ = writeln!(
+            s,
+            "{:<10} {:>14} {:>11} {:>9}  equation",
+            "parameter", "value", "std", "rel.std %"
+        );
+        for (k, p) in id.parameters.iter().enumerate() {
+            let _ = writeln!(
+                s,
+                "{:<10} {:>14.6e} {:>11.3e} {:>9}  {}",
+                p.name,
+                id.x[k],
+                id.std[k],
+                rel(id.x[k], id.std[k]),
+                p.equation
+            );
+        }
+        s
+    }
+
+    fn gains_json(id: &GainIdentification) -> String {
+        let v = json!({
+            "robot": id.robot,
+            "estimator": id.estimator,
+            "reference": id.reference,
+            "gains": (0..id.gains.len()).map(|k| json!({
+                "joint": id.joints[k], "name": id.joint_names[k],
+                "value": id.gains[k], "std": id.gains_std[k]})).collect::<Vec<_>>(),
+            "parameters": id.parameters.iter().enumerate().map(|(k, p)| json!({
+                "name": p.name, "equation": p.equation,
+                "value": id.x[k], "std": id.std[k]})).collect::<Vec<_>>(),
+            "condition_number": id.condition_number,
+            "residual_rms": id.residual_rms,
+            "rows": id.rows,
+            "std_inflation": id.std_inflation,
+            "logs": id.logs.iter().map(|l| l.source.clone()).collect::<Vec<_>>(),
+        });
+        format!("{}\n", serde_json::to_string_pretty(&v).expect("json"))
+    }
+
+    fn estimate_line(s: &mut String, e: &Estimate, unit: &str) {
+        let _ = match (e.value, e.std) {
+            (Some(v), Some(sd)) => writeln!(
+                s,
+                "{:<10} {:<8} {:>14.6e} {:>11.3e} {:>9}",
+                e.name,
+                unit,
+                v,
+                sd,
+                rel(v, sd)
+            ),
+            _ => writeln!(
+                s,
+                "{:<10} {:<8} {:>14} {:>11} {:>9}",
+                e.name, unit, "not identifiable", "-", "-"
+            ),
+        };
+    }
+
+    fn payload_text(id: &PayloadIdentification, before_after: bool) -> String {
+        let mut s = format!(
+            "Payload on link {} of {} ({}; {}): its standard parameters about O_{} in R_{}\n\n",
+            id.link,
+            id.robot,
+            id.estimator,
+            if before_after {
+                "identified with the robot's parameters from logs before and after"
+            } else {
+                "the robot's parameters those of the robot file"
+            },
+            id.link,
+            id.link
+        );
+        let _ = writeln!(
+            s,
+            "{:<10} {:<8} {:>14} {:>11} {:>9}",
+            "parameter", "unit", "value", "std", "rel.std %"
+        );
+        for (k, e) in id.payload.iter().enumerate() {
+            estimate_line(&mut s, e, unit(k, false));
+        }
+        let _ = writeln!(
+            s,
+            "\nidentifiable: {} of 10 combinations change the torques at all (rank of the \
+             link's columns in the base parameters), {} of 10 determined by these logs \
+             (relative singular-value tolerance {:e})",
+            id.structural_rank, id.rank, id.tolerance
+        );
+        for c in &id.structural_null {
+            let _ = writeln!(s, "  never in the torques: {c}");
+        }
+        if id.rank < 10 {
+            for c in &id.undetermined {
+                let _ = writeln!(s, "  not determined: {c}");
+            }
+        }
+        let _ = writeln!(
+            s,
+            "condition number {:.4e} (unit columns); relative error {:.4e} over {} rows",
+            id.condition_number, id.relative_error, id.rows
+        );
+        if !id.others.is_empty() {
+            let _ = writeln!(s, "\nalso identified:");
+            for e in &id.others {
+                estimate_line(&mut s, e, "");
+            }
+        }
+        s
+    }
+
+    fn payload_json(id: &PayloadIdentification) -> String {
+        let est = |v: &[Estimate]| -> Vec<serde_json::Value> {
+            v.iter()
+                .map(|e| json!({"name": e.name, "value": e.value, "std": e.std}))
+                .collect()
+        };
+        let v = json!({
+            "robot": id.robot,
+            "link": id.link,
+            "estimator": id.estimator,
+            "payload": est(&id.payload),
+            "structural_rank": id.structural_rank,
+            "structural_null": id.structural_null,
+            "rank": id.rank,
+            "undetermined": id.undetermined,
+            "tolerance": id.tolerance,
+            "others": est(&id.others),
+            "condition_number": id.condition_number,
+            "relative_error": id.relative_error,
+            "rows": id.rows,
+            "logs": id.logs.iter().map(|l| l.source.clone()).collect::<Vec<_>>(),
+        });
+        format!("{}\n", serde_json::to_string_pretty(&v).expect("json"))
+    }
 }

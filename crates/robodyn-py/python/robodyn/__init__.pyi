@@ -437,6 +437,44 @@ def identify_from_statistics(robot: Union[Robot, str, PathLike], statistics: Seq
     """Identify from merged statistics (of this robot, computed with the same row-shaping options:
     checked, InputError otherwise). IDIM-IV needs the logs themselves (InputError)."""
 
+def excite(
+    robot: Union[Robot, str, PathLike],
+    period: float,
+    harmonics: int,
+    *,
+    start: Optional[Union[float, ArrayLike]] = None,
+    q_min: Optional[Union[float, ArrayLike]] = None,
+    q_max: Optional[Union[float, ArrayLike]] = None,
+    qd_max: Optional[Union[float, ArrayLike]] = None,
+    qdd_max: Optional[Union[float, ArrayLike]] = None,
+    tau_max: Optional[Union[float, ArrayLike]] = None,
+    samples: int = 100,
+    iterations: int = 1500,
+    restarts: int = 20,
+    seed: int = 1,
+    rotor: str = "actuated",
+    friction: bool = True,
+    offsets: bool = False,
+    rate: float = 200.0,
+    periods: int = 1,
+) -> Dict[str, Any]:
+    """Design an exciting trajectory (the CLI's ``robodyn excite``, the same numbers): a finite
+    Fourier series per actuated joint, at rest at t = 0 and T, minimizing the condition number of
+    the base-parameter observation matrix under the limits (one number or one per joint; default
+    the robot file's ``limits``; velocity and acceleration limits required). Returns a dict:
+    ``t`` (M,), ``q``, ``qd``, ``qdd`` (M, nq) sampled at ``rate`` over ``periods`` periods (the
+    CLI's CSV rows), ``condition_number``, ``initial_condition_number``, ``binding`` ((what,
+    joint)), ``peaks`` (nq, 4: largest |q - start|, |qd|, |qdd|, |tau|), ``joints``,
+    ``evaluations``."""
+
+class IdentStatisticsBuilder:
+    """The statistics of many logs of one robot with one set of options, the parameter model built
+    once: ``builder(log)`` gives ``ident_statistics(robot, log, **options)``. Not picklable: make
+    one per worker (``ident_statistics`` keeps one per robot and options in each process)."""
+    def __init__(self, robot: Union[Robot, str, PathLike], **options: Any) -> None: ...
+    def __call__(self, log: Log) -> IdentStatistics:
+        """The statistics of one log."""
+
 class IdentStatistics:
     """Per joint, the triangular factor of [W y] of the fit and validation rows of one or more logs,
     with the robot's fingerprint and the options that shaped the rows. Picklable (as JSON)."""

@@ -12,6 +12,10 @@
 //! - [`consistency`]: physically consistent standard parameters (SDP, pseudo-inertia PSD),
 //!   solved by [`conic`], a small interior-point method for 4x4 PSD blocks and bounds;
 //! - [`excitation`]: finite Fourier series minimizing the condition number;
+//! - [`gains`]: drive gains identified jointly with the parameters (currents and a reference);
+//! - [`payload`]: a payload's standard parameters on a link, with its identifiability;
+//! - [`stacked`]: least squares over blocks of rows sharing unknowns, rank-revealing (the
+//!   joint problems of [`gains`] and [`payload`]);
 //! - [`signs`]: the signs physics fixes (friction, rotor inertias, sums of masses and moments
 //!   of inertia), checked on the estimate;
 //! - [`statistics`]: the sufficient statistics of one log, merged over a set of logs
@@ -26,12 +30,15 @@ pub mod data;
 pub mod estimators;
 pub mod excitation;
 pub mod fuzz_checks;
+pub mod gains;
 pub mod model_access;
 pub mod observation;
 pub mod parameters;
+pub mod payload;
 pub mod report;
 pub mod signal;
 pub mod signs;
+pub mod stacked;
 pub mod statistics;
 
 use crate::error::{Error, Result};

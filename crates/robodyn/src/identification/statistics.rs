@@ -394,3 +394,38 @@ pub fn statistics(
     let (stats, _) = super::log_statistics(access, &mut model, log, opt)?;
     Ok(stats)
 }
+
+/// The statistics of many logs of one robot with one set of options, the robot's models and
+/// its parameter model (the numerical base parameters) built once: a worker of a distributed
+/// engine keeps one and calls [`StatisticsBuilder::statistics`] per log. The same numbers as
+/// [`statistics`] of each log.
+pub struct StatisticsBuilder {
+    access: ModelAccess,
+    model: super::parameters::ParameterModel,
+    opt: Options,
+}
+
+impl StatisticsBuilder {
+    /// The builder of `access`'s robot with the options `opt` (checked).
+    pub fn new(mut access: ModelAccess, opt: Options) -> Result<StatisticsBuilder> {
+        opt.validate()?;
+        let model = super::parameters::ParameterModel::build(&mut access, &opt.parameters)?;
+        Ok(StatisticsBuilder { access, model, opt })
+    }
+
+    /// The statistics of one log.
+    pub fn statistics(&mut self, log: &dyn LogSource) -> Result<Statistics> {
+        let (stats, _) = super::log_statistics(&mut self.access, &mut self.model, log, &self.opt)?;
+        Ok(stats)
+    }
+
+    /// The options the statistics are computed with.
+    pub fn options(&self) -> &Options {
+        &self.opt
+    }
+
+    /// The robot's models.
+    pub fn access(&self) -> &ModelAccess {
+        &self.access
+    }
+}
