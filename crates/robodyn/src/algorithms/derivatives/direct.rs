@@ -174,7 +174,9 @@ pub fn direct_dynamics_derivatives_into(
     let state = (q, qd, out.qdd.as_slice());
     let [dq, dqd] = dtau;
     idm_derivatives_world(model, ws, world, env, state, h, [dq, dqd], None);
-    out.ainv.fill_with_identity();
+    // a slice fill: nalgebra's `fill` goes entry by entry
+    out.ainv.as_mut_slice().fill(0.0);
+    out.ainv.fill_diagonal(1.0);
     solve_columns(model, factor, &mut out.ainv);
     neg_product(&out.ainv, dq, &mut out.dqdd_dq);
     neg_product(&out.ainv, dqd, &mut out.dqdd_dqd);

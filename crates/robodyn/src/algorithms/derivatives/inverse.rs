@@ -278,8 +278,8 @@ pub(crate) fn idm_derivative_columns(
     }
     let idx = &model.index;
     if !idx.serial {
-        dtau_dq.fill(0.0);
-        dtau_dqd.fill(0.0);
+        dtau_dq.as_mut_slice().fill(0.0);
+        dtau_dqd.as_mut_slice().fill(0.0);
     }
     let cq = dtau_dq.as_mut_slice().chunks_exact_mut(n);
     let cv = dtau_dqd.as_mut_slice().chunks_exact_mut(n);

@@ -262,10 +262,10 @@ pub(crate) fn idm_derivatives_world(
 ) {
     rnea_with_environment(model, ws, env, q, qd, qdd, tau);
     if !model.index.serial {
-        dtau_dq.fill(0.0);
-        dtau_dqd.fill(0.0);
+        dtau_dq.as_mut_slice().fill(0.0);
+        dtau_dqd.as_mut_slice().fill(0.0);
         if let Some(a) = a.as_deref_mut() {
-            a.fill(0.0);
+            a.as_mut_slice().fill(0.0);
         }
     }
     forward(model, ws, t, env, qd, qdd);
