@@ -246,16 +246,30 @@ pub fn identify(
     let mut opt = self::options(options)?;
     opt.keep_validation_rows = true;
     let mut access = ModelAccess::new(description(robot)?).py()?;
+    let many = logs.cast::<PyList>().is_ok() || logs.cast::<PyTuple>().is_ok();
     let logs = self::logs(logs, &labels(&access))?;
-    let id = py
-        .detach(|| {
-            let refs: Vec<&dyn LogSource> = logs.iter().map(|l| l as &dyn LogSource).collect();
-            ident::identify_logs(&mut access, &refs, &opt)
+    let n = access.actuated_joints().len();
+    let (id, predictions) = py
+        .detach(|| -> robodyn::Result<_> {
+            // each log read once, recorded: the identification and the predictions read the
+            // recording (arrays are a stream read once)
+            let recorded = logs
+                .iter()
+                .map(|l| robodyn::identification::data::record(l, n).map(|r| r.1))
+                .collect::<robodyn::Result<Vec<_>>>()?;
+            let refs: Vec<&dyn LogSource> = recorded.iter().map(|l| l as &dyn LogSource).collect();
+            let id = ident::identify_logs(&mut access, &refs, &opt)?;
+            let predictions = refs
+                .iter()
+                .map(|l| ident::predictions::predictions(&mut access, &id, *l, &opt))
+                .collect::<robodyn::Result<Vec<_>>>()?;
+            Ok((id, predictions))
         })
         .py()?;
     Ok(Identification {
         id,
         desc: access.description().clone(),
+        predictions: Some((predictions, many)),
     })
 }
 
@@ -300,6 +314,7 @@ pub fn identify_from_statistics(
     Ok(Identification {
         id,
         desc: access.description().clone(),
+        predictions: None,
     })
 }
 
@@ -367,6 +382,9 @@ pub struct Identification {
     id: ident::Identification,
     /// The robot's description (the identified robot's geometry).
     desc: RobotDescription,
+    /// The model's torques at every sample of each log, and whether the logs were given as a
+    /// list (None from statistics: no log to predict).
+    predictions: Option<(Vec<ident::predictions::Predictions>, bool)>,
 }
 
 /// t, measured and predicted torques of the validation segment.
@@ -485,6 +503,35 @@ impl Identification {
             to2d(&rows.y)?,
             to2d(&self.id.predicted_validation())?,
         ))
+    }
+
+    /// The identified model's torques at every sample of the log (the samples between the
+    /// borders the processing drops), to compare with the measured torques: a dict `t` (M,),
+    /// `tau` (M, N) (joint side, N m or N), `joints` (frame numbers, the columns of `tau`);
+    /// a list of such dicts when the logs were given as a list; None when identified from
+    /// statistics (no log). `robodyn identify --predictions FILE`.
+    #[getter]
+    fn predictions<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let Some((preds, many)) = &self.predictions else {
+            return Ok(py.None().into_bound(py));
+        };
+        let one = |p: &ident::predictions::Predictions| -> PyResult<Bound<'py, PyAny>> {
+            let d = PyDict::new(py);
+            let flat: Vec<f64> = p.tau.iter().flatten().copied().collect();
+            d.set_item("t", PyArray1::from_slice(py, &p.t))?;
+            d.set_item(
+                "tau",
+                PyArray1::from_vec(py, flat).reshape([p.t.len(), p.joints.len()])?,
+            )?;
+            d.set_item("joints", p.joints.clone())?;
+            Ok(d.into_any())
+        };
+        if *many {
+            let items = preds.iter().map(one).collect::<PyResult<Vec<_>>>()?;
+            Ok(PyList::new(py, items)?.into_any())
+        } else {
+            one(&preds[0])
+        }
     }
 
     /// The report as `robodyn identify` prints it.

@@ -428,6 +428,10 @@ class Identification:
     warnings: List[Dict[str, Any]]
     """kind, parameters, message."""
     notes: List[str]
+    predictions: Union[Dict[str, Any], List[Dict[str, Any]], None]
+    """The model's torques at every sample of the log (between the processing's borders): a dict
+    ``t`` (M,), ``tau`` (M, N), ``joints`` (frame numbers); a list of them when the logs were a
+    list; None from statistics. ``robodyn identify --predictions FILE``."""
     def validation_prediction(self) -> Tuple[Array, Array, Array]:
         """(t (M,), measured (M, N), predicted (M, N)) torques of the validation segment's decimated
         samples, for a plot."""
