@@ -22,13 +22,14 @@ use robodyn::RobotDescription;
 use std::path::PathBuf;
 
 /// The option names of `identify` (the fields of the library's `identification::Options`).
-const OPTIONS: [&str; 22] = [
+const OPTIONS: [&str; 23] = [
     "estimator",
     "consistent",
     "standard",
     "rotor",
     "friction",
     "offsets",
+    "joint_drives",
     "seed",
     "essential",
     "essential_max_std",
@@ -71,6 +72,7 @@ fn options(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<Options> {
             "rotor" => o.parameters.rotors = crate::robot::parse_rotor(&v.extract::<String>()?)?,
             "friction" => o.parameters.friction = v.extract()?,
             "offsets" => o.parameters.offsets = v.extract()?,
+            "joint_drives" => o.parameters.joint_drives = v.extract()?,
             "seed" => o.parameters.seed = v.extract()?,
             "essential" => {
                 if v.extract::<bool>()? {
@@ -230,7 +232,7 @@ fn labels(access: &ModelAccess) -> JointLabels {
 ///
 /// Options (the library's `identification::Options`, the CLI's flags): `estimator` ("ols",
 /// "wls" default, "iv"), `consistent`, `standard` (compute the consistent standard parameters
-/// for `write_robot`/`robot()`), `rotor`, `friction`, `offsets`, `seed`, `essential`,
+/// for `write_robot`/`robot()`), `rotor`, `friction`, `offsets`, `joint_drives`, `seed`, `essential`,
 /// `essential_max_std`, `essential_tolerance`, `bandwidth`, `cutoff`, `filter_order`,
 /// `decimation`, `border`, `validation` ((from, to) fractions, or None; default (0.8, 1.0)),
 /// `use_log_derivatives`, `gains`, `min_speed`, `coulomb_band`, `iv_iterations`,

@@ -58,6 +58,10 @@ pub struct Args {
     /// Leave out the Coulomb and viscous friction.
     #[arg(long)]
     pub no_friction: bool,
+    /// With a transmission, identify the motors' drive parameters only (without the joint-side
+    /// inertia and friction of the joints a motor's terms do not span, e.g. the TX40's joint 6).
+    #[arg(long)]
+    pub no_joint_drives: bool,
     /// Add a constant torque offset per joint.
     #[arg(long)]
     pub offsets: bool,
@@ -376,6 +380,7 @@ fn options(a: &Args, gains: Option<Vec<f64>>) -> CliResult<Options> {
             rotors: a.rotor,
             friction: !a.no_friction,
             offsets: a.offsets,
+            joint_drives: !a.no_joint_drives,
             seed: a.seed,
         },
         estimator: a.estimator,

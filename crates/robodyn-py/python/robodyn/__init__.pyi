@@ -378,7 +378,7 @@ def identify(robot: Union[Robot, str, PathLike], logs: Union[Log, Sequence[Log]]
     transmission) of ``robot`` from one log or a list of logs of it (the CLI's repeated ``--data``):
     the same numbers as ``robodyn identify``. Options (the library's identification Options, the
     CLI's flags): estimator ("ols", "wls", "iv"), consistent, standard (compute consistent standard
-    parameters for ``robot()``/``write_robot``), rotor, friction, offsets, seed, essential,
+    parameters for ``robot()``/``write_robot``), rotor, friction, offsets, joint_drives, seed, essential,
     essential_max_std, essential_tolerance, bandwidth, cutoff, filter_order, decimation, border,
     validation ((from, to) fractions or None; default (0.8, 1.0)), use_log_derivatives, gains,
     min_speed, coulomb_band, iv_iterations, iv_bandwidth. An unknown option raises InputError."""
