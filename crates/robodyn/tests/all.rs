@@ -77,6 +77,8 @@ mod identification_consistency;
 mod identification_coverage;
 #[path = "identification_hostile.rs"]
 mod identification_hostile;
+#[path = "identification_joint_drives.rs"]
+mod identification_joint_drives;
 #[path = "identification_statistics.rs"]
 mod identification_statistics;
 #[path = "identification_synthetic.rs"]
