@@ -91,8 +91,7 @@ fn joint_side_drive_parameters_of_the_coupled_wrist() {
             value(name)
         );
     }
-    for m in 2..6 {
-        let (ia, fs, fv) = MOTOR[m];
+    for (m, &(ia, fs, fv)) in MOTOR.iter().enumerate().skip(2) {
         for (name, truth) in [("IA", ia), ("FS", fs), ("FV", fv)] {
             let name = format!("{name}{}", m + 1);
             assert!(
