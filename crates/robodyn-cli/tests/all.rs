@@ -41,6 +41,8 @@ mod cli_identify;
 mod cli_identify_hostile;
 #[path = "cli_identify_many.rs"]
 mod cli_identify_many;
+#[path = "cli_identify_predictions.rs"]
+mod cli_identify_predictions;
 #[path = "cli_info.rs"]
 mod cli_info;
 #[path = "cli_info_assembly.rs"]

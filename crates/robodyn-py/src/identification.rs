@@ -24,13 +24,14 @@ use std::path::PathBuf;
 use std::sync::Mutex;
 
 /// The option names of `identify` (the fields of the library's `identification::Options`).
-const OPTIONS: [&str; 22] = [
+const OPTIONS: [&str; 23] = [
     "estimator",
     "consistent",
     "standard",
     "rotor",
     "friction",
     "offsets",
+    "joint_drives",
     "seed",
     "essential",
     "essential_max_std",
@@ -73,6 +74,7 @@ fn options(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<Options> {
             "rotor" => o.parameters.rotors = crate::robot::parse_rotor(&v.extract::<String>()?)?,
             "friction" => o.parameters.friction = v.extract()?,
             "offsets" => o.parameters.offsets = v.extract()?,
+            "joint_drives" => o.parameters.joint_drives = v.extract()?,
             "seed" => o.parameters.seed = v.extract()?,
             "essential" => {
                 if v.extract::<bool>()? {
@@ -232,7 +234,7 @@ fn labels(access: &ModelAccess) -> JointLabels {
 ///
 /// Options (the library's `identification::Options`, the CLI's flags): `estimator` ("ols",
 /// "wls" default, "iv"), `consistent`, `standard` (compute the consistent standard parameters
-/// for `write_robot`/`robot()`), `rotor`, `friction`, `offsets`, `seed`, `essential`,
+/// for `write_robot`/`robot()`), `rotor`, `friction`, `offsets`, `joint_drives`, `seed`, `essential`,
 /// `essential_max_std`, `essential_tolerance`, `bandwidth`, `cutoff`, `filter_order`,
 /// `decimation`, `border`, `validation` ((from, to) fractions, or None; default (0.8, 1.0)),
 /// `use_log_derivatives`, `gains`, `min_speed`, `coulomb_band`, `iv_iterations`,
@@ -248,16 +250,30 @@ pub fn identify(
     let mut opt = self::options(options)?;
     opt.keep_validation_rows = true;
     let mut access = ModelAccess::new(description(robot)?).py()?;
+    let many = logs.cast::<PyList>().is_ok() || logs.cast::<PyTuple>().is_ok();
     let logs = self::logs(logs, &labels(&access))?;
-    let id = py
-        .detach(|| {
-            let refs: Vec<&dyn LogSource> = logs.iter().map(|l| l as &dyn LogSource).collect();
-            ident::identify_logs(&mut access, &refs, &opt)
+    let n = access.actuated_joints().len();
+    let (id, predictions) = py
+        .detach(|| -> robodyn::Result<_> {
+            // each log read once, recorded: the identification and the predictions read the
+            // recording (arrays are a stream read once)
+            let recorded = logs
+                .iter()
+                .map(|l| robodyn::identification::data::record(l, n).map(|r| r.1))
+                .collect::<robodyn::Result<Vec<_>>>()?;
+            let refs: Vec<&dyn LogSource> = recorded.iter().map(|l| l as &dyn LogSource).collect();
+            let id = ident::identify_logs(&mut access, &refs, &opt)?;
+            let predictions = refs
+                .iter()
+                .map(|l| ident::predictions::predictions(&mut access, &id, *l, &opt))
+                .collect::<robodyn::Result<Vec<_>>>()?;
+            Ok((id, predictions))
         })
         .py()?;
     Ok(Identification {
         id,
         desc: access.description().clone(),
+        predictions: Some((predictions, many)),
     })
 }
 
@@ -381,6 +397,7 @@ pub fn identify_from_statistics(
     Ok(Identification {
         id,
         desc: access.description().clone(),
+        predictions: None,
     })
 }
 
@@ -448,6 +465,9 @@ pub struct Identification {
     id: ident::Identification,
     /// The robot's description (the identified robot's geometry).
     desc: RobotDescription,
+    /// The model's torques at every sample of each log, and whether the logs were given as a
+    /// list (None from statistics: no log to predict).
+    predictions: Option<(Vec<ident::predictions::Predictions>, bool)>,
 }
 
 /// t, measured and predicted torques of the validation segment.
@@ -566,6 +586,35 @@ impl Identification {
             to2d(&rows.y)?,
             to2d(&self.id.predicted_validation())?,
         ))
+    }
+
+    /// The identified model's torques at every sample of the log (the samples between the
+    /// borders the processing drops), to compare with the measured torques: a dict `t` (M,),
+    /// `tau` (M, N) (joint side, N m or N), `joints` (frame numbers, the columns of `tau`);
+    /// a list of such dicts when the logs were given as a list; None when identified from
+    /// statistics (no log). `robodyn identify --predictions FILE`.
+    #[getter]
+    fn predictions<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let Some((preds, many)) = &self.predictions else {
+            return Ok(py.None().into_bound(py));
+        };
+        let one = |p: &ident::predictions::Predictions| -> PyResult<Bound<'py, PyAny>> {
+            let d = PyDict::new(py);
+            let flat: Vec<f64> = p.tau.iter().flatten().copied().collect();
+            d.set_item("t", PyArray1::from_slice(py, &p.t))?;
+            d.set_item(
+                "tau",
+                PyArray1::from_vec(py, flat).reshape([p.t.len(), p.joints.len()])?,
+            )?;
+            d.set_item("joints", p.joints.clone())?;
+            Ok(d.into_any())
+        };
+        if *many {
+            let items = preds.iter().map(one).collect::<PyResult<Vec<_>>>()?;
+            Ok(PyList::new(py, items)?.into_any())
+        } else {
+            one(&preds[0])
+        }
     }
 
     /// The report as `robodyn identify` prints it.

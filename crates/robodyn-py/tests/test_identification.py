@@ -157,3 +157,43 @@ def test_pandas_dataframe_and_errors(tmp_path):
         robodyn.identify_from_statistics(robot, [mine], bandwidth=5.0)
     with pytest.raises(robodyn.InputError, match="IDIM-IV"):
         robodyn.identify_from_statistics(robot, [mine], estimator="iv")
+
+
+def test_predictions_equal_the_idm_torques_and_the_cli_file(tmp_path):
+    """Noise-free logs made with Robot.idm (Newton-Euler): the OLS model's predictions at every
+    sample are the idm torques (the identification's regressor times the identified values,
+    another route); as a list of logs, a list of predictions; the CLI's --predictions file of
+    the same log holds the same doubles."""
+    robot = robodyn.load(robot_path("rx90.toml"))
+    logs = [fourier_log(robot, s) for s in (1, 2)]
+    id_ = robodyn.identify(robot, logs, estimator="ols", validation=None)
+    preds = id_.predictions
+    assert isinstance(preds, list) and len(preds) == 2
+    for log, p in zip(logs, preds):
+        assert p["joints"] == list(range(1, 7))
+        np.testing.assert_array_equal(p["t"], log["t"])
+        tau = np.column_stack([log[f"tau{j}"] for j in range(1, 7)])
+        assert p["tau"].shape == tau.shape
+        scale = np.abs(tau).max()
+        assert np.abs(p["tau"] - tau).max() < 1e-8 * scale
+    one = robodyn.identify(robot, logs[0], estimator="ols", validation=None)
+    assert isinstance(one.predictions, dict)
+    # the CLI on the same log written as CSV: the same numbers in its file
+    csv_log = tmp_path / "log.csv"
+    names = list(logs[0])
+    np.savetxt(csv_log, np.column_stack([logs[0][k] for k in names]), delimiter=",",
+               header=",".join(names), comments="", fmt="%.17g")
+    out = tmp_path / "pred.csv"
+    r = subprocess.run(cli() + ["identify", str(robot_path("rx90.toml")), "--data", str(csv_log),
+                                "--estimator", "ols", "--validation", "none",
+                                "--predictions", str(out)], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    table = np.genfromtxt(out, delimiter=",", names=True)
+    assert list(table.dtype.names) == ["t"] + [f"tau{j}" for j in range(1, 7)]
+    from_file = robodyn.identify(robot, str(csv_log), estimator="ols", validation=None)
+    np.testing.assert_array_equal(table["t"], from_file.predictions["t"])
+    for j in range(6):
+        np.testing.assert_array_equal(table[f"tau{j + 1}"], from_file.predictions["tau"][:, j])
+    # from statistics there is no log to predict
+    stats = [robodyn.ident_statistics(robot, log, estimator="ols", validation=None) for log in logs]
+    assert robodyn.identify_from_statistics(robot, stats, estimator="ols", validation=None).predictions is None

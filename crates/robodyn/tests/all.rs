@@ -81,6 +81,8 @@ mod identification_coverage;
 mod identification_gains;
 #[path = "identification_hostile.rs"]
 mod identification_hostile;
+#[path = "identification_joint_drives.rs"]
+mod identification_joint_drives;
 #[path = "identification_payload.rs"]
 mod identification_payload;
 #[path = "identification_statistics.rs"]

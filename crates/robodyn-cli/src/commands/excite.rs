@@ -124,6 +124,7 @@ pub fn run(a: Args) -> CliResult {
             friction: !a.no_friction,
             offsets: a.offsets,
             seed: a.seed,
+            ..ParameterOptions::default()
         },
     )?;
     let opt = DesignOptions {

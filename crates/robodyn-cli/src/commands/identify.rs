@@ -8,6 +8,7 @@ use robodyn::algorithms::regressor::RotorMode;
 use robodyn::identification::data::{CsvLog, Effort, JointLabels, LogSource};
 use robodyn::identification::model_access::ModelAccess;
 use robodyn::identification::parameters::ParameterOptions;
+use robodyn::identification::predictions::{predict, write_csv_header, write_csv_row};
 use robodyn::identification::{
     identify_from_statistics, identify_logs, report, statistics::statistics, EssentialOptions,
     Estimator, Identification, Options, Statistics,
@@ -57,6 +58,10 @@ pub struct Args {
     /// Leave out the Coulomb and viscous friction.
     #[arg(long)]
     pub no_friction: bool,
+    /// With a transmission, identify the motors' drive parameters only (without the joint-side
+    /// inertia and friction of the joints a motor's terms do not span, e.g. the TX40's joint 6).
+    #[arg(long)]
+    pub no_joint_drives: bool,
     /// Add a constant torque offset per joint.
     #[arg(long)]
     pub offsets: bool,
@@ -122,6 +127,12 @@ pub struct Args {
     /// joint.
     #[arg(long)]
     pub plot: Option<PathBuf>,
+    /// Write the identified model's torques at every sample of the log (CSV `t,tau<j>...` at
+    /// the log's rate, from the filtered positions as in the fit; the samples between the
+    /// borders) to compare with the measured torques. With several `--data` logs, one file per
+    /// log, in their order (`--predictions a.csv --predictions b.csv`).
+    #[arg(long, value_name = "FILE.csv", conflicts_with_all = ["merge", "partial"])]
+    pub predictions: Vec<PathBuf>,
     /// Write a physically consistent robot file (.toml) with the identified parameters.
     #[arg(long, value_name = "FILE.toml")]
     pub write_robot: Option<PathBuf>,
@@ -223,6 +234,7 @@ pub fn run(a: Args) -> CliResult {
         ("--write-robot", a.write_robot.as_deref()),
         ("--partial", a.partial.as_deref()),
     ])?;
+    check_predictions(&a)?;
     let desc = a.robot.description()?.0;
     let mut access = ModelAccess::new(desc)?;
     if a.estimate_gains || a.payload.is_some() {
@@ -234,12 +246,13 @@ pub fn run(a: Args) -> CliResult {
         .map(|g| parse_list("gains", g))
         .transpose()?;
     let opt = options(&a, gains.clone())?;
+    let mut logs = Vec::new();
     let id = if a.merge.is_empty() {
         let labels = JointLabels {
             numbers: access.actuated_joints().to_vec(),
             names: access.joint_names(),
         };
-        let logs = a
+        logs = a
             .data
             .iter()
             .map(|d| CsvLog::open(d, &labels))
@@ -265,8 +278,13 @@ pub fn run(a: Args) -> CliResult {
         Format::Json => format!("{}\n", serde_json::to_string_pretty(&report::to_json(&id))?),
         Format::Csv => report::to_csv(&id),
     };
-    write_files(&a, &access, &id, &text)?;
-    for p in [&a.plot, &a.write_robot].into_iter().flatten() {
+    let predictions = write_predictions(&a.predictions, &mut access, &id, (&logs, &opt))?;
+    write_files(&a, &access, &id, &text, predictions)?;
+    for p in [&a.plot, &a.write_robot]
+        .into_iter()
+        .flatten()
+        .chain(&a.predictions)
+    {
         eprintln!("wrote {}", p.display());
     }
     // the warnings once: in the report when it goes to standard output with them (text, JSON),
@@ -289,6 +307,71 @@ pub fn run(a: Args) -> CliResult {
         .into());
     }
     Ok(())
+}
+
+/// `--predictions`: one file per `--data` log, each a file (read again), none standard output,
+/// distinct from the other outputs; checked before any work.
+fn check_predictions(a: &Args) -> CliResult {
+    if a.predictions.is_empty() {
+        return Ok(());
+    }
+    if a.predictions.len() != a.data.len() {
+        return Err(format!(
+            "--predictions given {} time(s) for {} --data log(s): one predictions file per log,              in the order of the logs",
+            a.predictions.len(),
+            a.data.len()
+        )
+        .into());
+    }
+    if let Some(p) = a.predictions.iter().find(|p| robodyn::io::is_stdio(p)) {
+        return Err(format!(
+            "--predictions {}: a file name expected (the report may go to standard output)",
+            p.display()
+        )
+        .into());
+    }
+    if a.data.iter().any(|d| robodyn::io::is_stdio(d)) {
+        return Err("--predictions reads the log again: give the log as a file, not as                     standard input (--data -)"
+            .into());
+    }
+    // a predictions file must not replace a log
+    for d in &a.data {
+        for p in &a.predictions {
+            crate::output::check_distinct(&[("--data", Some(d)), ("--predictions", Some(p))])?;
+        }
+    }
+    let mut named: Vec<(String, Option<&Path>)> = a
+        .predictions
+        .iter()
+        .enumerate()
+        .map(|(k, p)| (format!("--predictions ({})", k + 1), Some(p.as_path())))
+        .collect();
+    named.extend([
+        ("--output".to_string(), a.output.as_deref()),
+        ("--plot".to_string(), a.plot.as_deref()),
+        ("--write-robot".to_string(), a.write_robot.as_deref()),
+    ]);
+    let refs: Vec<(&str, Option<&Path>)> = named.iter().map(|(n, p)| (n.as_str(), *p)).collect();
+    crate::output::check_distinct(&refs)
+}
+
+/// The predictions of each log written to its file (temporary files, put in place with the
+/// other outputs).
+fn write_predictions(
+    paths: &[PathBuf],
+    access: &mut ModelAccess,
+    id: &Identification,
+    (logs, opt): (&[CsvLog], &Options),
+) -> CliResult<Vec<crate::output::Output>> {
+    let mut files = Vec::with_capacity(paths.len());
+    for (path, log) in paths.iter().zip(logs) {
+        let mut out = crate::output::Output::create(Some(path))?;
+        let w = out.writer();
+        write_csv_header(w, access.actuated_joints())?;
+        predict(access, id, log, opt, &mut |t, tau| write_csv_row(w, t, tau))?;
+        files.push(out);
+    }
+    Ok(files)
 }
 
 /// `--partial`: the statistics of the logs, merged, written as JSON (all or nothing).
@@ -327,6 +410,7 @@ fn options(a: &Args, gains: Option<Vec<f64>>) -> CliResult<Options> {
             rotors: a.rotor,
             friction: !a.no_friction,
             offsets: a.offsets,
+            joint_drives: !a.no_joint_drives,
             seed: a.seed,
         },
         estimator: a.estimator,
@@ -355,8 +439,15 @@ fn options(a: &Args, gains: Option<Vec<f64>>) -> CliResult<Options> {
 
 /// The report, the fit plot and the identified robot file: all or nothing, the files put in
 /// place once all are written.
-fn write_files(a: &Args, access: &ModelAccess, id: &Identification, text: &str) -> CliResult {
+fn write_files(
+    a: &Args,
+    access: &ModelAccess,
+    id: &Identification,
+    text: &str,
+    predictions: Vec<crate::output::Output>,
+) -> CliResult {
     let mut files = vec![crate::output::Output::create(a.output.as_deref())?];
+    files.extend(predictions);
     files[0].write_all(text.as_bytes())?;
     if let Some(p) = &a.plot {
         let mut plot = crate::output::Output::create(Some(p))?;

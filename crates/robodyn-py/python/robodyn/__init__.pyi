@@ -424,7 +424,7 @@ def identify(robot: Union[Robot, str, PathLike], logs: Union[Log, Sequence[Log]]
     transmission) of ``robot`` from one log or a list of logs of it (the CLI's repeated ``--data``):
     the same numbers as ``robodyn identify``. Options (the library's identification Options, the
     CLI's flags): estimator ("ols", "wls", "iv"), consistent, standard (compute consistent standard
-    parameters for ``robot()``/``write_robot``), rotor, friction, offsets, seed, essential,
+    parameters for ``robot()``/``write_robot``), rotor, friction, offsets, joint_drives, seed, essential,
     essential_max_std, essential_tolerance, bandwidth, cutoff, filter_order, decimation, border,
     validation ((from, to) fractions or None; default (0.8, 1.0)), use_log_derivatives, gains,
     min_speed, coulomb_band, iv_iterations, iv_bandwidth. An unknown option raises InputError."""
@@ -512,6 +512,10 @@ class Identification:
     warnings: List[Dict[str, Any]]
     """kind, parameters, message."""
     notes: List[str]
+    predictions: Union[Dict[str, Any], List[Dict[str, Any]], None]
+    """The model's torques at every sample of the log (between the processing's borders): a dict
+    ``t`` (M,), ``tau`` (M, N), ``joints`` (frame numbers); a list of them when the logs were a
+    list; None from statistics. ``robodyn identify --predictions FILE``."""
     def validation_prediction(self) -> Tuple[Array, Array, Array]:
         """(t (M,), measured (M, N), predicted (M, N)) torques of the validation segment's decimated
         samples, for a plot."""

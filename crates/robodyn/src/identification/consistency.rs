@@ -22,7 +22,7 @@
 use super::conic;
 use super::estimators::LsSolution;
 use super::model_access::ModelAccess;
-use super::parameters::{Kind, ParameterModel};
+use super::parameters::ParameterModel;
 use super::Consistent;
 use crate::algorithms::regressor::PARAMS_PER_LINK;
 use crate::error::{Error, Result};
@@ -78,7 +78,7 @@ impl Variables {
             .params
             .iter()
             .enumerate()
-            .filter(|(_, p)| matches!(p.kind, Kind::Offset(_)))
+            .filter(|(_, p)| p.kind.is_free())
             .map(|(i, _)| i)
             .collect();
         Variables {

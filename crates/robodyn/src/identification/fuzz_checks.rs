@@ -200,6 +200,7 @@ fn options(data: &[u8]) -> Options {
             friction: b.flag(),
             offsets: b.flag(),
             seed: u64::from(b.byte()),
+            ..ParameterOptions::default()
         },
         estimator: [Estimator::Ols, Estimator::Wls, Estimator::Iv][usize::from(b.byte() % 3)],
         consistent: false,

@@ -20,6 +20,7 @@
 //!   of inertia), checked on the estimate;
 //! - [`statistics`]: the sufficient statistics of one log, merged over a set of logs
 //!   (map-reduce; serialized as JSON);
+//! - [`predictions`]: the identified model's torques at every sample of a log;
 //! - [`report`]: table (text, JSON, CSV) and SVG plots;
 //! - [`model_access`]: the only calls into the rest of the library;
 //! - [`fuzz_checks`]: the properties the fuzz targets check (`fuzz/`).
@@ -35,6 +36,7 @@ pub mod model_access;
 pub mod observation;
 pub mod parameters;
 pub mod payload;
+pub mod predictions;
 pub mod report;
 pub mod signal;
 pub mod signs;
@@ -847,7 +849,10 @@ pub fn identify_from_statistics(
 }
 
 /// Read a log once: its summary, and its recording unless it is repeatable.
-fn read_once(log: &dyn LogSource, n: usize) -> Result<(LogSummary, Option<data::RecordedLog>)> {
+pub(crate) fn read_once(
+    log: &dyn LogSource,
+    n: usize,
+) -> Result<(LogSummary, Option<data::RecordedLog>)> {
     if log.repeatable() {
         Ok((summarize(log, n)?, None))
     } else {

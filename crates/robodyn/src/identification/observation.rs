@@ -220,11 +220,21 @@ struct Processed {
     y: Vec<f64>,
 }
 
+/// Where the model's torques of every kept sample go in a prediction pass: the parameters x
+/// and a sink called with (t, tau) per sample, tau the N joint torques W x + tau_e.
+pub struct PredictionSink<'a> {
+    /// The identified parameters (in the order of the parameter model).
+    pub x: &'a [f64],
+    /// Called once per sample between the borders, in order.
+    pub sink: &'a mut dyn FnMut(f64, &[f64]) -> Result<()>,
+}
+
 struct Pass<'a> {
     params: &'a mut ParameterModel,
     access: &'a mut ModelAccess,
     proc: &'a Processing,
     instruments: Option<&'a mut Instruments>,
+    predict: Option<PredictionSink<'a>>,
     n: usize,
     p: usize,
     stream: Option<ZeroPhaseStream>,
@@ -359,6 +369,9 @@ impl Pass<'_> {
             &mut self.tau_e,
         )?;
         self.check_rows(s.t, &s.y)?;
+        if let Some(pr) = self.predict.as_mut() {
+            return predicted(pr, (s.t, &self.w, &self.tau_e), self.params);
+        }
         let iv = self.instruments.is_some();
         let validation = self
             .proc
@@ -428,6 +441,28 @@ impl Pass<'_> {
     }
 }
 
+/// The model's torques W x + tau_e of one sample sent to the sink: an error naming the joint
+/// and the time where one is not finite (never a NaN in the predictions).
+fn predicted(
+    pr: &mut PredictionSink<'_>,
+    (t, w, tau_e): (f64, &[f64], &[f64]),
+    params: &ParameterModel,
+) -> Result<()> {
+    let p = pr.x.len();
+    let tau: Vec<f64> = tau_e
+        .iter()
+        .enumerate()
+        .map(|(k, e)| e + (0..p).map(|c| w[k * p + c] * pr.x[c]).sum::<f64>())
+        .collect();
+    if let Some(k) = tau.iter().position(|v| !v.is_finite()) {
+        return Err(Error::Numerical(format!(
+            "at t = {t} s the predicted torque of joint {} is {} (are the parameters finite?)",
+            params.joints[k], tau[k]
+        )));
+    }
+    (pr.sink)(t, &tau)
+}
+
 /// Run one pass over `log`.
 pub fn run_pass(
     log: &dyn LogSource,
@@ -435,6 +470,36 @@ pub fn run_pass(
     access: &mut ModelAccess,
     proc: &Processing,
     instruments: Option<&mut Instruments>,
+) -> Result<PassResult> {
+    pass(log, (params, access), proc, instruments, None)
+}
+
+/// A pass over `log` that sends the model's torques W x + tau_e of every sample between the
+/// borders (from the filtered positions and their differences, or the log's derivatives) to
+/// `predict`, instead of building the least-squares factors.
+pub fn run_prediction_pass<'a>(
+    log: &dyn LogSource,
+    params: &'a mut ParameterModel,
+    access: &'a mut ModelAccess,
+    proc: &'a Processing,
+    predict: PredictionSink<'a>,
+) -> Result<usize> {
+    if predict.x.len() != params.count() {
+        return Err(Error::Input(format!(
+            "{} parameter values for a model of {} parameters",
+            predict.x.len(),
+            params.count()
+        )));
+    }
+    Ok(pass(log, (params, access), proc, None, Some(predict))?.samples_used)
+}
+
+fn pass<'a>(
+    log: &dyn LogSource,
+    (params, access): (&'a mut ParameterModel, &'a mut ModelAccess),
+    proc: &'a Processing,
+    instruments: Option<&'a mut Instruments>,
+    predict: Option<PredictionSink<'a>>,
 ) -> Result<PassResult> {
     access.restart();
     let n = params.joints_count();
@@ -452,6 +517,7 @@ pub fn run_pass(
         access,
         proc,
         instruments,
+        predict,
         n,
         p,
         pending: VecDeque::new(),

@@ -31,8 +31,26 @@ pub enum Kind {
         /// `IA`, `FS` or `FV` index within a link's 13 standard parameters.
         which: usize,
     },
+    /// Joint-side drive parameter (`IA`, `FS` or `FV` index) of actuated joint k (0-based):
+    /// with a transmission, the inertia and friction on the joint side of the gears, acting on
+    /// q_k alone (IA_k qdd_k + FV_k qd_k + FS_k sign(qd_k) in joint k's torque), next to the
+    /// motors'.
+    Joint {
+        /// Actuated joint k (0-based, in the transmission's order).
+        joint: usize,
+        /// `IA`, `FS` or `FV` index within a link's 13 standard parameters.
+        which: usize,
+    },
     /// Constant torque offset of actuated joint number k (0-based).
     Offset(usize),
+}
+
+impl Kind {
+    /// Whether the parameter is not a combination of the robot's standard parameters (an
+    /// offset, a joint-side drive parameter of a transmission): a free variable of the fit.
+    pub fn is_free(&self) -> bool {
+        matches!(self, Kind::Offset(_) | Kind::Joint { .. })
+    }
 }
 
 /// One identified parameter.
@@ -56,6 +74,11 @@ pub struct ParameterOptions {
     pub friction: bool,
     /// A constant torque offset per actuated joint is a parameter.
     pub offsets: bool,
+    /// With a transmission: the joint-side rotor inertia (when rotors are identified) and
+    /// friction (when friction is) of each actuated joint as parameters next to the motors',
+    /// those a motor's column already spans left out (the TX40 keeps joint 6's: motor 6 turns
+    /// with q5 + q6). No effect without a transmission.
+    pub joint_drives: bool,
     /// Seed of the random states of the numerical base-parameter method.
     pub seed: u64,
 }
@@ -66,6 +89,7 @@ impl Default for ParameterOptions {
             rotors: Rotors::Actuated,
             friction: true,
             offsets: false,
+            joint_drives: true,
             seed: 1,
         }
     }
@@ -157,16 +181,49 @@ impl ParameterModel {
         if let Some(r) = &transmission {
             check_transmission(r, n)?;
             let mut wanted = Vec::new();
+            let mut which_drives = Vec::new();
+            if opt.rotors != Rotors::None {
+                which_drives.push(IA);
+            }
+            if opt.friction {
+                which_drives.extend([FS, FV]);
+            }
             for k in 0..n {
-                if opt.rotors != Rotors::None {
-                    wanted.push((k, IA));
-                }
-                if opt.friction {
-                    wanted.extend([(k, FS), (k, FV)]);
+                wanted.extend(
+                    which_drives
+                        .iter()
+                        .map(|&w| Kind::Motor { motor: k, which: w }),
+                );
+            }
+            if opt.joint_drives {
+                for k in 0..n {
+                    wanted.extend(
+                        which_drives
+                            .iter()
+                            .map(|&w| Kind::Joint { joint: k, which: w }),
+                    );
                 }
             }
             let (kept, grouped) = model.reduce_motor_columns(access, &wanted, opt.seed)?;
-            for &(k, which) in &kept {
+            for kind in kept {
+                let (k, which) = match kind {
+                    Kind::Joint { joint, which } => {
+                        let name = format!("{}J{}", DRIVE_NAMES[drive_slot(which)], joints[joint]);
+                        params.push(Parameter {
+                            equation: format!(
+                                "joint-side {} of joint {}",
+                                DRIVE_WORDS[drive_slot(which)],
+                                joints[joint]
+                            ),
+                            name,
+                            kind,
+                        });
+                        map.push(Vec::new());
+                        continue;
+                    }
+                    Kind::Motor { motor, which } => (motor, which),
+                    _ => unreachable!("drive columns"),
+                };
                 let j = joints[k];
                 let index = PARAMS_PER_LINK * (j - 1) + which;
                 params.push(Parameter {
@@ -176,8 +233,12 @@ impl ParameterModel {
                 });
                 map.push(vec![(index, 1.0)]);
             }
-            // grouped motor parameters: x_r += coef K_motor in the parameters they join
-            for ((k, which), coefs) in grouped {
+            // grouped motor parameters: x_r += coef K_motor in the parameters they join (a
+            // joint-side column a motor's spans is left out: the motor's parameter stands for it)
+            for (kind, coefs) in grouped {
+                let Kind::Motor { motor: k, which } = kind else {
+                    continue;
+                };
                 let index = PARAMS_PER_LINK * (joints[k] - 1) + which;
                 for (r, c) in coefs {
                     map[r].push((index, c));
@@ -243,7 +304,7 @@ impl ParameterModel {
                 Kind::Motor { motor, which } => {
                     k[PARAMS_PER_LINK * (self.motor_links[motor] - 1) + which] = *v
                 }
-                Kind::Offset(_) => {}
+                Kind::Offset(_) | Kind::Joint { .. } => {}
             }
         }
         k
@@ -287,6 +348,32 @@ impl ParameterModel {
         }
     }
 
+    /// The column of a drive parameter (motor or joint side) at (qd_a, qdd_a): for a motor,
+    /// [`ParameterModel::motor_column`]; for joint k's own, qdd_k, sign(qd_k) (dead band
+    /// `band`) or qd_k in row k only.
+    fn drive_column(
+        r: &[Vec<f64>],
+        kind: &Kind,
+        (qd, qdd): (&[f64], &[f64]),
+        band: f64,
+        out: &mut [f64],
+    ) {
+        match *kind {
+            Kind::Motor { motor, which } => {
+                Self::motor_column(r, motor, which, (qd, qdd), band, out)
+            }
+            Kind::Joint { joint, which } => {
+                out.fill(0.0);
+                out[joint] = match which {
+                    IA => qdd[joint],
+                    FV => qd[joint],
+                    _ => coulomb_sign(qd[joint], band),
+                };
+            }
+            _ => unreachable!("drive columns"),
+        }
+    }
+
     /// Which motor columns are independent of the link base parameters and of the motor
     /// columns before them (kept), and the coefficients of the others over the kept columns
     /// (base parameter r, or motor parameter after the base ones).
@@ -294,12 +381,9 @@ impl ParameterModel {
     fn reduce_motor_columns(
         &self,
         access: &mut ModelAccess,
-        wanted: &[(usize, usize)],
+        wanted: &[Kind],
         seed: u64,
-    ) -> Result<(
-        Vec<(usize, usize)>,
-        Vec<((usize, usize), Vec<(usize, f64)>)>,
-    )> {
+    ) -> Result<(Vec<Kind>, Vec<(Kind, Vec<(usize, f64)>)>)> {
         let r = self.transmission.as_ref().expect("transmission");
         let nb = self.base.base.len();
         let total = nb + wanted.len();
@@ -314,8 +398,8 @@ impl ParameterModel {
                     w[(s * self.n + i, c)] = base_rows[i * nb + c];
                 }
             }
-            for (c, &(k, which)) in wanted.iter().enumerate() {
-                Self::motor_column(r, k, which, (qd, qdd), 0.0, &mut col);
+            for (c, kind) in wanted.iter().enumerate() {
+                Self::drive_column(r, kind, (qd, qdd), 0.0, &mut col);
                 for i in 0..self.n {
                     w[(s * self.n + i, nb + c)] = col[i];
                 }
@@ -329,7 +413,7 @@ impl ParameterModel {
         let mut kept_cols: Vec<usize> = (0..nb).collect();
         let mut kept = Vec::new();
         let mut grouped = Vec::new();
-        for (c, &m) in wanted.iter().enumerate() {
+        for (c, m) in wanted.iter().cloned().enumerate() {
             let b = column(nb + c);
             let norm = (0..rows).map(|i| b[(i, 0)] * b[(i, 0)]).sum::<f64>().sqrt();
             if norm == 0.0 {
@@ -347,7 +431,7 @@ impl ParameterModel {
                 .sqrt();
             if std::env::var("ROBODYN_DEBUG").is_ok() {
                 eprintln!(
-                    "motor column {m:?}: relative distance {:e}",
+                    "drive column {m:?}: relative distance {:e}",
                     residual / norm
                 );
             }
@@ -399,10 +483,10 @@ impl ParameterModel {
         }
         for (c, prm) in self.params.iter().enumerate().skip(nb) {
             match prm.kind {
-                Kind::Motor { motor, which } => {
+                Kind::Motor { .. } | Kind::Joint { .. } => {
                     let r = self.transmission.as_ref().expect("transmission");
                     let band = self.coulomb_band;
-                    Self::motor_column(r, motor, which, (qda, qdda), band, &mut col);
+                    Self::drive_column(r, &prm.kind, (qda, qdda), band, &mut col);
                     for i in 0..n {
                         out[i * p + c] = col[i];
                     }
@@ -441,6 +525,21 @@ impl ParameterModel {
             out[base + FV] = v[2];
         }
         out
+    }
+}
+
+/// The drive parameters' names (joint-side `FVJ6`), by [`drive_slot`].
+const DRIVE_NAMES: [&str; 3] = ["IA", "FS", "FV"];
+
+/// The drive parameters in words, by [`drive_slot`].
+const DRIVE_WORDS: [&str; 3] = ["rotor inertia", "Coulomb friction", "viscous friction"];
+
+/// 0, 1, 2 for `IA`, `FS`, `FV`.
+fn drive_slot(which: usize) -> usize {
+    match which {
+        IA => 0,
+        FS => 1,
+        _ => 2,
     }
 }
 

@@ -40,6 +40,7 @@ pub fn parameter_unit(id: &Identification, i: usize) -> &'static str {
             )
         }
         Kind::Motor { which, .. } => param::unit(which, false),
+        Kind::Joint { joint, which } => param::unit(which, prismatic(id.joints[joint])),
         Kind::Offset(k) => torque_unit(prismatic(id.joints[k])),
     }
 }

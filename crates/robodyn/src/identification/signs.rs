@@ -25,7 +25,7 @@
 //! significant) and not at rounding level (its torques above 1e-9 of the measured ones).
 
 use super::estimators::output_sq;
-use super::parameters::{Kind, ParameterModel};
+use super::parameters::ParameterModel;
 use super::{Warning, WarningKind};
 use crate::algorithms::regressor::PARAMS_PER_LINK;
 use crate::model::param::{FS, FV, IA};
@@ -62,7 +62,7 @@ pub fn constraints(model: &ParameterModel) -> Vec<SignConstraint> {
         .params
         .iter()
         .enumerate()
-        .filter(|(_, p)| !matches!(p.kind, Kind::Offset(_)))
+        .filter(|(_, p)| !p.kind.is_free())
         .filter_map(|(r, _)| {
             let terms = &model.map[r];
             let sign = sign_of(terms)?;
