@@ -151,6 +151,7 @@ pub fn excite<'py>(
         friction,
         offsets,
         seed,
+        ..ParameterOptions::default()
     };
     let opt = DesignOptions {
         period,
