@@ -5,17 +5,7 @@
 //! and a predictions file that is a log are refused before anything is written.
 
 mod common;
-use common::{csv, robot, run, tmp};
-use std::process::Command;
-
-fn fails(args: &[&str]) -> String {
-    let out = Command::new(env!("CARGO_BIN_EXE_robodyn"))
-        .args(args)
-        .output()
-        .unwrap();
-    assert!(!out.status.success(), "robodyn {args:?} should fail");
-    String::from_utf8_lossy(&out.stderr).to_string()
-}
+use common::{csv, fails, robot, run, tmp};
 
 /// A simulated log of the RX-90 tracking an excitation (t, q, qd, qdd, tau at 250 Hz).
 fn simulated_log(tag: &str) -> (String, std::path::PathBuf) {

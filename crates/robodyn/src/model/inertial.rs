@@ -206,25 +206,10 @@ mod tests {
     use super::{body_inconsistency, pseudo_inertia, Inconsistency};
 
     /// Standard parameters about O_j of a body of mass m, centre of mass c and inertia J_G
-    /// (diagonal) about it: J = J_G + m (c'c I - c c'), MS = m c.
+    /// (diagonal) about it: [`crate::identification::payload::rigid_body`].
     fn body(m: f64, c: [f64; 3], jg: [f64; 3]) -> [f64; 10] {
-        let cc = c[0] * c[0] + c[1] * c[1] + c[2] * c[2];
-        let j = |a: usize, b: usize| {
-            let d = if a == b { jg[a] + m * cc } else { 0.0 };
-            d - m * c[a] * c[b]
-        };
-        [
-            j(0, 0),
-            j(0, 1),
-            j(0, 2),
-            j(1, 1),
-            j(1, 2),
-            j(2, 2),
-            m * c[0],
-            m * c[1],
-            m * c[2],
-            m,
-        ]
+        let i_c = [[jg[0], 0.0, 0.0], [0.0, jg[1], 0.0], [0.0, 0.0, jg[2]]];
+        crate::identification::payload::rigid_body(m, c, i_c)
     }
 
     #[test]
