@@ -23,6 +23,12 @@ pub struct RobotArgs {
     /// robot, the value a constant expression as for `--q`).
     #[arg(long = "set", value_name = "NAME=VALUE")]
     pub set: Vec<String>,
+    /// Make a URDF's root link the floating base (link 0 of a free-flyer root, Pinocchio's
+    /// `JointModelFreeFlyer`): states then have nq = 7 + N positions (base position, quaternion
+    /// x y z w, joints) and nv = 6 + N velocities. A .toml or .par file says it itself
+    /// (`base = "floating"`, `is_floating = 1`).
+    #[arg(long)]
+    pub floating: bool,
 }
 
 impl RobotArgs {
@@ -57,7 +63,13 @@ impl RobotArgs {
 
     /// [`RobotArgs::description`] without printing the warnings.
     fn read(&self) -> CliResult<(robodyn::model::RobotDescription, robodyn::io::SourceMap)> {
-        let (mut desc, mut map) = robodyn::io::load_description_mapped(&self.robot)?;
+        let options = if self.floating {
+            robodyn::io::LoadOptions::floating()
+        } else {
+            robodyn::io::LoadOptions::default()
+        };
+        let (mut desc, mut map) =
+            robodyn::io::load_description_with_options(&self.robot, &BTreeMap::new(), &options)?;
         let o = self.overrides()?;
         robodyn::io::set_values_mapped(&mut desc, &mut map, &o)
             .map_err(|e| format!("--set: {e}"))?;

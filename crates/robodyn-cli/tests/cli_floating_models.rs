@@ -291,3 +291,87 @@ fn wrong_states_and_other_commands_are_refused_clearly() {
         assert!(e.contains("floating base"), "{args:?}: {e}");
     }
 }
+
+/// `--floating` makes a URDF's root link the floating base: with the base held still (zero base
+/// velocity and acceleration, identity pose) the joint rows of `idm` are the fixed-base torques
+/// of the same URDF (a different recursion: the fixed base's), and at rest the base's force is
+/// the weight of the whole robot (the masses read from the file's text); `--floating` on a file whose base does not float is refused.
+#[test]
+fn urdf_made_floating_from_the_command_line() {
+    let urdf = robot("rx90.urdf");
+    let q = [0.1, -0.4, 0.3, 0.8, -0.5, 0.6];
+    let qd = [0.3, -0.2, 0.5, 0.1, 0.4, -0.6];
+    let qdd = [0.2, 0.1, -0.3, 0.5, -0.4, 0.7];
+    let fixed = csv(&run(&[
+        "idm",
+        &urdf,
+        "--q",
+        &list(&q),
+        "--qd",
+        &list(&qd),
+        "--qdd",
+        &list(&qdd),
+    ]));
+    let base_q = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0];
+    let qf: Vec<f64> = base_q.iter().chain(&q).copied().collect();
+    let vf: Vec<f64> = [0.0; 6].iter().chain(&qd).copied().collect();
+    let af: Vec<f64> = [0.0; 6].iter().chain(&qdd).copied().collect();
+    let (head, rows) = csv(&run(&[
+        "idm",
+        &urdf,
+        "--floating",
+        "--q",
+        &list(&qf),
+        "--qd",
+        &list(&vf),
+        "--qdd",
+        &list(&af),
+    ]));
+    assert_eq!(head.len(), 12, "{head:?}");
+    assert_eq!(head[0], "base_fx");
+    assert_close(&rows[0][6..], &fixed.1[0], "joint rows of the held base");
+    // the weight of every link, the base's own included, along z: the masses read from the
+    // file's text, gravity from the fixed robot
+    let text = std::fs::read_to_string(&urdf).unwrap();
+    let mass: f64 = text
+        .split("<mass value=\"")
+        .skip(1)
+        .map(|s| s[..s.find('"').unwrap()].parse::<f64>().unwrap())
+        .sum();
+    let g = -robodyn::io::load(&urdf).unwrap().environment().gravity.z;
+    assert!(g > 0.0 && mass > 0.0, "gravity {g}, mass {mass}");
+    // at rest the base carries the weight only
+    let zeros = list(&[0.0; 12]);
+    let (_, rest) = csv(&run(&[
+        "idm",
+        &urdf,
+        "--floating",
+        "--q",
+        &list(&qf),
+        "--qd",
+        &zeros,
+        "--qdd",
+        &zeros,
+    ]));
+    let f = &rest[0][..3];
+    assert!(
+        f[0].abs() + f[1].abs() <= 1e-9 * mass * g && (f[2] - mass * g).abs() <= 1e-9 * mass * g,
+        "base force {f:?} at rest against M g = {}",
+        mass * g
+    );
+    let e = robodyn_within(
+        &[
+            "idm",
+            &robot("rx90.toml"),
+            "--floating",
+            "--q",
+            "0,0,0,0,0,0",
+        ],
+        30.0,
+    );
+    assert!(
+        e.code != Some(0) && e.stderr.contains("floating base is asked for"),
+        "{}",
+        e.stderr
+    );
+}

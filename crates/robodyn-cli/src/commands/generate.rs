@@ -158,6 +158,7 @@ pub fn run(a: Args) -> CliResult {
     let rargs = crate::common::RobotArgs {
         robot: a.robot.clone(),
         set: a.set.clone(),
+        floating: false,
     };
     let (desc, _) = rargs.description()?;
     // a literal 0 in a SYMORO .par: the parameter does not exist (as in base-params, regressor)
