@@ -282,6 +282,36 @@ impl Robot {
     /// one state on this robot's kept buffers, N states over all cores in blocks with the GIL
     /// released (signals checked between blocks). Inputs are joint vectors (N entries each):
     /// a floating robot is refused (its functions go through [`Robot::eval_state`]).
+    /// The three N x N matrices of a derivative model at each state, split into a tuple of
+    /// arrays ((n, n) each for one state, (N, n, n) for N states): the shared frame of
+    /// `idm_derivatives` and `ddm_derivatives`; `f` fills a state's 3 n^2 outputs.
+    fn derivative_matrices<'py, F>(
+        &self,
+        py: Python<'py>,
+        name: &str,
+        friction: bool,
+        inputs: [(&str, Option<&Bound<'py, PyAny>>); 3],
+        f: F,
+    ) -> PyResult<Bound<'py, PyAny>>
+    where
+        F: Fn(&robodyn::Robot, &mut Work, [&[f64]; 3], &mut [f64]) -> robodyn::Result<()>
+            + Sync
+            + Send,
+    {
+        let models = self.models();
+        let robot = models.select(friction)?;
+        fixed_base_only(robot, name)?;
+        let n = robot.dof();
+        let call = Call {
+            inputs: &inputs,
+            one: &[3, n, n],
+            stacked: false,
+            out: None,
+        };
+        let r = self.eval(py, &models, robot, call, f)?;
+        split_three(py, r)
+    }
+
     pub fn eval<'py, F>(
         &self,
         py: Python<'py>,
@@ -867,23 +897,19 @@ impl Robot {
     ) -> PyResult<Bound<'py, PyAny>> {
         let qd = alias("qd", qd, "v", v)?;
         let qdd = alias("qdd", qdd, "a", a)?;
-        let models = self.models();
-        let robot = models.select(friction)?;
-        fixed_base_only(robot, "Robot.idm_derivatives")?;
-        let n = robot.dof();
-        let call = Call {
-            inputs: &[("q", Some(q)), ("qd", qd), ("qdd", qdd)],
-            one: &[3, n, n],
-            stacked: false,
-            out: None,
-        };
-        let r = self.eval(py, &models, robot, call, |r, w, x, o| {
-            let (data, d, _) = w.deriv(r);
-            inverse_dynamics_derivatives_into(r, data, r.environment(), x[0], x[1], x[2], d)?;
-            copy_matrices(&[&d.dtau_dq, &d.dtau_dqd, &d.a], o);
-            Ok(())
-        })?;
-        split_three(py, r)
+        let inputs = [("q", Some(q)), ("qd", qd), ("qdd", qdd)];
+        self.derivative_matrices(
+            py,
+            "Robot.idm_derivatives",
+            friction,
+            inputs,
+            |r, w, x, o| {
+                let (data, d, _) = w.deriv(r);
+                inverse_dynamics_derivatives_into(r, data, r.environment(), x[0], x[1], x[2], d)?;
+                copy_matrices(&[&d.dtau_dq, &d.dtau_dqd, &d.a], o);
+                Ok(())
+            },
+        )
     }
 
     /// Derivatives of the direct dynamic model at qdd = ddm(q, qd, tau) (composite method):
@@ -901,23 +927,19 @@ impl Robot {
         friction: bool,
     ) -> PyResult<Bound<'py, PyAny>> {
         let qd = alias("qd", qd, "v", v)?;
-        let models = self.models();
-        let robot = models.select(friction)?;
-        fixed_base_only(robot, "Robot.ddm_derivatives")?;
-        let n = robot.dof();
-        let call = Call {
-            inputs: &[("q", Some(q)), ("qd", qd), ("tau", tau)],
-            one: &[3, n, n],
-            stacked: false,
-            out: None,
-        };
-        let r = self.eval(py, &models, robot, call, |r, w, x, o| {
-            let (data, _, d) = w.deriv(r);
-            direct_dynamics_derivatives_into(r, data, r.environment(), x[0], x[1], x[2], d)?;
-            copy_matrices(&[&d.dqdd_dq, &d.dqdd_dqd, &d.ainv], o);
-            Ok(())
-        })?;
-        split_three(py, r)
+        let inputs = [("q", Some(q)), ("qd", qd), ("tau", tau)];
+        self.derivative_matrices(
+            py,
+            "Robot.ddm_derivatives",
+            friction,
+            inputs,
+            |r, w, x, o| {
+                let (data, _, d) = w.deriv(r);
+                direct_dynamics_derivatives_into(r, data, r.environment(), x[0], x[1], x[2], d)?;
+                copy_matrices(&[&d.dqdd_dq, &d.dqdd_dqd, &d.ainv], o);
+                Ok(())
+            },
+        )
     }
 
     /// Geometric model: 0T_j (4 x 4 homogeneous matrices, metres) of the frames 1..NF
