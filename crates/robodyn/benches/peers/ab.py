@@ -28,7 +28,7 @@ sys.path.insert(0, HERE)
 import run as peers  # noqa: E402
 
 ALGORITHMS = ["rnea", "crba_full", "aba", "composite", "joint_jacobians", "all_frame_jacobians",
-              "frame_jacobian", "com_jacobian"]
+              "frame_jacobian", "com_jacobian", "rnea_derivatives", "aba_derivatives"]
 
 
 def build(root, target):

@@ -1,15 +1,15 @@
-//! Derivatives of the direct dynamic model of a tree (docs/models/derivatives.md, D15–D17):
+//! Derivatives of the direct dynamic model of a tree (docs/models/derivatives.md, D15–D17a):
 //! differentiating A(q) qdd + H(q, qd) = Gamma at qdd = ddm(q, qd, Gamma) gives
 //! dqdd/dq = -A^-1 dGamma/dq, dqdd/dqd = -A^-1 dGamma/dqd (the inverse model's derivatives at
 //! that qdd) and dqdd/dGamma = A^-1, in four named steps:
 //! 1. `accelerations`: A by composite links, its L'DL factorization (the direct model's own,
 //!    [`ltdl_factor`]) and qdd = A^-1 (Gamma - H);
 //! 2. the inverse model's derivatives at (q, qd, qdd) (`world::idm_derivatives_world`);
-//! 3. `solve_columns`: A^-1 column by column from the same factors;
+//! 3. `inverse_from_factors`: A^-1 from the same factors, down the tree (D17a);
 //! 4. dqdd/dq = -A^-1 dGamma/dq and dqdd/dqd = -A^-1 dGamma/dqd as two matrix products.
 
 use super::world::idm_derivatives_world;
-use super::{check_square, DerivativesData};
+use super::{check_square, DerivativesData, TreeLists};
 use crate::algorithms::direct_dynamics::{ltdl_factor, ltdl_solve};
 use crate::algorithms::inertia_matrix::composite_inertia_matrix;
 use crate::algorithms::inverse_dynamics::{check_state, rnea_with_environment};
@@ -73,20 +73,52 @@ fn accelerations(
     check_finite_result("qdd", qdd)
 }
 
-/// Step 3: every column c of `m` replaced by A^-1 c, from the L'DL factors.
-fn solve_columns(model: &DynModel<f64>, factor: &DMatrix<f64>, m: &mut DMatrix<f64>) {
+/// Step 3: X = A^-1 from the L'DL factors (A = L'DL, L unit lower over the tree, D on the
+/// diagonal of `factor`): L X = D^-1 L^-T is upper triangular with diagonal D^-1, so for i >= j
+///
+///     X_ij = delta_ij / D_j - sum over the ancestors a of i of L_ia X_aj      (D17a)
+///
+/// Column j is computed down from row j; its rows above j are those of X_ja written when
+/// column a < j was done (X is symmetric), and every X_ij is written at (i, j) and (j, i).
+/// Rows outside the subtree of j's topmost movable ancestor are zero (`TreeLists::span`),
+/// skipped. Indices here are 0-based (link k + 1).
+fn inverse_from_factors(
+    model: &DynModel<f64>,
+    factor: &DMatrix<f64>,
+    tree: &TreeLists,
+    x: &mut DMatrix<f64>,
+) {
     let n = model.nl;
-    if n == 0 {
-        return;
-    }
-    for col in m.as_mut_slice().chunks_exact_mut(n) {
-        ltdl_solve(model, factor, col);
+    let h = factor.as_slice();
+    let xs = x.as_mut_slice();
+    xs.fill(0.0);
+    for j in 0..n {
+        if !model.index.movable[j + 1] {
+            continue;
+        }
+        for i in j..tree.span[j].1 {
+            if !model.index.movable[i + 1] {
+                continue;
+            }
+            let (l_i, x_j) = (&h[i * n..(i + 1) * n], &xs[j * n..(j + 1) * n]);
+            let carried: f64 = tree.ancestors[i].iter().map(|&a| l_i[a] * x_j[a]).sum();
+            let s = if i == j { 1.0 / h[j * n + j] } else { 0.0 } - carried;
+            xs[i + j * n] = s;
+            xs[j + i * n] = s;
+        }
     }
 }
 
 /// Step 4: `out` = -A^-1 `b`, column by column, skipping the zeros of `b` (a tree's
-/// dGamma/dq has none only between ancestors and descendants). Allocation-free.
-fn neg_product(ainv: &DMatrix<f64>, b: &DMatrix<f64>, out: &mut DMatrix<f64>) {
+/// dGamma/dq has none only between ancestors and descendants) and the rows of A^-1's column k
+/// outside `span[k]` (joints of another subtree of the base: zero). Allocation-free (a dense
+/// product from faer or nalgebra would allocate its packing buffers).
+fn neg_product(
+    ainv: &DMatrix<f64>,
+    span: &[(usize, usize)],
+    b: &DMatrix<f64>,
+    out: &mut DMatrix<f64>,
+) {
     let n = ainv.nrows();
     if n == 0 {
         return;
@@ -98,9 +130,10 @@ fn neg_product(ainv: &DMatrix<f64>, b: &DMatrix<f64>, out: &mut DMatrix<f64>) {
         .zip(b.as_slice().chunks_exact(n))
     {
         oc.fill(0.0);
-        for (ak, &x) in a.chunks_exact(n).zip(bc) {
+        for ((ak, &x), &(lo, hi)) in a.chunks_exact(n).zip(bc).zip(span) {
             if x != 0.0 {
-                oc.iter_mut().zip(ak).for_each(|(o, y)| *o -= y * x);
+                let o = &mut oc[lo..hi];
+                o.iter_mut().zip(&ak[lo..hi]).for_each(|(o, y)| *o -= y * x);
             }
         }
     }
@@ -169,17 +202,15 @@ pub fn direct_dynamics_derivatives_into(
         dtau,
         factor,
         h,
+        tree,
         ..
     } = data;
     let state = (q, qd, out.qdd.as_slice());
     let [dq, dqd] = dtau;
     idm_derivatives_world(model, ws, world, env, state, h, [dq, dqd], None);
-    // a slice fill: nalgebra's `fill` goes entry by entry
-    out.ainv.as_mut_slice().fill(0.0);
-    out.ainv.fill_diagonal(1.0);
-    solve_columns(model, factor, &mut out.ainv);
-    neg_product(&out.ainv, dq, &mut out.dqdd_dq);
-    neg_product(&out.ainv, dqd, &mut out.dqdd_dqd);
+    inverse_from_factors(model, factor, tree, &mut out.ainv);
+    neg_product(&out.ainv, &tree.span, dq, &mut out.dqdd_dq);
+    neg_product(&out.ainv, &tree.span, dqd, &mut out.dqdd_dqd);
     check_finite_matrix("dqdd_dq", &out.dqdd_dq)?;
     check_finite_matrix("dqdd_dqd", &out.dqdd_dqd)?;
     check_finite_matrix("Ainv", &out.ainv)

@@ -36,7 +36,7 @@ pub use regressor::{
 
 use crate::data::Data;
 use crate::error::{Error, Result};
-use crate::model::Robot;
+use crate::model::{DynModel, Robot};
 use nalgebra::{DMatrix, Vector3};
 
 /// The tangents of one direction (a joint position or a joint velocity) for every link: link
@@ -83,6 +83,8 @@ pub struct DerivativesData {
     /// N-vectors: the torques with qdd = 0 (H), a right-hand side.
     pub(crate) h: Vec<f64>,
     pub(crate) zeros: Vec<f64>,
+    /// The tree's index lists of the direct derivatives' A^-1.
+    pub(crate) tree: TreeLists,
 }
 
 impl DerivativesData {
@@ -98,6 +100,7 @@ impl DerivativesData {
             factor: DMatrix::zeros(n, n),
             h: vec![0.0; n],
             zeros: vec![0.0; n],
+            tree: TreeLists::new(robot.dynamic()),
         }
     }
 
@@ -119,6 +122,40 @@ impl DerivativesData {
             ));
         }
         Ok(())
+    }
+}
+
+/// Index lists of the tree of A over the links 1..NL, 0-based (link k + 1 at k), made once.
+#[derive(Clone, Debug)]
+pub(crate) struct TreeLists {
+    /// The movable proper ancestors of each link, from the nearest.
+    pub(crate) ancestors: Vec<Vec<usize>>,
+    /// The first and one-past-last link of the subtree of each link's topmost movable
+    /// ancestor: the rows where its column of A^-1 can be nonzero (A, hence A^-1, is block
+    /// diagonal over the subtrees of a fixed base).
+    pub(crate) span: Vec<(usize, usize)>,
+}
+
+impl TreeLists {
+    fn new(model: &DynModel<f64>) -> Self {
+        let lambda = &model.index.movable_parent;
+        let chain = |mut j: usize| {
+            let mut up = Vec::new();
+            while lambda[j] != 0 {
+                j = lambda[j];
+                up.push(j - 1);
+            }
+            up
+        };
+        let ancestors: Vec<Vec<usize>> = (1..=model.nl).map(chain).collect();
+        let top = |k: usize| ancestors[k].last().copied().unwrap_or(k);
+        let span = (0..model.nl)
+            .map(|k| {
+                let members = (0..model.nl).filter(|&i| top(i) == top(k));
+                members.fold((usize::MAX, 0), |(lo, hi), i| (lo.min(i), hi.max(i + 1)))
+            })
+            .collect();
+        TreeLists { ancestors, span }
     }
 }
 
