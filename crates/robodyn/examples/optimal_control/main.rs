@@ -359,7 +359,7 @@ fn run() -> Res<()> {
         Some(p) => p,
         None => default_panda()?,
     };
-    let robot = load_robot(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let robot = load_robot(&path)?;
     if robot.is_floating() {
         return Err(format!(
             "{}: a floating-base robot; this example needs a fixed base",
