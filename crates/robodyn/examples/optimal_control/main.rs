@@ -29,7 +29,8 @@
 //! Prints: the problem, then per sensitivity route the SQP iterations, the median wall-clock
 //! time over R paired rounds (default 5; the two routes alternate in each round) with its
 //! range, the cost, the largest defect and the first-order optimality residual; the median of
-//! the rounds' time ratios; the gap between the two solutions; the optimality residual of the
+//! the rounds' time ratios; the same for the process's CPU time (Linux, /proc/self/stat: on a
+//! shared machine the wall clock also counts the time other processes had the core); the gap between the two solutions; the optimality residual of the
 //! analytical solution measured with finite-difference sensitivities (an independent route);
 //! the final state reached by the joint torques Gamma_c + g(q) re-simulated with gravity by the
 //! articulated-body method with 8x finer RK4 steps; the SQP iterations of the analytical run.
@@ -159,11 +160,24 @@ fn is_prismatic(robot: &Robot, k: usize) -> bool {
     robot.frame(robot.coordinates().frame(k)).joint == JointType::Prismatic
 }
 
-/// One route's runs: the solutions' times (s) and the last solution.
+/// One route's runs: the solutions' wall-clock and CPU times (s) and the last solution.
 struct Runs {
     how: Sensitivities,
     times: Vec<f64>,
+    cpu: Vec<f64>,
     solution: Option<shooting::Solution>,
+}
+
+/// The CPU time of this process (user + system, s) from /proc/self/stat (Linux; 10 ms ticks
+/// at the usual 100 Hz), or None elsewhere: on a shared machine it is what the process used,
+/// where the wall clock also counts the time other processes had the core.
+fn cpu_time() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // the fields after the command name (which is in parentheses): utime, stime are 14, 15
+    let rest = &stat[stat.rfind(')')? + 2..];
+    let f: Vec<&str> = rest.split_whitespace().collect();
+    let ticks: f64 = f.get(11)?.parse::<f64>().ok()? + f.get(12)?.parse::<f64>().ok()?;
+    Some(ticks / 100.0)
 }
 
 fn median(v: &[f64]) -> f64 {
@@ -182,15 +196,19 @@ fn timed_rounds(robot: &Robot, p: &Problem, rounds: usize) -> Res<[Runs; 2]> {
     let mut runs = [Sensitivities::Analytical, Sensitivities::CentralDifferences].map(|how| Runs {
         how,
         times: Vec::new(),
+        cpu: Vec::new(),
         solution: None,
     });
     for _ in 0..rounds {
         for r in runs.iter_mut() {
             let (x, u) = initial_guess(robot, p)?;
-            let t = Instant::now();
+            let (t, c) = (Instant::now(), cpu_time());
             let sol = solve(robot, p, &Options::new(r.how), x, u)
                 .map_err(|e| format!("{} sensitivities: {e}", r.how.name()))?;
             r.times.push(t.elapsed().as_secs_f64());
+            if let (Some(c0), Some(c1)) = (c, cpu_time()) {
+                r.cpu.push(c1 - c0);
+            }
             r.solution = Some(sol);
         }
     }
@@ -236,6 +254,21 @@ fn report_runs(robot: &Robot, p: &Problem, runs: &[Runs; 2]) -> Res<()> {
         median(&ratios),
         ratios.len()
     );
+    if runs.iter().all(|r| r.cpu.len() == r.times.len()) {
+        let cpu: Vec<f64> = runs[1]
+            .cpu
+            .iter()
+            .zip(&runs[0].cpu)
+            .map(|(f, a)| f / a)
+            .collect();
+        println!(
+            "CPU time (this process), median: analytical {:.2} s, finite differences {:.2} s, \
+             ratio {:.2}x (median of the rounds' ratios)",
+            median(&runs[0].cpu),
+            median(&runs[1].cpu),
+            median(&cpu)
+        );
+    }
     Ok(())
 }
 
