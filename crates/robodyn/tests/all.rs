@@ -125,6 +125,8 @@ mod loop_closure;
 mod named_values;
 #[path = "no_cli_flags.rs"]
 mod no_cli_flags;
+#[path = "optimal_control.rs"]
+mod optimal_control;
 #[path = "parallel_links.rs"]
 mod parallel_links;
 #[path = "properties.rs"]
