@@ -18,7 +18,11 @@ impl Expr {
     /// ```
     /// use robodyn_symbolic::Expr;
     /// let e = Expr::parse("a*sin(q)^2 + q").unwrap();
-    /// assert_eq!(e.diff("q"), Expr::parse("2*a*cos(q)*sin(q) + 1").unwrap());
+    /// let d = e.diff("q"); // 2*a*cos(q)*sin(q) + 1
+    /// let at = |s: &str| match s { "a" => Some(3.0), "q" => Some(0.5), _ => None };
+    /// let expected = 2.0 * 3.0 * 0.5f64.cos() * 0.5f64.sin() + 1.0;
+    /// assert!((d.eval(&at).unwrap() - expected).abs() < 1e-15);
+    /// assert!(e.diff("b").is_zero());
     /// ```
     pub fn diff(&self, x: &str) -> Expr {
         self.derivative(&|s| (s == x).then(Expr::one))
