@@ -50,7 +50,7 @@ mod robots {
 use robots::{rx90_description as rx90, sr400_description as sr400};
 
 /// Value of any symbol of a generated program: robot symbols, standard parameters `XX<j>`.
-fn env_of(desc: &RobotDescription) -> impl Fn(&str) -> Option<f64> + '_ {
+pub(crate) fn env_of(desc: &RobotDescription) -> impl Fn(&str) -> Option<f64> + '_ {
     move |s: &str| {
         if let Some(v) = desc.symbols.get(s) {
             return Some(*v);

@@ -16,8 +16,8 @@
 //! of example-robot-data when installed. Friction is kept: Fv on the diagonal of dGamma/dqd,
 //! the Coulomb term's derivative 0 (random velocities are away from 0).
 
+use crate::codegen_kinematics::evaluate;
 use robodyn::codegen::{generate, GenOptions, ModelKind};
-use robodyn::model::STANDARD_PARAMETERS;
 use robodyn::{inverse_dynamics_derivatives, Robot, RobotDescription};
 use robodyn_symbolic::Program;
 use robodyn_testing::{random_state, random_tree_description, rng, TreeOptions};
@@ -43,22 +43,8 @@ fn robot_file(name: &str) -> RobotDescription {
     robodyn::io::load_description(&path).unwrap()
 }
 
-/// Value of a symbol of a generated program: the robot's symbols, the standard parameters.
-fn env_of(desc: &RobotDescription) -> impl Fn(&str) -> Option<f64> + '_ {
-    move |s: &str| {
-        if let Some(v) = desc.symbols.get(s) {
-            return Some(*v);
-        }
-        let i = s.trim_end_matches(|c: char| c.is_ascii_digit()).len();
-        let (p, n) = (&s[..i], s[i..].parse::<usize>().ok()?);
-        let k = STANDARD_PARAMETERS.iter().position(|&x| x == p)?;
-        let l = desc.links.get(n.checked_sub(1)?)?;
-        l.params[k].eval(&|t| desc.symbols.get(t).copied()).ok()
-    }
-}
-
 fn parameters(prog: &Program, desc: &RobotDescription) -> Vec<f64> {
-    let env = env_of(desc);
+    let env = crate::codegen_compile::env_of(desc);
     prog.inputs
         .iter()
         .filter(|g| g.by_name)
@@ -144,19 +130,6 @@ pub(crate) fn derivative_cases() -> Vec<DerivativeCase> {
         });
     }
     cases
-}
-
-/// The program's outputs (interpreted) for one input set (one vector per input group).
-fn evaluate(prog: &Program, set: &[Vec<f64>]) -> Vec<f64> {
-    let values = |s: &str| {
-        prog.inputs.iter().zip(set).find_map(|(g, v)| {
-            g.symbols
-                .iter()
-                .position(|x| x.as_deref() == Some(s))
-                .map(|k| v[k])
-        })
-    };
-    prog.evaluate(&values).unwrap()
 }
 
 /// Largest difference relative to max(1, largest reference entry), per block.

@@ -6,7 +6,7 @@
 //! 1. record the customized IDM Gamma(q, qd, qdd) (Newton–Euler, as `ModelKind::Idm`) and the
 //!    inertia matrix A(q) (composite links, as `ModelKind::Inertia`) in one recording, so that
 //!    they share the sines and cosines;
-//! 2. differentiate the IDM's assignments along each joint position q<j> and velocity QP<j>:
+//! 2. differentiate the IDM's assignments along each joint position `q<j>` and velocity `QP<j>`:
 //!    every assignment `v = f(args)` gives `dv/dx = sum of df/darg * darg/dx` over the arguments
 //!    that depend on x; an intermediate that does not depend on x has no derivative (most
 //!    depend on a few joints: the forward recursion's link k on joints 1..k, the backward one
