@@ -33,6 +33,8 @@ mod cli_floating_simulate;
 mod cli_gains_payload;
 #[path = "cli_generate.rs"]
 mod cli_generate;
+#[path = "cli_generate_derivatives.rs"]
+mod cli_generate_derivatives;
 #[path = "cli_generate_names.rs"]
 mod cli_generate_names;
 #[path = "cli_identify.rs"]

@@ -33,6 +33,7 @@
 
 #![deny(missing_docs)]
 
+mod diff;
 pub mod emit;
 mod expr;
 mod optimize;
@@ -40,6 +41,7 @@ mod parse;
 mod print;
 pub mod program;
 
+pub use diff::Tangents;
 pub use emit::{check_function_name, emit, parameter_fields, parameter_type, Lang};
 pub use expr::{cmp_expr, EvalError, Expr, Func, Node};
 pub use parse::ParseError;

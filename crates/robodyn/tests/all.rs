@@ -37,6 +37,8 @@ mod codegen_bench_sources;
 mod codegen_compile;
 #[path = "codegen_counts.rs"]
 mod codegen_counts;
+#[path = "codegen_derivatives.rs"]
+mod codegen_derivatives;
 #[path = "codegen_errors.rs"]
 mod codegen_errors;
 #[path = "codegen_kinematics.rs"]

@@ -8,6 +8,8 @@
 //! - closed: generated Gamma_cl vs G^T rnea with G written by hand from Example 10.1 (SR400,
 //!   constant G); for the other closed robots (G depending on q, loop-closure Jacobian written
 //!   out, multiplier form 10.36-10.37) vs the numeric closed-chain model G^T Gamma_tr (10.40);
+//! - idm_derivatives: generated [dGamma/dq, dGamma/dqd, A] vs the numeric analytical
+//!   `inverse_dynamics_derivatives` (cases of `codegen_derivatives.rs`);
 //! - w: generated W = d q_p / d q_a vs the numeric W of the closed-chain model (both checked
 //!   against finite differences of the loop closure in `generated_w_is_the_derivative_of_loop_closure`).
 //!
@@ -48,7 +50,7 @@ mod robots {
 use robots::{rx90_description as rx90, sr400_description as sr400};
 
 /// Value of any symbol of a generated program: robot symbols, standard parameters `XX<j>`.
-fn env_of(desc: &RobotDescription) -> impl Fn(&str) -> Option<f64> + '_ {
+pub(crate) fn env_of(desc: &RobotDescription) -> impl Fn(&str) -> Option<f64> + '_ {
     move |s: &str| {
         if let Some(v) = desc.symbols.get(s) {
             return Some(*v);
@@ -379,6 +381,17 @@ fn all_cases() -> Vec<Case> {
         cases.extend(tree_cases(&d, false, seed, &format!("tree{seed}")));
     }
     cases.extend(fixed_frame_cases());
+    // the derivatives of the IDM: see codegen_derivatives.rs
+    cases.extend(
+        crate::codegen_derivatives::derivative_cases()
+            .into_iter()
+            .map(|c| Case {
+                prog: c.prog,
+                inputs: c.inputs,
+                expected: c.expected,
+                what: c.what,
+            }),
+    );
     // the geometric and kinematic models (DGM iT_j, Jacobian iJ_j): see codegen_kinematics.rs
     cases.extend(
         crate::codegen_kinematics::kinematic_cases()

@@ -249,7 +249,7 @@ pub(crate) fn rel_err(got: &[f64], expected: &[f64]) -> f64 {
 }
 
 /// The program's outputs (interpreted) for one input set (one vector per input group).
-fn evaluate(prog: &Program, set: &[Vec<f64>]) -> Vec<f64> {
+pub(crate) fn evaluate(prog: &Program, set: &[Vec<f64>]) -> Vec<f64> {
     let values = |s: &str| {
         prog.inputs.iter().zip(set).find_map(|(g, v)| {
             g.symbols

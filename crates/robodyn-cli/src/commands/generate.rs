@@ -12,6 +12,9 @@ use std::path::PathBuf;
 pub enum Model {
     /// Inverse dynamic model Gamma(q, qd, qdd) of the (equivalent) tree.
     Idm,
+    /// Derivatives of the inverse dynamic model: dGamma/dq, dGamma/dqd and A = dGamma/dqdd,
+    /// each N x N column-major, one after the other (3 N^2 outputs).
+    IdmDerivatives,
     /// Inertia matrix A(q).
     Inertia,
     /// Vector H(q, qd).
@@ -194,6 +197,7 @@ pub fn run(a: Args) -> CliResult {
     let opt = GenOptions {
         model: match a.model {
             Model::Idm => ModelKind::Idm,
+            Model::IdmDerivatives => ModelKind::IdmDerivatives,
             Model::Inertia => ModelKind::Inertia,
             Model::H => ModelKind::H,
             Model::Ddm => ModelKind::Ddm,

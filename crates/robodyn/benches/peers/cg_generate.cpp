@@ -1,15 +1,17 @@
-// Pinocchio + CppADCodeGen: writes the C sources of the generated rnea, crba and aba of a model
+// Pinocchio + CppADCodeGen: writes the C sources of the generated rnea, crba, aba and rnea
+// derivatives of a model
 // (driven by codegen.py; NOT run by CI).
 //
 //   cg_generate MODEL OUTDIR
 //
-// Pinocchio's own code generators (CodeGenRNEA, CodeGenCRBA, CodeGenABA of
+// Pinocchio's own code generators (CodeGenRNEA, CodeGenCRBA, CodeGenABA, CodeGenRNEADerivatives of
 // pinocchio/codegen/cppadcg-algo.hpp: the algorithm traced on CppAD::AD<CG<double>>, the tape
 // optimized, the C source emitted by CppADCodeGen) with the zero-order forward function only
 // (no Jacobian). The functions are named `<name>_forward_zero(in, out, atomics)` with
 // in[0] = x (rnea: [q v a], crba: q, aba: [q v tau]) and out[0] = y (rnea: tau, crba: the upper
-// triangle of M row by row, aba: ddq; Pinocchio's generators run crba and aba in the WORLD
-// convention). codegen.py compiles them with the same flags as robodyn's generated C.
+// triangle of M row by row, aba: ddq; drnea: [q v a] -> [dtau_dq, dtau_dv, dtau_da], each
+// nv x nv row-major, computeRNEADerivatives traced; Pinocchio's generators run crba and aba in
+// the WORLD convention). codegen.py compiles them with the same flags as robodyn's generated C.
 
 #include <pinocchio/codegen/cppadcg-algo.hpp>
 
@@ -57,6 +59,11 @@ int main(int argc, char** argv) {
   }
   {
     pinocchio::CodeGenABA<double> gen(model, "aba");
+    emit(gen, dir);
+  }
+  {
+    // computeRNEADerivatives traced: out = [dtau_dq, dtau_dv, dtau_da], each row-major
+    pinocchio::CodeGenRNEADerivatives<double> gen(model, "drnea");
     emit(gen, dir);
   }
   return 0;

@@ -1,7 +1,9 @@
 /* Generated code, side by side: Pinocchio + CppADCodeGen against robodyn's `generate --lang c`
  * (driven by codegen.py; NOT run by CI). Linked with, for one robot:
- *   cg_rnea(x, y), cg_crba(x, y), cg_aba(x, y)   wrappers of CppADCodeGen's forward_zero functions
- *   rd_idm(q, qd, qdd, out), rd_inertia(q, out), rd_ddm(q, qd, gam, out)   robodyn's
+ *   cg_rnea(x, y), cg_crba(x, y), cg_aba(x, y), cg_drnea(x, y)   wrappers of CppADCodeGen's
+ *     forward_zero functions (drnea: computeRNEADerivatives traced)
+ *   rd_idm(q, qd, qdd, out), rd_inertia(q, out), rd_ddm(q, qd, gam, out),
+ *   rd_idm_derivatives(q, qd, qdd, out)   robodyn's
  * every generated function in its own translation unit, all compiled with the same flags.
  *
  *   cg_timing STATES RESULTS [samples] [target_us]
@@ -10,7 +12,8 @@
  * Pinocchio's order is entry idx[k] of robodyn's NL-vectors), nv ranks (its position among
  * robodyn's movable joints, the order of the generated outputs), then n_states lines q v a tau
  * in Pinocchio's order. RESULTS: per state, lines `<side>_<algo> values` with rnea tau, the full
- * inertia matrix row by row and ddq, all in Pinocchio's order. Prints `time <name> <median ns>`. */
+ * inertia matrix row by row, ddq and the derivatives [dtau_dq, dtau_dv, dtau_da] each row by row,
+ * all in Pinocchio's order (dtau_da from its upper triangle: Pinocchio fills only that one). Prints `time <name> <median ns>`. */
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -20,9 +23,11 @@
 void cg_rnea(const double *x, double *y);
 void cg_crba(const double *x, double *y);
 void cg_aba(const double *x, double *y);
+void cg_drnea(const double *x, double *y);
 void rd_idm(const double *q, const double *qd, const double *qdd, double *out);
 void rd_inertia(const double *q, double *out);
 void rd_ddm(const double *q, const double *qd, const double *gam, double *out);
+void rd_idm_derivatives(const double *q, const double *qd, const double *qdd, double *out);
 
 static int nv, nl, ns;
 static int *idx, *rank_;
@@ -54,8 +59,8 @@ static void read_states(const char *path) {
   rqd = calloc((size_t)ns * nl, sizeof(double));
   rqdd = calloc((size_t)ns * nl, sizeof(double));
   rtau = calloc((size_t)ns * nl, sizeof(double));
-  y = calloc((size_t)nv * nv, sizeof(double));
-  out = calloc((size_t)nv * nv, sizeof(double));
+  y = calloc((size_t)3 * nv * nv, sizeof(double));
+  out = calloc((size_t)3 * nv * nv, sizeof(double));
   for (int s = 0; s < ns; ++s) {
     double v[4][nv];
     for (int part = 0; part < 4; ++part)
@@ -96,7 +101,7 @@ static int lower(int i, int j) {
 
 static void write_results(const char *path) {
   FILE *f = fopen(path, "w");
-  double *m = malloc(sizeof(double) * nv * nv), *v = malloc(sizeof(double) * nv);
+  double *m = malloc(sizeof(double) * 3 * nv * nv), *v = malloc(sizeof(double) * nv);
   for (int s = 0; s < ns; ++s) {
     const double *q = rq + s * nl, *qd = rqd + s * nl;
     cg_rnea(x_rnea + s * 3 * nv, y);
@@ -117,6 +122,21 @@ static void write_results(const char *path) {
     rd_ddm(q, qd, rtau + s * nl, out);
     for (int k = 0; k < nv; ++k) v[k] = out[rank_[k]];
     put(f, "rd_ddm", v, nv);
+    /* derivatives: CppADCodeGen's blocks row-major; robodyn's column-major in its joint order */
+    cg_drnea(x_rnea + s * 3 * nv, y);
+    for (int b = 0; b < 3; ++b)
+      for (int i = 0; i < nv; ++i)
+        for (int j = 0; j < nv; ++j) {
+          int r = b == 2 && i > j ? j : i, c = b == 2 && i > j ? i : j;
+          m[b * nv * nv + i * nv + j] = y[b * nv * nv + r * nv + c];
+        }
+    put(f, "cg_drnea", m, 3 * nv * nv);
+    rd_idm_derivatives(q, qd, rqdd + s * nl, out);
+    for (int b = 0; b < 3; ++b)
+      for (int i = 0; i < nv; ++i)
+        for (int j = 0; j < nv; ++j)
+          m[b * nv * nv + i * nv + j] = out[b * nv * nv + rank_[j] * nv + rank_[i]];
+    put(f, "rd_drnea", m, 3 * nv * nv);
   }
   fclose(f);
   free(m);
@@ -167,5 +187,7 @@ int main(int argc, char **argv) {
   TIME("rd_inertia_c", rd_inertia(rq + s * nl, out));
   TIME("cg_aba", cg_aba(x_aba + s * 3 * nv, y));
   TIME("rd_ddm_c", rd_ddm(rq + s * nl, rqd + s * nl, rtau + s * nl, out));
+  TIME("cg_drnea", cg_drnea(x_rnea + s * 3 * nv, y));
+  TIME("rd_idm_derivatives_c", rd_idm_derivatives(rq + s * nl, rqd + s * nl, rqdd + s * nl, out));
   return 0;
 }

@@ -1,16 +1,17 @@
 //! robodyn's `generate --lang rust` output timed like cg_timing.c times the C (driven by
 //! codegen.py; NOT run by CI; compiled with rustc directly, no crate):
 //!
-//!   RD_IDM=... RD_INERTIA=... RD_DDM=... rustc -C opt-level=3 -C target-cpu=native cg_timing.rs
+//!   RD_IDM=... RD_INERTIA=... RD_DDM=... RD_IDM_DERIVATIVES=... rustc -C opt-level=3 -C target-cpu=native cg_timing.rs
 //!   (with median.rs beside it)
 //!   cg_timing STATES RESULTS [samples] [target_us]
 //!
-//! Same STATES file and protocol as cg_timing.c; RESULTS lines `rs_rnea`, `rs_crba`, `rs_ddm` in
-//! Pinocchio's order.
+//! Same STATES file and protocol as cg_timing.c; RESULTS lines `rs_rnea`, `rs_crba`, `rs_ddm`,
+//! `rs_drnea` (the derivatives' three blocks, each row by row) in Pinocchio's order.
 
 include!(env!("RD_IDM"));
 include!(env!("RD_INERTIA"));
 include!(env!("RD_DDM"));
+include!(env!("RD_IDM_DERIVATIVES"));
 
 use std::hint::black_box;
 mod median;
@@ -70,7 +71,7 @@ fn main() {
     let samples: usize = args.get(3).map_or(21, |s| s.parse().unwrap());
     let target_us: f64 = args.get(4).map_or(400.0, |s| s.parse().unwrap());
     let (nv, ns) = (st.nv, st.q.len());
-    let mut out = vec![0.0; nv * (nv + 1) / 2];
+    let mut out = vec![0.0; 3 * nv * nv];
     let mut text = String::new();
     let put = |text: &mut String, tag: &str, v: &mut dyn Iterator<Item = f64>| {
         text.push_str(tag);
@@ -91,6 +92,14 @@ fn main() {
         put(&mut text, "rs_crba", &mut m.into_iter());
         rd_ddm(&st.q[s], &st.qd[s], &st.tau[s], &mut out);
         put(&mut text, "rs_ddm", &mut st.rank.iter().map(|&r| out[r]));
+        rd_idm_derivatives(&st.q[s], &st.qd[s], &st.qdd[s], &mut out);
+        let d: Vec<f64> = (0..3 * nv * nv)
+            .map(|k| {
+                let (b, i, j) = (k / (nv * nv), (k / nv) % nv, k % nv);
+                out[b * nv * nv + st.rank[j] * nv + st.rank[i]]
+            })
+            .collect();
+        put(&mut text, "rs_drnea", &mut d.into_iter());
     }
     std::fs::write(&args[2], text).expect("results file");
     let states: Vec<usize> = (0..ns).collect();
@@ -104,6 +113,10 @@ fn main() {
     });
     time("rd_ddm_rust", &states, samples, target_us, |&s| {
         rd_ddm(black_box(&st.q[s]), &st.qd[s], &st.tau[s], &mut out);
+        black_box(&out);
+    });
+    time("rd_idm_derivatives_rust", &states, samples, target_us, |&s| {
+        rd_idm_derivatives(black_box(&st.q[s]), &st.qd[s], &st.qdd[s], &mut out);
         black_box(&out);
     });
 }

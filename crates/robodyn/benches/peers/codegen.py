@@ -6,17 +6,21 @@ CppADCodeGen, on UR5 and Panda (fixed base). NOT run by CI.
     python3 crates/robodyn/benches/peers/codegen.py [--rounds 5] [--robots ur5,panda]
 
 1. Same models and states as run.py (Pinocchio's URDF parser, dumped; seed 1).
-2. cg_generate.cpp (Pinocchio's CodeGenRNEA / CodeGenCRBA / CodeGenABA on CppADCodeGen, built
-   once) writes the C of rnea, crba (upper triangle) and aba (WORLD) for the robot; robodyn's CLI
-   writes `--model idm`, `--model inertia` (lower triangle) and `--model ddm` (A^-1 (Gamma - H)
-   with L D L' written out) with `--numeric --no-friction --no-rotor`, in C and in Rust.
+2. cg_generate.cpp (Pinocchio's CodeGenRNEA / CodeGenCRBA / CodeGenABA / CodeGenRNEADerivatives
+   on CppADCodeGen, built once) writes the C of rnea, crba (upper triangle), aba (WORLD) and of
+   computeRNEADerivatives traced (dtau_dq, dtau_dv, dtau_da) for the robot; robodyn's CLI writes
+   `--model idm`, `--model inertia` (lower triangle), `--model ddm` (A^-1 (Gamma - H) with
+   L D L' written out) and `--model idm-derivatives` (dGamma/dq, dGamma/dqd, A) with
+   `--numeric --no-friction --no-rotor`, in C and in Rust. The operation counts of both sides'
+   derivative code are printed (CppADCodeGen's counted in its C as robodyn counts its own:
+   binary `*`, `/`, `+`, `-`).
 3. Every C function is compiled in its own translation unit with the same flags (default
    `-O3 -march=native`; CppADCodeGen's sources called directly, not through its dlopen'ed
    model-library wrapper, so that no call overhead is added to the peer) and linked with
    cg_timing.c; the Rust code is compiled into cg_timing.rs by rustc -C opt-level=3
    -C target-cpu=native.
-4. All results are checked against Pinocchio's numeric rnea / crba / aba (Python bindings) on the
-   same states; then interleaved rounds pinned to one core; medians as in run.py.
+4. All results are checked against Pinocchio's numeric rnea / crba / aba /
+   computeRNEADerivatives (Python bindings) on the same states; then interleaved rounds pinned to one core; medians as in run.py.
 """
 
 import json
@@ -79,7 +83,7 @@ def reference(pin, model, states_path):
     """Pinocchio's numeric results (Python bindings) on the states, in the RESULTS layout."""
     data = model.createData()
     nv = model.nv
-    out = {"rnea": [], "crba": [], "aba": []}
+    out = {"rnea": [], "crba": [], "aba": [], "drnea": []}
     with open(states_path) as fh:
         for line in fh.read().splitlines()[1:]:
             x = np.array([float(v) for v in line.split()])
@@ -88,6 +92,10 @@ def reference(pin, model, states_path):
             m = pin.crba(model, data, q).copy()
             out["crba"].append(np.triu(m) + np.triu(m, 1).T)
             out["aba"].append(pin.aba(model, data, q, v, tau).copy())
+            dq, dv, da = (np.array(m) for m in pin.computeRNEADerivatives(model, data, q, v, a))
+            # Pinocchio fills the upper triangle of dtau_da = M
+            da = np.triu(da) + np.triu(da, 1).T
+            out["drnea"].append(np.concatenate([dq.ravel(), dv.ravel(), da.ravel()]))
     return {k: np.array(v).reshape(len(v), -1) for k, v in out.items()}
 
 
@@ -104,7 +112,7 @@ def build_robot(key, cli, gen, cflags, pin, prefix):
     write_cg_states(sfile, cgstates, model.nv, nl, idx, rank)
     peers.run([gen, mfile, d])
     objs = []
-    for name in ("rnea", "crba", "aba"):
+    for name in ("rnea", "crba", "aba", "drnea"):
         wrapper = os.path.join(d, f"cg_{name}.c")
         with open(wrapper, "w") as fh:
             fh.write(f'#include "{name}_forward_zero.c"\n'
@@ -114,11 +122,15 @@ def build_robot(key, cli, gen, cflags, pin, prefix):
                      f"  {name}_forward_zero(in, out, atomics);\n}}\n")
         objs.append(wrapper)
     rs = {}
-    for model_kind, fname in (("idm", "rd_idm"), ("inertia", "rd_inertia"), ("ddm", "rd_ddm")):
+    ops = {}
+    for model_kind, fname in (("idm", "rd_idm"), ("inertia", "rd_inertia"), ("ddm", "rd_ddm"),
+                              ("idm-derivatives", "rd_idm_derivatives")):
         for lang, ext in (("c", "c"), ("rust", "rs")):
             path = os.path.join(d, f"{fname}.{ext}")
-            peers.run([cli, "generate", urdf, "--model", model_kind, "--numeric", "--no-friction", "--no-rotor",
-                       "--lang", lang, "--name", fname, "--output", path], capture_output=True)
+            res = peers.run([cli, "generate", urdf, "--model", model_kind, "--numeric", "--no-friction",
+                             "--no-rotor", "--lang", lang, "--name", fname, "--output", path],
+                            capture_output=True)
+            ops[fname] = res.stderr.strip()
             if ext == "c":
                 objs.append(path)
             else:
@@ -131,11 +143,35 @@ def build_robot(key, cli, gen, cflags, pin, prefix):
     cexe = os.path.join(d, "cg_timing_c")
     peers.run(["gcc", *cflags.split(), os.path.join(HERE, "cg_timing.c"), *o_files, "-o", cexe, "-lm"])
     rexe = os.path.join(d, "cg_timing_rs")
-    env = dict(os.environ, RD_IDM=rs["rd_idm"], RD_INERTIA=rs["rd_inertia"], RD_DDM=rs["rd_ddm"])
+    env = dict(os.environ, RD_IDM=rs["rd_idm"], RD_INERTIA=rs["rd_inertia"], RD_DDM=rs["rd_ddm"],
+               RD_IDM_DERIVATIVES=rs["rd_idm_derivatives"])
     peers.run(["nice", "-n", "19", "rustc", "--edition", "2021", "-C", "opt-level=3", "-C", "target-cpu=native",
                os.path.join(HERE, "cg_timing.rs"), "-o", rexe], env=env)
     return {"dir": d, "cgstates": cgstates, "c": cexe, "rs": rexe, "ref": reference(pin, model, sfile),
-            "nv": model.nv}
+            "nv": model.nv, "ops": ops,
+            "cg_ops": count_c_ops(os.path.join(d, "drnea_forward_zero.c"))}
+
+
+def count_c_ops(path):
+    """(multiplications, additions, function calls) of a CppADCodeGen C function: its binary
+    `*` and `/`, binary `+` and `-` (a sign after an operand), and calls, as robodyn counts its
+    own generated C (tests/codegen_opcount.rs)."""
+    import re
+    with open(path) as fh:
+        text = fh.read()
+    body = text[text.index("{", text.index("_forward_zero(")):]
+    mul = add = calls = 0
+    for line in body.splitlines():
+        line = line.strip()
+        if "=" not in line or not line.endswith(";") or line.startswith(("//", "/*", "*")):
+            continue
+        rhs = line.split("=", 1)[1]
+        # numbers (with exponents) are operands, not operators
+        rhs = re.sub(r"\d+\.?\d*(e[+-]?\d+)?", "0", rhs, flags=re.I)
+        calls += len(re.findall(r"\b(sin|cos|tan|sqrt|pow|exp|log|atan2?)\s*\(", rhs))
+        mul += rhs.count("*") + rhs.count("/")
+        add += len(re.findall(r"[\w\])]\s*[+-]", rhs))
+    return mul, add, calls
 
 
 def check(robot):
@@ -146,7 +182,8 @@ def check(robot):
         res.update(peers.read_results(out))
     pairs = [("cg_rnea", "rnea"), ("rd_rnea", "rnea"), ("rs_rnea", "rnea"),
              ("cg_crba", "crba"), ("rd_crba", "crba"), ("rs_crba", "crba"),
-             ("cg_aba", "aba"), ("rd_ddm", "aba"), ("rs_ddm", "aba")]
+             ("cg_aba", "aba"), ("rd_ddm", "aba"), ("rs_ddm", "aba"),
+             ("cg_drnea", "drnea"), ("rd_drnea", "drnea"), ("rs_drnea", "drnea")]
     worst = {}
     for tag, ref in pairs:
         r = robot["ref"][ref]
@@ -174,6 +211,9 @@ def main():
         worst = check(robot)
         ok &= all(v < 1e-9 for v in worst.values())
         print(f"  {peers.ROBOTS[key][0]}: " + ", ".join(f"{k} {v:.1e}" for k, v in worst.items()))
+        m, a, c = robot["cg_ops"]
+        print(f"    derivative code: robodyn {robot['ops']['rd_idm_derivatives']}; "
+              f"CppADCodeGen drnea_forward_zero: {m} multiplications, {a} additions, {c} calls")
     if not ok:
         sys.exit("results disagree: no timing")
     times = peers.interleaved(
@@ -191,7 +231,8 @@ def main():
         c, rs = times[key]["c"], times[key]["rs"]
         for label, rname, cname in [("inverse dynamics (IDM / rnea)", "idm", "cg_rnea"),
                                     ("inertia matrix (crba)", "inertia", "cg_crba"),
-                                    ("direct dynamics (robodyn L D L' / cg ABA)", "ddm", "cg_aba")]:
+                                    ("direct dynamics (robodyn L D L' / cg ABA)", "ddm", "cg_aba"),
+                                    ("IDM derivatives (dq, dv, M)", "idm_derivatives", "cg_drnea")]:
             (mc, sc), (mr, sr), (mg, sg) = med(c, f"rd_{rname}_c"), med(rs, f"rd_{rname}_rust"), med(c, cname)
             # ratios per round (C: the same program; Rust: the program run next to it), their
             # median and range, as in run.py

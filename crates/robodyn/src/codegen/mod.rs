@@ -15,12 +15,14 @@
 //! the frame numbers (`q<j>`, `GAM<j>`, `W<c><j>`).
 
 mod closed;
+mod derivatives;
 mod geometric;
 mod linear;
 mod parallel_links;
 
 pub use closed::constant_g;
 use closed::{closed_form, closed_torques, closed_w, ClosedForm};
+pub use derivatives::BLOCKS as DERIVATIVE_BLOCKS;
 pub use geometric::{Frames, DGM_OUTPUTS};
 pub use parallel_links::parallel_links;
 
@@ -50,6 +52,11 @@ pub enum ModelKind {
     Jacobian(Frames),
     /// Inverse dynamic model of the (equivalent) tree: Gamma(q, qd, qdd).
     Idm,
+    /// Derivatives of the inverse dynamic model of the (equivalent) tree: dGamma/dq,
+    /// dGamma/dqd and A = dGamma/dqdd, each N x N column-major, one after the other (3 N^2
+    /// outputs, [`DERIVATIVE_BLOCKS`]): the customized IDM differentiated in forward mode,
+    /// structural zeros never computed. Coulomb friction's derivative is 0 (where qd != 0).
+    IdmDerivatives,
     /// Inertia matrix A(q) (lower triangle).
     Inertia,
     /// Vector H(q, qd) = Gamma(q, qd, 0) (centrifugal, Coriolis, gravity, friction, wrenches).
@@ -65,13 +72,14 @@ pub enum ModelKind {
 }
 
 impl ModelKind {
-    /// Short name (`dgm`, `jacobian`, `idm`, `inertia`, `h`, `ddm`, `closed`, `w`): the default
-    /// function name's suffix.
+    /// Short name (`dgm`, `jacobian`, `idm`, `idm_derivatives`, `inertia`, `h`, `ddm`,
+    /// `closed`, `w`): the default function name's suffix.
     pub fn name(self) -> &'static str {
         match self {
             ModelKind::Dgm(_) => "dgm",
             ModelKind::Jacobian(_) => "jacobian",
             ModelKind::Idm => "idm",
+            ModelKind::IdmDerivatives => "idm_derivatives",
             ModelKind::Inertia => "inertia",
             ModelKind::H => "h",
             ModelKind::Ddm => "ddm",
@@ -402,7 +410,15 @@ pub fn generate_with_progress(
     let (outputs, assignments) = record(&reserved_names(desc, opt), || {
         record_model(desc, &model, opt, &form, &shared)
     });
-    let outputs = outputs?;
+    let mut outputs = outputs?;
+    let mut assignments = assignments;
+    if opt.model == ModelKind::IdmDerivatives {
+        let frames: Vec<usize> = (1..=model.nl).map(|k| model.wrench_link(k)).collect();
+        progress("differentiating the inverse dynamic model (forward mode)");
+        let a_low = outputs.split_off(frames.len());
+        (assignments, outputs) =
+            derivatives::derivative_program(assignments, outputs, a_low, &frames);
+    }
     let mut description = describe(desc, opt, kinematic);
     if closed {
         description.extend(form.describe(nl));
@@ -476,7 +492,7 @@ fn joint_inputs(joints: &[usize], model: ModelKind) -> Vec<InputGroup> {
     };
     let mut inputs = vec![group("q", "q", "joint positions")];
     match model {
-        ModelKind::Idm | ModelKind::Closed => {
+        ModelKind::Idm | ModelKind::IdmDerivatives | ModelKind::Closed => {
             inputs.push(group("qd", "QP", "joint velocities"));
             inputs.push(group("qdd", "QDP", "joint accelerations"));
         }
@@ -539,25 +555,20 @@ fn record_model(
             }
         }
         ModelKind::W => closed_w(model, form, &q),
+        ModelKind::IdmDerivatives => {
+            // Gamma, then the lower triangle of A (split and differentiated by
+            // `derivatives::derivative_program`)
+            rnea(model, &mut ws, &q, &qd, &qdd, &mut tau);
+            let mut out = outputs("GAM", &tau);
+            out.extend(lower_triangle(model, &q));
+            Ok(out)
+        }
         ModelKind::H => {
             let zero = vec![Expr::zero(); nl];
             rnea(model, &mut ws, &q, &qd, &zero, &mut tau);
             Ok(outputs("H", &tau))
         }
-        ModelKind::Inertia => {
-            // the folded model: every link is a movable joint
-            let a = inertia_matrix_expr(model, &q);
-            let mut out = Vec::new();
-            for i in 0..nl {
-                for j in 0..=i {
-                    out.push(Assignment {
-                        name: pair_name("A", frame(i), frame(j)),
-                        expr: a[(i, j)].clone(),
-                    });
-                }
-            }
-            Ok(out)
-        }
+        ModelKind::Inertia => Ok(lower_triangle(model, &q)),
         ModelKind::Ddm => {
             let zero = vec![Expr::zero(); nl];
             rnea(model, &mut ws, &q, &qd, &zero, &mut tau);
@@ -587,6 +598,23 @@ fn record_model(
             ))
         }
     }
+}
+
+/// The lower triangle of the inertia matrix A(q) of a folded model (every link a movable
+/// joint), row by row: outputs `A<i><j>`.
+fn lower_triangle(model: &DynModel<Expr>, q: &[Expr]) -> Vec<Assignment> {
+    let frame = |k: usize| model.wrench_link(k + 1);
+    let a = inertia_matrix_expr(model, q);
+    let mut out = Vec::new();
+    for i in 0..model.nl {
+        for j in 0..=i {
+            out.push(Assignment {
+                name: pair_name("A", frame(i), frame(j)),
+                expr: a[(i, j)].clone(),
+            });
+        }
+    }
+    out
 }
 
 /// The parameter input `p`: every symbol that is neither an input nor an intermediate, passed
@@ -684,6 +712,7 @@ fn describe(
     let model = match opt.model {
         ModelKind::Dgm(_) | ModelKind::Jacobian(_) => "geometric model",
         ModelKind::Idm => "customized inverse dynamic model Gamma = f(q, qd, qdd) (Newton-Euler, eqs 10.3-10.12)",
+        ModelKind::IdmDerivatives => "derivatives of the customized inverse dynamic model: out = [dGamma/dq, dGamma/dqd, A = dGamma/dqdd], each N x N column-major (forward-mode differentiation of the Newton-Euler model; Coulomb friction's derivative is 0 where qd != 0)",
         ModelKind::Inertia => "inertia matrix A(q), lower triangle (Newton-Euler columns)",
         ModelKind::H => "vector H(q, qd) = Gamma(q, qd, 0)",
         ModelKind::Ddm => "direct dynamic model qdd = A^-1 (Gamma - H), A = L' D L along the parent array written out",
