@@ -357,6 +357,7 @@ pub fn generate(
 ) -> PyResult<Generated> {
     let kind = match model {
         "idm" => ModelKind::Idm,
+        "idm_derivatives" => ModelKind::IdmDerivatives,
         "inertia" => ModelKind::Inertia,
         "h" => ModelKind::H,
         "ddm" => ModelKind::Ddm,
@@ -364,7 +365,7 @@ pub fn generate(
         "w" => ModelKind::W,
         _ => {
             return Err(InputError::new_err(format!(
-                "model = {model:?}: expected idm, inertia, h, ddm, closed or w"
+                "model = {model:?}: expected idm, idm_derivatives, inertia, h, ddm, closed or w"
             )))
         }
     };

@@ -294,7 +294,7 @@ class Robot:
         numeric set). rotor: "actuated", "all" or "none"; zeros: what a literal 0 means
         ("absent" for SYMORO .par files by default, else "value")."""
     def generate(self, model: str = "idm", lang: str = "python", params: str = "standard", symmetric: bool = False, friction: bool = True, rotor: bool = True, numeric: bool = False, name: Optional[str] = None) -> Generated:
-        """Customized symbolic model (idm, inertia, h, ddm, closed, w) as code (text, latex,
+        """Customized symbolic model (idm, idm_derivatives, inertia, h, ddm, closed, w) as code (text, latex,
         rust, c, python, julia, matlab) with its operation counts; params "standard" or "base"."""
     def simulate(self, duration: float, q0: Optional[ArrayLike] = None, qd0: Optional[ArrayLike] = None, torque: Torque = None, dt: Optional[float] = None, rtol: float = 1e-8, atol: float = 1e-10, output_dt: float = 0.01, method: str = "aba", coulomb_smoothing: Optional[float] = None, max_steps: int = 5_000_000) -> Dict[str, Any]:
         """Simulate from (q0, qd0) (rad, m; rad/s, m/s; default zeros) over [0, duration] (s);
