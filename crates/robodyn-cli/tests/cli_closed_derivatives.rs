@@ -33,12 +33,7 @@ fn rel(m: &DMatrix<f64>, e: &DMatrix<f64>) -> f64 {
 }
 
 /// Central differences along argument `which` of `f` (N values), from a copy of `branch` each.
-fn central(
-    branch: &Branch,
-    x: &[Vec<f64>; 3],
-    which: usize,
-    f: &Model<'_>,
-) -> DMatrix<f64> {
+fn central(branch: &Branch, x: &[Vec<f64>; 3], which: usize, f: &Model<'_>) -> DMatrix<f64> {
     let n = x[0].len();
     let mut m = DMatrix::zeros(n, n);
     for k in 0..n {

@@ -59,12 +59,7 @@ fn states(chain: &ClosedChain, seed: u64, count: usize) -> Vec<[Vec<f64>; 3]> {
 
 /// Central differences of `f(branch, x)` (N values) along argument `which` of the state, each
 /// evaluation from a copy of `branch` at the state (the tracker re-closes the loops at q ± h).
-fn central(
-    branch: &Branch,
-    x: &[Vec<f64>; 3],
-    which: usize,
-    f: &Model<'_>,
-) -> DMatrix<f64> {
+fn central(branch: &Branch, x: &[Vec<f64>; 3], which: usize, f: &Model<'_>) -> DMatrix<f64> {
     let n = x[0].len();
     let mut m = DMatrix::zeros(n, n);
     for k in 0..n {
