@@ -15,6 +15,7 @@ macro_rules! outln {
 
 mod commands;
 mod common;
+mod derivatives;
 mod hint;
 mod kinematic_state;
 mod output;

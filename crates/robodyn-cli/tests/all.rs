@@ -17,6 +17,8 @@ mod cli_base_params_closed;
 mod cli_closed;
 #[path = "cli_closed_budget.rs"]
 mod cli_closed_budget;
+#[path = "cli_closed_derivatives.rs"]
+mod cli_closed_derivatives;
 #[path = "cli_closed_rows.rs"]
 mod cli_closed_rows;
 #[path = "cli_columns.rs"]

@@ -4,7 +4,7 @@
 
 use crate::arrays::{in_blocks, inputs, Output, Shape};
 use crate::errors::{InputError, IntoPy};
-use crate::robot::{alias, copy_rows, Call, Robot};
+use crate::robot::{alias, copy_matrices, copy_rows, split_three, Call, Robot};
 use nalgebra::DMatrix;
 use numpy::PyArrayMethods;
 use pyo3::create_exception;
@@ -14,8 +14,10 @@ use pyo3::types::PyDict;
 use robodyn::algorithms::kinematics::closed_frame_jacobian;
 use robodyn::algorithms::regressor::PARAMS_PER_LINK;
 use robodyn::{
-    closed_direct_dynamics_into, closed_inverse_dynamics_into, closed_regressor_into, loop_closure,
-    loop_closure_into, Branch, ClosedData, Conditioning,
+    closed_direct_dynamics_derivatives_into, closed_direct_dynamics_into,
+    closed_inverse_dynamics_derivatives_into, closed_inverse_dynamics_into, closed_regressor_into,
+    loop_closure, loop_closure_into, Branch, ClosedData, ClosedDdmDerivatives,
+    ClosedDerivativesData, ClosedIdmDerivatives, Conditioning,
 };
 use std::sync::{Arc, Mutex};
 
@@ -31,6 +33,29 @@ struct Tracker {
     data: ClosedData,
     phi: DMatrix<f64>,
     tau_e: Vec<f64>,
+    /// The derivatives' buffers and outputs, made at the first derivatives call.
+    deriv: Option<Box<Derivatives>>,
+}
+
+/// The closed-chain derivatives' buffers and outputs.
+struct Derivatives {
+    data: ClosedDerivativesData,
+    idm: ClosedIdmDerivatives,
+    ddm: ClosedDdmDerivatives,
+}
+
+impl Tracker {
+    /// The derivatives' buffers for `chain` (made once) and the branch.
+    fn deriv(&mut self, chain: &robodyn::ClosedChain) -> (&mut Derivatives, &mut Branch) {
+        let d = self.deriv.get_or_insert_with(|| {
+            Box::new(Derivatives {
+                data: ClosedDerivativesData::new(chain),
+                idm: ClosedIdmDerivatives::new(chain),
+                ddm: ClosedDdmDerivatives::new(chain),
+            })
+        });
+        (d, &mut self.branch)
+    }
 }
 
 /// A closed-chain robot: vectors over the actuated joints (`joint_names`), the passive ones
@@ -141,6 +166,41 @@ type JointModel = fn(
 ) -> robodyn::Result<Conditioning>;
 
 impl ClosedChain {
+    /// The three N x N matrices of a derivative model at each state (one state, or N rows
+    /// followed in order on the branch), split into a tuple of arrays ((n, n) each, or
+    /// (N, n, n)): what `idm_derivatives` and `ddm_derivatives` share.
+    fn derivative_matrices<'py, F>(
+        &self,
+        py: Python<'py>,
+        name: &str,
+        inputs: [(&str, Option<&Bound<'py, PyAny>>); 3],
+        f: F,
+    ) -> PyResult<Bound<'py, PyAny>>
+    where
+        F: Fn(
+                &robodyn::ClosedChain,
+                &mut Derivatives,
+                &mut Branch,
+                [&[f64]; 3],
+                &mut [f64],
+            ) -> robodyn::Result<Conditioning>
+            + Send
+            + Sync,
+    {
+        let n = self.chain.dof();
+        let call = Call {
+            inputs: &inputs,
+            one: &[3, n, n],
+            stacked: false,
+            out: None,
+        };
+        let r = self.eval(py, name, call, |c, t, x, o| {
+            let (d, b) = t.deriv(c);
+            f(c, d, b, x, o)
+        })?;
+        split_three(py, r)
+    }
+
     /// `model` on one state or N states of the three named `inputs` (over the actuated
     /// joints), its result named `result` in messages: what `idm` and `ddm` share.
     fn dynamics<'py>(
@@ -189,6 +249,7 @@ impl ClosedChain {
                 data,
                 phi: DMatrix::zeros(0, 0),
                 tau_e: vec![0.0; chain.dof()],
+                deriv: None,
             }),
             chain: Arc::new(chain),
             source: robot.source.clone(),
@@ -384,6 +445,74 @@ impl ClosedChain {
         let qd_a = alias("qd_a", qd_a, "v", v)?;
         let inputs = [("q_a", Some(q_a)), ("qd_a", qd_a), ("tau_a", tau_a)];
         self.dynamics(py, "qdd_a", inputs, out, closed_direct_dynamics_into)
+    }
+
+    /// Derivatives of the closed-chain inverse dynamic model (docs/models/derivatives.md,
+    /// C1–C9): (dtau_dq, dtau_dqd, A_cl), the derivatives of Γ_cl with respect to q_a, qd_a and
+    /// qdd_a with the loops kept closed on the branch (entry [j, k]: of tau_a,j with respect to
+    /// joint k), exact (the tree's analytical derivatives and dual numbers through the closure).
+    /// Shapes (nq, nq) each for one state, (N, nq, nq) for N states (rows followed in order on
+    /// one branch). Arguments as idm.
+    #[pyo3(signature = (q_a, qd_a=None, qdd_a=None, *, v=None, a=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn idm_derivatives<'py>(
+        &self,
+        py: Python<'py>,
+        q_a: &Bound<'py, PyAny>,
+        qd_a: Option<&Bound<'py, PyAny>>,
+        qdd_a: Option<&Bound<'py, PyAny>>,
+        v: Option<&Bound<'py, PyAny>>,
+        a: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let qd_a = alias("qd_a", qd_a, "v", v)?;
+        let qdd_a = alias("qdd_a", qdd_a, "a", a)?;
+        let inputs = [("q_a", Some(q_a)), ("qd_a", qd_a), ("qdd_a", qdd_a)];
+        self.derivative_matrices(py, "idm_derivatives", inputs, |c, d, b, x, o| {
+            let env = c.robot().environment();
+            let cond = closed_inverse_dynamics_derivatives_into(
+                c,
+                &mut d.data,
+                b,
+                env,
+                x[0],
+                x[1],
+                x[2],
+                &mut d.idm,
+            )?;
+            copy_matrices(&[&d.idm.dtau_dq, &d.idm.dtau_dqd, &d.idm.a], o);
+            Ok(cond)
+        })
+    }
+
+    /// Derivatives of the closed-chain direct dynamic model at qdd_a = ddm(q_a, qd_a, tau_a)
+    /// (C10–C11): (dqdd_dq, dqdd_dqd, Ainv) with Ainv = dqdd_a/dtau_a = A_cl^-1, from the
+    /// Cholesky factor of the closed direct model. Shapes as idm_derivatives; arguments as ddm.
+    #[pyo3(signature = (q_a, qd_a=None, tau_a=None, *, v=None))]
+    fn ddm_derivatives<'py>(
+        &self,
+        py: Python<'py>,
+        q_a: &Bound<'py, PyAny>,
+        qd_a: Option<&Bound<'py, PyAny>>,
+        tau_a: Option<&Bound<'py, PyAny>>,
+        v: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let qd_a = alias("qd_a", qd_a, "v", v)?;
+        let inputs = [("q_a", Some(q_a)), ("qd_a", qd_a), ("tau_a", tau_a)];
+        self.derivative_matrices(py, "ddm_derivatives", inputs, |c, d, b, x, o| {
+            let env = c.robot().environment();
+            let cond = closed_direct_dynamics_derivatives_into(
+                c,
+                &mut d.data,
+                b,
+                env,
+                x[0],
+                x[1],
+                x[2],
+                &mut d.ddm,
+            )?;
+            copy_matrices(&[&d.ddm.dqdd_dq, &d.ddm.dqdd_dqd, &d.ddm.ainv], o);
+            Ok(cond)
+        })
     }
 
     /// Regressor of the closed chain, G^T Φ over all 13 NL standard parameters (K order,

@@ -84,7 +84,7 @@ pub fn copy_rows(m: &DMatrix<f64>, cols: &[usize], out: &mut [f64]) {
 }
 
 /// The N x N matrices `m` one after the other into `out`, each row-major.
-fn copy_matrices(m: &[&DMatrix<f64>], out: &mut [f64]) {
+pub(crate) fn copy_matrices(m: &[&DMatrix<f64>], out: &mut [f64]) {
     let mut k = 0;
     for a in m {
         for r in 0..a.nrows() {
@@ -98,7 +98,10 @@ fn copy_matrices(m: &[&DMatrix<f64>], out: &mut [f64]) {
 
 /// An array of shape (3, n, n) or (N, 3, n, n) as a tuple of three C-contiguous arrays of
 /// shape (n, n) or (N, n, n).
-fn split_three<'py>(py: Python<'py>, r: Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+pub(crate) fn split_three<'py>(
+    py: Python<'py>,
+    r: Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, PyAny>> {
     let np = py.import("numpy")?;
     let moved = np.getattr("moveaxis")?.call1((r, -3, 0))?;
     let parts: Vec<Bound<'py, PyAny>> = (0..3)

@@ -98,9 +98,12 @@ pub use algorithms::centroidal::{
     centroidal_map, centroidal_map_into, centroidal_momentum, Centroidal,
 };
 pub use algorithms::closed_chain::{
-    closed_direct_dynamics, closed_direct_dynamics_into, closed_inertia_matrix_into,
-    closed_inverse_dynamics, closed_inverse_dynamics_into, closed_regressor_into, closed_state,
-    loop_closure, loop_closure_into, Branch, ClosedChain, ClosedData, Conditioning,
+    closed_direct_dynamics, closed_direct_dynamics_derivatives,
+    closed_direct_dynamics_derivatives_into, closed_direct_dynamics_into,
+    closed_inertia_matrix_into, closed_inverse_dynamics, closed_inverse_dynamics_derivatives,
+    closed_inverse_dynamics_derivatives_into, closed_inverse_dynamics_into, closed_regressor_into,
+    closed_state, loop_closure, loop_closure_into, Branch, ClosedChain, ClosedData,
+    ClosedDdmDerivatives, ClosedDerivativesData, ClosedIdmDerivatives, Conditioning,
     ConditioningLimits,
 };
 pub use algorithms::derivatives::{

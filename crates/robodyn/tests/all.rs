@@ -27,6 +27,8 @@ mod batch;
 mod branch_tracker;
 #[path = "closed_chain.rs"]
 mod closed_chain;
+#[path = "closed_derivatives.rs"]
+mod closed_derivatives;
 #[path = "closed_simulation.rs"]
 mod closed_simulation;
 #[path = "codegen_base.rs"]

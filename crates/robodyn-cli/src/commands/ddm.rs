@@ -6,9 +6,13 @@
 //! row on the assembly branch (the library's branch tracker, started at the robot's `assembly`
 //! or `--guess`); rows near a singularity are flagged on stderr and in JSON.
 
-use crate::common::{choices, CliResult, RobotArgs};
+use crate::common::{choices, start_branch, CliResult, RobotArgs};
+use crate::derivatives::{state, write, Table};
 use crate::rows::{evaluate, EvaluationArgs};
-use robodyn::{closed_direct_dynamics_into, direct_dynamics_batch, Method};
+use robodyn::{
+    closed_direct_dynamics_derivatives_into, closed_direct_dynamics_into, direct_dynamics_batch,
+    direct_dynamics_derivatives, ClosedChain, ClosedDdmDerivatives, ClosedDerivativesData, Method,
+};
 use std::path::PathBuf;
 
 #[derive(clap::Args, Debug)]
@@ -32,11 +36,22 @@ pub struct Args {
     /// Direct model of a tree robot (closed chains always use A_cl, H_cl of 10.46-10.48).
     #[arg(long, default_value = "composite", value_parser = choices(&Method::ALL, Method::name, Method::describe))]
     pub method: Method,
+    /// Instead of the accelerations, write the derivatives of the model at the one state of
+    /// --q/--qd/--tau: dqdd_dq, dqdd_dqd and Ainv = dqdd/dtau (N x N over the movable joints;
+    /// row j is the derivative of qdd_j; closed chains: over the actuated joints, the loops kept
+    /// closed on the branch, Ainv = A_cl^-1). csv: columns matrix, joint, then one per joint;
+    /// json: {"joints", "q", "qd", "tau", "qdd", "dqdd_dq", "dqdd_dqd", "Ainv"} (closed chains:
+    /// and "rcond_wp", "rcond_a_cl", "singularity_warning").
+    #[arg(long, conflicts_with_all = ["input", "carry"])]
+    pub derivatives: bool,
     #[command(flatten)]
     pub eval: EvaluationArgs,
 }
 
 pub fn run(a: Args) -> CliResult {
+    if a.derivatives {
+        return derivatives(&a);
+    }
     let method = a.method;
     evaluate(
         &a.robot,
@@ -64,4 +79,65 @@ pub fn run(a: Args) -> CliResult {
             )
         },
     )
+}
+
+/// `ddm --derivatives`: the three matrices at one state, in the table format of `--format`
+/// (a closed chain's over its actuated joints, on the branch of `--guess` or the assembly).
+fn derivatives(a: &Args) -> CliResult {
+    let robot = a.robot.load()?;
+    let lists = [("q", &a.q), ("qd", &a.qd), ("tau", &a.tau)];
+    if !robot.is_tree() {
+        let chain = ClosedChain::new(&robot)?;
+        let [q, qd, tau] = state(chain.dof(), lists)?;
+        let mut branch = start_branch(&chain, &q, a.eval.guess.as_deref())?;
+        let env = robot.environment();
+        let mut data = ClosedDerivativesData::new(&chain);
+        let mut d = ClosedDdmDerivatives::new(&chain);
+        let c = closed_direct_dynamics_derivatives_into(
+            &chain,
+            &mut data,
+            &mut branch,
+            env,
+            &q,
+            &qd,
+            &tau,
+            &mut d,
+        )?;
+        let joints = chain.coordinates().frames().to_vec();
+        let table = Table {
+            joints: &joints,
+            vectors: [
+                ("q", &q),
+                ("qd", &qd),
+                ("tau", &tau),
+                ("qdd", d.qdd.as_slice()),
+            ],
+            matrices: [
+                ("dqdd_dq", &d.dqdd_dq),
+                ("dqdd_dqd", &d.dqdd_dqd),
+                ("Ainv", &d.ainv),
+            ],
+            closed: Some((&chain, c)),
+        };
+        return write(&table, &a.eval.out);
+    }
+    let [q, qd, tau] = state(robot.dof(), lists)?;
+    let d = direct_dynamics_derivatives(&robot, &q, &qd, &tau)?;
+    let joints = robot.coordinates().frames().to_vec();
+    let table = Table {
+        joints: &joints,
+        vectors: [
+            ("q", &q),
+            ("qd", &qd),
+            ("tau", &tau),
+            ("qdd", d.qdd.as_slice()),
+        ],
+        matrices: [
+            ("dqdd_dq", &d.dqdd_dq),
+            ("dqdd_dqd", &d.dqdd_dqd),
+            ("Ainv", &d.ainv),
+        ],
+        closed: None,
+    };
+    write(&table, &a.eval.out)
 }

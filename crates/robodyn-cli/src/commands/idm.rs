@@ -6,11 +6,13 @@
 //! (the library's branch tracker: each row continued from the previous one, the first from the
 //! robot's `assembly` or `--guess`); rows near a singularity are flagged on stderr and in JSON.
 
-use crate::common::{format_number, parse_list, write_text, CliResult, RobotArgs, TableFormat};
+use crate::common::{start_branch, CliResult, RobotArgs};
+use crate::derivatives::{state, write, Table};
 use crate::rows::{evaluate, EvaluationArgs};
 use robodyn::{
-    closed_inverse_dynamics_into, inverse_dynamics, inverse_dynamics_batch,
-    inverse_dynamics_derivatives,
+    closed_inverse_dynamics_derivatives_into, closed_inverse_dynamics_into, inverse_dynamics,
+    inverse_dynamics_batch, inverse_dynamics_derivatives, ClosedChain, ClosedDerivativesData,
+    ClosedIdmDerivatives,
 };
 use std::path::PathBuf;
 
@@ -34,9 +36,11 @@ pub struct Args {
     pub qdd: Option<String>,
     /// Instead of the torques, write the derivatives of the model at the one state of
     /// --q/--qd/--qdd: dtau_dq, dtau_dqd and A = dtau/dqdd (N x N over the movable joints; row j
-    /// is the derivative of tau_j; trees only). csv: columns matrix, joint, then one per joint;
-    /// json: {"joints", "q", "qd", "qdd", "tau", "dtau_dq", "dtau_dqd", "A"}.
-    #[arg(long, conflicts_with_all = ["input", "guess", "carry"])]
+    /// is the derivative of tau_j; closed chains: over the actuated joints, the loops kept
+    /// closed on the branch, A = A_cl). csv: columns matrix, joint, then one per joint;
+    /// json: {"joints", "q", "qd", "qdd", "tau", "dtau_dq", "dtau_dqd", "A"} (closed chains:
+    /// and "rcond_wp", "singularity_warning").
+    #[arg(long, conflicts_with_all = ["input", "carry"])]
     pub derivatives: bool,
     #[command(flatten)]
     pub eval: EvaluationArgs,
@@ -71,58 +75,64 @@ pub fn run(a: Args) -> CliResult {
     )
 }
 
-/// `idm --derivatives`: the three matrices at one state, in the table format of `--format`.
+/// `idm --derivatives`: the three matrices at one state, in the table format of `--format`
+/// (a closed chain's over its actuated joints, on the branch of `--guess` or the assembly).
 fn derivatives(a: &Args) -> CliResult {
     let robot = a.robot.load()?;
+    let lists = [("q", &a.q), ("qd", &a.qd), ("qdd", &a.qdd)];
     if !robot.is_tree() {
-        return Err(
-            "idm --derivatives: the derivatives of a closed chain's model are not \
-                    available yet (trees only); drop --derivatives for the torques"
-                .into(),
-        );
+        let chain = ClosedChain::new(&robot)?;
+        let [q, qd, qdd] = state(chain.dof(), lists)?;
+        let mut branch = start_branch(&chain, &q, a.eval.guess.as_deref())?;
+        let env = robot.environment();
+        let mut data = ClosedDerivativesData::new(&chain);
+        let mut d = ClosedIdmDerivatives::new(&chain);
+        let c = closed_inverse_dynamics_derivatives_into(
+            &chain,
+            &mut data,
+            &mut branch,
+            env,
+            &q,
+            &qd,
+            &qdd,
+            &mut d,
+        )?;
+        let joints = chain.coordinates().frames().to_vec();
+        let table = Table {
+            joints: &joints,
+            vectors: [
+                ("q", &q),
+                ("qd", &qd),
+                ("qdd", &qdd),
+                ("tau", d.tau.as_slice()),
+            ],
+            matrices: [
+                ("dtau_dq", &d.dtau_dq),
+                ("dtau_dqd", &d.dtau_dqd),
+                ("A", &d.a),
+            ],
+            closed: Some((&chain, c)),
+        };
+        return write(&table, &a.eval.out);
     }
-    let n = robot.dof();
-    let list = |name: &str, s: &Option<String>| match s {
-        Some(s) => parse_list(name, s),
-        None => Ok(vec![0.0; n]),
-    };
-    let (q, qd, qdd) = (list("q", &a.q)?, list("qd", &a.qd)?, list("qdd", &a.qdd)?);
+    let [q, qd, qdd] = state(robot.dof(), lists)?;
     let d = inverse_dynamics_derivatives(&robot, &q, &qd, &qdd)?;
     let tau = inverse_dynamics(&robot, &q, &qd, &qdd)?;
     let joints = robot.coordinates().frames().to_vec();
-    let mats = [
-        ("dtau_dq", &d.dtau_dq),
-        ("dtau_dqd", &d.dtau_dqd),
-        ("A", &d.a),
-    ];
-    let rows = |m: &robodyn::nalgebra::DMatrix<f64>| -> Vec<Vec<f64>> {
-        (0..n).map(|i| m.row(i).iter().copied().collect()).collect()
+    let table = Table {
+        joints: &joints,
+        vectors: [
+            ("q", &q),
+            ("qd", &qd),
+            ("qdd", &qdd),
+            ("tau", tau.as_slice()),
+        ],
+        matrices: [
+            ("dtau_dq", &d.dtau_dq),
+            ("dtau_dqd", &d.dtau_dqd),
+            ("A", &d.a),
+        ],
+        closed: None,
     };
-    let text = match a.eval.out.format {
-        TableFormat::Csv => {
-            let mut t = String::from("matrix,joint");
-            for j in &joints {
-                t += &format!(",{j}");
-            }
-            t.push('\n');
-            for (name, m) in mats {
-                for (i, j) in joints.iter().enumerate() {
-                    t += &format!("{name},{j}");
-                    for x in m.row(i).iter() {
-                        t += &format!(",{}", format_number(*x));
-                    }
-                    t.push('\n');
-                }
-            }
-            t
-        }
-        TableFormat::Json => {
-            let v = serde_json::json!({
-                "joints": joints, "q": q, "qd": qd, "qdd": qdd, "tau": tau.as_slice(),
-                "dtau_dq": rows(&d.dtau_dq), "dtau_dqd": rows(&d.dtau_dqd), "A": rows(&d.a),
-            });
-            serde_json::to_string_pretty(&v)? + "\n"
-        }
-    };
-    write_text(a.eval.out.output.as_deref(), &text)
+    write(&table, &a.eval.out)
 }

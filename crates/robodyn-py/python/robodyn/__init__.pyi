@@ -356,6 +356,17 @@ class ClosedChain:
         """Closed-chain direct dynamic model qdd_a = A_cl^-1 (Gamma_cl - H_cl) (eqs 10.46-10.48):
         the accelerations (rad/s^2, m/s^2) of the actuated joints for q_a, qd_a (v: Pinocchio's
         name) and their torques tau_a (N m, N). Shapes as idm. out: as for idm."""
+    def idm_derivatives(self, q_a: ArrayLike, qd_a: Optional[ArrayLike] = None, qdd_a: Optional[ArrayLike] = None, *, v: Optional[ArrayLike] = None, a: Optional[ArrayLike] = None) -> Tuple[Array, Array, Array]:
+        """Derivatives of the closed-chain inverse dynamic model (docs/models/derivatives.md,
+        C1-C9): (dtau_dq, dtau_dqd, A_cl), the derivatives of Gamma_cl with respect to q_a, qd_a
+        and qdd_a with the loops kept closed on the branch (entry [j, k]: of tau_a,j with respect
+        to joint k), exact (the tree's analytical derivatives and dual numbers through the
+        closure). Shapes (nq, nq) each for one state, (N, nq, nq) for N states (rows followed in
+        order on one branch). Arguments as idm."""
+    def ddm_derivatives(self, q_a: ArrayLike, qd_a: Optional[ArrayLike] = None, tau_a: Optional[ArrayLike] = None, *, v: Optional[ArrayLike] = None) -> Tuple[Array, Array, Array]:
+        """Derivatives of the closed-chain direct dynamic model at qdd_a = ddm(q_a, qd_a, tau_a)
+        (C10-C11): (dqdd_dq, dqdd_dqd, Ainv) with Ainv = dqdd_a/dtau_a = A_cl^-1, from the
+        Cholesky factor of the closed direct model. Shapes as idm_derivatives; arguments as ddm."""
     def regressor(self, q_a: ArrayLike, qd_a: Optional[ArrayLike] = None, qdd_a: Optional[ArrayLike] = None, *, v: Optional[ArrayLike] = None, a: Optional[ArrayLike] = None, out: Optional[Array] = None) -> Array:
         """Regressor of the closed chain, G^T Phi over all 13 NL standard parameters (K order,
         ``robot.parameter_names``): (nq, 13 NL) for one state, stacked (N nq, 13 NL) for N

@@ -30,7 +30,8 @@
 //! branch tracker ([`crate::Branch`], [`crate::algorithms::closed_chain::loop_closure`]).
 
 use crate::error::{check_vector, Error, Result};
-use crate::model::{ClosedLoop, JointType, Robot};
+use crate::model::{ClosedLoop, DynModel, JointType, Robot};
+use crate::scalar::DynScalar;
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 use rand::Rng;
 
@@ -77,19 +78,20 @@ pub(crate) struct LoopClosure {
     pub tolerance: f64,
 }
 
-/// Buffers of the loop-closure computations (absolute kinematics in R_0, frames 0..NF).
+/// Buffers of the loop-closure computations (absolute kinematics in R_0, frames 0..NF), in
+/// numbers (`f64`) or in another scalar (the dual numbers of the closed-chain derivatives).
 #[derive(Clone, Debug)]
-pub(crate) struct LoopWorkspace {
-    pub rot: Vec<Matrix3<f64>>,
-    pub pos: Vec<Vector3<f64>>,
+pub(crate) struct LoopWorkspace<T: DynScalar = f64> {
+    pub rot: Vec<Matrix3<T>>,
+    pub pos: Vec<Vector3<T>>,
     /// Angular velocity, velocity of the origin, angular and linear acceleration of links 0..NL.
-    pub w: Vec<Vector3<f64>>,
-    pub v: Vec<Vector3<f64>>,
-    pub wd: Vec<Vector3<f64>>,
-    pub vd: Vec<Vector3<f64>>,
+    pub w: Vec<Vector3<T>>,
+    pub v: Vec<Vector3<T>>,
+    pub wd: Vec<Vector3<T>>,
+    pub vd: Vec<Vector3<T>>,
     q: Vec<f64>,
     /// Candidate-equation columns of the Jacobian (one per tree joint).
-    cols: Vec<[f64; CANDIDATES]>,
+    cols: Vec<[T; CANDIDATES]>,
 }
 
 /// A solution of the closure equations from a guess (damped Newton; internal: the start of a
@@ -107,16 +109,18 @@ pub(crate) struct GuessSolution {
     pub residual: f64,
 }
 
-fn skew(a: &Vector3<f64>) -> Matrix3<f64> {
-    Matrix3::new(0.0, -a.z, a.y, a.z, 0.0, -a.x, -a.y, a.x, 0.0)
+fn skew<T: DynScalar + Copy>(a: &Vector3<T>) -> Matrix3<T> {
+    let z = T::zero();
+    Matrix3::new(z, -a.z, a.y, a.z, z, -a.x, -a.y, a.x, z)
 }
 
-fn vee_antisym(m: &Matrix3<f64>) -> Vector3<f64> {
+fn vee_antisym<T: DynScalar + Copy>(m: &Matrix3<T>) -> Vector3<T> {
     // vee((M - M^T) / 2)
+    let h = T::from_f64(0.5);
     Vector3::new(
-        0.5 * (m[(2, 1)] - m[(1, 2)]),
-        0.5 * (m[(0, 2)] - m[(2, 0)]),
-        0.5 * (m[(1, 0)] - m[(0, 1)]),
+        h * (m[(2, 1)] - m[(1, 2)]),
+        h * (m[(0, 2)] - m[(2, 0)]),
+        h * (m[(1, 0)] - m[(0, 1)]),
     )
 }
 
@@ -274,6 +278,11 @@ impl LoopClosure {
     }
 
     pub fn workspace(&self) -> LoopWorkspace {
+        self.workspace_in()
+    }
+
+    /// [`Self::workspace`] in scalar `T`.
+    pub fn workspace_in<T: DynScalar + Copy>(&self) -> LoopWorkspace<T> {
         let nf = self.robot.nf();
         let nl = self.robot.nl();
         let z = || vec![Vector3::zeros(); nl + 1];
@@ -285,7 +294,7 @@ impl LoopClosure {
             wd: z(),
             vd: z(),
             q: vec![0.0; nl],
-            cols: vec![[0.0; CANDIDATES]; nl],
+            cols: vec![[T::zero(); CANDIDATES]; nl],
         }
     }
 
@@ -298,12 +307,24 @@ impl LoopClosure {
         qd: Option<&[f64]>,
         qdd: Option<&[f64]>,
     ) {
-        let model = self.robot.numeric();
+        self.kinematics_in(self.robot.numeric(), ws, q, qd, qdd);
+    }
+
+    /// [`Self::kinematics`] in scalar `T`, with `model` the robot's numeric model in `T`
+    /// ([`crate::algorithms::energy::convert_model`]).
+    pub fn kinematics_in<T: DynScalar + Copy>(
+        &self,
+        model: &DynModel<T>,
+        ws: &mut LoopWorkspace<T>,
+        q: &[T],
+        qd: Option<&[T]>,
+        qdd: Option<&[T]>,
+    ) {
         let nl = self.robot.nl();
         for j in 1..=self.robot.nf() {
             let fr = model.frame(j);
             let i = fr.ant;
-            let qj = if j <= nl { q[j - 1] } else { 0.0 };
+            let qj = if j <= nl { q[j - 1] } else { T::zero() };
             let (a, p) = fr.transform(&qj);
             ws.pos[j] = ws.pos[i] + ws.rot[i] * p;
             ws.rot[j] = ws.rot[i] * a;
@@ -314,7 +335,7 @@ impl LoopClosure {
             let z = ws.rot[j].column(2).into_owned();
             let r = ws.pos[j] - ws.pos[i];
             let (wi, vi, wdi, vdi) = (ws.w[i], ws.v[i], ws.wd[i], ws.vd[i]);
-            let a = qdd.map_or(0.0, |x| x[j - 1]);
+            let a = qdd.map_or(T::zero(), |x| x[j - 1]);
             let mut w = wi;
             let mut v = vi + wi.cross(&r);
             let mut wd = wdi;
@@ -326,7 +347,7 @@ impl LoopClosure {
                 }
                 JointType::Prismatic => {
                     v += z * qd[j - 1];
-                    vd += z * a + wi.cross(&z) * (2.0 * qd[j - 1]);
+                    vd += z * a + wi.cross(&z) * (qd[j - 1] + qd[j - 1]);
                 }
                 JointType::Fixed => {}
             }
@@ -355,17 +376,27 @@ impl LoopClosure {
         }
     }
 
-    /// Derivative of the candidates of loop `l` with respect to the tree joints (5 x NL).
-    fn candidates_jacobian(&self, ws: &LoopWorkspace, l: usize, out: &mut [[f64; CANDIDATES]]) {
+    /// Derivative of the candidates of loop `l` with respect to the tree joints (5 x NL): exact
+    /// at every configuration, closed or not (the derivative of R_k^T in rho combines with
+    /// that of P_k into the lever arm P_{k+B} - O_m).
+    fn candidates_jacobian<T: DynScalar + Copy>(
+        &self,
+        ws: &LoopWorkspace<T>,
+        l: usize,
+        out: &mut [[T; CANDIDATES]],
+    ) {
         let lp = &self.loops[l];
         let (k, t) = (lp.topology.cut, lp.topology.twin);
         let rkt = ws.rot[k].transpose();
         let rrel = rkt * ws.rot[t];
         let u = rrel.column(2).into_owned();
         for o in out.iter_mut() {
-            *o = [0.0; CANDIDATES];
+            *o = [T::zero(); CANDIDATES];
         }
-        let branches = [(&lp.topology.branch_j, 1.0), (&lp.topology.branch_i, -1.0)];
+        let branches = [
+            (&lp.topology.branch_j, T::one()),
+            (&lp.topology.branch_i, -T::one()),
+        ];
         for (branch, s) in branches {
             for &m in branch.iter() {
                 let fr = self.robot.numeric().frame(m);
@@ -420,7 +451,11 @@ impl LoopClosure {
 
     /// d phi / d q_tr (p x NL, columns by joint number) at the placements in `ws`: at a closed
     /// configuration this is [Wa Wp] of (10.27) with the columns in joint order.
-    pub fn constraint_jacobian(&self, ws: &mut LoopWorkspace, out: &mut DMatrix<f64>) {
+    pub fn constraint_jacobian<T: DynScalar + Copy>(
+        &self,
+        ws: &mut LoopWorkspace<T>,
+        out: &mut DMatrix<T>,
+    ) {
         let mut cols = std::mem::take(&mut ws.cols);
         for (l, lp) in self.loops.iter().enumerate() {
             self.candidates_jacobian(ws, l, &mut cols);
@@ -434,14 +469,14 @@ impl LoopClosure {
     }
 
     /// Ψ of (10.28) (p entries): d²phi/dt² at qdd = 0, after [`Self::kinematics`] with the state's
-    /// velocities and qdd = 0.
-    pub fn psi(&self, ws: &LoopWorkspace, out: &mut DVector<f64>) {
+    /// velocities and qdd = 0 (at any configuration, closed or not).
+    pub fn psi<T: DynScalar + Copy>(&self, ws: &LoopWorkspace<T>, out: &mut DVector<T>) {
         for (l, lp) in self.loops.iter().enumerate() {
             let (k, t) = (lp.topology.cut, lp.topology.twin);
             let (i, j) = (lp.topology.link_i, lp.topology.link_j);
             let rkt = ws.rot[k].transpose();
             // point velocities/accelerations of O_k (on link i) and O_{k+B} (on link j)
-            let pv = |link: usize, x: &Vector3<f64>| {
+            let pv = |link: usize, x: &Vector3<T>| {
                 let r = x - ws.pos[link];
                 let w = ws.w[link];
                 (
@@ -461,7 +496,7 @@ impl LoopClosure {
             let wrel = rkt * (ws.w[j] - ws.w[i]);
             let wrel_d = rkt * (ws.wd[j] - ws.wd[i]) - wb.cross(&wrel);
             let rrel = rkt * ws.rot[t];
-            let c: [f64; CANDIDATES] = match lp.cut_joint {
+            let c: [T; CANDIDATES] = match lp.cut_joint {
                 JointType::Prismatic => {
                     // R_rel'' = [wrel']x R_rel + [wrel]x [wrel]x R_rel
                     let s = skew(&wrel);

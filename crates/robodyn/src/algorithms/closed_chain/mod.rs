@@ -27,6 +27,7 @@
 
 mod continuation;
 mod data;
+mod derivatives;
 mod direct;
 mod inverse;
 mod model;
@@ -35,6 +36,11 @@ mod tracker;
 
 use crate::algorithms::loop_closure::fmt_vec;
 pub use data::ClosedData;
+pub use derivatives::{
+    closed_direct_dynamics_derivatives, closed_direct_dynamics_derivatives_into,
+    closed_inverse_dynamics_derivatives, closed_inverse_dynamics_derivatives_into,
+    ClosedDdmDerivatives, ClosedDerivativesData, ClosedIdmDerivatives,
+};
 pub(crate) use direct::closed_direct_dynamics_smoothed;
 pub use direct::{
     closed_direct_dynamics, closed_direct_dynamics_into, closed_inertia_matrix_into, ClosedDdm,
