@@ -74,6 +74,7 @@ pub fn run(a: Args) -> CliResult {
 /// `idm --derivatives`: the three matrices at one state, in the table format of `--format`.
 fn derivatives(a: &Args) -> CliResult {
     let robot = a.robot.load()?;
+    crate::common::refuse_motor_drives(&robot, &a.robot.robot, "idm --derivatives")?;
     if !robot.is_tree() {
         return Err(
             "idm --derivatives: the derivatives of a closed chain's model are not \
