@@ -50,7 +50,7 @@ def logs(tmp_path_factory):
     k = robodyn.load(rx90).standard_parameters
     sets = []
     for i, name in enumerate(NAMES):
-        sets += ["--set", f"{name}6={k[13 * 5 + i] + phi[i]!r}"]
+        sets += ["--set", f"{name}6={float(k[13 * 5 + i] + phi[i])!r}"]
     paths = {}
     for name, extra in [("empty", []), ("loaded", sets)]:
         paths[name] = d / f"{name}.csv"
