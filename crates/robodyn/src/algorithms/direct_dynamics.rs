@@ -533,7 +533,8 @@ pub fn direct_dynamics_into(
         [q, qd, tau],
         "qdd",
         qdd,
-        |m, d, q, qd, tau, a| match robot.motor_drives() {
+        // motors without inertia and friction change nothing: the recursions alone
+        |m, d, q, qd, tau, a| match robot.motor_drives().filter(|d| !d.is_inert()) {
             None => ddm(m, d, env, method, q, qd, tau, a),
             Some(drives) => ddm_with_drives(m, drives, d, env, q, qd, tau, a),
         },
