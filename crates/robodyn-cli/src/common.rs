@@ -3,7 +3,6 @@
 use crate::output::Output;
 pub use crate::output::{check_finite, write_table, write_text, TableFormat, TableWriter};
 use clap::Args;
-use robodyn::model::param;
 use robodyn::Robot;
 use std::collections::BTreeMap;
 use std::io::Write;
@@ -76,40 +75,38 @@ impl RobotArgs {
         Ok((desc, map))
     }
 
-    /// Load and validate the robot (all symbols need values). A motor-joint transmission with
-    /// nonzero motor drive parameters is refused: only `identify` and `excite` apply it. The
-    /// loader's warnings are printed once the robot is valid (an invalid one is an error that
-    /// says why).
+    /// Load and validate the robot (all symbols need values). The loader's warnings are
+    /// printed once the robot is valid (an invalid one is an error that says why). A motor-joint
+    /// `[transmission]` is part of the library's models (idm, ddm, inertia, simulate add the
+    /// motors' reflected inertia and friction); [`transmission_note`] says so on stderr.
     pub fn load(&self) -> CliResult<Robot> {
         let (desc, map) = self.read()?;
         let robot = Robot::new(desc).map_err(|e| map.locate(e))?;
-        if let Some(t) = &robot.description().transmission {
-            let k = robot.standard_parameters();
-            let identity = t.matrix.iter().enumerate().all(|(r, row)| {
-                row.iter()
-                    .enumerate()
-                    .all(|(c, &x)| x == if r == c { 1.0 } else { 0.0 })
-            });
-            // K: the standard parameters link after link, the drive ones IA, FS, FV
-            let per_link = robodyn::model::STANDARD_PARAMETERS.len();
-            let drive = [param::IA, param::FS, param::FV];
-            let driven = t
-                .joints
-                .iter()
-                .any(|&j| drive.iter().any(|p| k[per_link * (j - 1) + p] != 0.0));
-            if !identity && driven {
-                return Err(format!(
-                    "{}: the robot has a motor-joint [transmission] and motor drive parameters \
-                     (IA, FS, FV); this command does not apply transmissions (only `robodyn \
-                     identify` and `robodyn excite` do), so it would read them as joint-side values",
-                    self.robot.display()
-                )
-                .into());
-            }
-        }
         print_warnings(&map);
         Ok(robot)
     }
+}
+
+/// With a motor-joint transmission whose motors have drive parameters: which side the torques
+/// of `command` are on, one `robodyn: note:` line on stderr (the tables' columns stay `tau<j>`).
+pub fn transmission_note(robot: &Robot, command: &str) {
+    if robot.motor_drives().is_some_and(|d| !d.is_inert()) {
+        eprintln!(
+            "robodyn: note: {command}: {} has a motor-joint [transmission]: torques tau<j> are \
+             joint-side (tau = R^T tau_motor); the model includes the motors' reflected rotor \
+             inertia and friction, R^T (IA m_dd + FV m_d + FS sign(m_d)) with m = R q (IA, FS, \
+             FV in motor units; A(q) has R^T IA R)",
+            robot.name()
+        );
+    }
+}
+
+/// Refuse a robot whose transmission's motors have drive parameters in a command that does not
+/// apply transmissions (`what`: the command), rather than read them as joint-side values.
+pub fn refuse_motor_drives(robot: &Robot, path: &std::path::Path, what: &str) -> CliResult {
+    robot
+        .require_no_motor_drives(what)
+        .map_err(|e| format!("{}: {e}", path.display()).into())
 }
 
 /// The loader's warnings, one `robodyn: warning: FILE:LINE: link 3: ...` line each.

@@ -44,6 +44,8 @@ pub fn evaluate(
 ) -> CliResult {
     let mut t = Phases::start(args.timings);
     let robot = robot.load()?;
+    let command = if result == "tau" { "idm" } else { "ddm" };
+    crate::common::transmission_note(&robot, command);
     t.lap("robot");
     let evaluation = Evaluation {
         input,

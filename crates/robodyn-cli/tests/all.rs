@@ -65,6 +65,8 @@ mod cli_random_options;
 mod cli_readme;
 #[path = "cli_simulate_names.rs"]
 mod cli_simulate_names;
+#[path = "cli_transmission.rs"]
+mod cli_transmission;
 #[path = "cli_view.rs"]
 mod cli_view;
 

@@ -51,7 +51,7 @@ const OPTIONS: [&str; 23] = [
 ];
 
 /// The library's options from the keyword arguments (unknown names refused with the list).
-fn options(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<Options> {
+pub(crate) fn options(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<Options> {
     let mut o = Options::default();
     let mut essential: Option<EssentialOptions> = None;
     let Some(kw) = kwargs else {
@@ -201,7 +201,7 @@ fn csv_text(columns: &[(String, Bound<'_, PyAny>)], name: &str) -> PyResult<Stri
 }
 
 /// The logs of `logs`: one log or a list of them.
-fn logs(obj: &Bound<'_, PyAny>, labels: &JointLabels) -> PyResult<Vec<CsvLog>> {
+pub(crate) fn logs(obj: &Bound<'_, PyAny>, labels: &JointLabels) -> PyResult<Vec<CsvLog>> {
     if let Ok(list) = obj.cast::<PyList>() {
         return list
             .iter()
@@ -219,7 +219,7 @@ fn logs(obj: &Bound<'_, PyAny>, labels: &JointLabels) -> PyResult<Vec<CsvLog>> {
     Ok(vec![one_log(obj, labels, 0)?])
 }
 
-fn labels(access: &ModelAccess) -> JointLabels {
+pub(crate) fn labels(access: &ModelAccess) -> JointLabels {
     JointLabels {
         numbers: access.actuated_joints().to_vec(),
         names: access.joint_names(),
@@ -239,9 +239,32 @@ fn labels(access: &ModelAccess) -> JointLabels {
 /// `decimation`, `border`, `validation` ((from, to) fractions, or None; default (0.8, 1.0)),
 /// `use_log_derivatives`, `gains`, `min_speed`, `coulomb_band`, `iv_iterations`,
 /// `iv_bandwidth`. Runs with the GIL released.
+///
+/// Drive gains and payloads (the CLI's `--estimate-gains`, `--payload`): with
+/// `estimate_gains=True`, `logs` are logs of motor currents (`i<j>`) and `reference` the logs
+/// fixing the scale (joint torques `tau<j>`, or currents carrying the payload
+/// `known_payload=(link, [XX, XY, XZ, YY, YZ, ZZ, MX, MY, MZ, M])`): returns a
+/// `GainIdentification`. With `payload=LINK`, the payload's 10 parameters on that link from
+/// `logs` carrying it, the robot's parameters those of `robot`, or identified too from logs
+/// without the payload given as `before`: returns a `PayloadIdentification`.
 #[pyfunction]
 #[pyo3(signature = (robot, logs, **options))]
-pub fn identify(
+pub fn identify<'py>(
+    py: Python<'py>,
+    robot: &Bound<'py, PyAny>,
+    logs: &Bound<'py, PyAny>,
+    options: Option<&Bound<'py, PyDict>>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let (joint, options) = crate::joint_problems::split(py, options)?;
+    if let Some(joint) = joint {
+        return joint.run(py, robot, logs, options.as_ref());
+    }
+    let id = identify_parameters(py, robot, logs, options.as_ref())?;
+    Ok(Bound::new(py, id)?.into_any())
+}
+
+/// `identify` of the parameters (no gains, no payload).
+fn identify_parameters(
     py: Python<'_>,
     robot: &Bound<'_, PyAny>,
     logs: &Bound<'_, PyAny>,
@@ -478,7 +501,7 @@ type Prediction<'py> = (
 );
 
 /// A JSON value as a Python object.
-fn py_json<'py>(py: Python<'py>, v: &serde_json::Value) -> PyResult<Bound<'py, PyAny>> {
+pub(crate) fn py_json<'py>(py: Python<'py>, v: &serde_json::Value) -> PyResult<Bound<'py, PyAny>> {
     py.import("json")?.call_method1("loads", (v.to_string(),))
 }
 

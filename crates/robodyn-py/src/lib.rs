@@ -9,6 +9,7 @@ mod errors;
 mod excitation;
 mod floating;
 mod identification;
+mod joint_problems;
 mod kinematics;
 mod models;
 mod robot;
@@ -126,6 +127,7 @@ fn _robodyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(load, m)?)?;
     m.add_function(wrap_pyfunction!(models::base_parameters_of_file, m)?)?;
     identification::register(m)?;
+    joint_problems::register(m)?;
     m.add_function(wrap_pyfunction!(excitation::excite, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())

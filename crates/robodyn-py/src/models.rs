@@ -177,6 +177,8 @@ fn base_parameters_of(
     rotor: &str,
     seed: u64,
 ) -> PyResult<BaseParameters> {
+    desc.require_no_motor_drive_parameters("base_parameters")
+        .py()?;
     let (symbolic, numeric) = match method {
         "symbolic" => (true, false),
         "numeric" => (false, true),

@@ -304,6 +304,8 @@ impl Robot {
         let models = self.models();
         let robot = models.select(friction)?;
         fixed_base_only(robot, name)?;
+        // the derivatives read IA, FS, FV per joint: not a transmission's motors yet
+        robot.require_no_motor_drives(name).py()?;
         let n = robot.dof();
         let call = Call {
             inputs: &inputs,
@@ -1020,6 +1022,8 @@ impl Robot {
         let models = self.models();
         let robot = &models.full;
         fixed_base_only(robot, "Robot.regressor")?;
+        // its IA, FS, FV columns are joint-side: with motors' values Phi K is not idm
+        robot.require_no_motor_drives("Robot.regressor").py()?;
         let (cols, _) = self.columns(robot, columns, friction, rotor, seed)?;
         let n = robot.dof();
         let nk = PARAMS_PER_LINK * robot.nl();

@@ -143,6 +143,8 @@ mod rnea_allocations;
 mod rotation_forms;
 #[path = "simulation.rs"]
 mod simulation;
+#[path = "transmission.rs"]
+mod transmission;
 #[path = "view.rs"]
 mod view;
 

@@ -73,6 +73,7 @@ impl Args {
 
 pub fn run(a: Args) -> CliResult {
     let (desc, _) = a.robot.description()?;
+    desc.require_no_motor_drive_parameters("base-params")?;
     let rotor = a.rotor;
     let zeros = a
         .zeros

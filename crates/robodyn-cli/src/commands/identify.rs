@@ -486,7 +486,6 @@ mod joint {
         identify_payload, Estimate, PayloadIdentification, PayloadLogs,
     };
     use robodyn::model::param::unit;
-    use serde_json::json;
     use std::fmt::Write;
     use std::path::PathBuf;
 
@@ -656,23 +655,10 @@ mod joint {
     }
 
     fn gains_json(id: &GainIdentification) -> String {
-        let v = json!({
-            "robot": id.robot,
-            "estimator": id.estimator,
-            "reference": id.reference,
-            "gains": (0..id.gains.len()).map(|k| json!({
-                "joint": id.joints[k], "name": id.joint_names[k],
-                "value": id.gains[k], "std": id.gains_std[k]})).collect::<Vec<_>>(),
-            "parameters": id.parameters.iter().enumerate().map(|(k, p)| json!({
-                "name": p.name, "equation": p.equation,
-                "value": id.x[k], "std": id.std[k]})).collect::<Vec<_>>(),
-            "condition_number": id.condition_number,
-            "residual_rms": id.residual_rms,
-            "rows": id.rows,
-            "std_inflation": id.std_inflation,
-            "logs": id.logs.iter().map(|l| l.source.clone()).collect::<Vec<_>>(),
-        });
-        format!("{}\n", serde_json::to_string_pretty(&v).expect("json"))
+        format!(
+            "{}\n",
+            serde_json::to_string_pretty(&id.to_json()).expect("json")
+        )
     }
 
     fn estimate_line(s: &mut String, e: &Estimate, unit: &str) {
@@ -746,27 +732,9 @@ mod joint {
     }
 
     fn payload_json(id: &PayloadIdentification) -> String {
-        let est = |v: &[Estimate]| -> Vec<serde_json::Value> {
-            v.iter()
-                .map(|e| json!({"name": e.name, "value": e.value, "std": e.std}))
-                .collect()
-        };
-        let v = json!({
-            "robot": id.robot,
-            "link": id.link,
-            "estimator": id.estimator,
-            "payload": est(&id.payload),
-            "structural_rank": id.structural_rank,
-            "structural_null": id.structural_null,
-            "rank": id.rank,
-            "undetermined": id.undetermined,
-            "tolerance": id.tolerance,
-            "others": est(&id.others),
-            "condition_number": id.condition_number,
-            "relative_error": id.relative_error,
-            "rows": id.rows,
-            "logs": id.logs.iter().map(|l| l.source.clone()).collect::<Vec<_>>(),
-        });
-        format!("{}\n", serde_json::to_string_pretty(&v).expect("json"))
+        format!(
+            "{}\n",
+            serde_json::to_string_pretty(&id.to_json()).expect("json")
+        )
     }
 }

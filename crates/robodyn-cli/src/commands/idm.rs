@@ -79,6 +79,7 @@ pub fn run(a: Args) -> CliResult {
 /// (a closed chain's over its actuated joints, on the branch of `--guess` or the assembly).
 fn derivatives(a: &Args) -> CliResult {
     let robot = a.robot.load()?;
+    crate::common::refuse_motor_drives(&robot, &a.robot.robot, "idm --derivatives")?;
     let lists = [("q", &a.q), ("qd", &a.qd), ("qdd", &a.qdd)];
     if !robot.is_tree() {
         let chain = ClosedChain::new(&robot)?;

@@ -28,6 +28,7 @@ pub struct Args {
 
 pub fn run(a: Args) -> CliResult {
     let robot = a.robot.load()?;
+    crate::common::transmission_note(&robot, "inertia");
     let joints = robot.coordinates().frames().to_vec();
     let q = match &a.q {
         Some(s) => parse_list("q", s)?,

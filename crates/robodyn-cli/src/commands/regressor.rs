@@ -50,6 +50,8 @@ pub fn run(a: Args) -> CliResult {
     let mut t = Phases::start(a.timings);
     let robot = a.robot.load()?;
     crate::common::fixed_base_only(&robot, "regressor")?;
+    // its IA, FS, FV columns are joint-side: with motors' values the product W K is not the IDM
+    crate::common::refuse_motor_drives(&robot, &a.robot.robot, "robodyn regressor")?;
     // a literal 0 in a SYMORO file means the parameter does not exist (docs/robot-format.md)
     let friction = if a.no_friction {
         Friction::None

@@ -584,6 +584,7 @@ pub fn run(a: Args) -> CliResult {
     check_options(&a)?;
     check_distinct(&[("--output", Some(&a.output)), ("--plot", a.plot.as_deref())])?;
     let robot = a.robot.load()?;
+    crate::common::transmission_note(&robot, "simulate");
     let (mut dynamics, joints, what, q0_default, label) = labelled_model(&robot, &a)?;
     let n = joints.len();
     let labels = dynamics.labels.clone();

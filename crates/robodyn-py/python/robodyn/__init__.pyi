@@ -10,7 +10,7 @@ rows in place, others converted); ``out=`` writes into a float64 C-contiguous wr
 """
 
 from os import PathLike
-from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Dict, List, Literal, Optional, Sequence, Tuple, Union, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -430,7 +430,13 @@ Log = Union[str, PathLike, Dict[str, ArrayLike], Any]
 """A CSV path, a dict of 1-D arrays named as the CSV's columns (t, q<j>, tau<j> or i<j>, optionally
 qd<j>, qdd<j>), or a pandas DataFrame with those columns."""
 
-def identify(robot: Union[Robot, str, PathLike], logs: Union[Log, Sequence[Log]], **options: Any) -> Identification:
+@overload
+def identify(robot: Union[Robot, str, PathLike], logs: Union[Log, Sequence[Log]], *, estimate_gains: Literal[True], reference: Union[Log, Sequence[Log]], known_payload: Optional[Tuple[int, Sequence[float]]] = None, **options: Any) -> GainIdentification: ...
+@overload
+def identify(robot: Union[Robot, str, PathLike], logs: Union[Log, Sequence[Log]], *, payload: int, before: Optional[Union[Log, Sequence[Log]]] = None, **options: Any) -> PayloadIdentification: ...
+@overload
+def identify(robot: Union[Robot, str, PathLike], logs: Union[Log, Sequence[Log]], **options: Any) -> Identification: ...
+def identify(robot: Union[Robot, str, PathLike], logs: Union[Log, Sequence[Log]], **options: Any) -> Any:
     """Identify the base parameters (friction, rotor inertias, offsets, drive parameters of a
     transmission) of ``robot`` from one log or a list of logs of it (the CLI's repeated ``--data``):
     the same numbers as ``robodyn identify``. Options (the library's identification Options, the
@@ -438,7 +444,15 @@ def identify(robot: Union[Robot, str, PathLike], logs: Union[Log, Sequence[Log]]
     parameters for ``robot()``/``write_robot``), rotor, friction, offsets, joint_drives, seed, essential,
     essential_max_std, essential_tolerance, bandwidth, cutoff, filter_order, decimation, border,
     validation ((from, to) fractions or None; default (0.8, 1.0)), use_log_derivatives, gains,
-    min_speed, coulomb_band, iv_iterations, iv_bandwidth. An unknown option raises InputError."""
+    min_speed, coulomb_band, iv_iterations, iv_bandwidth. An unknown option raises InputError.
+
+    Drive gains (``robodyn identify --estimate-gains``): ``estimate_gains=True`` with ``logs`` of
+    motor currents (``i<j>`` columns) and ``reference``, logs fixing the scale: joint torques
+    (``tau<j>``), or currents carrying ``known_payload=(link, [XX, XY, XZ, YY, YZ, ZZ, MX, MY, MZ,
+    M])``; returns a ``GainIdentification``. Payload (``--payload LINK``): ``payload=LINK`` with
+    ``logs`` of the robot carrying it, the robot's parameters those of ``robot``, or identified too
+    from ``before``, logs without the payload; returns a ``PayloadIdentification``. Neither takes
+    gains, consistent, standard or essential (InputError)."""
 
 def ident_statistics(robot: Union[Robot, str, PathLike], log: Log, **options: Any) -> IdentStatistics:
     """The sufficient statistics of one log (options as ``identify``): picklable, merged by
@@ -499,6 +513,46 @@ class IdentStatistics:
     """Rows of the fit (all joints)."""
     logs: List[str]
     """The logs' names."""
+
+class GainIdentification:
+    """The result of ``identify(..., estimate_gains=True, reference=...)``: drive gains (torque
+    per unit of current) and the parameters identified with them, as the CLI's JSON report."""
+    report: Dict[str, Any]
+    """The JSON report of ``robodyn identify --estimate-gains --format json``."""
+    gains: List[Dict[str, Any]]
+    """joint, name, value, std: one per motor."""
+    gain_values: Array
+    gain_std: Array
+    parameters: List[Dict[str, Any]]
+    """name, equation, value, std."""
+    values: Array
+    std: Array
+    reference: str
+    """What fixed the scale, in words."""
+    condition_number: float
+    residual_rms: float
+
+class PayloadIdentification:
+    """The result of ``identify(..., payload=LINK)``: the payload's standard parameters XX, XY, XZ,
+    YY, YZ, ZZ (about O_link), MX, MY, MZ, M in R_link, those the logs determine."""
+    report: Dict[str, Any]
+    """The JSON report of ``robodyn identify --payload LINK --format json``."""
+    payload: List[Dict[str, Any]]
+    """name, value, std (None where not determined on its own)."""
+    values: Array
+    """The 10 values (NaN where not determined)."""
+    std: Array
+    names: List[str]
+    others: List[Dict[str, Any]]
+    """The other unknowns: offsets, or the robot's parameters (before/after)."""
+    link: int
+    rank: int
+    """Combinations of the 10 the logs determine."""
+    structural_rank: int
+    """Combinations that change the torques at all."""
+    undetermined: List[str]
+    relative_error: float
+    condition_number: float
 
 class Identification:
     """The result of ``identify``."""

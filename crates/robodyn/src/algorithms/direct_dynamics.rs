@@ -502,7 +502,9 @@ pub fn ddm(
 
 /// Direct dynamic model into `qdd`: the accelerations (rad/s², m/s²) of the movable joints for
 /// positions `q`, velocities `qd` and joint torques/forces `tau` (N m, N), all over the movable
-/// joints in frame order, under `env`, by `method`. Allocation-free.
+/// joints in frame order, under `env`, by `method`. Allocation-free. With a motor–joint
+/// transmission `tau` is joint-side and the motors' reflected inertia and friction are part of
+/// the model ([`crate::model::MotorDrives`]); both methods then solve A + R' Ia R densely.
 ///
 /// Errors: [`Error::Dimension`], [`Error::NotFinite`] for bad inputs; [`Error::Singular`] when
 /// the inertia matrix (or an articulated inertia) is singular.
@@ -531,8 +533,74 @@ pub fn direct_dynamics_into(
         [q, qd, tau],
         "qdd",
         qdd,
-        |m, d, q, qd, tau, a| ddm(m, d, env, method, q, qd, tau, a),
+        // motors without inertia and friction change nothing: the recursions alone
+        |m, d, q, qd, tau, a| match robot.motor_drives().filter(|d| !d.is_inert()) {
+            None => ddm(m, d, env, method, q, qd, tau, a),
+            Some(drives) => ddm_with_drives(m, drives, d, env, q, qd, tau, a),
+        },
     )
+}
+
+/// qdd = (A + R' Ia R)^-1 (Gamma - H - R' (Fv m_d + Fs sign(m_d))) for a robot with a
+/// motor–joint transmission ([`crate::model::MotorDrives`]): A and H of the links by composite
+/// links and Newton–Euler on the model of the dynamic recursions (tree arrays = joint
+/// vectors), the drives added, a dense Cholesky solve (the reflected inertia couples joints
+/// that need not be ancestors of each other, which neither the tree L'DL nor the articulated
+/// bodies carry). Both methods come here. Allocation-free.
+#[allow(clippy::too_many_arguments)]
+fn ddm_with_drives(
+    model: &DynModel<f64>,
+    drives: &crate::model::MotorDrives,
+    ws: &mut Data,
+    env: &Environment,
+    q: &[f64],
+    qd: &[f64],
+    tau: &[f64],
+    qdd: &mut [f64],
+) -> Result<()> {
+    let n = model.nl;
+    let mut a = std::mem::replace(&mut ws.a_dyn, DMatrix::zeros(0, 0));
+    if a.shape() != (n, n) {
+        a = DMatrix::zeros(n, n);
+    }
+    let mut h = std::mem::take(&mut ws.h);
+    let z = std::mem::take(&mut ws.zeros);
+    crate::algorithms::inertia_matrix::composite_inertia_matrix(model, ws, q, &mut a);
+    drives.add_inertia(&mut a);
+    rnea_with_environment(model, ws, env, q, qd, &z, &mut h);
+    drives.add_torques(qd, None, &mut h);
+    ws.h = h;
+    ws.zeros = z;
+    let scale = a.diagonal().amax();
+    let solved = match nalgebra::Cholesky::new(a) {
+        Some(c) => {
+            for j in 0..n {
+                qdd[j] = tau[j] - ws.h[j];
+            }
+            let mut x = nalgebra::DVectorViewMut::from_slice(qdd, n);
+            c.solve_mut(&mut x);
+            let l = c.unpack_dirty();
+            let lo = l.diagonal().min();
+            ws.a_dyn = l;
+            lo * lo > PIVOT_TOL * scale
+        }
+        None => false,
+    };
+    if !solved {
+        return Err(Error::Singular {
+            what: "the inertia matrix A + R' Ia R (links and reflected rotor inertias)".into(),
+            rcond: 0.0,
+            limit: PIVOT_TOL,
+            at: crate::error::Configuration::Joints {
+                name: "q",
+                values: q.to_vec(),
+            },
+            hint: "the direct dynamic model is singular: some joint has no mass or inertia \
+                   along its axis or the inertial parameters are not physical"
+                .into(),
+        });
+    }
+    check_finite(qdd)
 }
 
 /// The inputs of the direct model over the movable joints (frame order): positions `q` (rad,

@@ -218,13 +218,24 @@ fn finite(x: f64, what: &str) -> Result<f64> {
 /// velocities w0, v0 of the robot's environment, plus rotors 1/2 Ia qd^2. `q`, `qd` over the
 /// movable joints.
 pub fn kinetic_energy(robot: &Robot, q: &[f64], qd: &[f64]) -> Result<f64> {
+    let rotors = drive_energy(robot, qd);
     let [q, qd] = tree_arrays(robot, ["q", "qd"], [q, qd])?;
     let m = robot.numeric();
     let b = &m.env.base;
     finite(
-        energies(m, &q, &qd, &b.w0, &b.v0).kinetic,
+        energies(m, &q, &qd, &b.w0, &b.v0).kinetic + rotors,
         "the kinetic energy",
     )
+}
+
+/// The kinetic energy of the motors of a transmission, 1/2 m_d' Ia m_d
+/// ([`crate::model::MotorDrives`]; 0 without one). A vector of the wrong length gives 0 here:
+/// the caller's check of the vectors refuses it.
+fn drive_energy(robot: &Robot, qd: &[f64]) -> f64 {
+    match robot.motor_drives() {
+        Some(d) if qd.len() == robot.dof() => d.kinetic_energy(qd),
+        _ => 0.0,
+    }
 }
 
 /// Potential energy in the gravity field (J, [9.25]), zero at 0P = 0. `q` over the movable
@@ -242,11 +253,12 @@ pub fn potential_energy(robot: &Robot, q: &[f64]) -> Result<f64> {
 
 /// Total mechanical energy (J): kinetic + potential.
 pub fn total_energy(robot: &Robot, q: &[f64], qd: &[f64]) -> Result<f64> {
+    let rotors = drive_energy(robot, qd);
     let [q, qd] = tree_arrays(robot, ["q", "qd"], [q, qd])?;
     let m = robot.numeric();
     let b = &m.env.base;
     let e = energies(m, &q, &qd, &b.w0, &b.v0);
-    finite(e.kinetic + e.potential, "the total energy")
+    finite(e.kinetic + e.potential + rotors, "the total energy")
 }
 
 /// Power (W) the links deliver to the environment through their external wrenches,
@@ -264,6 +276,12 @@ pub fn wrench_power(robot: &Robot, q: &[f64], qd: &[f64]) -> Result<f64> {
 /// dE/dt (W) = dE/dq qd + dE/dqd qdd of the total energy E = T + U for a fixed base
 /// (w0 = v0 = 0), by forward automatic differentiation (exact to rounding).
 pub fn total_energy_rate(robot: &Robot, q: &[f64], qd: &[f64], qdd: &[f64]) -> Result<f64> {
+    let rotors = match robot.motor_drives() {
+        Some(d) if qd.len() == robot.dof() && qdd.len() == robot.dof() => {
+            d.kinetic_energy_rate(qd, qdd)
+        }
+        _ => 0.0,
+    };
     let [q, qd, qdd] = tree_arrays(robot, ["q", "qd", "qdd"], [q, qd, qdd])?;
     let m: DynModel<HyperDual64> = convert_model(robot.numeric());
     let qh: Vec<_> = (0..q.len())
@@ -274,14 +292,15 @@ pub fn total_energy_rate(robot: &Robot, q: &[f64], qd: &[f64], qdd: &[f64]) -> R
         .collect();
     let z = Vector3::zeros();
     let e = energies(&m, &qh, &qdh, &z, &z);
-    finite((e.kinetic + e.potential).eps1, "dE/dt")
+    finite((e.kinetic + e.potential).eps1 + rotors, "dE/dt")
 }
 
 /// Joint torques of the movable joints by the Euler–Lagrange equations (§10.2.1):
 ///
 /// `Gamma_k = d/dt(dT/dqd_k) - dT/dq_k + dU/dq_k + Fs_k sign(qd_k) + Fv_k qd_k + dP/dqd_k`,
 ///
-/// where T includes the rotors (so `Ia qdd` comes out of d/dt(dT/dqd)), P is the power
+/// where T includes the rotors (so `Ia qdd` comes out of d/dt(dT/dqd); with a motor–joint
+/// transmission the motors' `1/2 (R qd)' Ia (R qd)` and their friction through R'), P is the power
 /// delivered to the environment by the external wrenches, and the base may move: T depends on
 /// time through w0 and v0 (components in R_0), whose rates are wp0 and vp0 - w0 x v0.
 /// d/dt(dT/dqd_k) is the mixed second derivative of T along e_{qd_k} and the direction
@@ -342,8 +361,21 @@ pub fn lagrangian_torques(
         )));
     }
     let c = robot.coordinates();
-    Ok(DVector::from_iterator(
-        c.len(),
-        c.frames().iter().map(|&j| tau[j - 1]),
-    ))
+    let mut out = DVector::from_iterator(c.len(), c.frames().iter().map(|&j| tau[j - 1]));
+    if let Some(d) = robot.motor_drives() {
+        // T of the motors, 1/2 (R qd)' Ia (R qd): d/dt(dT/dqd) = R' Ia R qdd, dT/dq = 0
+        let (qd, qdd) = (&moved(robot, &qd), &moved(robot, &qdd));
+        d.add_torques(qd, Some(qdd), out.as_mut_slice());
+    }
+    Ok(out)
+}
+
+/// A tree array's entries of the movable joints (the joint vector).
+fn moved(robot: &Robot, x: &[f64]) -> Vec<f64> {
+    robot
+        .coordinates()
+        .frames()
+        .iter()
+        .map(|&j| x[j - 1])
+        .collect()
 }

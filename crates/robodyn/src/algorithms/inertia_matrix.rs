@@ -243,7 +243,8 @@ fn name_composite<T: DynScalar>(model: &DynModel<T>, ws: &mut Data<T>, k: usize)
 
 /// Inertia matrix A(q) into `a` (N x N over the movable joints, frame order; kg m², kg, and
 /// kg m for the coupling of a revolute and a prismatic joint) by composite links, rotor inertias
-/// on the diagonal. `q` over the movable joints (rad, m). Allocation-free.
+/// on the diagonal (with a motor–joint transmission, the motors' R' Ia R,
+/// [`crate::model::MotorDrives`]). `q` over the movable joints (rad, m). Allocation-free.
 pub fn inertia_matrix_into(
     robot: &Robot,
     data: &mut Data,
@@ -267,6 +268,9 @@ pub fn inertia_matrix_into(
     }
     // the model of the dynamic recursions: its A is the matrix over the movable joints
     composite_inertia_matrix(robot.dynamic(), data, q, a);
+    if let Some(drives) = robot.motor_drives() {
+        drives.add_inertia(a);
+    }
     crate::error::check_finite_matrix("A", a)
 }
 
@@ -305,6 +309,9 @@ pub fn h_vector_into(
             let z = std::mem::take(&mut d.zeros);
             rnea_with_environment(m, d, env, q, qd, &z, t);
             d.zeros = z;
+            if let Some(drives) = robot.motor_drives() {
+                drives.add_torques(qd, None, t);
+            }
             Ok(())
         },
     )

@@ -515,7 +515,9 @@ pub(crate) fn tree_vector_map(
 /// Inverse dynamic model (eqs 10.3–10.12) into `tau`: the joint torques (N m) / forces (N) of the
 /// movable joints for positions `q` (rad, m), velocities `qd` and accelerations `qdd`, all with
 /// `robot.coordinates().len()` entries in frame order, under the per-call inputs `env`
-/// (gravity, base motion, external wrenches). Allocation-free.
+/// (gravity, base motion, external wrenches). Allocation-free. With a motor–joint transmission
+/// the motors' reflected inertia and friction are added and the torques are joint-side
+/// ([`crate::model::MotorDrives`]).
 ///
 /// Errors: [`crate::Error::Dimension`] for a vector of the wrong length or a `data` of another
 /// robot, [`crate::Error::NotFinite`] for a NaN or infinite entry.
@@ -597,6 +599,9 @@ pub fn inverse_dynamics_into(
         tau,
         |m, d, q, qd, qdd, t| {
             rnea_with_environment(m, d, env, q, qd, qdd, t);
+            if let Some(drives) = robot.motor_drives() {
+                drives.add_torques(qd, Some(qdd), t);
+            }
             Ok(())
         },
     )

@@ -357,6 +357,13 @@ pub fn generate_with_progress(
 ) -> Result<Program> {
     crate::model::validate_structure(desc)?;
     crate::model::require_fixed_base(desc, "code generation")?;
+    let geometric = matches!(
+        opt.model,
+        ModelKind::Dgm(_) | ModelKind::Jacobian(_) | ModelKind::W
+    );
+    if !geometric && (opt.friction || opt.rotor) {
+        desc.require_no_motor_drive_parameters("code generation with rotor inertia or friction")?;
+    }
     progress("building the symbolic model");
     let model = symbolic_model(desc, opt)?;
     let nl = desc.nl;

@@ -93,6 +93,31 @@ pub struct GainIdentification {
     pub std_inflation: f64,
 }
 
+impl GainIdentification {
+    /// The report as JSON (`robodyn identify --estimate-gains --format json`, Python's
+    /// `GainIdentification.report`): robot, estimator, reference, gains (joint, name, value,
+    /// std), parameters (name, equation, value, std), condition number, residual RMS, rows,
+    /// std inflation, logs.
+    pub fn to_json(&self) -> serde_json::Value {
+        serde_json::json!({
+            "robot": self.robot,
+            "estimator": self.estimator,
+            "reference": self.reference,
+            "gains": (0..self.gains.len()).map(|k| serde_json::json!({
+                "joint": self.joints[k], "name": self.joint_names[k],
+                "value": self.gains[k], "std": self.gains_std[k]})).collect::<Vec<_>>(),
+            "parameters": self.parameters.iter().enumerate().map(|(k, p)| serde_json::json!({
+                "name": p.name, "equation": p.equation,
+                "value": self.x[k], "std": self.std[k]})).collect::<Vec<_>>(),
+            "condition_number": self.condition_number,
+            "residual_rms": self.residual_rms,
+            "rows": self.rows,
+            "std_inflation": self.std_inflation,
+            "logs": self.logs.iter().map(|l| l.source.clone()).collect::<Vec<_>>(),
+        })
+    }
+}
+
 /// Identify the drive gains of `access`'s robot and its parameters from logs of motor
 /// `currents` ([`Effort::Current`]; [`Currents`] marks a log in memory) and a `reference`
 /// fixing the scale. `opt` as for [`super::identify`], without gains; IDIM-IV is refused.

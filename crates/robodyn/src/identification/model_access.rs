@@ -69,6 +69,8 @@ struct Closed {
 /// Access to a robot's models for identification.
 pub struct ModelAccess {
     robot: Robot,
+    /// The description as given (with its transmission).
+    desc: RobotDescription,
     transmission: Option<Transmission>,
     actuated: Vec<usize>,
     closed: Option<Closed>,
@@ -84,7 +86,11 @@ impl ModelAccess {
     /// From a description: validated into the library's robot (the transmission is kept aside).
     pub fn new(desc: RobotDescription) -> Result<ModelAccess> {
         crate::model::require_fixed_base(&desc, "identification")?;
-        let transmission = desc.transmission.clone();
+        // the library's robot without the transmission: the identification's parameter model
+        // applies it itself (its motor columns), its models read IA, FS, FV per link
+        let full = desc.clone();
+        let mut desc = desc;
+        let transmission = desc.transmission.take();
         let robot = Robot::new(desc)?;
         let (n, nl) = (robot.dof(), robot.nl());
         let (actuated, closed) = if robot.is_tree() {
@@ -125,6 +131,7 @@ impl ModelAccess {
             qdd: vec![0.0; n],
             tau_e: vec![0.0; n],
             robot,
+            desc: full,
             transmission,
             actuated,
             closed,
@@ -136,9 +143,9 @@ impl ModelAccess {
         self.robot.name()
     }
 
-    /// The robot's description.
+    /// The robot's description (with its transmission).
     pub fn description(&self) -> &RobotDescription {
-        self.robot.description()
+        &self.desc
     }
 
     /// NL.

@@ -157,6 +157,36 @@ pub struct PayloadIdentification {
     pub logs: Vec<ProcessingReport>,
 }
 
+impl PayloadIdentification {
+    /// The report as JSON (`robodyn identify --payload LINK --format json`, Python's
+    /// `PayloadIdentification.report`): robot, link, estimator, payload and others (name,
+    /// value, std; null where not determined), ranks, the combinations not determined,
+    /// tolerance, condition number, relative error, rows, logs.
+    pub fn to_json(&self) -> serde_json::Value {
+        let est = |v: &[Estimate]| -> Vec<serde_json::Value> {
+            v.iter()
+                .map(|e| serde_json::json!({"name": e.name, "value": e.value, "std": e.std}))
+                .collect()
+        };
+        serde_json::json!({
+            "robot": self.robot,
+            "link": self.link,
+            "estimator": self.estimator,
+            "payload": est(&self.payload),
+            "structural_rank": self.structural_rank,
+            "structural_null": self.structural_null,
+            "rank": self.rank,
+            "undetermined": self.undetermined,
+            "tolerance": self.tolerance,
+            "others": est(&self.others),
+            "condition_number": self.condition_number,
+            "relative_error": self.relative_error,
+            "rows": self.rows,
+            "logs": self.logs.iter().map(|l| l.source.clone()).collect::<Vec<_>>(),
+        })
+    }
+}
+
 /// Identify the payload on link `link` of `access`'s robot (see the module documentation).
 /// `opt` as for [`super::identify`] (IDIM-IV refused).
 pub fn identify_payload(

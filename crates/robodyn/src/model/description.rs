@@ -1,5 +1,6 @@
 //! The robot description as written in a file: every entry an expression over named symbols.
 
+use crate::error::{Error, Item, Result};
 use robodyn_symbolic::Expr;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -423,7 +424,32 @@ impl RobotDescription {
         &mut self.frames[j - 1]
     }
 
-    /// Link j (1-based).
+    /// Error when a `[transmission]` lists a joint whose IA, FS or FV is not the literal 0: the
+    /// motors' drive parameters, in motor units. Models built from the description that read
+    /// these per joint (generated code, base parameters; `what` names it) refuse such a robot
+    /// rather than take them for joint-side values ([`crate::Robot`]'s models apply them).
+    pub fn require_no_motor_drive_parameters(&self, what: &str) -> Result<()> {
+        let Some(t) = &self.transmission else {
+            return Ok(());
+        };
+        let drives = |&j: &usize| {
+            (1..=self.nl).contains(&j)
+                && [param::IA, param::FS, param::FV]
+                    .iter()
+                    .any(|&k| !self.link(j).params[k].is_zero())
+        };
+        match t.joints.iter().find(|j| drives(j)) {
+            Some(j) => Err(Error::invalid(
+                Item::Base("transmission".into()),
+                format!(
+                    "{what} does not apply motor-joint transmissions yet: joint {j}'s motor has \
+                     IA, FS or FV (motor units), which it would read as joint-side values"
+                ),
+            )),
+            None => Ok(()),
+        }
+    }
+
     pub fn link(&self, j: usize) -> &LinkDesc {
         &self.links[j - 1]
     }

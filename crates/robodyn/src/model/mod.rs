@@ -5,6 +5,7 @@
 mod constants;
 mod coordinates;
 mod description;
+mod drives;
 mod environment;
 mod floating;
 pub mod inertial;
@@ -21,6 +22,7 @@ pub use description::{
     RotorMode, Tool, Transmission, GEOMETRIC_PARAMETERS, PARAMS_PER_LINK, STANDARD_PARAMETERS,
     WRENCH_COMPONENTS,
 };
+pub use drives::MotorDrives;
 pub use environment::{BaseMotion, Environment, Wrench};
 pub use floating::{
     require_fixed_base, BaseKind, FloatingBase, BASE_CONFIGURATION_NAMES, BASE_VELOCITY_NAMES,
@@ -44,6 +46,9 @@ pub struct Robot {
     coords: Coordinates,
     /// The floating base (link 0's body), when the base floats.
     floating: Option<FloatingBase>,
+    /// The motors of the description's transmission, when it has one (their IA, FS, FV are
+    /// zero in `numeric` and `dynamic`: the checked functions add them through R).
+    drives: Option<MotorDrives>,
 }
 
 /// Check counts and antecedents and derive the topology. Needs no numeric values, so it also
@@ -244,6 +249,27 @@ fn check_tools(desc: &RobotDescription) -> Result<()> {
     Ok(())
 }
 
+/// The drives of the description's transmission ([`MotorDrives::new`]); a floating base with a
+/// transmission is refused (not supported yet).
+fn robot_drives(
+    desc: &RobotDescription,
+    movable: &[usize],
+    value: &impl Fn(&Expr) -> f64,
+) -> Result<Option<MotorDrives>> {
+    if desc.transmission.is_some() && desc.floating_base.is_some() {
+        return Err(Error::invalid(
+            Item::Base("transmission".into()),
+            "a motor-joint transmission on a floating-base robot is not supported yet",
+        ));
+    }
+    let k: Vec<f64> = desc
+        .links
+        .iter()
+        .flat_map(|l| l.params.iter().map(value))
+        .collect();
+    MotorDrives::new(desc, &k, movable)
+}
+
 /// Link 0 of a floating base: every parameter and wrench component has a finite value, mass
 /// non-negative. Returns its 13 standard parameters.
 fn check_link0(
@@ -344,8 +370,16 @@ impl Robot {
             }
         }
         let value = |e: &Expr| e.eval(&env).expect("checked above");
-        let numeric = DynModel::build(&desc, value, |_, _, e| value(e));
+        let mut numeric = DynModel::build(&desc, value, |_, _, e| value(e));
         let movable = desc.movable_joints();
+        let drives = robot_drives(&desc, &movable, &value)?;
+        if drives.is_some() {
+            // the transmission's IA, FS, FV are the motors': the drives add them through R
+            for &j in &desc.transmission.as_ref().expect("drives").joints {
+                let l = &mut numeric.links[j - 1];
+                (l.ia, l.fs, l.fv) = (0.0, 0.0, 0.0);
+            }
+        }
         let names = movable
             .iter()
             .map(|&j| desc.frame(j).name.clone())
@@ -361,7 +395,32 @@ impl Robot {
             dynamic,
             coords,
             floating,
+            drives,
         })
+    }
+
+    /// The motors of the robot's motor–joint transmission ([`Transmission`]), when it has one:
+    /// the inverse and direct models, A(q), H(q, qd), the energies and the simulation add their
+    /// reflected inertia and friction; joint torques are joint-side (tau = R' tau_motor).
+    #[inline]
+    pub fn motor_drives(&self) -> Option<&MotorDrives> {
+        self.drives.as_ref()
+    }
+
+    /// Error when the robot has a transmission whose motors have a nonzero IA, FS or FV: the
+    /// refusal of the functions that do not apply transmissions yet (`what` names the
+    /// function), never a wrong number. Motors without inertia and friction change nothing.
+    pub fn require_no_motor_drives(&self, what: &str) -> Result<()> {
+        if self.drives.as_ref().is_some_and(|d| !d.is_inert()) {
+            return Err(Error::invalid(
+                Item::Base("transmission".into()),
+                format!(
+                    "{what} does not apply motor-joint transmissions yet (it would read the \
+                     motors' IA, FS, FV as joint-side values)"
+                ),
+            ));
+        }
+        Ok(())
     }
 
     /// What moves the base: fixed, mobile (imposed motion) or floating.

@@ -204,6 +204,10 @@ impl TreeDynamics<'_> {
             let (fs, s) = (model.link(j).fs, qd[off + k]);
             self.tau[off + k] += fs * (s.sign() - (s / v).tanh());
         }
+        if let Some(drives) = self.robot.motor_drives() {
+            // a transmission's motors (their velocities scaled by their gear ratios)
+            drives.add_coulomb_smoothing(&qd[off..], v, &mut self.tau[off..]);
+        }
         Ok(())
     }
 }

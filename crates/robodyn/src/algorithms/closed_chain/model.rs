@@ -96,6 +96,7 @@ impl ClosedChain {
     /// the passive joints. Error for a tree or a wrong number of actuators.
     pub fn new(robot: &Robot) -> Result<ClosedChain> {
         robot.require_fixed_base("the closed-chain model")?;
+        robot.require_no_motor_drives("the closed-chain model")?;
         let closure = LoopClosure::new(robot)?;
         let coords_of = |js: &[usize]| {
             Coordinates::new(

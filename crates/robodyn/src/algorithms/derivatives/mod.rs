@@ -113,6 +113,8 @@ impl DerivativesData {
     /// Error unless this data was made for `robot`.
     pub fn check(&self, robot: &Robot) -> Result<()> {
         self.data.check(robot)?;
+        // the derivatives read IA, FS, FV per joint: not a transmission's motors yet
+        robot.require_no_motor_drives("the derivatives of the dynamic models")?;
         if self.factor.nrows() != robot.dof() || self.dir[0].w.len() != robot.dynamic().nl + 1 {
             return Err(Error::dimension(
                 "derivatives data",

@@ -33,6 +33,7 @@ pub struct RegressorDerivativesData {
 impl RegressorDerivativesData {
     /// Step 1: the 13 NL unit-parameter models of `robot` (made once; allocates).
     pub fn new(robot: &Robot) -> Result<Self> {
+        robot.require_no_motor_drives("the regressor derivatives")?;
         let np = PARAMS_PER_LINK * robot.nl();
         let mut k = vec![0.0; np];
         let mut models = Vec::with_capacity(np);
