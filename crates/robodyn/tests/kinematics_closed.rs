@@ -141,8 +141,10 @@ fn motion_by_differences(
 /// J_a q̈_a + J̇_a q̇_a of `closed_frame_drift` against the frame's acceleration along a closed
 /// trajectory by second differences of the closed geometric model, in the three references:
 /// LocalWorldAligned (a_O, ẇ); Local the derivative of (R^T v_O, R^T w), R^T (a_O - w x v_O, ẇ);
-/// World the derivative of (v_O + O x w, w), (a_O + v_O x w + O x ẇ, ẇ).
-fn check_drift(name: &str, s: [&[f64]; 3]) {
+/// World the derivative of (v_O + O x w, w), (a_O + v_O x w + O x ẇ, ẇ). `g_moves`: whether
+/// Ġ q̇_a is non-zero on this mechanism (on the SR400's parallelogram q_p is linear in q_a, so
+/// Ġ = 0 and only J̇_tr q̇_tr is tested there).
+fn check_drift(name: &str, s: [&[f64]; 3], g_moves: bool) {
     let robot = common::robot(name);
     let chain = ClosedChain::new(&robot).unwrap().with_tolerance(1e-13);
     let mut branch = chain.assembly_branch().unwrap();
@@ -183,7 +185,7 @@ fn check_drift(name: &str, s: [&[f64]; 3]) {
     }
     assert!(checked >= 9, "{name}: {checked} frame-references checked");
     assert!(
-        g_term > 1e-2 && tree_term > 1e-2,
+        (g_term > 1e-2 || !g_moves) && tree_term > 1e-2,
         "{name}: J_tr Ġ q̇_a up to {g_term}, J̇_tr q̇_tr up to {tree_term}: too small to be tested"
     );
 }
@@ -197,15 +199,20 @@ fn sr400_actuated_acceleration_matches_the_closed_geometric_model() {
             &[0.7, -0.5, 0.9, 0.6, -0.8, 0.4],
             &[0.3, 0.2, -0.4, 0.5, 0.1, -0.2],
         ],
+        false,
     );
 }
 
 #[test]
 fn fivebar_actuated_acceleration_matches_the_closed_geometric_model() {
-    check_drift("fivebar.toml", [&[0.1, -0.15], &[0.8, -0.6], &[0.4, 0.3]]);
+    check_drift(
+        "fivebar.toml",
+        [&[0.1, -0.15], &[0.8, -0.6], &[0.4, 0.3]],
+        true,
+    );
 }
 
 #[test]
 fn spatial_loop_actuated_acceleration_matches_the_closed_geometric_model() {
-    check_drift("spatial_loop.toml", [&[0.2], &[1.1], &[-0.7]]);
+    check_drift("spatial_loop.toml", [&[0.2], &[1.1], &[-0.7]], true);
 }

@@ -202,7 +202,7 @@ pub(crate) fn place_support(data: &mut KinematicsData, q: &[f64], f: &FrameId) {
 /// 0T_k = 0T_a(k) a(k)T_k for moving link k at joint value `qk`, and with `COLUMN` its World
 /// column from the placement still in registers (read back from memory it cost a third more).
 #[inline(always)]
-pub(crate) fn place<const COLUMN: bool>(data: &mut KinematicsData, k: usize, qk: f64) {
+fn place<const COLUMN: bool>(data: &mut KinematicsData, k: usize, qk: f64) {
     let fc = data.tree.frame(k);
     let (r, p) = fc.placement(&qk);
     let a = fc.ant;
