@@ -20,12 +20,12 @@ use robodyn::algorithms::derivatives::{
     direct_dynamics_derivatives_into, inverse_dynamics_derivatives_into, DdmDerivatives,
     DerivativesData, IdmDerivatives,
 };
-use robodyn::algorithms::kinematics::center_of_mass_jacobian_into;
+use robodyn::algorithms::kinematics::center_of_mass_jacobian_from_q_into;
 use robodyn::model::param;
 use robodyn::{
     direct_dynamics_into, frame_jacobian_from_q_into, frame_jacobian_into, inertia_matrix_into,
-    inverse_dynamics_into, joint_jacobians_into, placements_into, Data, FrameId, KinematicsData,
-    Method, Reference, Robot,
+    inverse_dynamics_into, joint_jacobians_into, Data, FrameId, KinematicsData, Method, Reference,
+    Robot,
 };
 use std::fmt::Write as _;
 use std::hint::black_box;
@@ -230,14 +230,20 @@ fn main() -> Result<(), Error> {
         put(&mut text, "composite", &out);
         frame_jacobian_from_q_into(&robot, &mut kin, &s.q, &tip, Reference::Local, &mut jac)?;
         put_matrix(&mut text, "jac", &jac, &idx, &[]);
-        placements_into(&robot, &mut kin, &s.q)?;
-        let g = robodyn::algorithms::kinematics::center_of_mass(
+        // G and its Jacobian from q in one pass pair (Pinocchio's jacobianCenterOfMass gives
+        // both); G checked against center_of_mass after a full forward pass
+        let g = center_of_mass_jacobian_from_q_into(&robot, &mut kin, &s.q, None, &mut jcom)?;
+        let g_fk = robodyn::algorithms::kinematics::center_of_mass(
             &robot,
             &mut kin_motion(&robot, s)?,
             None,
         )?;
-        center_of_mass_jacobian_into(&robot, &mut kin, None, &mut jcom)?;
-        put_matrix(&mut text, "com", &jcom, &idx, g.position.as_slice());
+        if (g - g_fk.position).amax() > 1e-12 {
+            return Err(
+                format!("G from q {g} differs from center_of_mass {}", g_fk.position).into(),
+            );
+        }
+        put_matrix(&mut text, "com", &jcom, &idx, g.as_slice());
         inverse_dynamics_derivatives_into(&robot, &mut dd, &env, &s.q, &s.qd, &s.qdd, &mut di)?;
         put_squares(&mut text, "drnea", &[&di.dtau_dq, &di.dtau_dqd], &idx);
         direct_dynamics_derivatives_into(&robot, &mut dd, &env, &s.q, &s.qd, &s.tau, &mut da)?;
@@ -289,9 +295,9 @@ fn main() -> Result<(), Error> {
         black_box(&jac);
     });
     time("com_jacobian", &states, samples, target_us, |s| {
-        placements_into(&robot, &mut kin, black_box(&s.q)).unwrap();
-        center_of_mass_jacobian_into(&robot, &mut kin, None, &mut jcom).unwrap();
-        black_box(&jcom);
+        let q = black_box(&s.q);
+        let g = center_of_mass_jacobian_from_q_into(&robot, &mut kin, q, None, &mut jcom).unwrap();
+        black_box((&jcom, g));
     });
     time("rnea_derivatives", &states, samples, target_us, |s| {
         let q = black_box(&s.q);

@@ -123,11 +123,11 @@ pub use algorithms::inverse_dynamics::{
     inverse_dynamics, inverse_dynamics_into, inverse_dynamics_state_into, State,
 };
 pub use algorithms::kinematics::{
-    center_of_mass, center_of_mass_jacobian_into, forward_kinematics_into, frame_acceleration,
-    frame_classical_acceleration, frame_classical_drift, frame_jacobian,
-    frame_jacobian_from_q_into, frame_jacobian_into, frame_jacobian_time_variation_into,
-    frame_placement, frame_velocity, joint_jacobians_into, placements_into, relative_placement,
-    FrameId, KinematicsData, Motion, Reference,
+    center_of_mass, center_of_mass_jacobian_from_q_into, center_of_mass_jacobian_into,
+    forward_kinematics_into, frame_acceleration, frame_classical_acceleration,
+    frame_classical_drift, frame_jacobian, frame_jacobian_from_q_into, frame_jacobian_into,
+    frame_jacobian_time_variation_into, frame_placement, frame_velocity, joint_jacobians_into,
+    placements_into, relative_placement, FrameId, KinematicsData, Motion, Reference,
 };
 pub use algorithms::regressor::{
     regressor, regressor_into, regressor_state_into, wrench_torques, wrench_torques_into,

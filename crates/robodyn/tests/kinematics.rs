@@ -15,7 +15,8 @@
 use nalgebra::{DMatrix, Matrix3, Vector3};
 use rand::Rng;
 use robodyn::algorithms::kinematics::{
-    center_of_mass, center_of_mass_jacobian_into, subtree_mass, total_mass,
+    center_of_mass, center_of_mass_jacobian_from_q_into, center_of_mass_jacobian_into,
+    subtree_mass, total_mass,
 };
 use robodyn::geometry::Transform;
 use robodyn::{
@@ -248,6 +249,29 @@ fn check_com(
             &format!("{ctx}: Jcom qd"),
             (&jcom * &qd).as_slice(),
             v.as_slice(),
+        );
+        // from q in one forward and one backward pass (on a data of another state): the same
+        // Jacobian, G of center_of_mass, and the placements left in the data
+        let mut fresh = fk(robot, &at(s, 0.3));
+        let mut jq = DMatrix::zeros(3, n);
+        let g =
+            center_of_mass_jacobian_from_q_into(robot, &mut fresh, &s[0], root.as_ref(), &mut jq)
+                .unwrap();
+        let scale = jcom.amax().max(c0.position.amax()).max(1.0);
+        assert!(
+            (&jq - &jcom).amax() <= 1e-14 * scale,
+            "{ctx}: Jcom from q\n{jq}\nvs\n{jcom}"
+        );
+        assert!(
+            (g - c0.position).amax() <= 1e-14 * scale,
+            "{ctx}: G from q {g} vs {}",
+            c0.position
+        );
+        let f = root.unwrap_or_else(|| robot.frame_id_of(robot.nl()).unwrap());
+        assert_eq!(
+            frame_placement(robot, &fresh, &f).unwrap(),
+            frame_placement(robot, &d0, &f).unwrap(),
+            "{ctx}: placements from q"
         );
         match root {
             None => assert!((c0.mass - total_mass(robot)).abs() < 1e-12, "{ctx}"),

@@ -17,9 +17,10 @@ mod jacobian;
 mod newton_euler;
 mod tree;
 
-pub use closed::{closed_frame_jacobian, ClosedJacobian};
+pub use closed::{closed_frame_drift, closed_frame_jacobian, ClosedDrift, ClosedJacobian};
 pub use com::{
-    center_of_mass, center_of_mass_jacobian_into, subtree_mass, total_mass, CenterOfMass,
+    center_of_mass, center_of_mass_jacobian_from_q_into, center_of_mass_jacobian_into,
+    subtree_mass, total_mass, CenterOfMass,
 };
 pub use forward::{
     forward_kinematics_into, frame_acceleration, frame_classical_acceleration, frame_placement,

@@ -146,17 +146,25 @@ pub(crate) fn anchor_of(robot: &Robot, j: usize) -> Anchor {
 pub(crate) fn mul_form(a: &Matrix3<f64>, b: &Matrix3<f64>, form: RotationForm) -> Matrix3<f64> {
     match form {
         RotationForm::General => a * b,
-        RotationForm::Axis(k) => {
-            let k = k as usize;
-            let (i0, i1) = match k {
-                0 => (1, 2),
-                1 => (0, 2),
-                _ => (0, 1),
-            };
-            let col = |c: usize| a.column(i0) * b[(i0, c)] + a.column(i1) * b[(i1, c)];
-            Matrix3::from_columns(&[col(0), col(1), a.column(k) * b[(k, 2)]])
-        }
+        RotationForm::Axis(0) => mul_axis::<0, 1, 2>(a, b),
+        RotationForm::Axis(1) => mul_axis::<1, 0, 2>(a, b),
+        RotationForm::Axis(_) => mul_axis::<2, 0, 1>(a, b),
     }
+}
+
+/// [`mul_form`] for `Axis(K)`, I0 and I1 the two other indices: column c < 2 of A B is
+/// A_I0 B[I0, c] + A_I1 B[I1, c], the third A_K B[K, 2]. The indices are constants, so the
+/// columns are fixed offsets (a closure over run-time indices was compiled as a call per
+/// column, a fifth of the placement pass).
+#[inline(always)]
+fn mul_axis<const K: usize, const I0: usize, const I1: usize>(
+    a: &Matrix3<f64>,
+    b: &Matrix3<f64>,
+) -> Matrix3<f64> {
+    let (x, y) = (a.column(I0), a.column(I1));
+    let c0 = x * b[(I0, 0)] + y * b[(I1, 0)];
+    let c1 = x * b[(I0, 1)] + y * b[(I1, 1)];
+    Matrix3::from_columns(&[c0, c1, a.column(K) * b[(K, 2)]])
 }
 
 /// A B for a rotation A = pre_rot Rz(theta) of form `form` (its zeros skipped: for `Axis(k)`,
