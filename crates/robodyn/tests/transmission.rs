@@ -332,3 +332,47 @@ fn unsupported_transmissions_are_refused() {
     let e = ClosedChain::new(&robot).unwrap_err().to_string();
     assert!(e.contains("transmission"), "{e}");
 }
+
+/// The models that do not apply transmissions yet refuse motors with drive parameters instead
+/// of reading motor-unit IA, FS, FV as joint-side values (the links' numeric model has them at
+/// zero once the robot carries its drives: reading it would give wrong numbers silently).
+#[test]
+fn models_without_transmissions_refuse_motor_drives() {
+    use robodyn::algorithms::derivatives::{
+        direct_dynamics_derivatives, inverse_dynamics_derivatives, RegressorDerivativesData,
+    };
+    use robodyn::codegen::{generate, Frames, GenOptions, ModelKind};
+    let d = tx40();
+    let robot = Robot::new(d.clone()).unwrap();
+    let x = [0.1; 6];
+    let errors = [
+        inverse_dynamics_derivatives(&robot, &x, &x, &x).map(|_| ()),
+        direct_dynamics_derivatives(&robot, &x, &x, &x).map(|_| ()),
+        RegressorDerivativesData::new(&robot).map(|_| ()),
+        d.require_no_motor_drive_parameters("base parameters"),
+        generate(&d, &GenOptions::default()).map(|_| ()),
+    ];
+    for e in errors {
+        let e = e.unwrap_err().to_string();
+        assert!(e.contains("transmission"), "{e}");
+    }
+    // motors without parameters change nothing: the bundled TX40 is accepted everywhere
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../robots/tx40.toml");
+    let bundled = robodyn::io::load(&path).unwrap();
+    inverse_dynamics_derivatives(&bundled, &x, &x, &x).unwrap();
+    let plain = robodyn::io::load_description(&path).unwrap();
+    plain
+        .require_no_motor_drive_parameters("base parameters")
+        .unwrap();
+    // the geometric models do not read IA, FS, FV
+    let frames = Frames {
+        frame: Some(6),
+        reference: Some(0),
+    };
+    let jacobian = GenOptions {
+        model: ModelKind::Jacobian(frames),
+        numeric: true,
+        ..GenOptions::default()
+    };
+    generate(&d, &jacobian).unwrap();
+}

@@ -450,6 +450,7 @@ impl RobotDescription {
         }
     }
 
+    /// Link j (1-based).
     pub fn link(&self, j: usize) -> &LinkDesc {
         &self.links[j - 1]
     }
