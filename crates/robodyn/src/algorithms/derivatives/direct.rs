@@ -76,7 +76,9 @@ fn accelerations(
 /// Step 3: X = A^-1 from the L'DL factors (A = L'DL, L unit lower over the tree, D on the
 /// diagonal of `factor`): L X = D^-1 L^-T is upper triangular with diagonal D^-1, so for i >= j
 ///
-///     X_ij = delta_ij / D_j - sum over the ancestors a of i of L_ia X_aj      (D17a)
+/// ```text
+/// X_ij = delta_ij / D_j - sum over the ancestors a of i of L_ia X_aj      (D17a)
+/// ```
 ///
 /// Column j is computed down from row j; its rows above j are those of X_ja written when
 /// column a < j was done (X is symmetric), and every X_ij is written at (i, j) and (j, i).
