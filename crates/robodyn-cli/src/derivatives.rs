@@ -3,14 +3,85 @@
 //! assembly branch) in the table format of `--format`.
 
 use crate::common::{
-    conditioning_json, format_number, parse_list, warn_conditioning, write_text, CliResult,
-    TableFormat, TableOutput,
+    conditioning_json, format_number, parse_list, start_branch, warn_conditioning, write_text,
+    CliResult, TableFormat, TableOutput,
 };
-use robodyn::nalgebra::DMatrix;
-use robodyn::{ClosedChain, Conditioning};
+use crate::rows::EvaluationArgs;
+use robodyn::nalgebra::{DMatrix, DVector};
+use robodyn::{Branch, ClosedChain, ClosedDerivativesData, Conditioning, Environment, Robot};
+
+/// What a model's derivatives are at one state: the model's value and its three matrices.
+pub type Derivatives = (DVector<f64>, [DMatrix<f64>; 3]);
+
+/// The names of a derivatives command's table: the three inputs (the state's `--q`, `--qd` and
+/// third list), the model's value and the three matrices.
+pub struct Names {
+    pub inputs: [&'static str; 3],
+    pub value: &'static str,
+    pub matrices: [&'static str; 3],
+}
+
+/// The closed-chain model's derivatives at one state (on the tracked branch) and the
+/// conditioning there.
+pub type ClosedModel<'f> = dyn FnMut(
+        &ClosedChain,
+        &mut ClosedDerivativesData,
+        &mut Branch,
+        &Environment,
+        [&[f64]; 3],
+    ) -> robodyn::Result<(Derivatives, Conditioning)>
+    + 'f;
+
+/// Evaluate and write a model's derivatives at the one state of the three lists: `tree` for a
+/// tree, `closed` for a closed chain (its branch started at `--guess` or the assembly).
+pub fn run(
+    robot: &Robot,
+    eval: &EvaluationArgs,
+    lists: [&Option<String>; 3],
+    names: &Names,
+    tree: impl FnOnce(&Robot, [&[f64]; 3]) -> robodyn::Result<Derivatives>,
+    closed: &mut ClosedModel,
+) -> CliResult {
+    let lists = [0, 1, 2].map(|k| (names.inputs[k], lists[k]));
+    let chain = (!robot.is_tree())
+        .then(|| ClosedChain::new(robot))
+        .transpose()?;
+    let n = chain.as_ref().map_or(robot.dof(), |c| c.dof());
+    let x = state(n, lists)?;
+    let xs = [x[0].as_slice(), x[1].as_slice(), x[2].as_slice()];
+    let (((value, m), conditioning), joints) = match &chain {
+        Some(chain) => {
+            let mut branch = start_branch(chain, xs[0], eval.guess.as_deref())?;
+            let mut data = ClosedDerivativesData::new(chain);
+            let env = robot.environment();
+            let d = closed(chain, &mut data, &mut branch, env, xs)?;
+            ((d.0, Some(d.1)), chain.coordinates().frames().to_vec())
+        }
+        None => (
+            (tree(robot, xs)?, None),
+            robot.coordinates().frames().to_vec(),
+        ),
+    };
+    let table = Table {
+        joints: &joints,
+        vectors: [
+            (names.inputs[0], xs[0]),
+            (names.inputs[1], xs[1]),
+            (names.inputs[2], xs[2]),
+            (names.value, value.as_slice()),
+        ],
+        matrices: [
+            (names.matrices[0], &m[0]),
+            (names.matrices[1], &m[1]),
+            (names.matrices[2], &m[2]),
+        ],
+        closed: chain.as_ref().zip(conditioning),
+    };
+    write(&table, &eval.out)
+}
 
 /// The one state of `--q`, `--qd` and the third list (default zeros), over `n` joints.
-pub fn state(n: usize, lists: [(&str, &Option<String>); 3]) -> CliResult<[Vec<f64>; 3]> {
+fn state(n: usize, lists: [(&str, &Option<String>); 3]) -> CliResult<[Vec<f64>; 3]> {
     let list = |(name, s): (&str, &Option<String>)| match s {
         Some(s) => parse_list(name, s),
         None => Ok(vec![0.0; n]),
@@ -19,7 +90,7 @@ pub fn state(n: usize, lists: [(&str, &Option<String>); 3]) -> CliResult<[Vec<f6
 }
 
 /// What one derivatives command writes.
-pub struct Table<'a> {
+struct Table<'a> {
     /// The joints of the rows and columns (frame numbers).
     pub joints: &'a [usize],
     /// The state's vectors and the model's value, by name (`q`, `qd`, `qdd`, `tau`).
@@ -33,7 +104,7 @@ pub struct Table<'a> {
 /// Write `t`: csv columns matrix, joint, then one per joint (one row per matrix row); json an
 /// object with `joints`, the vectors, the matrices as lists of rows and, for a closed chain,
 /// `rcond_wp` (`rcond_a_cl`) and `singularity_warning`.
-pub fn write(t: &Table, out: &TableOutput) -> CliResult {
+fn write(t: &Table, out: &TableOutput) -> CliResult {
     if let Some((chain, c)) = &t.closed {
         warn_conditioning(chain, None, c);
     }

@@ -11,7 +11,7 @@ use pyo3::create_exception;
 use pyo3::exceptions::PyUserWarning;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use robodyn::algorithms::kinematics::closed_frame_jacobian;
+use robodyn::algorithms::kinematics::{closed_frame_drift, closed_frame_jacobian};
 use robodyn::algorithms::regressor::PARAMS_PER_LINK;
 use robodyn::{
     closed_direct_dynamics_derivatives_into, closed_direct_dynamics_into,
@@ -403,6 +403,37 @@ impl ClosedChain {
             let j = closed_frame_jacobian(c, &mut t.branch, x[0], &f, rf)?;
             crate::kinematics::write_matrix(&j.j_a, o);
             Ok(j.state.conditioning)
+        })
+    }
+
+    /// Drift J̇_a qd_a = J_tr Ġ qd_a + J̇_tr qd_tr of the frame named `frame` in `reference`
+    /// (as `jacobian`): the derivative of the frame's velocity J_a qd_a on the closure
+    /// manifold is J_a qdd_a + J̇_a qd_a ("local_world_aligned": the acceleration of the
+    /// frame's origin and the angular acceleration in the base axes). [linear; angular]
+    /// (m/s², rad/s²) for q_a (rad, m) and qd_a (rad/s, m/s): shape (6,) for one state,
+    /// (N, 6) for (N, nq) (rows followed in order on one branch). out: as for idm.
+    #[pyo3(signature = (q_a, qd_a, frame, reference="world", *, out=None))]
+    fn drift<'py>(
+        &self,
+        py: Python<'py>,
+        q_a: &Bound<'py, PyAny>,
+        qd_a: &Bound<'py, PyAny>,
+        frame: &str,
+        reference: &str,
+        out: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let rf = crate::kinematics::parse_reference(reference)?;
+        let f = self.chain.robot().frame_id(frame).py()?;
+        let call = Call {
+            inputs: &[("q_a", Some(q_a)), ("qd_a", Some(qd_a))],
+            one: &[6],
+            stacked: false,
+            out,
+        };
+        self.eval(py, "drift", call, move |c, t, x, o| {
+            let d = closed_frame_drift(c, &mut t.branch, x[0], x[1], &f, rf)?;
+            o.copy_from_slice(d.drift.to_vector().as_slice());
+            Ok(d.jacobian.state.conditioning)
         })
     }
 

@@ -416,24 +416,36 @@ struct Callback<'a> {
     inner: &'a mut (dyn Dynamics + Send),
     f: Py<PyAny>,
     tau: Vec<f64>,
+    widths: TorqueWidths,
     error: Option<PyErr>,
 }
 
-fn call_torque(f: &Py<PyAny>, t: f64, q: &[f64], qd: &[f64], out: &mut [f64]) -> PyResult<()> {
+/// The callback's torques at (t, q, qd) into `out` (nv): nv values, or the joints' alone with
+/// a floating base (its wrench zero).
+fn call_torque(
+    f: &Py<PyAny>,
+    widths: TorqueWidths,
+    t: f64,
+    q: &[f64],
+    qd: &[f64],
+    out: &mut [f64],
+) -> PyResult<()> {
     Python::attach(|py| {
         let r = f.call1(
             py,
             (t, PyArray1::from_slice(py, q), PyArray1::from_slice(py, qd)),
         )?;
         let (v, _) = crate::arrays::values(r.bind(py))?;
-        if v.len() != out.len() {
+        if !widths.accepts(v.len()) {
             return Err(crate::errors::DimensionError::new_err(format!(
                 "the torque callback returned {} values, {} expected",
                 v.len(),
-                out.len()
+                widths.expected()
             )));
         }
-        out.copy_from_slice(&v);
+        let base = out.len() - v.len();
+        out[..base].fill(0.0);
+        out[base..].copy_from_slice(&v);
         Ok(())
     })
 }
@@ -444,8 +456,26 @@ macro_rules! delegate_dynamics {
         fn dof(&self) -> usize {
             self.inner.dof()
         }
+        fn nq(&self) -> usize {
+            self.inner.nq()
+        }
         fn labels(&self) -> Vec<String> {
             self.inner.labels()
+        }
+        fn column_names(&self) -> [Vec<String>; 4] {
+            self.inner.column_names()
+        }
+        fn anchor(&mut self, q: &[f64], x: &mut [f64]) -> robodyn::Result<()> {
+            self.inner.anchor(q, x)
+        }
+        fn configuration(&self, x: &[f64], q: &mut [f64]) {
+            self.inner.configuration(x, q)
+        }
+        fn chart_rate(&self, x: &[f64], qd: &[f64], dx: &mut [f64]) {
+            self.inner.chart_rate(x, qd, dx)
+        }
+        fn reanchor(&mut self, x: &mut [f64]) -> bool {
+            self.inner.reanchor(x)
         }
         fn energy(&mut self, q: &[f64], qd: &[f64]) -> robodyn::Result<f64> {
             self.inner.energy(q, qd)
@@ -469,7 +499,7 @@ impl Dynamics for Callback<'_> {
         _tau: &[f64],
         qdd: &mut [f64],
     ) -> robodyn::Result<()> {
-        if let Err(e) = call_torque(&self.f, t, q, qd, &mut self.tau) {
+        if let Err(e) = call_torque(&self.f, self.widths, t, q, qd, &mut self.tau) {
             self.error = Some(e);
             return Err(robodyn::Error::Input("the torque callback failed".into()));
         }
@@ -525,35 +555,73 @@ pub struct SimArgs<'py> {
     pub max_steps: usize,
 }
 
-/// The torque input of a simulation (a callable is returned apart: it is called from the run).
+/// The torque input of a simulation of `nv` coordinates whose first `base` are a floating
+/// base's (a callable is returned apart: it is called from the run). Joint torques alone (nv -
+/// base columns) leave the base free ([`TorqueInput::with_free_base`]).
 fn torque_input(
     torque: Option<&Bound<'_, PyAny>>,
-    n: usize,
+    nv: usize,
+    base: usize,
 ) -> PyResult<(TorqueInput, Option<Py<PyAny>>)> {
-    Ok(match torque {
-        None => (TorqueInput::Constant(vec![0.0; n]), None),
-        Some(t) if t.is_callable() => (
-            TorqueInput::Constant(vec![0.0; n]),
-            Some(t.clone().unbind()),
-        ),
+    let widths = TorqueWidths { nv, base };
+    let input = match torque {
+        None => return Ok((TorqueInput::Constant(vec![0.0; nv]), None)),
+        Some(t) if t.is_callable() => {
+            return Ok((
+                TorqueInput::Constant(vec![0.0; nv]),
+                Some(t.clone().unbind()),
+            ))
+        }
         Some(t) if t.is_instance_of::<PyTuple>() => {
             let (times, values): (Bound<PyAny>, Bound<PyAny>) = t.extract()?;
             let (times, _) = crate::arrays::values(&times)?;
             let (flat, shape) = crate::arrays::values(&values)?;
-            if shape.len() != 2 || shape[1] != n || shape[0] != times.len() {
+            if shape.len() != 2 || !widths.accepts(shape[1]) || shape[0] != times.len() {
                 return Err(crate::errors::DimensionError::new_err(format!(
-                    "torque = (times, values): values has shape {shape:?}, expected ({}, {n})",
-                    times.len()
+                    "torque = (times, values): values has shape {shape:?}, expected ({}, {})",
+                    times.len(),
+                    widths.expected()
                 )));
             }
-            let rows = flat.chunks(n.max(1)).map(|c| c.to_vec()).collect();
-            (
-                TorqueInput::Series(TimeSeries::new(times, rows).py()?),
-                None,
-            )
+            let rows = flat.chunks(shape[1].max(1)).map(|c| c.to_vec()).collect();
+            TorqueInput::Series(TimeSeries::new(times, rows).py()?)
         }
-        Some(t) => (TorqueInput::Constant(crate::arrays::values(t)?.0), None),
-    })
+        Some(t) => TorqueInput::Constant(crate::arrays::values(t)?.0),
+    };
+    Ok((widths.widen(input), None))
+}
+
+/// The accepted widths of a torque input: nv, or the joints' nv - base with a floating base.
+#[derive(Clone, Copy)]
+struct TorqueWidths {
+    nv: usize,
+    base: usize,
+}
+
+impl TorqueWidths {
+    fn accepts(self, w: usize) -> bool {
+        w == self.nv || (self.base > 0 && w == self.nv - self.base)
+    }
+    /// What the messages say is expected.
+    fn expected(self) -> String {
+        match self.base {
+            0 => self.nv.to_string(),
+            b => format!("{} joints or {} with the base wrench", self.nv - b, self.nv),
+        }
+    }
+    /// Joint torques alone widened with a free base's zero wrench.
+    fn widen(self, input: TorqueInput) -> TorqueInput {
+        let width = match &input {
+            TorqueInput::Constant(v) => v.len(),
+            TorqueInput::Series(s) => s.width(),
+            TorqueInput::Pd { .. } => self.nv,
+        };
+        if self.base > 0 && width == self.nv - self.base {
+            input.with_free_base(self.base)
+        } else {
+            input
+        }
+    }
 }
 
 /// Run a simulation of `dynamics` and return the trajectory as a dict of arrays.
@@ -562,11 +630,15 @@ pub fn run_simulation<'py>(
     dynamics: &mut (dyn Dynamics + Send),
     a: SimArgs<'py>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let n = dynamics.dof();
+    let (nq, n) = (dynamics.nq(), dynamics.dof());
+    let widths = TorqueWidths {
+        nv: n,
+        base: n - dynamics.labels().len(),
+    };
     if a.max_steps == 0 {
         return Err(InputError::new_err("max_steps = 0: must be at least 1"));
     }
-    let (input, callback) = torque_input(a.torque.as_ref(), n)?;
+    let (input, callback) = torque_input(a.torque.as_ref(), n, widths.base)?;
     let opts = SimOptions {
         duration: a.duration,
         integrator: Integrator::fixed_or_adaptive(a.dt, a.rtol, a.atol),
@@ -580,6 +652,7 @@ pub fn run_simulation<'py>(
             inner: dynamics,
             f: f.clone_ref(py),
             tau: vec![0.0; n],
+            widths,
             error: None,
         }),
         None => dynamics,
@@ -609,44 +682,57 @@ pub fn run_simulation<'py>(
         // the recorded torques are the callback's at each output row
         for row in rec.rows.iter_mut() {
             let (t, rest) = row.split_at_mut(1);
-            let (q, rest) = rest.split_at_mut(n);
+            let (q, rest) = rest.split_at_mut(nq);
             let (qd, rest) = rest.split_at_mut(n);
-            call_torque(f, t[0], q, qd, &mut rest[n..2 * n])?;
+            call_torque(f, widths, t[0], q, qd, &mut rest[n..2 * n])?;
         }
     }
     result.py()?;
-    trajectory(py, &rec, n)
+    trajectory(py, &rec, nq, n, widths)
 }
 
-/// The recorded trajectory as a dict of arrays.
-fn trajectory<'py>(py: Python<'py>, rec: &Recorder, n: usize) -> PyResult<Bound<'py, PyDict>> {
+/// The recorded trajectory as a dict of arrays: its rows are t, q (nq), qd, qdd, tau (nv),
+/// energy, extras.
+fn trajectory<'py>(
+    py: Python<'py>,
+    rec: &Recorder,
+    nq: usize,
+    nv: usize,
+    widths: TorqueWidths,
+) -> PyResult<Bound<'py, PyDict>> {
     let out = PyDict::new(py);
     let rows = rec.rows.len();
     let col = |c: usize| -> Vec<f64> { rec.rows.iter().map(|r| r[c]).collect() };
-    let block = |c0: usize| -> Vec<f64> {
+    let block = |c0: usize, w: usize| -> Vec<f64> {
         rec.rows
             .iter()
-            .flat_map(|r| r[c0..c0 + n].iter().copied())
+            .flat_map(|r| r[c0..c0 + w].iter().copied())
             .collect()
     };
     out.set_item("t", PyArray1::from_vec(py, col(0)))?;
-    for (k, name) in ["q", "qd", "qdd", "tau"].iter().enumerate() {
+    let mut c0 = 1;
+    for (name, w) in [("q", nq), ("qd", nv), ("qdd", nv), ("tau", nv)] {
         out.set_item(
-            *name,
-            PyArray1::from_vec(py, block(1 + k * n)).reshape([rows, n])?,
+            name,
+            PyArray1::from_vec(py, block(c0, w)).reshape([rows, w])?,
         )?;
+        c0 += w;
     }
-    out.set_item("energy", PyArray1::from_vec(py, col(1 + 4 * n)))?;
-    for (k, h) in rec.headers.iter().enumerate().skip(2 + 4 * n) {
+    out.set_item("energy", PyArray1::from_vec(py, col(c0)))?;
+    for (k, h) in rec.headers.iter().enumerate().skip(c0 + 1) {
         out.set_item(h, PyArray1::from_vec(py, col(k)))?;
     }
+    // the joints' labels (after a floating base's 7 configuration columns)
+    let joints = &rec.headers[1 + nq - (nv - widths.base)..1 + nq];
     out.set_item(
         "joint_labels",
-        rec.headers[1..1 + n]
+        joints
             .iter()
             .map(|h| h[1..].to_string())
             .collect::<Vec<_>>(),
     )?;
+    out.set_item("q_columns", rec.headers[1..1 + nq].to_vec())?;
+    out.set_item("v_columns", rec.headers[1 + nq..1 + nq + nv].to_vec())?;
     Ok(out)
 }
 

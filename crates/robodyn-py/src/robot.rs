@@ -471,7 +471,17 @@ impl Robot {
 
 /// The functions of a `Robot` that take a floating robot's state (nq / nv vectors).
 pub const FLOATING_FUNCTIONS: &str =
-    "idm, h, inertia, ddm, integrate, centroidal_momentum and centroidal_map";
+    "idm, h, inertia, ddm, integrate, centroidal_momentum, centroidal_map and simulate";
+
+/// The default initial configuration of a simulation: joints at zero and, for a floating
+/// robot, the base at the world's origin with the identity orientation (nq entries).
+fn neutral_configuration(robot: &robodyn::Robot) -> Vec<f64> {
+    let mut q = vec![0.0; robot.nq()];
+    if robot.is_floating() {
+        q[6] = 1.0;
+    }
+    q
+}
 
 /// The refusal of a function (`what`, e.g. "Robot.jacobian") that does not support floating
 /// robots: InputError naming it and the functions that do; Ok for a fixed or mobile base.
@@ -1092,9 +1102,14 @@ impl Robot {
     }
 
     /// Simulate from (q0, qd0) (rad, m; rad/s, m/s; default zeros) over [0, duration] (s);
-    /// returns a dict of arrays: t (M,) s, q, qd, qdd, tau (M, nq), energy (M,) J, and
-    /// joint_labels. torque: None (zero), a constant vector (nq,) N m / N, a (times, values)
-    /// series ((K,), (K, nq)) interpolated linearly, or a callable torque(t, q, qd) -> tau.
+    /// returns a dict of arrays: t (M,) s, q (M, nq), qd, qdd, tau (M, nv), energy (M,) J,
+    /// joint_labels, q_columns and v_columns (the names of q's and of the others' columns).
+    /// torque: None (zero), a constant vector (n,) N m / N, a (times, values) series ((K,),
+    /// (K, n)) interpolated linearly, or a callable torque(t, q, qd) -> tau. A floating robot
+    /// (docs/models/floating_base.md): q0 has nq entries (default: the base at the origin,
+    /// identity quaternion, joints at zero), qd0 nv; the torques are the n joints' (the base
+    /// free) or nv values whose first 6 are a wrench applied on the base (base frame); the
+    /// base pose is integrated on SE(3), and the dict adds the centre of mass and momenta.
     /// RK4 with a fixed step dt (s), else Dormand–Prince 5(4) with rtol, atol; a row every
     /// output_dt (s). max_steps (the CLI's default, 5,000,000) bounds the integration steps: a
     /// run that needs more is an error, said before it starts when the step or the output step
@@ -1117,13 +1132,11 @@ impl Robot {
         max_steps: usize,
     ) -> PyResult<Bound<'py, PyDict>> {
         let robot = self.model();
-        fixed_base_only(&robot, "Robot.simulate")?;
-        let n = robot.dof();
         let mut dynamics = crate::models::tree_dynamics(&robot, method, coulomb_smoothing)?;
         let args = crate::models::SimArgs {
             duration,
-            q0: q0.unwrap_or_else(|| vec![0.0; n]),
-            qd0: qd0.unwrap_or_else(|| vec![0.0; n]),
+            q0: q0.unwrap_or_else(|| neutral_configuration(&robot)),
+            qd0: qd0.unwrap_or_else(|| vec![0.0; robot.nv()]),
             torque,
             dt,
             rtol,

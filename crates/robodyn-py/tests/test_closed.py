@@ -124,3 +124,27 @@ def test_singular_start_and_branch_lost():
     # the tracker stays at its last good point: evaluations continue from there
     chain.reset()
     np.testing.assert_allclose(chain.branch["q_a"], start)
+
+
+@pytest.mark.parametrize("name", ["sr400.toml", "fivebar.toml", "spatial_loop.toml"])
+def test_closed_drift_is_the_derivative_of_the_actuated_jacobian(name):
+    """drift(q_a, qd_a) = d/dt J_a(q_a + t qd_a) qd_a at t = 0, by central differences of
+    ClosedChain.jacobian (h = 1e-4: truncation ~h^2 |J'''| ~ 1e-8, the loop solver's
+    tolerance / h ~ 1e-8); a missing term of the drift changes it by O(|qd|^2) ~ 0.1."""
+    robot = robodyn.load(robot_path(name))
+    chain = robodyn.ClosedChain(robot)
+    qa = np.array(chain.branch["q_a"]) + 0.1
+    qd = 0.8 * np.cos(np.arange(chain.nq) + 1.0)
+    h = 1e-4
+    frames = [f for f in robot.frame_names if f not in ("0",)][:4] + [robot.frame_names[-1]]
+    for frame in frames:
+        for ref in ("world", "local", "local_world_aligned"):
+            d = chain.drift(qa, qd, frame, ref)
+            assert d.shape == (6,)
+            jp = chain.jacobian(qa + h * qd, frame, ref)
+            jm = chain.jacobian(qa - h * qd, frame, ref)
+            fd = (jp - jm) / (2 * h) @ qd
+            np.testing.assert_allclose(d, fd, rtol=0, atol=1e-6 * max(1.0, np.abs(fd).max()),
+                                       err_msg=f"{name} {frame} {ref}")
+    batch = chain.drift(np.array([qa, qa + 0.01]), np.array([qd, qd]), frames[-1])
+    assert batch.shape == (2, 6)

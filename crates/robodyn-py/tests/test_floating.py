@@ -204,7 +204,6 @@ def test_state_sizes_and_names():
         (lambda r, q: r.regressor(q), "Robot.regressor"),
         (lambda r, q: r.idm_derivatives(q), "Robot.idm_derivatives"),
         (lambda r, q: r.ddm_derivatives(q), "Robot.ddm_derivatives"),
-        (lambda r, q: r.simulate(0.1), "Robot.simulate"),
         (lambda r, q: r.generate(), "Robot.generate"),
     ],
 )
@@ -219,3 +218,91 @@ def test_functions_without_floating_support_say_so(call, name):
 def test_load_floating_refuses_a_fixed_toml():
     with pytest.raises(robodyn.InputError, match="floating base is asked for"):
         robodyn.load(robot_path("rx90.toml"), floating=True)
+
+
+def quaternion_matrix(q):
+    """wR_0 from a quaternion (x, y, z, w), written out (not robodyn's, not Pinocchio's)."""
+    x, y, z, w = q
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+        ]
+    )
+
+
+def spinning_start(robot, rng):
+    q0 = np.zeros(robot.nq)
+    q0[7:] = rng.uniform(-1, 1, robot.dof)
+    quat = rng.normal(size=4)
+    q0[3:7] = quat / np.linalg.norm(quat)
+    qd0 = rng.uniform(-1, 1, robot.nv)
+    qd0[3:6] = [2.0, -3.0, 4.0]  # a fast spin of the base
+    return q0, qd0
+
+
+def test_simulate_floating_conserves_the_free_body_laws():
+    """A free floating RX-90 (gravity given) spinning with its joints driven: the laws of a
+    free body, which the simulator does not use, hold on its output. The momenta are those
+    of the robot's own centroidal_momentum (checked against Pinocchio above) at the output
+    states: P(t) = P(0) + M g t, the angular momentum about the centre of mass constant, the
+    energy constant when no torque acts."""
+    robot = rx90float()
+    g = np.array([0.0, 0.0, -9.81])
+    rng = np.random.default_rng(2027)
+    q0, qd0 = spinning_start(robot, rng)
+    out = robot.simulate(0.5, q0=q0, qd0=qd0, rtol=1e-11, atol=1e-12, output_dt=0.05)
+    assert out["q"].shape == (11, robot.nq) and out["qd"].shape == (11, robot.nv)
+    assert out["tau"].shape == (11, robot.nv) and not np.any(out["tau"])
+    assert out["joint_labels"] == ["1", "2", "3", "4", "5", "6"]
+    assert out["q_columns"][:7] == ["base_x", "base_y", "base_z", "base_qx", "base_qy", "base_qz", "base_qw"]
+    assert out["v_columns"][6] == "qd1"
+    np.testing.assert_allclose(np.linalg.norm(out["q"][:, 3:7], axis=1), 1.0, atol=1e-13)
+    momenta = [robot.centroidal_momentum(q, v) for q, v in zip(out["q"], out["qd"])]
+    mass = momenta[0]["mass"]
+    p0, l0 = momenta[0]["linear"], momenta[0]["angular"]
+    for t, m in zip(out["t"], momenta):
+        np.testing.assert_allclose(m["linear"], p0 + mass * g * t, rtol=0, atol=1e-7 * (1 + abs(p0).max()))
+        np.testing.assert_allclose(m["angular"], l0, rtol=0, atol=1e-7 * (1 + abs(l0).max()))
+    e = out["energy"]
+    assert abs(e - e[0]).max() < 1e-7 * abs(e).max()
+    # the joints moved and the base turned: the test is not of a body at rest
+    assert abs(out["q"][-1, 7:] - q0[7:]).max() > 0.05
+    assert abs(out["q"][-1, 3:7] - q0[3:7]).max() > 0.2
+
+
+def test_simulate_floating_torque_shapes_and_an_applied_base_force():
+    """Joint torques alone leave the base free: a constant (n,), its (nv,) form with a zero
+    wrench and a callable give one trajectory. A callable's wrench on the base: a force of
+    constant world direction (turned into the base frame from the quaternion of q, written
+    out here) gives P(t) = P(0) + F t without gravity."""
+    robot = robodyn.load(robot_path("rx90float.toml"), G3=0.0)
+    rng = np.random.default_rng(7)
+    q0, qd0 = spinning_start(robot, rng)
+    tau = rng.uniform(-5, 5, robot.dof)
+    kw = dict(q0=q0, qd0=qd0, dt=1e-3, output_dt=0.02)
+    joints = robot.simulate(0.2, torque=tau, **kw)
+    full = robot.simulate(0.2, torque=np.r_[np.zeros(6), tau], **kw)
+    called = robot.simulate(0.2, torque=lambda t, q, qd: tau, **kw)
+    for other in (full, called):
+        np.testing.assert_array_equal(other["q"], joints["q"])
+    np.testing.assert_array_equal(joints["tau"][:, :6], 0.0)
+
+    force = np.array([30.0, -20.0, 10.0])
+
+    def pushed(t, q, qd):
+        assert q.shape == (robot.nq,) and qd.shape == (robot.nv,)
+        r = quaternion_matrix(q[3:7])
+        # the force through the base's origin, its moment zero about O_0
+        return np.r_[r.T @ force, np.zeros(3), tau]
+
+    out = robot.simulate(0.3, torque=pushed, q0=q0, qd0=qd0, rtol=1e-11, atol=1e-12, output_dt=0.05)
+    p0 = robot.centroidal_momentum(q0, qd0)["linear"]
+    for t, q, v in zip(out["t"], out["q"], out["qd"]):
+        p = robot.centroidal_momentum(q, v)["linear"]
+        np.testing.assert_allclose(p, p0 + force * t, rtol=0, atol=1e-7 * (1 + abs(p0).max()))
+    with pytest.raises(robodyn.DimensionError, match="6 joints or 12 with the base wrench"):
+        robot.simulate(0.1, torque=np.zeros(7))
+    with pytest.raises(robodyn.DimensionError, match="callback returned 3 values"):
+        robot.simulate(0.1, torque=lambda t, q, qd: np.zeros(3))

@@ -120,3 +120,31 @@ impl DynScalar for Expr {
         Expr::func(robodyn_symbolic::Func::Sign, self.clone())
     }
 }
+
+/// The recursions on num-dual's forward-mode numbers: `$t` is a dual type whose real part is
+/// `re` (`Dual64`: one exact directional derivative; `HyperDual64`: two, and the mixed second
+/// derivative). The sign is the real part's, with a zero derivative (away from 0).
+macro_rules! dual_scalar {
+    ($($t:ty),*) => {$(
+        impl DynScalar for $t {
+            #[inline]
+            fn from_f64(x: f64) -> Self {
+                <$t>::from_re(x)
+            }
+            #[inline]
+            fn sin(&self) -> Self {
+                num_dual::DualNum::sin(self)
+            }
+            #[inline]
+            fn cos(&self) -> Self {
+                num_dual::DualNum::cos(self)
+            }
+            #[inline]
+            fn sign(&self) -> Self {
+                <$t>::from_re(DynScalar::sign(&self.re))
+            }
+        }
+    )*};
+}
+
+dual_scalar!(num_dual::Dual64, num_dual::HyperDual64);

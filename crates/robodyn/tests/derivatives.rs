@@ -125,6 +125,10 @@ const H: f64 = 1e-6;
 /// returns the two largest relative gaps.
 fn check_idm(robot: &Robot, label: &str, q: &[f64], qd: &[f64], qdd: &[f64]) -> [f64; 2] {
     let d = inverse_dynamics_derivatives(robot, q, qd, qdd).unwrap();
+    // the torques the derivatives carry are the inverse model's (friction, rotors included)
+    let tau = inverse_dynamics(robot, q, qd, qdd).unwrap();
+    let e_tau = (&d.tau - &tau).amax() / tau.amax().max(1.0);
+    assert!(e_tau <= 1e-13, "{label}: tau vs inverse_dynamics {e_tau:e}");
     let [hq, hv] = hyper_dual(robot, q, qd, qdd);
     // the model's viscous friction, which rnea on any scalar applies as Fv qd
     let e_ad = rel(&d.dtau_dq, &hq).max(rel(&d.dtau_dqd, &hv));
@@ -300,6 +304,13 @@ fn bad_inputs_are_errors() {
     let mut wrong = IdmDerivatives::new(&other);
     let e = inverse_dynamics_derivatives_into(&robot, &mut data, env, &z, &z, &z, &mut wrong);
     assert!(e.is_err(), "matrices of another robot accepted");
+    let mut short_tau = IdmDerivatives::new(&robot);
+    short_tau.tau = short_tau.tau.rows(0, 1).into_owned();
+    let e = inverse_dynamics_derivatives_into(&robot, &mut data, env, &z, &z, &z, &mut short_tau);
+    assert!(
+        matches!(e, Err(Error::Dimension { ref what, .. }) if what == "tau"),
+        "{e:?}"
+    );
     let mut other_data = DerivativesData::new(&other);
     let e = inverse_dynamics_derivatives_into(&robot, &mut other_data, env, &z, &z, &z, &mut d);
     assert!(e.is_err(), "data of another robot accepted");

@@ -6,12 +6,12 @@
 //! row on the assembly branch (the library's branch tracker, started at the robot's `assembly`
 //! or `--guess`); rows near a singularity are flagged on stderr and in JSON.
 
-use crate::common::{choices, start_branch, CliResult, RobotArgs};
-use crate::derivatives::{state, write, Table};
+use crate::common::{choices, CliResult, RobotArgs};
+use crate::derivatives::{ClosedModel, Names};
 use crate::rows::{evaluate, EvaluationArgs};
 use robodyn::{
     closed_direct_dynamics_derivatives_into, closed_direct_dynamics_into, direct_dynamics_batch,
-    direct_dynamics_derivatives, ClosedChain, ClosedDdmDerivatives, ClosedDerivativesData, Method,
+    direct_dynamics_derivatives, ClosedDdmDerivatives, Method, Robot,
 };
 use std::path::PathBuf;
 
@@ -85,59 +85,22 @@ pub fn run(a: Args) -> CliResult {
 /// (a closed chain's over its actuated joints, on the branch of `--guess` or the assembly).
 fn derivatives(a: &Args) -> CliResult {
     let robot = a.robot.load()?;
-    let lists = [("q", &a.q), ("qd", &a.qd), ("tau", &a.tau)];
-    if !robot.is_tree() {
-        let chain = ClosedChain::new(&robot)?;
-        let [q, qd, tau] = state(chain.dof(), lists)?;
-        let mut branch = start_branch(&chain, &q, a.eval.guess.as_deref())?;
-        let env = robot.environment();
-        let mut data = ClosedDerivativesData::new(&chain);
-        let mut d = ClosedDdmDerivatives::new(&chain);
-        let c = closed_direct_dynamics_derivatives_into(
-            &chain,
-            &mut data,
-            &mut branch,
-            env,
-            &q,
-            &qd,
-            &tau,
-            &mut d,
-        )?;
-        let joints = chain.coordinates().frames().to_vec();
-        let table = Table {
-            joints: &joints,
-            vectors: [
-                ("q", &q),
-                ("qd", &qd),
-                ("tau", &tau),
-                ("qdd", d.qdd.as_slice()),
-            ],
-            matrices: [
-                ("dqdd_dq", &d.dqdd_dq),
-                ("dqdd_dqd", &d.dqdd_dqd),
-                ("Ainv", &d.ainv),
-            ],
-            closed: Some((&chain, c)),
-        };
-        return write(&table, &a.eval.out);
-    }
-    let [q, qd, tau] = state(robot.dof(), lists)?;
-    let d = direct_dynamics_derivatives(&robot, &q, &qd, &tau)?;
-    let joints = robot.coordinates().frames().to_vec();
-    let table = Table {
-        joints: &joints,
-        vectors: [
-            ("q", &q),
-            ("qd", &qd),
-            ("tau", &tau),
-            ("qdd", d.qdd.as_slice()),
-        ],
-        matrices: [
-            ("dqdd_dq", &d.dqdd_dq),
-            ("dqdd_dqd", &d.dqdd_dqd),
-            ("Ainv", &d.ainv),
-        ],
-        closed: None,
+    let names = Names {
+        inputs: ["q", "qd", "tau"],
+        value: "qdd",
+        matrices: ["dqdd_dq", "dqdd_dqd", "Ainv"],
     };
-    write(&table, &a.eval.out)
+    let tree = |r: &Robot, x: [&[f64]; 3]| {
+        let d = direct_dynamics_derivatives(r, x[0], x[1], x[2])?;
+        Ok((d.qdd, [d.dqdd_dq, d.dqdd_dqd, d.ainv]))
+    };
+    let closed: &mut ClosedModel = &mut |chain, data, branch, env, x| {
+        let mut d = ClosedDdmDerivatives::new(chain);
+        let c = closed_direct_dynamics_derivatives_into(
+            chain, data, branch, env, x[0], x[1], x[2], &mut d,
+        )?;
+        Ok(((d.qdd, [d.dqdd_dq, d.dqdd_dqd, d.ainv]), c))
+    };
+    let lists = [&a.q, &a.qd, &a.tau];
+    crate::derivatives::run(&robot, &a.eval, lists, &names, tree, closed)
 }

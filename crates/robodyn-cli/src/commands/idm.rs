@@ -6,13 +6,12 @@
 //! (the library's branch tracker: each row continued from the previous one, the first from the
 //! robot's `assembly` or `--guess`); rows near a singularity are flagged on stderr and in JSON.
 
-use crate::common::{start_branch, CliResult, RobotArgs};
-use crate::derivatives::{state, write, Table};
+use crate::common::{CliResult, RobotArgs};
+use crate::derivatives::{ClosedModel, Names};
 use crate::rows::{evaluate, EvaluationArgs};
 use robodyn::{
-    closed_inverse_dynamics_derivatives_into, closed_inverse_dynamics_into, inverse_dynamics,
-    inverse_dynamics_batch, inverse_dynamics_derivatives, ClosedChain, ClosedDerivativesData,
-    ClosedIdmDerivatives,
+    closed_inverse_dynamics_derivatives_into, closed_inverse_dynamics_into, inverse_dynamics_batch,
+    inverse_dynamics_derivatives, ClosedIdmDerivatives, Robot,
 };
 use std::path::PathBuf;
 
@@ -80,60 +79,22 @@ pub fn run(a: Args) -> CliResult {
 fn derivatives(a: &Args) -> CliResult {
     let robot = a.robot.load()?;
     crate::common::refuse_motor_drives(&robot, &a.robot.robot, "idm --derivatives")?;
-    let lists = [("q", &a.q), ("qd", &a.qd), ("qdd", &a.qdd)];
-    if !robot.is_tree() {
-        let chain = ClosedChain::new(&robot)?;
-        let [q, qd, qdd] = state(chain.dof(), lists)?;
-        let mut branch = start_branch(&chain, &q, a.eval.guess.as_deref())?;
-        let env = robot.environment();
-        let mut data = ClosedDerivativesData::new(&chain);
-        let mut d = ClosedIdmDerivatives::new(&chain);
-        let c = closed_inverse_dynamics_derivatives_into(
-            &chain,
-            &mut data,
-            &mut branch,
-            env,
-            &q,
-            &qd,
-            &qdd,
-            &mut d,
-        )?;
-        let joints = chain.coordinates().frames().to_vec();
-        let table = Table {
-            joints: &joints,
-            vectors: [
-                ("q", &q),
-                ("qd", &qd),
-                ("qdd", &qdd),
-                ("tau", d.tau.as_slice()),
-            ],
-            matrices: [
-                ("dtau_dq", &d.dtau_dq),
-                ("dtau_dqd", &d.dtau_dqd),
-                ("A", &d.a),
-            ],
-            closed: Some((&chain, c)),
-        };
-        return write(&table, &a.eval.out);
-    }
-    let [q, qd, qdd] = state(robot.dof(), lists)?;
-    let d = inverse_dynamics_derivatives(&robot, &q, &qd, &qdd)?;
-    let tau = inverse_dynamics(&robot, &q, &qd, &qdd)?;
-    let joints = robot.coordinates().frames().to_vec();
-    let table = Table {
-        joints: &joints,
-        vectors: [
-            ("q", &q),
-            ("qd", &qd),
-            ("qdd", &qdd),
-            ("tau", tau.as_slice()),
-        ],
-        matrices: [
-            ("dtau_dq", &d.dtau_dq),
-            ("dtau_dqd", &d.dtau_dqd),
-            ("A", &d.a),
-        ],
-        closed: None,
+    let names = Names {
+        inputs: ["q", "qd", "qdd"],
+        value: "tau",
+        matrices: ["dtau_dq", "dtau_dqd", "A"],
     };
-    write(&table, &a.eval.out)
+    let tree = |r: &Robot, x: [&[f64]; 3]| {
+        let d = inverse_dynamics_derivatives(r, x[0], x[1], x[2])?;
+        Ok((d.tau, [d.dtau_dq, d.dtau_dqd, d.a]))
+    };
+    let closed: &mut ClosedModel = &mut |chain, data, branch, env, x| {
+        let mut d = ClosedIdmDerivatives::new(chain);
+        let c = closed_inverse_dynamics_derivatives_into(
+            chain, data, branch, env, x[0], x[1], x[2], &mut d,
+        )?;
+        Ok(((d.tau, [d.dtau_dq, d.dtau_dqd, d.a]), c))
+    };
+    let lists = [&a.q, &a.qd, &a.qdd];
+    crate::derivatives::run(&robot, &a.eval, lists, &names, tree, closed)
 }

@@ -298,10 +298,13 @@ class Robot:
         rust, c, python, julia, matlab) with its operation counts; params "standard" or "base"."""
     def simulate(self, duration: float, q0: Optional[ArrayLike] = None, qd0: Optional[ArrayLike] = None, torque: Torque = None, dt: Optional[float] = None, rtol: float = 1e-8, atol: float = 1e-10, output_dt: float = 0.01, method: str = "aba", coulomb_smoothing: Optional[float] = None, max_steps: int = 5_000_000) -> Dict[str, Any]:
         """Simulate from (q0, qd0) (rad, m; rad/s, m/s; default zeros) over [0, duration] (s);
-        returns a dict of arrays: t (M,) s, q, qd, qdd, tau (M, nq), energy (M,) J, and
-        joint_labels. torque: None (zero), a constant vector (nq,) N m / N, a (times, values)
-        series ((K,), (K, nq)) interpolated linearly, or a callable torque(t, q, qd) -> tau.
-        RK4 with a fixed step dt (s), else Dormand-Prince 5(4) with rtol, atol; a row every
+        returns a dict of arrays: t (M,) s, q (M, nq), qd, qdd, tau (M, nv), energy (M,) J,
+        joint_labels, q_columns and v_columns. torque: None (zero), a constant vector (n,)
+        N m / N, a (times, values) series ((K,), (K, n)) interpolated linearly, or a callable
+        torque(t, q, qd) -> tau. A floating robot: q0 (nq,) (default: base at the origin,
+        identity quaternion, joints zero), qd0 (nv,); torques of the n joints (the base free) or
+        nv values whose first 6 are a wrench on the base (base frame); the base pose is
+        integrated on SE(3); the dict adds the centre of mass and the momenta. RK4 with a fixed step dt (s), else Dormand-Prince 5(4) with rtol, atol; a row every
         output_dt (s). max_steps (the CLI's default, 5,000,000) bounds the integration steps: a
         run that needs more is an error, said before it starts when the step or the output step
         already needs more. Ctrl-C stops the run (KeyboardInterrupt)."""
@@ -346,6 +349,10 @@ class ClosedChain:
         ``reference`` (as Robot.jacobian): the frame's velocity is J_a qd_a on the closure
         manifold. Shape (6, nq) for q_a of shape (nq,), (N, 6, nq) for (N, nq) (rows followed in
         order on one branch). out: as for idm."""
+    def drift(self, q_a: ArrayLike, qd_a: ArrayLike, frame: str, reference: str = "world", *, out: Optional[Array] = None) -> Array:
+        """Drift J̇_a qd_a of the frame named `frame` in `reference` (as jacobian): the derivative
+        of the frame's velocity J_a qd_a on the closure manifold is J_a qdd_a + J̇_a qd_a.
+        [linear; angular] (m/s², rad/s²): shape (6,) for one state, (N, 6) for (N, nq)."""
     def idm(self, q_a: ArrayLike, qd_a: Optional[ArrayLike] = None, qdd_a: Optional[ArrayLike] = None, *, v: Optional[ArrayLike] = None, a: Optional[ArrayLike] = None, out: Optional[Array] = None) -> Array:
         """Closed-chain inverse dynamic model Gamma_cl = G^T Gamma_tr (eq 10.40): the torques
         (N m) / forces (N) of the actuated joints for their positions q_a (rad, m), velocities

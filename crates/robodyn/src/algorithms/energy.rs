@@ -15,29 +15,7 @@ use crate::error::{Error, Result};
 use crate::model::{BaseMotion, DynModel, Environment, JointType, LinkConstants, Robot};
 use crate::scalar::DynScalar;
 use nalgebra::{DVector, Matrix3, Vector3};
-use num_dual::{DualNum, HyperDual64};
-
-/// Hyper-dual numbers `re + eps1 e1 + eps2 e2 + eps1eps2 e1 e2` give exact first derivatives
-/// along two directions and the mixed second derivative.
-impl DynScalar for HyperDual64 {
-    #[inline]
-    fn from_f64(x: f64) -> Self {
-        HyperDual64::from_re(x)
-    }
-    #[inline]
-    fn sin(&self) -> Self {
-        DualNum::sin(self)
-    }
-    #[inline]
-    fn cos(&self) -> Self {
-        DualNum::cos(self)
-    }
-    /// sign of the real part; its derivative is zero (away from 0).
-    #[inline]
-    fn sign(&self) -> Self {
-        HyperDual64::from_re(DynScalar::sign(&self.re))
-    }
-}
+use num_dual::HyperDual64;
 
 /// Velocities of every link (eqs 10.1–10.2): `w[j]` = jw_j and `v[j]` = jV_j (velocity of O_j),
 /// in R_j, for j = 0..NL (index 0 is the base, with w0 and v0). Also returns the placements

@@ -22,30 +22,8 @@ use crate::algorithms::inverse_dynamics::rnea_with_environment;
 use crate::algorithms::loop_closure::LoopWorkspace;
 use crate::error::{check_finite_matrix, check_finite_result, Error, Result};
 use crate::model::{DynModel, Environment};
-use crate::scalar::DynScalar;
 use nalgebra::{DMatrix, DVector};
-use num_dual::{Dual64, DualNum};
-
-/// Dual numbers `re + eps e` (e² = 0): one exact directional derivative.
-impl DynScalar for Dual64 {
-    #[inline]
-    fn from_f64(x: f64) -> Self {
-        Dual64::from_re(x)
-    }
-    #[inline]
-    fn sin(&self) -> Self {
-        DualNum::sin(self)
-    }
-    #[inline]
-    fn cos(&self) -> Self {
-        DualNum::cos(self)
-    }
-    /// sign of the real part; its derivative is zero (away from 0).
-    #[inline]
-    fn sign(&self) -> Self {
-        Dual64::from_re(DynScalar::sign(&self.re))
-    }
-}
+use num_dual::Dual64;
 
 /// The derivatives of the closed-chain inverse dynamic model at one state, N x N each over the
 /// actuated joints ([`ClosedChain::coordinates`]): entry (j, k) is the derivative of Γ_cl,j

@@ -22,14 +22,16 @@ use super::{check_square, DerivativesData, Tangent};
 use crate::algorithms::inverse_dynamics::{check_state, rnea_with_environment};
 use crate::batch::{count_rows, for_each_row};
 use crate::data::Data;
-use crate::error::{check_finite_matrix, Result};
+use crate::error::{check_finite_matrix, Error, Result};
 use crate::model::{DynModel, Environment, FrameConstants, JointType, Robot};
-use nalgebra::{DMatrix, Vector3};
+use nalgebra::{DMatrix, DVector, Vector3};
 
 /// The derivatives of the inverse dynamic model at one state, N x N each over the movable
 /// joints (frame order): entry (j, k) is the derivative of Gamma_j.
 #[derive(Clone, Debug, PartialEq)]
 pub struct IdmDerivatives {
+    /// Gamma at the state (N m or N), as [`crate::inverse_dynamics`] gives it.
+    pub tau: DVector<f64>,
     /// dGamma/dq (N m/rad, N/m, N m/m, N/rad).
     pub dtau_dq: DMatrix<f64>,
     /// dGamma/dqd, viscous friction Fv on the diagonal.
@@ -43,6 +45,7 @@ impl IdmDerivatives {
     pub fn new(robot: &Robot) -> Self {
         let n = robot.dof();
         IdmDerivatives {
+            tau: DVector::zeros(n),
             dtau_dq: DMatrix::zeros(n, n),
             dtau_dqd: DMatrix::zeros(n, n),
             a: DMatrix::zeros(n, n),
@@ -295,8 +298,8 @@ pub(crate) fn idm_derivative_columns(
     }
 }
 
-/// Derivatives of the inverse dynamic model into `out`: dGamma/dq, dGamma/dqd and A =
-/// dGamma/dqdd (N x N over the movable joints, frame order) at positions `q` (rad, m),
+/// Derivatives of the inverse dynamic model into `out`: Gamma itself, dGamma/dq, dGamma/dqd and
+/// A = dGamma/dqdd (N x N over the movable joints, frame order) at positions `q` (rad, m),
 /// velocities `qd` and accelerations `qdd` over the movable joints, under `env` (gravity, base
 /// motion, external wrenches, constant in the link frames). Allocation-free.
 ///
@@ -321,8 +324,10 @@ pub(crate) fn idm_derivative_columns(
 /// let (q, qd, qdd) = ([0.1; 6], [0.2; 6], [0.3; 6]);
 /// let env = robot.environment();
 /// inverse_dynamics_derivatives_into(&robot, &mut data, env, &q, &qd, &qdd, &mut d)?;
-/// // A = dGamma/dqdd is the inertia matrix
+/// // A = dGamma/dqdd is the inertia matrix, tau the inverse model's torques
 /// assert!((&d.a - robodyn::inertia_matrix(&robot, &q)?).amax() < 1e-12);
+/// let tau = robodyn::inverse_dynamics(&robot, &q, &qd, &qdd)?;
+/// assert!((&d.tau - tau).amax() < 1e-12);
 /// # Ok(())
 /// # }
 /// ```
@@ -347,6 +352,11 @@ pub fn inverse_dynamics_derivatives_into(
             ("A", &out.a),
         ],
     )?;
+    if out.tau.len() != robot.dof() {
+        let n = robot.dof();
+        let what = robot.coordinates().describe("movable joints");
+        return Err(Error::dimension("tau", n, out.tau.len(), what));
+    }
     let model = robot.dynamic();
     let DerivativesData {
         data: ws, world, h, ..
@@ -361,6 +371,7 @@ pub fn inverse_dynamics_derivatives_into(
         [&mut out.dtau_dq, &mut out.dtau_dqd],
         Some(&mut out.a),
     );
+    out.tau.as_mut_slice().copy_from_slice(h);
     check_finite_matrix("dtau_dq", &out.dtau_dq)?;
     check_finite_matrix("dtau_dqd", &out.dtau_dqd)?;
     check_finite_matrix("A", &out.a)
