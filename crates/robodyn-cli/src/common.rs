@@ -271,8 +271,8 @@ pub fn fixed_base_only(robot: &robodyn::Robot, what: &str) -> CliResult<()> {
     if robot.is_floating() {
         return Err(format!(
             "{what}: robot `{}` has a floating base, not supported there yet; the \
-             commands of floating robots are idm, ddm, inertia (states of nq = 7 + {n} and \
-             nv = 6 + {n} values, the base first), simulate and info",
+             commands of floating robots are idm, ddm, inertia, fk, jacobian, com (states \
+             of nq = 7 + {n} and nv = 6 + {n} values, the base first), simulate and info",
             robot.name(),
             n = robot.dof()
         )

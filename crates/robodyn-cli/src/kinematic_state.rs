@@ -1,12 +1,14 @@
 //! The states the kinematic commands (`fk`, `jacobian`, `com`) share: the robot and one state
 //! from `--q/--qd/--qdd`, or every state of an `--input` table (columns as `idm` reads them);
 //! a closed chain's actuated joints completed on the assembly branch (a table's rows one after
-//! the other on the branch tracker); and the frames named by `--frame`.
+//! the other on the branch tracker); a floating robot's states with the base first (nq, nv
+//! entries; a table's base columns as `simulate` writes them); and the frames named by
+//! `--frame`.
 
 use crate::common::{
     format_number, parse_list, start_branch, warn_conditioning, CliResult, NamesArg, RobotArgs,
 };
-use crate::states::{Chunk, StateInput, StateRequest};
+use crate::states::{base_columns3, Chunk, StateInput, StateRequest};
 use nalgebra::DMatrix;
 use robodyn::{
     closed_state, forward_kinematics_into, Branch, ClosedChain, FrameId, KinematicsData, Robot,
@@ -19,17 +21,21 @@ pub struct StateArgs {
     #[command(flatten)]
     pub robot: RobotArgs,
     /// CSV of states with columns q<j> (required), qd<j>, qdd<j> (optional: zeros) for the
-    /// movable joints (closed chains: the actuated joints), as `idm` reads them; the output is
-    /// a CSV table with the state's row number (and the table's other columns) on every line.
+    /// movable joints (closed chains: the actuated joints), as `idm` reads them (a floating
+    /// base's columns base_x .. base_qw, base_vx .. base_wz, base_ax .. base_dwz first, as
+    /// `simulate` writes them); the output is a CSV table with the state's row number (and the
+    /// table's other columns) on every line.
     #[arg(long, conflicts_with_all = ["q", "qd", "qdd"])]
     pub input: Option<PathBuf>,
     #[command(flatten)]
     pub names: NamesArg,
     /// Joint positions, comma separated (movable joints in frame order; closed chains: the
-    /// actuated joints; default zeros).
+    /// actuated joints; a floating base: nq = 7 + N values, x,y,z,qx,qy,qz,qw of the base in
+    /// the world first; default zeros, the base at the world origin).
     #[arg(long, allow_hyphen_values = true)]
     pub q: Option<String>,
-    /// Joint velocities (default zeros).
+    /// Joint velocities (a floating base: nv = 6 + N values, the base's linear and angular
+    /// velocity in its own frame first; default zeros).
     #[arg(long, allow_hyphen_values = true)]
     pub qd: Option<String>,
     /// Joint accelerations (default zeros).
@@ -47,7 +53,8 @@ pub struct StateArgs {
 pub struct Evaluated {
     pub robot: Robot,
     pub data: KinematicsData,
-    /// The state's q: the movable joints (closed chains: the actuated joints given).
+    /// The state's q: the movable joints (closed chains: the actuated joints given; a floating
+    /// robot's base pose first).
     pub q: Vec<f64>,
     /// The chain and its G at the state (closed chains).
     pub closed: Option<(ClosedChain, DMatrix<f64>)>,
@@ -57,7 +64,6 @@ impl StateArgs {
     /// The robot and, when it has loops, its closed chain.
     fn load(&self) -> CliResult<(Robot, Option<ClosedChain>)> {
         let robot = self.robot.load()?;
-        crate::common::fixed_base_only(&robot, "the kinematics commands (fk, jacobian, com)")?;
         let chain = (!robot.is_tree())
             .then(|| ClosedChain::new(&robot))
             .transpose()?;
@@ -71,16 +77,22 @@ impl StateArgs {
             Some(c) => c.dof(),
             None => robot.dof(),
         };
-        let list = |name: &str, s: &Option<String>| -> CliResult<Vec<f64>> {
+        let list = |name: &str, s: &Option<String>, base: &[f64]| -> CliResult<Vec<f64>> {
             match s {
                 Some(s) => parse_list(name, s),
-                None => Ok(vec![0.0; n]),
+                None => Ok([base, &vec![0.0; n]].concat()),
             }
         };
+        // a floating base defaults to the world origin, unit quaternion (0, 0, 0, 1), at rest
+        let (bq, bv): (&[f64], &[f64]) = if robot.is_floating() {
+            (&[0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0], &[0.0; 6])
+        } else {
+            (&[], &[])
+        };
         let x = [
-            list("q", &self.q)?,
-            list("qd", &self.qd)?,
-            list("qdd", &self.qdd)?,
+            list("q", &self.q, bq)?,
+            list("qd", &self.qd, bv)?,
+            list("qdd", &self.qdd, bv)?,
         ];
         let mut e = Evaluated::new(robot, chain);
         let mut branch = None;
@@ -117,22 +129,21 @@ impl StateArgs {
             names: self.names,
             what,
             carry: &[],
-            base: Default::default(),
+            base: base_columns3(&robot, ["q", "qd", "qdd"]),
         })?;
         let carried = states.carried_headers().to_vec();
         let mut value = setup(&robot, &carried)?;
-        let (n, nc) = (coords.len(), carried.len());
+        // entries of q, qd, qdd (a floating base's nq, nv)
+        let n = [robot.nq(), robot.nv(), robot.nv()].map(|b| b - robot.dof() + coords.len());
+        let nc = carried.len();
         let mut e = Evaluated::new(robot, chain);
         let (mut chunk, mut branch) = (Chunk::default(), None);
-        while states.next_chunk(crate::common::chunk_states(3 * n + nc), &mut chunk)? {
+        let per_state = n.iter().sum::<usize>() + nc;
+        while states.next_chunk(crate::common::chunk_states(per_state), &mut chunk)? {
             for s in 0..chunk.count {
                 let row = chunk.first + s;
-                e.at(
-                    &mut branch,
-                    self.guess.as_deref(),
-                    chunk.state(s, n),
-                    Some(row),
-                )?;
+                let x = std::array::from_fn(|i| &chunk.x[i][s * n[i]..(s + 1) * n[i]]);
+                e.at(&mut branch, self.guess.as_deref(), x, Some(row))?;
                 each(&mut value, row, chunk.carried(s, nc), &mut e)?;
             }
         }
@@ -186,11 +197,11 @@ impl Evaluated {
     }
 }
 
-/// The names of the joints of a state table's results: the movable joints (closed chains: the
-/// actuated ones).
+/// The names of the columns of a state table's Jacobians: the movable joints (closed chains:
+/// the actuated ones; a floating robot's base velocity entries first).
 pub fn joint_names(robot: &Robot) -> CliResult<Vec<String>> {
     Ok(if robot.is_tree() {
-        robot.coordinates().names().to_vec()
+        robot.velocity_names()
     } else {
         ClosedChain::new(robot)?.coordinates().names().to_vec()
     })

@@ -27,6 +27,8 @@ mod cli_columns;
 mod cli_conventions;
 #[path = "cli_derivatives.rs"]
 mod cli_derivatives;
+#[path = "cli_floating_kinematics.rs"]
+mod cli_floating_kinematics;
 #[path = "cli_floating_models.rs"]
 mod cli_floating_models;
 #[path = "cli_floating_simulate.rs"]

@@ -281,9 +281,6 @@ fn wrong_states_and_other_commands_are_refused_clearly() {
     assert!(e.contains("give --q") && e.contains("quaternion"), "{e}");
     // commands without floating support say so (never a fixed-base answer)
     for args in [
-        vec!["fk", rx.as_str(), "--q", "0,0,0,0,0,0,1,0,0,0,0,0,0"],
-        vec!["jacobian", rx.as_str(), "--frame", "6"],
-        vec!["com", rx.as_str()],
         vec!["base-params", rx.as_str()],
         vec!["generate", rx.as_str()],
     ] {

@@ -121,13 +121,13 @@ impl Robot {
         Ok(d)
     }
 
-    /// `f` on the model over one state or N states of `inputs` (up to three), `one` the
-    /// result's shape for one state: the call every kinematic function makes.
+    /// `f` on the model over one state or N states of `inputs` (up to three: q with nq
+    /// entries, qd and qdd with nv, the base first on a floating robot), `one` the result's
+    /// shape for one state: the call every kinematic function makes.
     #[allow(clippy::too_many_arguments)]
     fn kinematics<'py, F>(
         &self,
         py: Python<'py>,
-        what: &str,
         inputs: &[(&str, Option<&Bound<'py, PyAny>>)],
         one: &[usize],
         out: Option<&Bound<'py, PyAny>>,
@@ -139,14 +139,13 @@ impl Robot {
             + Send,
     {
         let models = self.models();
-        crate::robot::fixed_base_only(&models.full, what)?;
         let call = Call {
             inputs,
             one,
             stacked: false,
             out,
         };
-        self.eval(py, &models, &models.full, call, f)
+        self.eval_state(py, &models, &models.full, call, f)
     }
 }
 
@@ -173,23 +172,16 @@ impl Robot {
         out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let f = self.model().frame_id(frame).py()?;
-        self.kinematics(
-            py,
-            "Robot.placement",
-            &[("q", Some(q))],
-            &[4, 4],
-            out,
-            move |r, w, x, o| {
-                placements_into(r, &mut w.kin, x[0])?;
-                let m = frame_placement(r, &w.kin, &f)?.matrix();
-                for a in 0..4 {
-                    for b in 0..4 {
-                        o[4 * a + b] = m[(a, b)];
-                    }
+        self.kinematics(py, &[("q", Some(q))], &[4, 4], out, move |r, w, x, o| {
+            placements_into(r, &mut w.kin, x[0])?;
+            let m = frame_placement(r, &w.kin, &f)?.matrix();
+            for a in 0..4 {
+                for b in 0..4 {
+                    o[4 * a + b] = m[(a, b)];
                 }
-                check_finite_result("placement", o)
-            },
-        )
+            }
+            check_finite_result("placement", o)
+        })
     }
 
     /// Jacobian of the frame named `frame` (as `placement`) in `reference`: "world" (spatial
@@ -209,21 +201,14 @@ impl Robot {
     ) -> PyResult<Bound<'py, PyAny>> {
         let rf = parse_reference(reference)?;
         let f = self.model().frame_id(frame).py()?;
-        let n = self.model().dof();
-        self.kinematics(
-            py,
-            "Robot.jacobian",
-            &[("q", Some(q))],
-            &[6, n],
-            out,
-            move |r, w, x, o| {
-                let (kin, j) = w.kin_split(6, n);
-                placements_into(r, kin, x[0])?;
-                frame_jacobian_into(r, kin, &f, rf, j)?;
-                write_matrix(j, o);
-                check_finite_result("J", o)
-            },
-        )
+        let n = self.model().nv();
+        self.kinematics(py, &[("q", Some(q))], &[6, n], out, move |r, w, x, o| {
+            let (kin, j) = w.kin_split(6, n);
+            placements_into(r, kin, x[0])?;
+            frame_jacobian_into(r, kin, &f, rf, j)?;
+            write_matrix(j, o);
+            check_finite_result("J", o)
+        })
     }
 
     /// Velocity of the frame named `frame` in `reference` (as `jacobian`): [linear; angular]
@@ -244,7 +229,6 @@ impl Robot {
         let f = self.model().frame_id(frame).py()?;
         self.kinematics(
             py,
-            "Robot.frame_velocity",
             &[("q", Some(q)), ("qd", Some(qd)), ("qdd", None)],
             &[6],
             out,
@@ -277,7 +261,6 @@ impl Robot {
         let f = self.model().frame_id(frame).py()?;
         self.kinematics(
             py,
-            "Robot.frame_acceleration",
             &[("q", Some(q)), ("qd", Some(qd)), ("qdd", Some(qdd))],
             &[6],
             out,
@@ -301,7 +284,6 @@ impl Robot {
     ) -> PyResult<Bound<'py, PyAny>> {
         self.kinematics(
             py,
-            "Robot.com",
             &[("q", Some(q)), ("qd", None), ("qdd", None)],
             &[3],
             out,
@@ -324,21 +306,14 @@ impl Robot {
         q: &Bound<'py, PyAny>,
         out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let n = self.model().dof();
-        self.kinematics(
-            py,
-            "Robot.com_jacobian",
-            &[("q", Some(q))],
-            &[3, n],
-            out,
-            move |r, w, x, o| {
-                let (kin, j) = w.kin_split(3, n);
-                placements_into(r, kin, x[0])?;
-                center_of_mass_jacobian_into(r, kin, None, j)?;
-                write_matrix(j, o);
-                check_finite_result("Jcom", o)
-            },
-        )
+        let n = self.model().nv();
+        self.kinematics(py, &[("q", Some(q))], &[3, n], out, move |r, w, x, o| {
+            let (kin, j) = w.kin_split(3, n);
+            placements_into(r, kin, x[0])?;
+            center_of_mass_jacobian_into(r, kin, None, j)?;
+            write_matrix(j, o);
+            check_finite_result("Jcom", o)
+        })
     }
 
     /// Inverse geometric model of the frame named `frame` (as `placement`) for `target` (4 x 4
@@ -367,7 +342,16 @@ impl Robot {
         target: &Bound<'py, PyAny>,
         q0: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        crate::robot::fixed_base_only(&self.model(), "Robot.ik")?;
+        let robot = self.model();
+        if robot.is_floating() {
+            return Err(crate::errors::InputError::new_err(format!(
+                "Robot.ik: robot `{}` has a floating base, whose pose no joint sets: a frame's \
+                 world pose is reached by moving the base alone, so the inverse geometric \
+                 model (which solves the joints) is not defined for it; for a target given in \
+                 the base frame, load the robot without floating=True",
+                robot.name()
+            )));
+        }
         if let Some(q0) = q0 {
             return self.numeric_ik(py, frame, target, q0);
         }

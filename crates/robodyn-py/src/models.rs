@@ -586,7 +586,17 @@ fn torque_input(
             let rows = flat.chunks(shape[1].max(1)).map(|c| c.to_vec()).collect();
             TorqueInput::Series(TimeSeries::new(times, rows).py()?)
         }
-        Some(t) => TorqueInput::Constant(crate::arrays::values(t)?.0),
+        Some(t) => {
+            let v = crate::arrays::values(t)?.0;
+            if !widths.accepts(v.len()) {
+                return Err(crate::errors::DimensionError::new_err(format!(
+                    "torque has {} values, {} expected",
+                    v.len(),
+                    widths.expected()
+                )));
+            }
+            TorqueInput::Constant(v)
+        }
     };
     Ok((widths.widen(input), None))
 }

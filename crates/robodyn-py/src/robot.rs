@@ -469,9 +469,31 @@ impl Robot {
     }
 }
 
+/// [`Robot::forward_kinematics`] of a floating robot: every description frame's placement in
+/// the world from the kinematics pass (its frames must all be tree frames: a cut joint's frame
+/// is refused by `frame_id_of`).
+fn floating_frames(
+    r: &robodyn::Robot,
+    w: &mut Work,
+    x: [&[f64]; 3],
+    o: &mut [f64],
+) -> robodyn::Result<()> {
+    robodyn::placements_into(r, &mut w.kin, x[0])?;
+    for j in 1..=r.nf() {
+        let m = robodyn::frame_placement(r, &w.kin, &r.frame_id_of(j)?)?.matrix();
+        for a in 0..4 {
+            for b in 0..4 {
+                o[16 * (j - 1) + 4 * a + b] = m[(a, b)];
+            }
+        }
+    }
+    robodyn::error::check_finite_result("0T_j", o)
+}
+
 /// The functions of a `Robot` that take a floating robot's state (nq / nv vectors).
 pub const FLOATING_FUNCTIONS: &str =
-    "idm, h, inertia, ddm, integrate, centroidal_momentum, centroidal_map and simulate";
+    "idm, h, inertia, ddm, integrate, centroidal_momentum, centroidal_map, simulate, placement, \
+     jacobian, frame_velocity, frame_acceleration, com and com_jacobian";
 
 /// The default initial configuration of a simulation: joints at zero and, for a floating
 /// robot, the base at the world's origin with the identity orientation (nq entries).
@@ -959,7 +981,9 @@ impl Robot {
 
     /// Geometric model: 0T_j (4 x 4 homogeneous matrices, metres) of the frames 1..NF
     /// (description_frame_names) for the movable joints' values q (rad, m; cut-joint variables taken as
-    /// 0): shape (NF, 4, 4) for q of shape (nq,), (N, NF, 4, 4) for (N, nq). out: as for idm.
+    /// 0): shape (NF, 4, 4) for q of shape (nq,), (N, NF, 4, 4) for (N, nq). A floating robot's
+    /// q holds its base pose first (nq = 7 + N) and the placements are in the world frame.
+    /// out: as for idm.
     #[pyo3(signature = (q, *, out=None))]
     fn forward_kinematics<'py>(
         &self,
@@ -968,7 +992,6 @@ impl Robot {
         out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let models = self.models();
-        fixed_base_only(&models.full, "Robot.forward_kinematics")?;
         let nf = models.full.nf();
         let call = Call {
             inputs: &[("q", Some(q))],
@@ -976,6 +999,9 @@ impl Robot {
             stacked: false,
             out,
         };
+        if models.full.is_floating() {
+            return self.eval_state(py, &models, &models.full, call, floating_frames);
+        }
         self.eval(py, &models, &models.full, call, |r, _w, x, o| {
             for (j, t) in robodyn::geometry::frame_transforms(r, x[0])?
                 .iter()

@@ -5,7 +5,10 @@ Cross-checks against Pinocchio with a free-flyer root (`buildModelFromUrdf(path,
 JointModelFreeFlyer())`, the joints matched by name) on example-robot-data's Talos (full), HyQ and
 Solo12: idm = rnea, inertia = crba, ddm (both methods) = aba, h = nonLinearEffects, integrate =
 pin.integrate, centroidal_momentum = computeCentroidalMomentum, centroidal_map =
-computeCentroidalMap; those need `pip install pin
+computeCentroidalMap, and the kinematics (placement and forward_kinematics = oMf of
+framesForwardKinematics, jacobian = getFrameJacobian, frame_velocity, frame_acceleration =
+getFrameVelocity, getFrameClassicalAcceleration in the three references, com, com_jacobian =
+centerOfMass, jacobianCenterOfMass; frames matched by name); those need `pip install pin
 example-robot-data` and are skipped visibly without them unless ROBODYN_REQUIRE names pinocchio
 (tests/pinocchio_ref.py). The hand-derived free fall and the refusals need nothing."""
 
@@ -197,10 +200,6 @@ def test_state_sizes_and_names():
 @pytest.mark.parametrize(
     "call, name",
     [
-        (lambda r, q: r.jacobian(q, "6"), "Robot.jacobian"),
-        (lambda r, q: r.placement(q, "6"), "Robot.placement"),
-        (lambda r, q: r.com(q), "Robot.com"),
-        (lambda r, q: r.forward_kinematics(q), "Robot.forward_kinematics"),
         (lambda r, q: r.regressor(q), "Robot.regressor"),
         (lambda r, q: r.idm_derivatives(q), "Robot.idm_derivatives"),
         (lambda r, q: r.ddm_derivatives(q), "Robot.ddm_derivatives"),
@@ -213,6 +212,77 @@ def test_functions_without_floating_support_say_so(call, name):
     q[6] = 1.0
     with pytest.raises(robodyn.InputError, match=name.replace(".", "\\.") + ": robot .* floating base"):
         call(robot, q)
+
+
+def test_ik_refuses_a_floating_robot_with_the_reason():
+    robot = rx90float()
+    target = np.eye(4)
+    q0 = np.zeros(robot.nq)
+    q0[6] = 1.0
+    for call in (lambda: robot.ik("6", target), lambda: robot.ik("6", target, q0)):
+        with pytest.raises(robodyn.InputError, match="Robot.ik: .*floating base, whose pose no joint sets"):
+            call()
+
+
+REFERENCES = ["world", "local", "local_world_aligned"]
+
+
+@needs_pinocchio
+@pytest.mark.filterwarnings("ignore::robodyn.RobotFileWarning")
+@pytest.mark.parametrize("name", URDFS)
+def test_kinematics_match_pinocchio_free_flyer(name):
+    path = find(name)
+    robot = robodyn.load(path, floating=True)
+    p = PinFloating(path, robot.joint_names)
+    m, d = p.model, p.data
+    rng = np.random.default_rng(2707)
+    rows = 12
+    qs, vs, accs = random_states(rng, robot, rows)
+    links = [f.name for f in m.frames if f.type == pin.FrameType.BODY]
+    frames = [links[k] for k in rng.choice(len(links), 4, replace=False)] + [links[0]]
+    nf = len(robot.description_frame_names)
+    fk = robot.forward_kinematics(qs)
+    assert fk.shape == (rows, nf, 4, 4)
+    coms, jcoms = robot.com(qs), robot.com_jacobian(qs)
+    assert coms.shape == (rows, 3) and jcoms.shape == (rows, 3, robot.nv)
+    by_frame = {}
+    for f in frames:
+        by_frame[f] = {
+            "placement": robot.placement(qs, f),
+            "J": {rf: robot.jacobian(qs, f, rf) for rf in REFERENCES},
+            "vel": {rf: robot.frame_velocity(qs, vs, f, rf) for rf in REFERENCES},
+            "acc": {rf: robot.frame_acceleration(qs, vs, accs, f, rf) for rf in REFERENCES},
+        }
+    assert by_frame[frames[0]]["J"]["local"].shape == (rows, 6, robot.nv)
+    compared = 0
+    for r in range(rows):
+        pq, pv, pa = p.q(qs[r]), p.v(vs[r]), p.v(accs[r])
+        pin.forwardKinematics(m, d, pq, pv, pa)
+        pin.computeJointJacobians(m, d, pq)
+        pin.updateFramePlacements(m, d)
+        for f, ours in by_frame.items():
+            fid = m.getFrameId(f, pin.FrameType.BODY)
+            close(ours["placement"][r], d.oMf[fid].homogeneous)
+            for rf in REFERENCES:
+                ref = getattr(pin.ReferenceFrame, rf.upper())
+                close(ours["J"][rf][r], pin.getFrameJacobian(m, d, fid, ref)[:, p.iv])
+                close(ours["vel"][rf][r], pin.getFrameVelocity(m, d, fid, ref).vector)
+                close(ours["acc"][rf][r], pin.getFrameClassicalAcceleration(m, d, fid, ref).vector)
+        # every description frame Pinocchio also names (URDF joints, fixed ones included): the
+        # origins (the description frame's z is the joint axis, not the URDF joint frame's)
+        for j, fname in enumerate(robot.description_frame_names):
+            if m.existFrame(fname):
+                close(fk[r, j, :3, 3], d.oMf[m.getFrameId(fname)].translation)
+                compared += 1
+        close(coms[r], pin.centerOfMass(m, d, pq))
+        close(jcoms[r], pin.jacobianCenterOfMass(m, d, pq)[:, p.iv])
+    assert compared >= rows * robot.dof
+    # one state (1-D arrays) gives the same as its row of the batch
+    f = frames[0]
+    close(robot.jacobian(qs[3], f, "local"), by_frame[f]["J"]["local"][3], rel=0)
+    close(robot.com(qs[3]), coms[3], rel=0)
+    with pytest.raises(robodyn.DimensionError):
+        robot.jacobian(qs[0, 7:], f)
 
 
 def test_load_floating_refuses_a_fixed_toml():

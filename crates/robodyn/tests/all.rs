@@ -67,6 +67,8 @@ mod fixed_frames;
 mod floating_base;
 #[path = "floating_centroidal.rs"]
 mod floating_centroidal;
+#[path = "floating_kinematics.rs"]
+mod floating_kinematics;
 #[path = "floating_pinocchio.rs"]
 mod floating_pinocchio;
 #[path = "floating_simulation.rs"]

@@ -1,6 +1,7 @@
 //! `robodyn com ROBOT --q ... [--qd ...] [--qdd ...] [--frame NAME] [--jacobian]`: the centre
 //! of mass of the robot (or of the subtree carried by a frame) in R_0, its velocity and
-//! acceleration, the mass, and with `--jacobian` its 3 x N Jacobian. Closed chains: the
+//! acceleration, the mass, and with `--jacobian` its 3 x nv Jacobian (a floating base's 6
+//! columns first; R_0 is then the world frame). Closed chains: the
 //! state completed on the assembly branch; the Jacobian over the actuated joints (J G).
 
 use crate::common::{format_number, write_text, CliResult, TableFormat};
@@ -87,10 +88,10 @@ fn centre(
     if !jacobian {
         return Ok((values, None));
     }
-    let mut j = nalgebra::DMatrix::zeros(3, e.robot.dof());
+    let mut j = nalgebra::DMatrix::zeros(3, e.robot.nv());
     center_of_mass_jacobian_into(&e.robot, &mut e.data, root, &mut j)?;
     let j = match &e.closed {
-        None => (j, e.robot.coordinates().names().to_vec()),
+        None => (j, e.robot.velocity_names()),
         Some((chain, g)) => (j * g, chain.coordinates().names().to_vec()),
     };
     Ok((values, Some(j)))

@@ -1,5 +1,5 @@
 //! `robodyn fk ROBOT --q ... [--frame NAME]...`: the direct geometric model, placements of
-//! frames in the base frame R_0, and with `--qd`/`--qdd` their velocities and classical
+//! frames in the base frame R_0 (the world frame for a floating base), and with `--qd`/`--qdd` their velocities and classical
 //! accelerations (at the frame's origin, in R_0's axes). Closed chains: `--q` holds the
 //! actuated joints; the passive ones come from the assembly branch.
 

@@ -1,5 +1,5 @@
 //! `robodyn jacobian ROBOT --q ... --frame NAME [--reference ...]`: the Jacobian of a frame,
-//! 6 x N with rows [linear; angular] (Pinocchio's order), in one of the three references of
+//! 6 x nv with rows [linear; angular] (Pinocchio's order; a floating base's 6 columns first), in one of the three references of
 //! docs/models/kinematics.md. Closed chains: the Jacobian in the actuated coordinates
 //! J_a = J_tr G on the assembly branch.
 
@@ -70,10 +70,10 @@ fn jacobian(
     f: &robodyn::FrameId,
     reference: Reference,
 ) -> CliResult<(nalgebra::DMatrix<f64>, Vec<String>)> {
-    let mut j = nalgebra::DMatrix::zeros(6, e.robot.dof());
+    let mut j = nalgebra::DMatrix::zeros(6, e.robot.nv());
     frame_jacobian_into(&e.robot, &e.data, f, reference, &mut j)?;
     Ok(match &e.closed {
-        None => (j, e.robot.coordinates().names().to_vec()),
+        None => (j, e.robot.velocity_names()),
         Some((chain, g)) => (j * g, chain.coordinates().names().to_vec()),
     })
 }

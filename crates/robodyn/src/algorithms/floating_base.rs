@@ -65,6 +65,21 @@ pub(crate) fn check_state(
     if let Some(env) = env {
         env.check(robot.nl())?;
     }
+    let (nv, n) = (robot.nv(), robot.dof());
+    if out.1 != nv {
+        return Err(Error::dimension(out.0, nv, out.1, format!("nv = 6 + {n}")));
+    }
+    check_floating_vectors(robot, q, vs)
+}
+
+/// Check the vectors of a floating state: `q` with nq entries (and a unit quaternion), each of
+/// `vs` with nv. Returns wR_0. The one check of the floating-base dynamic and kinematic
+/// functions.
+pub(crate) fn check_floating_vectors(
+    robot: &Robot,
+    q: &[f64],
+    vs: &[(&str, &[f64])],
+) -> Result<Matrix3<f64>> {
     let (nq, nv) = (robot.nq(), robot.nv());
     let n = robot.dof();
     check_vector("q", q, nq, || {
@@ -74,9 +89,6 @@ pub(crate) fn check_state(
         check_vector(name, v, nv, || {
             format!("nv = 6 + {n}: base linear, angular (in the base frame), joints")
         })?;
-    }
-    if out.1 != nv {
-        return Err(Error::dimension(out.0, nv, out.1, format!("nv = 6 + {n}")));
     }
     Ok(base_rotation(q)?.to_rotation_matrix().into_inner())
 }

@@ -131,7 +131,7 @@ impl Coordinates {
             return Err(crate::Error::Input(format!(
                 "`{what}` over the {} movable joints: the robot has a floating base, which this \
                  function does not support yet (the floating-base models inverse_dynamics, \
-                 inertia_matrix, h_vector, direct_dynamics take configurations of nq = 7 + {} \
+                 inertia_matrix, h_vector, direct_dynamics and the kinematics take configurations of nq = 7 + {} \
                  and velocities of nv = 6 + {} entries)",
                 self.len(),
                 self.len(),

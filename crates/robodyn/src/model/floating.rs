@@ -53,7 +53,7 @@ pub fn require_fixed_base(desc: &super::RobotDescription, what: &str) -> crate::
         return Err(crate::Error::Input(format!(
             "{what}: robot `{}` has a floating base, which {what} does not support yet (the \
              floating-base models are inverse_dynamics, inertia_matrix, h_vector and \
-             direct_dynamics over nq / nv vectors)",
+             direct_dynamics and the kinematics (placements, frame Jacobians, centre of mass) over nq / nv vectors)",
             desc.name
         )));
     }

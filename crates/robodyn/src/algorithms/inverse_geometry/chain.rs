@@ -85,6 +85,7 @@ impl Chain {
     /// The chain from the base to `frame`: every joint on the path revolute, the movable joints
     /// that are not on the path ignored.
     pub fn new(robot: &Robot, frame: usize) -> Result<Chain> {
+        super::refuse_floating(robot, "the closed-form inverse geometric model")?;
         check_frame(robot, frame)?;
         let mut chain = Chain {
             c: Vec::new(),

@@ -350,6 +350,7 @@ impl ClosedFormIgm {
     /// Errors: [`Error::Input`] when the robot is not a serial chain, or its chain is of no
     /// class handled (the message names the numeric inverse geometric model).
     pub fn new(robot: &Robot) -> Result<Self> {
+        super::refuse_floating(robot, "the closed-form inverse geometric model")?;
         Self::for_frame(robot, super::chain::terminal_frame(robot)?)
     }
 

@@ -68,6 +68,7 @@ pub fn inverse_kinematics(
                 .into(),
         });
     }
+    super::refuse_floating(robot, "the inverse kinematic model")?;
     check_vector("twist", twist, 6, || "[vx, vy, vz, wx, wy, wz]".into())?;
     let mut data = KinematicsData::new(robot);
     placements_into(robot, &mut data, q)?;

@@ -48,6 +48,24 @@ use nalgebra::{Matrix3, Matrix4};
 /// Tolerance of the checks of a placement: |R^T R - I|, |det R - 1| and the last row.
 pub const PLACEMENT_TOLERANCE: f64 = 1e-9;
 
+/// The refusal of the inverse models (`what` names one) for a floating robot: its frames'
+/// poses in the world depend on the base pose (7 of the nq coordinates), which no joint sets,
+/// so a joint solution for a world target is undefined (or, solving for the base too, a
+/// free-flying body reaching anything). The joints that place a frame relative to the base
+/// are those of the same robot on a fixed base.
+pub(crate) fn refuse_floating(robot: &crate::Robot, what: &str) -> Result<()> {
+    if robot.is_floating() {
+        return Err(Error::Input(format!(
+            "{what}: robot `{}` has a floating base, whose pose no joint sets: a frame's world \
+             pose is reached by moving the base alone, so the inverse models (which solve the \
+             joints) are not defined for it; for a target given in the base frame, load the \
+             robot with a fixed base",
+            robot.name()
+        )));
+    }
+    Ok(())
+}
+
 /// A 4x4 placement as a [`Transform`], checked: finite, rotation part orthonormal with
 /// determinant 1, last row (0, 0, 0, 1), each within [`PLACEMENT_TOLERANCE`].
 pub(crate) fn transform_of(what: &str, m: &Matrix4<f64>) -> Result<Transform> {

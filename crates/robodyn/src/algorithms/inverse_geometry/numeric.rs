@@ -91,6 +91,7 @@ impl NumericIgm {
     ///
     /// Errors: [`Error::Setting`] for non-positive tolerances, zero starts or iterations.
     pub fn new(robot: &Robot, frame: FrameId, options: NumericOptions) -> Result<Self> {
+        super::refuse_floating(robot, "the numeric inverse geometric model")?;
         let bad = |field: &'static str, why: &str| Error::Setting {
             option: field,
             reason: why.to_string(),

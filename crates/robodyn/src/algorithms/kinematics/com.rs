@@ -1,7 +1,9 @@
 //! Centre of mass of the robot or of a subtree: position, velocity, acceleration (in R_0), its
-//! Jacobian (3 x N) and the mass. As in Pinocchio and in the dynamic model, the bodies are
-//! those of the links a joint moves: links rigidly attached to the base (through fixed frames
-//! only) carry no joint, never move, and are not counted, like the root link.
+//! Jacobian (3 x nv) and the mass. As in Pinocchio and in the dynamic model, the bodies are
+//! those of the links that move: on a fixed base, links rigidly attached to the base (through
+//! fixed frames only) carry no joint, never move, and are not counted, like the root link; a
+//! floating base's body (link 0 and the links fixed on it) moves and is counted, in the world
+//! frame.
 
 use super::forward::{placements_into, KinematicsData, Level};
 use super::frames::FrameId;
@@ -109,7 +111,8 @@ pub fn center_of_mass(
     };
     let (mut mass, mut first, mut vel, mut acc) =
         (0.0, Vector3::zeros(), Vector3::zeros(), Vector3::zeros());
-    for k in 1..bm.len() {
+    // link 0 is a floating base's body (massless and at rest on a fixed base)
+    for k in 0..bm.len() {
         let m = bm[k];
         let c = data.rot[k] * bms[k]; // sum m_j (G_j - O_k) in R_0
         let (w, wd) = (data.w[k], data.wd[k]);
@@ -130,7 +133,8 @@ pub fn center_of_mass(
 }
 
 /// The Jacobian of the centre of mass (of the robot, or of the subtree carried by `root`) into
-/// `out` (3 x N): G's velocity is `out` q̇. After [`placements_into`](super::placements_into)
+/// `out` (3 x nv): G's velocity is `out` q̇ (a floating base's 6 columns first: R_0 along its
+/// translations, z x (G - O_0) about its axes z). After [`placements_into`](super::placements_into)
 /// or [`forward_kinematics_into`](super::forward_kinematics_into). Column of joint k:
 /// z_k x (S_k - M_k O_k) / M (revolute), M_k z_k / M (prismatic), with M_k and S_k the mass and
 /// first moment sum m_j 0P_Gj of the counted links moved by joint k (Pinocchio's
@@ -138,7 +142,7 @@ pub fn center_of_mass(
 /// [`center_of_mass_jacobian_from_q_into`] places the links first.
 ///
 /// Errors: as [`center_of_mass`] (a `data` with placements suffices), and
-/// [`Error::Dimension`] for an `out` that is not 3 x N.
+/// [`Error::Dimension`] for an `out` that is not 3 x nv.
 pub fn center_of_mass_jacobian_into(
     robot: &Robot,
     data: &mut KinematicsData,
@@ -150,7 +154,7 @@ pub fn center_of_mass_jacobian_into(
     com_jacobian(robot, data, root, out).map(|_| ())
 }
 
-/// The Jacobian of the centre of mass at joint positions `q` into `out` (3 x N): the
+/// The Jacobian of the centre of mass at the configuration `q` (nq) into `out` (3 x nv): the
 /// placements of [`placements_into`](super::placements_into) (`data` holds them afterwards),
 /// then [`center_of_mass_jacobian_into`] (Pinocchio's `jacobianCenterOfMass(model, data, q)`,
 /// which gives G too). Returns G (0P_G, m). Allocation-free.
@@ -181,21 +185,15 @@ fn com_jacobian(
     out: &mut DMatrix<f64>,
 ) -> Result<Vector3<f64>> {
     let (r, whole) = select_bodies(robot, data, root)?;
-    clear_base_sums(data);
     let mut mass = 0.0;
-    for k in 1..=data.tree.n() {
+    // link 0: a floating base's body (none on a fixed base: its sums start at zero)
+    for k in 0..=data.tree.n() {
         mass += own_moment(data, k, whole);
     }
     if mass <= 0.0 {
         return Err(no_mass(robot, r));
     }
     Ok(subtree_columns(data, mass, out.as_mut_slice()))
-}
-
-/// The base's subtree sums start at zero (its own bodies never move and are not counted).
-fn clear_base_sums(data: &mut KinematicsData) {
-    data.sub_m[0] = 0.0;
-    data.sub_ms[0] = Vector3::zeros();
 }
 
 /// Moving link k's counted bodies (the whole robot's, or the subtree's of `select_bodies`):
@@ -215,10 +213,13 @@ fn own_moment(data: &mut KinematicsData, k: usize, whole: bool) -> f64 {
 
 /// From the last moving link to the first: link k's subtree sums are complete (its children
 /// come after it), so joint k's column is written, z_k x (S_k - M_k O_k) / M (revolute) or
-/// M_k z_k / M (prismatic), and the sums are added to its antecedent's. Returns G = S_0 / M.
+/// M_k z_k / M (prismatic), and the sums are added to its antecedent's. A floating base's
+/// columns are those of joints on its axes through O_0, with the sums of the whole set.
+/// Returns G = S_0 / M.
 #[inline(always)]
 fn subtree_columns(data: &mut KinematicsData, mass: f64, out: &mut [f64]) -> Vector3<f64> {
     let inv = 1.0 / mass;
+    let nb = data.nb;
     for k in (1..=data.tree.n()).rev() {
         let (mk, sk) = (data.sub_m[k], data.sub_ms[k]);
         let z: Vector3<f64> = data.rot[k].column(2).into_owned();
@@ -227,12 +228,22 @@ fn subtree_columns(data: &mut KinematicsData, mass: f64, out: &mut [f64]) -> Vec
         } else {
             z * (mk * inv)
         };
-        out[3 * (k - 1)..3 * k].copy_from_slice(col.as_slice());
+        out[3 * (nb + k - 1)..3 * (nb + k)].copy_from_slice(col.as_slice());
         let a = data.tree.parent[k];
         data.sub_m[a] += mk;
         data.sub_ms[a] += sk;
     }
-    data.sub_ms[0] * inv
+    let (m0, s0, o0) = (data.sub_m[0], data.sub_ms[0], data.pos[0]);
+    for c in 0..nb {
+        let z: Vector3<f64> = data.rot[0].column(c % 3).into_owned();
+        let col = if c >= 3 {
+            z.cross(&(s0 - m0 * o0)) * inv
+        } else {
+            z * (m0 * inv)
+        };
+        out[3 * c..3 * c + 3].copy_from_slice(col.as_slice());
+    }
+    s0 * inv
 }
 
 /// The mass of the links a joint moves (kg): what [`center_of_mass`] weighs.
@@ -257,8 +268,10 @@ pub fn subtree_mass(robot: &Robot, root: &FrameId) -> Result<f64> {
     let mut member = vec![false; robot.nl() + 1];
     moving_links(robot, &mut moving);
     mark_subtree(robot, carrying_link(robot, root.parent()), &mut member);
+    // every link of a floating robot moves
+    let floating = robot.is_floating();
     Ok((1..=robot.nl())
-        .filter(|&j| member[j] && moving[j])
+        .filter(|&j| member[j] && (moving[j] || floating))
         .map(|j| robot.numeric().link(j).mass)
         .sum())
 }

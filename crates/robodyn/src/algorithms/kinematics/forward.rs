@@ -4,6 +4,7 @@
 use super::frames::FrameId;
 use super::tree::{mul_form, MovingTree};
 use super::{Motion, Reference};
+use crate::algorithms::floating_base::{check_floating_vectors, v3};
 use crate::error::{Error, Result};
 use crate::geometry::Transform;
 use crate::model::{JointType, Robot};
@@ -22,8 +23,9 @@ pub(crate) enum Level {
 
 /// Buffers and results of the kinematic functions for one robot (Pinocchio's `Data` for
 /// `forwardKinematics`, `computeJointJacobians`, `centerOfMass`). The passes run over the
-/// movable joints only, as Pinocchio's model: per movable joint k (0 the base), all in R_0 at
-/// the origin of its frame, the placement, the angular velocity and acceleration, the linear
+/// movable joints only, as Pinocchio's model: per movable joint k (0 the base), all in R_0 (the
+/// world frame for a floating base, whose pose and twist are link 0's) at the origin of its
+/// frame, the placement, the angular velocity and acceleration, the linear
 /// velocity and (classical) acceleration; every other frame of the description is fixed on its
 /// nearest movable ancestor and read from it. Made once per thread with
 /// [`KinematicsData::new`]; [`forward_kinematics_into`] or [`placements_into`] fill it, and the
@@ -33,6 +35,9 @@ pub(crate) enum Level {
 #[derive(Clone, Debug)]
 pub struct KinematicsData {
     pub(crate) nf: usize,
+    /// The base's entries in velocity vectors and Jacobian columns: 6 for a floating base
+    /// (its twist comes first), 0 otherwise.
+    pub(crate) nb: usize,
     pub(crate) level: Level,
     pub(crate) tree: MovingTree,
     /// Per moving link 0..N (0 the base).
@@ -48,7 +53,7 @@ pub struct KinematicsData {
     /// read them then, and compute them from the placements otherwise.
     pub(crate) col: Vec<[f64; 6]>,
     pub(crate) columns: bool,
-    /// The q̈ of the last [`forward_kinematics_into`] (movable joints).
+    /// The q̈ of the last [`forward_kinematics_into`] (nv: the base's 6 first when it floats).
     pub(crate) qdd: Vec<f64>,
     /// The moving links from a frame to the base (scratch of the support-only pass).
     pub(crate) chain: Vec<usize>,
@@ -67,8 +72,10 @@ impl KinematicsData {
     pub fn new(robot: &Robot) -> KinematicsData {
         let n = robot.dof();
         let v = || vec![Vector3::zeros(); n + 1];
+        let nb = robot.nv() - n;
         KinematicsData {
             nf: robot.nf(),
+            nb,
             level: Level::None,
             tree: MovingTree::new(robot),
             rot: vec![Matrix3::identity(); n + 1],
@@ -79,7 +86,7 @@ impl KinematicsData {
             a: v(),
             col: vec![[0.0; 6]; n + 1],
             columns: false,
-            qdd: vec![0.0; n],
+            qdd: vec![0.0; n + nb],
             chain: Vec::with_capacity(n + 1),
             body_m: vec![0.0; n + 1],
             body_ms: v(),
@@ -92,7 +99,7 @@ impl KinematicsData {
     /// Error unless this data was made for a robot of `robot`'s size ([`Error::Dimension`]).
     pub fn check(&self, robot: &Robot) -> Result<()> {
         if self.nf != robot.nf()
-            || self.qdd.len() != robot.dof()
+            || self.qdd.len() != robot.nv()
             || self.member.len() != robot.nl() + 1
         {
             return Err(Error::dimension(
@@ -124,17 +131,17 @@ impl KinematicsData {
     }
 }
 
-/// Placements 0T_j of every frame for joint positions `q` (movable joints, frame order) into
-/// `data`: enough for [`frame_placement`], the Jacobians and the centre of mass position.
+/// Placements 0T_j of every frame for the configuration `q` into `data`: enough for
+/// [`frame_placement`], the Jacobians and the centre of mass position. `q` holds the movable
+/// joints in frame order, after the base pose (position in the world, quaternion x y z w) when
+/// the base floats (nq = 7 + N entries): the placements are then in the world frame.
 /// Allocation-free.
 ///
 /// Errors: [`Error::Dimension`] for a `q` of the wrong length or a `data` of another robot,
-/// [`Error::NotFinite`] for a NaN or infinite entry.
+/// [`Error::NotFinite`] for a NaN or infinite entry, [`Error::Input`] for a base quaternion
+/// that is not a unit one.
 pub fn placements_into(robot: &Robot, data: &mut KinematicsData, q: &[f64]) -> Result<()> {
-    data.check(robot)?;
-    robot.coordinates().check("q", q, "movable joints")?;
-    data.level = Level::None;
-    data.columns = false;
+    let q = set_configuration(robot, data, q)?;
     for k in 1..=data.tree.n() {
         place::<false>(data, k, q[k - 1]);
     }
@@ -151,15 +158,67 @@ pub fn placements_into(robot: &Robot, data: &mut KinematicsData, q: &[f64]) -> R
 ///
 /// Errors: as [`placements_into`].
 pub fn joint_jacobians_into(robot: &Robot, data: &mut KinematicsData, q: &[f64]) -> Result<()> {
-    data.check(robot)?;
-    robot.coordinates().check("q", q, "movable joints")?;
-    data.level = Level::None;
+    let q = set_configuration(robot, data, q)?;
     for k in 1..=data.tree.n() {
         place::<true>(data, k, q[k - 1]);
     }
     data.columns = true;
     data.level = Level::Placements;
     Ok(())
+}
+
+/// The checked entry of every pass on a configuration: `data` fits `robot`, `q` has nq entries
+/// (the one check of joint vectors for a fixed base; the base pose and a unit quaternion for a
+/// floating one, whose placement wT_0 becomes link 0's). Returns the joints' part of `q`.
+pub(crate) fn set_configuration<'a>(
+    robot: &Robot,
+    data: &mut KinematicsData,
+    q: &'a [f64],
+) -> Result<&'a [f64]> {
+    data.check(robot)?;
+    data.level = Level::None;
+    data.columns = false;
+    if data.nb == 0 {
+        robot.coordinates().check("q", q, "movable joints")?;
+        return Ok(q);
+    }
+    data.rot[0] = check_floating_vectors(robot, q, &[])?;
+    data.pos[0] = v3(&q[..3]);
+    Ok(&q[7..])
+}
+
+/// The checked velocities and accelerations (nv entries) of a pass after
+/// [`set_configuration`]: q̈ kept in `data`, and for a floating base its motion in the world
+/// made link 0's (w_0 = R w, v_0 = R v, wd_0 = R wd, a_0 = R (a + w x v) the classical
+/// acceleration of O_0, with v, w, a, wd in R_0 as the state holds them). Returns the joints'
+/// parts.
+fn set_motion<'a>(
+    robot: &Robot,
+    data: &mut KinematicsData,
+    qd: &'a [f64],
+    qdd: &'a [f64],
+) -> Result<(&'a [f64], &'a [f64])> {
+    if data.nb == 0 {
+        let c = robot.coordinates();
+        c.check("qd", qd, "movable joints")?;
+        c.check("qdd", qdd, "movable joints")?;
+        data.qdd.copy_from_slice(qdd);
+        return Ok((qd, qdd));
+    }
+    let n = robot.dof();
+    for (name, x) in [("qd", qd), ("qdd", qdd)] {
+        crate::error::check_vector(name, x, n + 6, || {
+            format!("nv = 6 + {n}: base linear, angular (in the base frame), joints")
+        })?;
+    }
+    let r = data.rot[0];
+    let (lin, w) = (v3(&qd[..3]), v3(&qd[3..6]));
+    data.w[0] = r * w;
+    data.v[0] = r * lin;
+    data.wd[0] = r * v3(&qdd[3..6]);
+    data.a[0] = r * (v3(&qdd[..3]) + w.cross(&lin));
+    data.qdd.copy_from_slice(qdd);
+    Ok((&qd[6..], &qdd[6..]))
 }
 
 /// Joint k's column of the `World` Jacobian from its placement: [O_k x z_k; z_k] (revolute),
@@ -172,18 +231,34 @@ pub(crate) fn world_column(data: &KinematicsData, k: usize) -> [f64; 6] {
 /// The World column of a joint placed at (`rot`, `pos`).
 #[inline(always)]
 fn column_of(rot: &Matrix3<f64>, pos: &Vector3<f64>, revolute: bool) -> [f64; 6] {
-    let z = rot.column(2);
+    axis_column(&rot.column(2).into_owned(), pos, revolute)
+}
+
+/// The World column of a motion about (revolute) or along (prismatic) the axis `z` through
+/// `pos`: [pos x z; z] or [z; 0].
+#[inline(always)]
+pub(crate) fn axis_column(z: &Vector3<f64>, pos: &Vector3<f64>, revolute: bool) -> [f64; 6] {
     if revolute {
-        let l = pos.cross(&z);
+        let l = pos.cross(z);
         [l.x, l.y, l.z, z.x, z.y, z.z]
     } else {
         [z.x, z.y, z.z, 0.0, 0.0, 0.0]
     }
 }
 
+/// Base column c (0..6) of a floating robot's `World` Jacobian: the base twist's entries are
+/// translations along (c < 3) and rotations about (c >= 3) the base axes x, y, z through O_0,
+/// so each is the column of a prismatic or revolute joint on that axis.
+#[inline]
+pub(crate) fn base_column(data: &KinematicsData, c: usize) -> [f64; 6] {
+    let z = data.rot[0].column(c % 3).into_owned();
+    axis_column(&z, &data.pos[0], c >= 3)
+}
+
 /// The placements of the moving links from the base to the one frame `f` is fixed on (its
-/// support: Pinocchio's `computeFrameJacobian` pass), into `data`. The other links keep older
-/// values, so `data` holds no full pass afterwards (its level is reset).
+/// support: Pinocchio's `computeFrameJacobian` pass), into `data`, `q` the joints' part after
+/// [`set_configuration`]. The other links keep older values, so `data` holds no full pass
+/// afterwards (its level is reset).
 pub(crate) fn place_support(data: &mut KinematicsData, q: &[f64], f: &FrameId) {
     data.level = Level::None;
     data.columns = false;
@@ -219,7 +294,9 @@ fn place<const COLUMN: bool>(data: &mut KinematicsData, k: usize, qk: f64) {
 /// The forward kinematic model of every frame for a state over the movable joints (frame
 /// order): positions `q` (rad, m), velocities `qd`, accelerations `qdd`, into `data`. Fills the
 /// placements 0T_j and, in R_0 at O_j, the angular velocity w_j, linear velocity v_j, angular
-/// acceleration wd_j and linear (classical) acceleration a_j, from the fixed base (no gravity):
+/// acceleration wd_j and linear (classical) acceleration a_j, from the base (no gravity). A
+/// floating base's state comes first (q: nq = 7 + N entries; qd, qdd: nv = 6 + N, the base
+/// twist in R_0 and its derivative): R_0 is then the world frame and the base moves as link 0:
 ///
 /// w_j = w_i + qd_j z_j (revolute), v_j = v_i + w_i x P + qd_j z_j (prismatic),
 /// wd_j = wd_i + w_i x qd_j z_j + qdd_j z_j (revolute),
@@ -252,14 +329,8 @@ pub fn forward_kinematics_into(
     qd: &[f64],
     qdd: &[f64],
 ) -> Result<()> {
-    data.check(robot)?;
-    let c = robot.coordinates();
-    c.check("q", q, "movable joints")?;
-    c.check("qd", qd, "movable joints")?;
-    c.check("qdd", qdd, "movable joints")?;
-    data.level = Level::None;
-    data.columns = false;
-    data.qdd.copy_from_slice(qdd);
+    let q = set_configuration(robot, data, q)?;
+    let (qd, qdd) = set_motion(robot, data, qd, qdd)?;
     for k in 1..=data.tree.n() {
         place::<false>(data, k, q[k - 1]);
         propagate(data, k, qd[k - 1], qdd[k - 1]);

@@ -1,9 +1,10 @@
-//! Frame Jacobians J(q) (6 x N, rows [linear; angular], columns the movable joints in frame
-//! order) in the three references, their time derivative J̇ and the classical drift J̇ q̇,
+//! Frame Jacobians J(q) (6 x nv, rows [linear; angular], columns the movable joints in frame
+//! order, after a floating base's twist) in the three references, their time derivative J̇ and the classical drift J̇ q̇,
 //! read from the placements (and velocities) of a [`KinematicsData`].
 
 use super::forward::{
-    frame_state, place_support, placement_of, world_column, FrameState, KinematicsData, Level,
+    base_column, frame_state, place_support, placement_of, set_configuration, world_column,
+    FrameState, KinematicsData, Level,
 };
 use super::frames::FrameId;
 use super::tree::{form_mul, form_mul_vector};
@@ -13,38 +14,48 @@ use crate::geometry::Transform;
 use crate::model::{JointType, Robot};
 use nalgebra::{DMatrix, Vector3};
 
-/// Call `f(k, j, revolute)` for each movable joint on the path from the base to the
-/// description frame `frame` (its moving link j and the moving links before it; k = j - 1 its
-/// entry in the joint vectors).
+/// Call `f(k, j, z, revolute)` for each motion axis on the path from the base to the
+/// description frame `frame`: each movable joint (its moving link j and the moving links
+/// before it, z its axis z_j in R_0), then a floating base's 6 (j = 0: translations along,
+/// rotations about its axes through O_0); k is the axis' entry in velocity vectors.
 #[inline]
-pub(crate) fn for_each_support_joint(
+pub(crate) fn for_each_support_axis(
     data: &KinematicsData,
     frame: usize,
-    mut f: impl FnMut(usize, usize, bool),
+    mut f: impl FnMut(usize, usize, Vector3<f64>, bool),
 ) {
     let mut j = data.tree.anchor[frame].link;
     while j != 0 {
         let fc = data.tree.frame(j);
-        f(j - 1, j, fc.joint == JointType::Revolute);
+        let z = data.rot[j].column(2).into_owned();
+        f(data.nb + j - 1, j, z, fc.joint == JointType::Revolute);
         j = fc.ant;
+    }
+    for c in 0..data.nb {
+        f(c, 0, data.rot[0].column(c % 3).into_owned(), c >= 3);
     }
 }
 
-/// Error unless `out` is rows x N.
+/// Error unless `out` is rows x nv.
 pub(crate) fn check_matrix(
     robot: &Robot,
     what: &str,
     out: &DMatrix<f64>,
     rows: usize,
 ) -> Result<()> {
-    let n = robot.dof();
+    let n = robot.nv();
     if out.nrows() != rows || out.ncols() != n {
+        let cols = if robot.is_floating() {
+            "nv = 6 + N: base twist, movable joints"
+        } else {
+            "movable joints"
+        };
         return Err(Error::dimension(
             what,
             rows * n,
             out.len(),
             format!(
-                "a {rows} x {n} matrix (movable joints), {} x {} given",
+                "a {rows} x {n} matrix ({cols}), {} x {} given",
                 out.nrows(),
                 out.ncols()
             ),
@@ -61,11 +72,16 @@ fn put(out: &mut DMatrix<f64>, k: usize, m: &Motion) {
     c[3..].copy_from_slice(m.angular.as_slice());
 }
 
-/// Column of the LocalWorldAligned Jacobian of the point `p` (R_0) for joint j: revolute
-/// [z_j x (p - O_j); z_j], prismatic [z_j; 0].
+/// Column of the LocalWorldAligned Jacobian of the point `p` (R_0) for the axis z of joint
+/// j: revolute [z x (p - O_j); z], prismatic [z; 0].
 #[inline]
-fn lwa_column(data: &KinematicsData, j: usize, revolute: bool, p: &Vector3<f64>) -> Motion {
-    let z: Vector3<f64> = data.rot[j].column(2).into_owned();
+fn lwa_column(
+    data: &KinematicsData,
+    j: usize,
+    z: Vector3<f64>,
+    revolute: bool,
+    p: &Vector3<f64>,
+) -> Motion {
     if revolute {
         Motion::new(z.cross(&(p - data.pos[j])), z)
     } else {
@@ -84,8 +100,9 @@ fn from_lwa(t: &Transform, m: Motion, reference: Reference) -> Motion {
     }
 }
 
-/// The Jacobian of frame `f` in `reference` into `out` (6 x N, rows [linear; angular], one
-/// column per movable joint, zero for joints not between the base and the frame), after
+/// The Jacobian of frame `f` in `reference` into `out` (6 x nv, rows [linear; angular], one
+/// column per movable joint, zero for joints not between the base and the frame, after the 6
+/// of a floating base's twist), after
 /// [`placements_into`](super::placements_into) or [`forward_kinematics_into`](super::forward_kinematics_into): J q̇ is
 /// [`frame_velocity`](super::frame_velocity) in the same reference. Computing the placements
 /// once and reading several frames' Jacobians is Pinocchio's `computeJointJacobians` then
@@ -96,7 +113,11 @@ fn from_lwa(t: &Transform, m: Motion, reference: Reference) -> Motion {
 /// - `Local`: the same rows in the frame's own axes: Khalil's nJ_n;
 /// - `World`: [O_j x z_j; z_j] (revolute), [z_j; 0] (prismatic), the spatial velocity in R_0.
 ///
-/// Errors: [`Error::Dimension`] for an `out` that is not 6 x N or a `data` of another robot,
+/// A floating base's columns are those of joints on its axes: its linear velocity (in R_0)
+/// translates along x_0, y_0, z_0, its angular velocity turns about them through O_0; R_0 is
+/// then the world frame.
+///
+/// Errors: [`Error::Dimension`] for an `out` that is not 6 x nv or a `data` of another robot,
 /// [`Error::Input`] for a `data` without placements or a frame of another robot.
 pub fn frame_jacobian_into(
     robot: &Robot,
@@ -122,8 +143,9 @@ fn column(data: &KinematicsData, j: usize) -> [f64; 6] {
     }
 }
 
-/// The columns of the frame Jacobian from the World columns of its support (a copy in
-/// `World`; moved to the frame's origin, and turned into its axes for `Local`).
+/// The columns of the frame Jacobian from the World columns of its support, a floating base's
+/// 6 included (a copy in `World`; moved to the frame's origin, and turned into its axes for
+/// `Local`).
 fn write_jacobian(
     data: &KinematicsData,
     f: &FrameId,
@@ -133,34 +155,52 @@ fn write_jacobian(
     // a slice's fill is a memset; DMatrix::fill walks the matrix by strides (~2 ns an entry)
     let o = out.as_mut_slice();
     o.fill(0.0);
+    let nb = data.nb;
     let mut j = data.tree.anchor[f.parent()].link;
     if reference == Reference::World {
         while j != 0 {
-            o[6 * (j - 1)..6 * j].copy_from_slice(&column(data, j));
+            o[6 * (nb + j - 1)..6 * (nb + j)].copy_from_slice(&column(data, j));
             j = data.tree.parent[j];
+        }
+        for c in 0..nb {
+            o[6 * c..6 * c + 6].copy_from_slice(&base_column(data, c));
         }
         return;
     }
     let t = placement_of(data, f);
     while j != 0 {
-        let c = &column(data, j);
-        let w = Vector3::new(c[3], c[4], c[5]);
-        // the velocity of the body point at O_f from that at O_0: v + w x O_f
-        let v = Vector3::new(c[0], c[1], c[2]) + w.cross(&t.pos);
-        let (v, w) = match reference {
-            Reference::Local => (t.rot.tr_mul(&v), t.rot.tr_mul(&w)),
-            _ => (v, w),
-        };
-        let col = &mut o[6 * (j - 1)..6 * j];
-        col[..3].copy_from_slice(v.as_slice());
-        col[3..].copy_from_slice(w.as_slice());
+        let k = nb + j - 1;
+        moved_column(&t, &column(data, j), reference, &mut o[6 * k..6 * k + 6]);
         j = data.tree.parent[j];
+    }
+    for c in 0..nb {
+        moved_column(
+            &t,
+            &base_column(data, c),
+            reference,
+            &mut o[6 * c..6 * c + 6],
+        );
     }
 }
 
-/// The Jacobian of frame `f` in `reference` at joint positions `q` into `out` (6 x N), from
-/// the placements of the frame's support only (the movable joints between the base and the
-/// frame): Pinocchio's `computeFrameJacobian`. Cheaper than [`placements_into`](super::placements_into) then
+/// The World column `c` moved to the origin of the frame placed at `t` (LocalWorldAligned),
+/// turned into its axes for `Local`, into `col`.
+#[inline(always)]
+fn moved_column(t: &Transform, c: &[f64; 6], reference: Reference, col: &mut [f64]) {
+    let w = Vector3::new(c[3], c[4], c[5]);
+    // the velocity of the body point at O_f from that at O_0: v + w x O_f
+    let v = Vector3::new(c[0], c[1], c[2]) + w.cross(&t.pos);
+    let (v, w) = match reference {
+        Reference::Local => (t.rot.tr_mul(&v), t.rot.tr_mul(&w)),
+        _ => (v, w),
+    };
+    col[..3].copy_from_slice(v.as_slice());
+    col[3..].copy_from_slice(w.as_slice());
+}
+
+/// The Jacobian of frame `f` in `reference` at the configuration `q` (nq) into `out` (6 x nv),
+/// from the placements of the frame's support only (the movable joints between the base and
+/// the frame): Pinocchio's `computeFrameJacobian`. Cheaper than [`placements_into`](super::placements_into) then
 /// [`frame_jacobian_into`] for one frame of a large tree; `data` is left without a full pass
 /// (the frame functions ask for one again). Allocation-free.
 ///
@@ -173,12 +213,10 @@ pub fn frame_jacobian_from_q_into(
     reference: Reference,
     out: &mut DMatrix<f64>,
 ) -> Result<()> {
-    data.check(robot)?;
-    robot.coordinates().check("q", q, "movable joints")?;
+    let q = set_configuration(robot, data, q)?;
     f.check(robot)?;
     check_matrix(robot, "J", out, 6)?;
     if reference == Reference::Local {
-        data.level = Level::None;
         local_jacobian_from_q(data, q, f, out);
     } else {
         place_support(data, q, f);
@@ -191,8 +229,10 @@ pub fn frame_jacobian_from_q_into(
 /// (Pinocchio's `computeFrameJacobian` in `LOCAL`), no placement in R_0 formed: with
 /// kT_f = (R, P) the frame's placement in moving link k, joint k's column is
 /// [R^T (z x P); R^T z] (revolute) or [R^T z; 0] (prismatic), z = (0, 0, 1) (R^T z is R's last
-/// row), then a(k)T_f = a(k)T_k kT_f.
+/// row), then a(k)T_f = a(k)T_k kT_f. A floating base's columns come last, from 0T_f, as
+/// those of joints on its axes (they do not depend on the base pose).
 fn local_jacobian_from_q(data: &KinematicsData, q: &[f64], f: &FrameId, out: &mut DMatrix<f64>) {
+    let nb = data.nb;
     let o = out.as_mut_slice();
     o.fill(0.0);
     let an = &data.tree.anchor[f.parent()];
@@ -206,7 +246,7 @@ fn local_jacobian_from_q(data: &KinematicsData, q: &[f64], f: &FrameId, out: &mu
         let fc = data.tree.frame(k);
         let (r, p) = (&t.rot, &t.pos);
         let z = r.row(2);
-        let col = &mut o[6 * (k - 1)..6 * k];
+        let col = &mut o[6 * (nb + k - 1)..6 * (nb + k)];
         if fc.joint == JointType::Revolute {
             let lin = r.row(1) * p.x - r.row(0) * p.y;
             col[..3].copy_from_slice(&[lin[0], lin[1], lin[2]]);
@@ -222,10 +262,16 @@ fn local_jacobian_from_q(data: &KinematicsData, q: &[f64], f: &FrameId, out: &mu
         };
         k = fc.ant;
     }
+    for c in 0..nb {
+        let axis = Vector3::ith(c % 3, 1.0);
+        let world = super::forward::axis_column(&axis, &Vector3::zeros(), c >= 3);
+        moved_column(&t, &world, Reference::Local, &mut o[6 * c..6 * c + 6]);
+    }
 }
 
-/// The Jacobian of frame `f` in `reference` at joint positions `q` (movable joints, frame
-/// order): 6 x N, rows [linear; angular]. Allocates; use [`frame_jacobian_into`] in loops.
+/// The Jacobian of frame `f` in `reference` at the configuration `q` (movable joints in frame
+/// order, after a floating base's pose): 6 x nv, rows [linear; angular]. Allocates; use
+/// [`frame_jacobian_into`] in loops.
 ///
 /// Errors: as [`placements_into`](super::placements_into) and [`frame_jacobian_into`].
 ///
@@ -250,12 +296,12 @@ pub fn frame_jacobian(
     reference: Reference,
 ) -> Result<DMatrix<f64>> {
     let mut data = KinematicsData::new(robot);
-    let mut out = DMatrix::zeros(6, robot.dof());
+    let mut out = DMatrix::zeros(6, robot.nv());
     frame_jacobian_from_q_into(robot, &mut data, q, f, reference, &mut out)?;
     Ok(out)
 }
 
-/// J̇ = dJ/dt of frame `f` in `reference` into `out` (6 x N) at the state of the last
+/// J̇ = dJ/dt of frame `f` in `reference` into `out` (6 x nv) at the state of the last
 /// [`forward_kinematics_into`](super::forward_kinematics_into) (Pinocchio's
 /// `getFrameJacobianTimeVariation`): J̇ q̇ + J q̈ is
 /// [`frame_acceleration`](super::frame_acceleration) in the same reference. With ż_j = w_j x z_j:
@@ -263,6 +309,9 @@ pub fn frame_jacobian(
 /// - `LocalWorldAligned`: [ż_j x (O_f - O_j) + z_j x (v_f - v_j); ż_j] (revolute), [ż_j; 0];
 /// - `Local`: nA_0 (J̇_lwa - [w x] J_lwa) row block by row block;
 /// - `World`: [v_j x z_j + O_j x ż_j; ż_j] (revolute), [ż_j; 0] (prismatic).
+///
+/// A floating base's 6 columns follow the same rules for its axes (j = 0, w_0 and v_0 the
+/// base's angular velocity and the velocity of O_0).
 ///
 /// Errors: as [`frame_jacobian_into`], and [`Error::Input`] for a `data` without velocities.
 pub fn frame_jacobian_time_variation_into(
@@ -277,8 +326,7 @@ pub fn frame_jacobian_time_variation_into(
     check_matrix(robot, "dJ", out, 6)?;
     out.as_mut_slice().fill(0.0);
     let s = frame_state(data, f);
-    for_each_support_joint(data, f.parent(), |k, j, revolute| {
-        let z: Vector3<f64> = data.rot[j].column(2).into_owned();
+    for_each_support_axis(data, f.parent(), |k, j, z, revolute| {
         let zd = data.w[j].cross(&z);
         let col = match (reference, revolute) {
             (_, false) => {
@@ -331,8 +379,8 @@ pub fn frame_classical_drift(
     let acc = super::frame_classical_acceleration(robot, data, f, reference)?;
     let s = frame_state(data, f);
     let mut jqdd = Motion::new(Vector3::zeros(), Vector3::zeros());
-    for_each_support_joint(data, f.parent(), |k, j, revolute| {
-        let col = from_lwa(&s.t, lwa_column(data, j, revolute, &s.t.pos), reference);
+    for_each_support_axis(data, f.parent(), |k, j, z, revolute| {
+        let col = from_lwa(&s.t, lwa_column(data, j, z, revolute, &s.t.pos), reference);
         let qdd = data.qdd[k];
         jqdd.linear += qdd * col.linear;
         jqdd.angular += qdd * col.angular;

@@ -42,6 +42,7 @@ pub fn frame_motion_from_newton_euler(
     env: &Environment,
     f: &FrameId,
 ) -> Result<NewtonEulerFrame> {
+    robot.require_fixed_base("frame_motion_from_newton_euler")?;
     data.check(robot)?;
     f.check(robot)?;
     // the frame's nearest movable joint k (its link in the pass) and kT_f

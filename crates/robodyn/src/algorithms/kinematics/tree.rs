@@ -69,6 +69,10 @@ impl MovingTree {
         };
         let (mut mass, mut ms) = (vec![0.0; c.len() + 1], vec![Vector3::zeros(); c.len() + 1]);
         tree.bodies(robot, |_| true, &mut mass, &mut ms);
+        if let Some(base) = robot.floating_base() {
+            // link 0 and the links fixed on it, about O_0 in R_0
+            (mass[0], ms[0]) = (base.body.mass, base.body.ms);
+        }
         (tree.mass, tree.ms) = (mass, ms);
         tree
     }
@@ -86,7 +90,7 @@ impl MovingTree {
     }
 
     /// Per moving link 0..N, the mass and first moment (in its axes) of the description links
-    /// 1..NL anchored on it for which `member` holds (links on the base left out).
+    /// 1..NL anchored on it for which `member` holds (links on a fixed base left out).
     pub fn bodies(
         &self,
         robot: &Robot,
@@ -96,9 +100,10 @@ impl MovingTree {
     ) {
         mass.fill(0.0);
         ms.fill(Vector3::zeros());
+        let floating = robot.is_floating();
         for j in 1..=robot.nl() {
             let a = &self.anchor[j];
-            if a.link == 0 || !member(j) {
+            if (a.link == 0 && !floating) || !member(j) {
                 continue;
             }
             let l = robot.numeric().link(j);
