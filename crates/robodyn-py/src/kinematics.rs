@@ -15,7 +15,7 @@ use robodyn::algorithms::inverse_geometry::{
 };
 use robodyn::algorithms::kinematics::{
     center_of_mass, center_of_mass_jacobian_into, forward_kinematics_into,
-    frame_classical_acceleration, frame_jacobian_into, frame_placement, frame_velocity,
+    frame_classical_acceleration, frame_jacobian_into, frame_jacobian_time_variation_into, frame_placement, frame_velocity,
     placements_into, total_mass, Motion, Reference,
 };
 use robodyn::error::check_finite_result;
@@ -208,6 +208,33 @@ impl Robot {
             frame_jacobian_into(r, kin, &f, rf, j)?;
             write_matrix(j, o);
             check_finite_result("J", o)
+        })
+    }
+
+    /// Time variation J̇ = dJ/dt of the Jacobian of the frame named `frame` in `reference` (as
+    /// `jacobian`) at q and qd (Pinocchio's getFrameJacobianTimeVariation): J̇ qd + J qdd is
+    /// the frame's acceleration in that reference. Shape (6, nq) for one state, (N, 6, nq) for
+    /// (N, nq). out: as for idm.
+    #[pyo3(signature = (q, qd, frame, reference="world", *, out=None))]
+    fn jacobian_time_variation<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        qd: &Bound<'py, PyAny>,
+        frame: &str,
+        reference: &str,
+        out: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let rf = parse_reference(reference)?;
+        let f = self.model().frame_id(frame).py()?;
+        let n = self.model().nv();
+        let inputs = [("q", Some(q)), ("qd", Some(qd)), ("qdd", None)];
+        self.kinematics(py, &inputs, &[6, n], out, move |r, w, x, o| {
+            let (kin, dj) = w.kin_split(6, n);
+            forward_kinematics_into(r, kin, x[0], x[1], x[2])?;
+            frame_jacobian_time_variation_into(r, kin, &f, rf, dj)?;
+            write_matrix(dj, o);
+            check_finite_result("dJ", o)
         })
     }
 

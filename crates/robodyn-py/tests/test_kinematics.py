@@ -277,3 +277,28 @@ def test_closed_chain_jacobian_is_the_derivative_of_the_placement():
     assert batch.shape == (2, 6, chain.nq)
     with pytest.raises(ValueError):
         chain.jacobian(q_a, frame, "global")
+
+
+@pytest.mark.parametrize("name, floating", [("rx90.urdf", False), ("scara.toml", False), ("rx90float.toml", True)])
+def test_jacobian_time_variation_is_the_derivative_of_the_jacobian(name, floating):
+    """jacobian_time_variation(q, qd) = d/dt J(q(t)) at t = 0 along q(t) = q + t qd (a floating
+    base: integrate(q, qd, t), its pose on SE(3)), by central differences of `jacobian`
+    (h = 1e-5: truncation ~1e-10, rounding ~1e-11); J̇ qd is of the order |qd|^2 ~ 1, so a missing
+    term cannot hide under the tolerance."""
+    robot = robodyn.load(robot_path(name), **({"G3": -9.81} if floating else {}))
+    rng = np.random.default_rng(26)
+    q = rng.uniform(-1, 1, robot.nq)
+    if floating:
+        q[3:7] /= np.linalg.norm(q[3:7])
+    qd = rng.uniform(-1, 1, robot.nv)
+    h = 1e-5
+    at = (lambda t: robot.integrate(q, qd, t)) if floating else (lambda t: q + t * qd)
+    for frame in robot.frame_names[1:]:
+        for ref in ("world", "local", "local_world_aligned"):
+            dj = robot.jacobian_time_variation(q, qd, frame, ref)
+            assert dj.shape == (6, robot.nv)
+            fd = (robot.jacobian(at(h), frame, ref) - robot.jacobian(at(-h), frame, ref)) / (2 * h)
+            np.testing.assert_allclose(dj, fd, rtol=0, atol=1e-7 * max(1.0, np.abs(fd).max()),
+                                       err_msg=f"{name} {frame} {ref}")
+    batch = robot.jacobian_time_variation(np.array([q, q]), np.array([qd, 2 * qd]), robot.frame_names[-1])
+    np.testing.assert_allclose(batch[1], 2 * batch[0], rtol=1e-12, atol=1e-14)

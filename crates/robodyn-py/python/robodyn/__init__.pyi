@@ -257,6 +257,10 @@ class Robot:
         "local_world_aligned" (Pinocchio's WORLD, LOCAL, LOCAL_WORLD_ALIGNED). Rows [linear;
         angular]: shape (6, nq) for q of shape (nq,), (N, 6, nq) for (N, nq). An unknown
         reference raises ValueError. out: as for idm."""
+    def jacobian_time_variation(self, q: ArrayLike, qd: ArrayLike, frame: str, reference: str = "world", *, out: Optional[Array] = None) -> Array:
+        """Time variation dJ/dt of the frame's Jacobian in `reference` (as jacobian) at q, qd
+        (Pinocchio's getFrameJacobianTimeVariation): J̇ qd + J qdd is the frame's acceleration in
+        that reference. Shape (6, nv) for one state, (N, 6, nv) for N states."""
     def frame_velocity(self, q: ArrayLike, qd: ArrayLike, frame: str, reference: str = "world", *, out: Optional[Array] = None) -> Array:
         """Velocity [linear; angular] (m/s, rad/s) of the frame named ``frame`` in ``reference``
         (as jacobian), J(q) qd: shape (6,) for one state, (N, 6) for N states (N, nq). out: as
