@@ -19,11 +19,18 @@ use super::transform_of;
 use crate::error::{Error, Result};
 use crate::geometry::Transform;
 use crate::model::Robot;
-use nalgebra::{Matrix3, Matrix4, Vector3};
+use nalgebra::{Matrix3, Matrix3x2, Matrix4, SMatrix, Vector3};
+use std::f64::consts::{FRAC_PI_2, PI};
 
 /// Relative tolerance of the class detection (parallel axes, concurrent axes) and of the
 /// singularity markers (a root whose equation's discriminant is within it of zero).
 pub const CLOSED_FORM_TOLERANCE: f64 = 1e-9;
+
+/// Largest error (rotation entries; lengths relative to the chain's scale) with which the
+/// wrist's mirror identity must hold for the second wrist solution to be found as the mirror
+/// of the first (`mirror_holds`): the orientation error it brings, well within the 1e-10 the
+/// tests ask of every solution.
+const MIRROR_TOLERANCE: f64 = 1e-13;
 
 /// The class of 6R chain the closed form solves, found from its axes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -149,6 +156,17 @@ impl Angle {
         Matrix3::from_rows(&[
             x * self.c - y * self.s,
             x * self.s + y * self.c,
+            m.row(2).into_owned(),
+        ])
+    }
+
+    /// Rz(theta)^T m for a 3-row m (rows [c x + s y, c y - s x, z] for its rows x, y, z).
+    #[inline]
+    fn left_tr_of<const C: usize>(&self, m: &SMatrix<f64, 3, C>) -> SMatrix<f64, 3, C> {
+        let (x, y) = (m.row(0), m.row(1));
+        SMatrix::<f64, 3, C>::from_rows(&[
+            x * self.c + y * self.s,
+            y * self.c - x * self.s,
             m.row(2).into_owned(),
         ])
     }
@@ -309,6 +327,9 @@ pub struct ClosedFormIgm {
     g: Vector3<f64>,
     p6: Vector3<f64>,
     wrist: DotEquation,
+    /// Whether the spherical wrist's second solution is the mirror (theta4 + pi, -theta5,
+    /// theta6 + pi) of the first (`mirror_holds`).
+    mirror: bool,
 }
 
 /// A geometric line: a point and a unit direction.
@@ -430,6 +451,7 @@ impl ClosedFormIgm {
             arm: DotEquation::new(&c2.rot.tr_mul(&c2.pos), &point3),
             point3,
             wrist: DotEquation::new(&g, &p6),
+            mirror: class == IgmClass::SphericalWrist && mirror_holds(&c4.rot, &chain.c[5].rot),
             g,
             p6,
             chain,
@@ -514,12 +536,22 @@ impl ClosedFormIgm {
         }))
     }
 
-    /// The rotation of A3 C3 = Rz(theta1) C1 Rz(theta2) C2 Rz(theta3) C3 (C0 removed): the
-    /// axes of the wrist's first frame.
-    fn a3c3(&self, th: &[Angle; 3]) -> Matrix3<f64> {
+    /// (A3 C3)_r^T M from m1 = C1_r^T Rz(theta1)^T M (shared by the branches of theta1), for
+    /// the columns of M needed: C3_r^T Rz(theta3)^T C2_r^T Rz(theta2)^T m1.
+    fn a3c3_tr<const C: usize>(
+        &self,
+        th2: &Angle,
+        th3: &Angle,
+        m1: &SMatrix<f64, 3, C>,
+    ) -> SMatrix<f64, 3, C> {
         let c = &self.chain.c;
-        let r = th[1].right_of(&th[0].left_of(&c[1].rot));
-        th[2].right_of(&(r * c[2].rot)) * c[3].rot
+        let m2 = c[2].rot.tr_mul(&th2.left_tr_of(m1));
+        c[3].rot.tr_mul(&th3.left_tr_of(&m2))
+    }
+
+    /// C1_r^T Rz(theta1)^T M: the part of (A3 C3)_r^T M shared by the branches of theta1.
+    fn m1<const C: usize>(&self, th1: &Angle, m: &SMatrix<f64, 3, C>) -> SMatrix<f64, 3, C> {
+        self.chain.c[1].rot.tr_mul(&th1.left_tr_of(m))
     }
 
     fn push(&self, th: &[f64; 6], singular: Singularity, out: &mut IgmSolutions) {
@@ -537,54 +569,93 @@ impl ClosedFormIgm {
         });
     }
 
+    /// The spherical wrist: the wrist centre gives theta1 and the planar arm (theta2,
+    /// theta3), each arm branch the orientation R left to the wrist.
     fn spherical(&self, m: &Transform, out: &mut IgmSolutions) {
         let c_m = m.rot * self.point6 + m.pos;
         let Some((t1, shoulder)) = self.theta1(&c_m) else {
             return;
         };
-        let (c4, c5) = (&self.chain.c[4], &self.chain.c[5]);
+        // the wrist needs the first and last columns of R = (A3 C3)_r^T M_r
+        let m_xz = Matrix3x2::from_columns(&[m.rot.column(0), m.rot.column(2)]);
         for th1 in t1 {
             let Some(arm) = self.planar(&th1, &c_m) else {
                 continue;
             };
+            let m1 = self.m1(&th1, &m_xz);
             for (th2, th3, s) in arm {
-                // R = (A3 C3)^T M = Rz(theta4) C4 Rz(theta5) C5 Rz(theta6)
-                let r = self.a3c3(&[th1, th2, th3]).tr_mul(&m.rot);
-                let b: Vector3<f64> = r.column(2).into();
-                let Some((t5, _)) =
-                    roots_or(self.wrist.roots(b.z, CLOSED_FORM_TOLERANCE), self.free[4])
-                else {
-                    continue;
+                // R = Rz(theta4) C4 Rz(theta5) C5 Rz(theta6): its columns x and z
+                let r = self.a3c3_tr(&th2, &th3, &m1);
+                let singular = Singularity {
+                    shoulder: shoulder || s.shoulder,
+                    ..s
                 };
-                for th5 in t5 {
-                    let c4r5 = th5.right_of(&c4.rot);
-                    let m5 = c4r5 * self.p6;
-                    let th4 = angle_between(&m5, &b, CLOSED_FORM_TOLERANCE);
-                    let wrist = th4.is_none();
-                    let th4 = th4.unwrap_or(self.free[3]);
-                    // Rz(theta6) = Q^T R, Q = Rz(theta4) C4 Rz(theta5) C5: its first column
-                    // (Q^T r0 = C5^T (C4 Rz5)^T Rz4^T r0)
-                    let r0 = r.column(0);
-                    let u = c4r5.tr_mul(&th4.unturn(&r0.into_owned()));
-                    let th6 = atan2(c5.rot.column(1).dot(&u), c5.rot.column(0).dot(&u));
-                    let singular = Singularity {
-                        shoulder: shoulder || s.shoulder,
-                        elbow: s.elbow,
-                        wrist,
-                    };
-                    let th = [th1.th, th2.th, th3.th, th4.th, th5.th, th6];
-                    self.push(&th, singular, out);
-                }
+                self.spherical_wrist(&[th1.th, th2.th, th3.th], &r, singular, out);
             }
         }
     }
 
+    /// The two wrist solutions of R = Rz(theta4) C4 Rz(theta5) C5 Rz(theta6) for one arm
+    /// branch: theta5 (type 2), theta4 and theta6 (atan2) per root; the second one as the
+    /// mirror of the first when [`Self::mirror`] holds and the wrist is not singular.
+    fn spherical_wrist(
+        &self,
+        arm: &[f64; 3],
+        r: &Matrix3x2<f64>,
+        s: Singularity,
+        out: &mut IgmSolutions,
+    ) {
+        let (r0, b): (Vector3<f64>, Vector3<f64>) = (r.column(0).into(), r.column(1).into());
+        let Some((t5, double)) =
+            roots_or(self.wrist.roots(b.z, CLOSED_FORM_TOLERANCE), self.free[4])
+        else {
+            return;
+        };
+        let [a1, a2, a3] = *arm;
+        let (first, wrist) = self.wrist_angles(&r0, &b, &t5[0]);
+        let [th4, th5, th6] = first;
+        self.push(
+            &[a1, a2, a3, th4, th5, th6],
+            Singularity { wrist, ..s },
+            out,
+        );
+        let (second, wrist) = if self.mirror && !double && !wrist {
+            ([th4 + PI, -th5, th6 + PI], false)
+        } else {
+            self.wrist_angles(&r0, &b, &t5[1])
+        };
+        let [th4, th5, th6] = second;
+        self.push(
+            &[a1, a2, a3, th4, th5, th6],
+            Singularity { wrist, ..s },
+            out,
+        );
+    }
+
+    /// theta4 and theta6 of R for one theta5 root (r0 = R e_x, b = R e_z), and whether the
+    /// wrist is singular (axes 4 and 6 aligned: theta4 its representative value).
+    fn wrist_angles(&self, r0: &Vector3<f64>, b: &Vector3<f64>, th5: &Angle) -> ([f64; 3], bool) {
+        let (c4, c5) = (&self.chain.c[4], &self.chain.c[5]);
+        let c4r5 = th5.right_of(&c4.rot);
+        let m5 = c4r5 * self.p6;
+        let th4 = angle_between(&m5, b, CLOSED_FORM_TOLERANCE);
+        let wrist = th4.is_none();
+        let th4 = th4.unwrap_or(self.free[3]);
+        // Rz(theta6) = Q^T R, Q = Rz(theta4) C4 Rz(theta5) C5: its first column
+        // (Q^T r0 = C5^T (C4 Rz5)^T Rz4^T r0)
+        let u = c4r5.tr_mul(&th4.unturn(r0));
+        let th6 = atan2(c5.rot.column(1).dot(&u), c5.rot.column(0).dot(&u));
+        ([th4.th, th5.th, th6], wrist)
+    }
+
+    /// The offset wrist: W gives theta1, then per theta1 the direction of axis 6 theta5 (two
+    /// roots), each root a branch. (The wrist mirror does not serve here: it moves W, which
+    /// is off axis 4, and so the planar arm.)
     fn offset(&self, m: &Transform, out: &mut IgmSolutions) {
         let w_m = m.rot * self.point6 + m.pos;
         let Some((t1, shoulder)) = self.theta1(&w_m) else {
             return;
         };
-        let (c4, c5) = (&self.chain.c[4], &self.chain.c[5]);
         let z6: Vector3<f64> = m.rot.column(2).into();
         for th1 in t1 {
             let z2 = th1.turn(&self.u2);
@@ -595,36 +666,86 @@ impl ClosedFormIgm {
             ) else {
                 continue;
             };
-            // axis 2 seen from frame 6: Rz(theta6) n = m6
-            let n = m.rot.tr_mul(&z2);
             for th5 in t5 {
-                let m6 = c5.rot.tr_mul(&th5.unturn(&self.g));
-                let th6 = angle_between(&n, &m6, CLOSED_FORM_TOLERANCE);
-                let wrist = th6.is_none();
-                let th6 = th6.unwrap_or(self.free[5]);
-                // A4 = M (C4 Rz5 C5 Rz6)^-1
-                let tail = Transform {
-                    rot: th6.right_of(&(th5.right_of(&c4.rot) * c5.rot)),
-                    pos: c4.pos + th5.right_of(&c4.rot) * c5.pos,
-                };
-                let a4 = m.compose(&tail.inverse());
-                let Some(arm) = self.planar(&th1, &a4.pos) else {
-                    continue;
-                };
-                for (th2, th3, s) in arm {
-                    let n4 = self.a3c3(&[th1, th2, th3]).tr_mul(&a4.rot);
-                    let th4 = atan2(n4[(1, 0)], n4[(0, 0)]);
-                    let singular = Singularity {
-                        shoulder: shoulder || s.shoulder,
-                        elbow: s.elbow,
-                        wrist,
-                    };
-                    let th = [th1.th, th2.th, th3.th, th4, th5.th, th6.th];
-                    self.push(&th, singular, out);
+                let b = self.offset_branch(m, &th1, &z2, &th5, shoulder);
+                for (th, singular) in &b.items[..b.len] {
+                    self.push(th, *singular, out);
                 }
             }
         }
     }
+
+    /// The solutions of one (theta1, theta5) branch of the offset wrist: theta6 from the
+    /// direction of axis 2 seen from frame 6, then A4 and the planar arm.
+    fn offset_branch(
+        &self,
+        m: &Transform,
+        th1: &Angle,
+        z2: &Vector3<f64>,
+        th5: &Angle,
+        shoulder: bool,
+    ) -> OffsetBranch {
+        let (c4, c5) = (&self.chain.c[4], &self.chain.c[5]);
+        let mut branch = OffsetBranch::default();
+        // axis 2 seen from frame 6: Rz(theta6) n = m6
+        let n = m.rot.tr_mul(z2);
+        let m6 = c5.rot.tr_mul(&th5.unturn(&self.g));
+        let th6 = angle_between(&n, &m6, CLOSED_FORM_TOLERANCE);
+        let wrist = th6.is_none();
+        let th6 = th6.unwrap_or(self.free[5]);
+        // A4 = M (C4 Rz5 C5 Rz6)^-1
+        let c4r5 = th5.right_of(&c4.rot);
+        let tail = Transform {
+            rot: th6.right_of(&(c4r5 * c5.rot)),
+            pos: c4.pos + c4r5 * c5.pos,
+        };
+        let a4 = m.compose(&tail.inverse());
+        let Some(arm) = self.planar(th1, &a4.pos) else {
+            return branch;
+        };
+        // Rz(theta4) = (A3 C3)_r^T (A4)_r: its first column
+        let m1 = self.m1(th1, &a4.rot.column(0).into_owned());
+        for (th2, th3, s) in arm {
+            let n4 = self.a3c3_tr(&th2, &th3, &m1);
+            let th4 = atan2(n4.y, n4.x);
+            let singular = Singularity {
+                shoulder: shoulder || s.shoulder,
+                elbow: s.elbow,
+                wrist,
+            };
+            branch.items[branch.len] = ([th1.th, th2.th, th3.th, th4, th5.th, th6.th], singular);
+            branch.len += 1;
+        }
+        branch
+    }
+}
+
+/// The solutions of one (theta1, theta5) branch of the offset wrist (0 or 2).
+#[derive(Clone, Copy, Default)]
+struct OffsetBranch {
+    items: [([f64; 6], Singularity); 2],
+    len: usize,
+}
+
+/// Whether the spherical wrist's second solution is the mirror of the first: (theta4 + pi,
+/// -theta5, theta6 + pi) gives link 6 the orientation (theta4, theta5, theta6) gives it, i.e.
+/// Rz(pi) W(-t) Rz(pi) = W(t) for W(t) = C4r Rz(t) C5r and every t (the wrist centre does not
+/// move). W is affine in (cos t, sin t), so t = 0, pi/2, pi prove it. It holds exactly for
+/// alpha5, alpha6 = ±pi/2 and gamma6 = 0 or pi, not for other wrists, which are solved root
+/// by root; [`MIRROR_TOLERANCE`] bounds the mirror's orientation error.
+fn mirror_holds(c4: &Matrix3<f64>, c5: &Matrix3<f64>) -> bool {
+    let half = Angle {
+        th: PI,
+        c: -1.0,
+        s: 0.0,
+    };
+    let w = |t: &Angle| t.right_of(c4) * c5;
+    [(0.0, 1.0, 0.0), (FRAC_PI_2, 0.0, 1.0), (PI, -1.0, 0.0)]
+        .iter()
+        .all(|&(th, c, s)| {
+            let mirrored = half.left_of(&half.right_of(&w(&Angle { th: -th, c, s: -s })));
+            (mirrored - w(&Angle { th, c, s })).amax() <= MIRROR_TOLERANCE
+        })
 }
 
 fn no_class(robot: &Robot, why: &str) -> Error {
