@@ -285,7 +285,7 @@ fn wrong_states_and_other_commands_are_refused_clearly() {
         vec!["jacobian", rx.as_str(), "--frame", "6"],
         vec!["com", rx.as_str()],
         vec!["base-params", rx.as_str()],
-        vec!["generate", rx.as_str()],
+        vec!["generate", rx.as_str(), "--model", "inertia"],
     ] {
         let e = fail(&args);
         assert!(e.contains("floating base"), "{args:?}: {e}");
