@@ -39,6 +39,8 @@ mod cli_gains_payload;
 mod cli_generate;
 #[path = "cli_generate_derivatives.rs"]
 mod cli_generate_derivatives;
+#[path = "cli_generate_floating.rs"]
+mod cli_generate_floating;
 #[path = "cli_generate_names.rs"]
 mod cli_generate_names;
 #[path = "cli_identify.rs"]

@@ -282,7 +282,7 @@ fn wrong_states_and_other_commands_are_refused_clearly() {
     // commands without floating support say so (never a fixed-base answer)
     for args in [
         vec!["base-params", rx.as_str()],
-        vec!["generate", rx.as_str()],
+        vec!["generate", rx.as_str(), "--model", "inertia"],
     ] {
         let e = fail(&args);
         assert!(e.contains("floating base"), "{args:?}: {e}");

@@ -9,7 +9,7 @@ use common::{octave_available, octave_eval, robot, run, tmp};
 use std::process::Command;
 
 /// Run a generated Python function `name` with the given argument vectors; its outputs.
-fn run_python(file: &std::path::Path, name: &str, args: &[Vec<f64>]) -> Vec<f64> {
+pub(crate) fn run_python(file: &std::path::Path, name: &str, args: &[Vec<f64>]) -> Vec<f64> {
     let list: Vec<String> = args
         .iter()
         .map(|a| {

@@ -1096,7 +1096,9 @@ impl Robot {
         crate::models::base_parameters(py, self, method, friction, rotor, zeros, seed)
     }
 
-    /// Customized symbolic model as code with its operation counts.
+    /// Customized symbolic model as code with its operation counts. On a floating robot the
+    /// model is "idm" only: inputs q (nq), qd, qdd (nv), outputs the base wrench (force, moment
+    /// about O_0, in the base frame) then the joint torques.
     #[pyo3(signature = (model="idm", lang="python", params="standard", symmetric=false, friction=true, rotor=true, numeric=false, name=None))]
     #[allow(clippy::too_many_arguments)]
     fn generate(
@@ -1111,7 +1113,6 @@ impl Robot {
         numeric: bool,
         name: Option<String>,
     ) -> PyResult<crate::models::Generated> {
-        fixed_base_only(&self.model(), "Robot.generate")?;
         crate::models::generate(
             py,
             &self.model(),

@@ -203,7 +203,6 @@ def test_state_sizes_and_names():
         (lambda r, q: r.regressor(q), "Robot.regressor"),
         (lambda r, q: r.idm_derivatives(q), "Robot.idm_derivatives"),
         (lambda r, q: r.ddm_derivatives(q), "Robot.ddm_derivatives"),
-        (lambda r, q: r.generate(), "Robot.generate"),
     ],
 )
 def test_functions_without_floating_support_say_so(call, name):
@@ -376,3 +375,36 @@ def test_simulate_floating_torque_shapes_and_an_applied_base_force():
         robot.simulate(0.1, torque=np.zeros(7))
     with pytest.raises(robodyn.DimensionError, match="callback returned 3 values"):
         robot.simulate(0.1, torque=lambda t, q, qd: np.zeros(3))
+
+
+def random_floating_state(robot, rng):
+    q = rng.uniform(-2.0, 2.0, robot.nq)
+    quat = rng.normal(size=4)
+    q[3:7] = quat / np.linalg.norm(quat)
+    return q, rng.uniform(-2.0, 2.0, robot.nv), rng.uniform(-5.0, 5.0, robot.nv)
+
+
+def test_generated_floating_idm_equals_idm():
+    """Robot.generate on a floating robot: the customized inverse dynamic model with the base
+    as the root, q (nq), qd, qdd (nv) in, the base wrench then the joint torques out; the
+    generated Python against the library's idm (numeric and with the parameters by name). The
+    other models refuse a floating robot, naming the one generated."""
+    robot = rx90float()
+    rng = np.random.default_rng(27)
+    g = robot.generate(model="idm", lang="python", numeric=True, name="gen_fidm")
+    assert g.multiplications > 0 and g.parameters == []
+    ns = {}
+    exec(compile(g.code, "<generated>", "exec"), ns)
+    s = robot.generate(model="idm", lang="python", name="gen_fsym")
+    assert ("M0", 20.0) in s.parameters  # link 0, the base body
+    exec(compile(s.code, "<generated>", "exec"), ns)
+    for _ in range(5):
+        q, v, a = random_floating_state(robot, rng)
+        want = robot.idm(q, v, a)
+        assert want.shape == (robot.nv,)
+        for out in (ns["gen_fidm"](q, v, a), ns["gen_fsym"](q, v, a, dict(s.parameters))):
+            out = np.asarray(out, dtype=float).reshape(-1)
+            np.testing.assert_allclose(out, want, rtol=0, atol=1e-10 * max(1.0, np.abs(want).max()))
+    for model in ["inertia", "h", "ddm", "idm_derivatives"]:
+        with pytest.raises(robodyn.InputError, match="floating base"):
+            robot.generate(model=model)

@@ -43,6 +43,8 @@ mod codegen_counts;
 mod codegen_derivatives;
 #[path = "codegen_errors.rs"]
 mod codegen_errors;
+#[path = "codegen_floating.rs"]
+mod codegen_floating;
 #[path = "codegen_kinematics.rs"]
 mod codegen_kinematics;
 #[path = "codegen_latex.rs"]

@@ -17,7 +17,8 @@
 //! ones as their equivalent trees, and as closed chains), a slider-crank with a prismatic cut
 //! joint, three random trees, and the SCARA with symbols named `end`, `p`, `in`, `out`; and the
 //! DGM and Jacobian programs of `codegen_kinematics.rs` (against `frame_transforms` and the
-//! derivative of the numeric DGM, to 1e-12).
+//! derivative of the numeric DGM, to 1e-12); and the floating-base inverse dynamic models of
+//! `codegen_floating.rs` (against the numeric `inverse_dynamics` of the floating robot).
 //!
 //! Every program is compiled (rustc, cc) into a harness that reads inputs on stdin and prints the
 //! outputs; tolerance 1e-10 relative (norm-wise over each output vector).
@@ -384,6 +385,17 @@ fn all_cases() -> Vec<Case> {
     // the derivatives of the IDM: see codegen_derivatives.rs
     cases.extend(
         crate::codegen_derivatives::derivative_cases()
+            .into_iter()
+            .map(|c| Case {
+                prog: c.prog,
+                inputs: c.inputs,
+                expected: c.expected,
+                what: c.what,
+            }),
+    );
+    // the inverse dynamic model of floating-base robots: see codegen_floating.rs
+    cases.extend(
+        crate::codegen_floating::floating_cases()
             .into_iter()
             .map(|c| Case {
                 prog: c.prog,

@@ -214,7 +214,11 @@ fn floating_states_are_checked_and_unsupported_functions_refuse() {
     .unwrap_err()
     .to_string();
     assert!(e.contains("nq = 7 + "), "{e}");
-    let opt = robodyn::codegen::GenOptions::default();
+    // the generator writes the floating idm (codegen_floating.rs), and refuses the other models
+    let opt = robodyn::codegen::GenOptions {
+        model: robodyn::codegen::ModelKind::Inertia,
+        ..Default::default()
+    };
     let e = robodyn::codegen::generate(robot.description(), &opt)
         .unwrap_err()
         .to_string();

@@ -47,6 +47,14 @@ pub struct Args {
     /// Give or override a symbol value, e.g. `--set d3=0.6` (repeatable).
     #[arg(long = "set", value_name = "NAME=VALUE")]
     pub set: Vec<String>,
+    /// Make a URDF's root link the floating base (a free-flyer root, Pinocchio's
+    /// `JointModelFreeFlyer`; a .toml or .par file says it itself: `base = "floating"`,
+    /// `is_floating = 1`). A floating robot's generated model is `--model idm` only: inputs q
+    /// (nq = 7 + N: base position, quaternion x y z w, joints), qd and qdd (nv = 6 + N: the base
+    /// twist in the base frame and its derivative, joints); outputs the base wrench (force,
+    /// moment about O_0, in the base frame) then the joint torques.
+    #[arg(long)]
+    pub floating: bool,
     /// The model to generate.
     #[arg(long, value_enum, default_value = "idm")]
     pub model: Model,
@@ -161,7 +169,7 @@ pub fn run(a: Args) -> CliResult {
     let rargs = crate::common::RobotArgs {
         robot: a.robot.clone(),
         set: a.set.clone(),
-        floating: false,
+        floating: a.floating,
     };
     let (desc, _) = rargs.description()?;
     // a literal 0 in a SYMORO .par: the parameter does not exist (as in base-params, regressor)

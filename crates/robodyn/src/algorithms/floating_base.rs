@@ -22,11 +22,13 @@ use crate::algorithms::direct_dynamics::{
 };
 use crate::algorithms::inertia_matrix::{composite_inertia_matrix, transport};
 use crate::algorithms::inverse_dynamics::{
-    backward_recursion, folded_wrench, forward_links, set_base_motion,
+    backward_recursion, euler_moment, folded_wrench, forward_links, name3, set_base_motion,
+    w_products,
 };
 use crate::data::Data;
 use crate::error::{check_finite_matrix, check_finite_result, check_vector, Error, Result};
-use crate::model::{FloatingBase, Robot, QUATERNION_TOLERANCE};
+use crate::model::{DynModel, Environment, FloatingBase, Robot, QUATERNION_TOLERANCE};
+use crate::scalar::DynScalar;
 use nalgebra::{DMatrix, Matrix3, Matrix6, Quaternion, UnitQuaternion, Vector3, Vector6};
 
 /// The floating base of a robot that has one.
@@ -127,45 +129,91 @@ fn newton_euler(
     a: &[f64],
     tau: &mut [f64],
 ) {
-    let model = robot.dynamic();
+    let (model, base) = (robot.dynamic(), base_of(robot));
+    floating_rnea(model, base, env, data, rot, &q[7..], v, a, tau);
+}
+
+/// Newton–Euler of a floating robot with the base as the root, on any scalar (the numeric
+/// robot's `f64`, the customized symbolic model's `Expr`), unchecked: the nv generalized forces
+/// into `tau` (the base wrench, force then moment about O_0, in R_0; then the joint torques) for
+/// the base orientation `rot` = wR_0, the joint positions `qj` (the N movable joints: tree
+/// arrays of the folded `model`, [`DynModel::fold_fixed`]), the velocities `v` and the
+/// accelerations `a` (nv each, Pinocchio's free-flyer convention). `base` is the base body of
+/// the unfolded model ([`FloatingBase::new`]).
+///
+/// Steps: the root motion [w_0, wd_0, Vd_0 - R' g] with Vd_0 = a_0 + w_0 x v_0 (the classical
+/// acceleration of O_0); the fixed base's forward and backward recursions from that root; the
+/// base wrench, link 0's own Newton–Euler wrench (eqs 10.7–10.8 at link 0, with the external
+/// wrenches of the links fixed on it) plus what its children transmit (eqs 10.10–10.11).
+/// In the symbolic model the base's quantities are named `G<c>0` (R' g), `VP<c>0` (Vd_0 - R' g),
+/// `U<r><c>0`, `F<c>0`, `No<c>0` (link 0's own wrench), `FDI<c><j>`, `NDI<c><j>` (from child j).
+///
+/// # Panics
+/// If a slice is shorter than stated or `ws` was made for a smaller model.
+#[allow(clippy::too_many_arguments)]
+pub fn floating_rnea<T: DynScalar>(
+    model: &DynModel<T>,
+    base: &FloatingBase<T>,
+    env: &Environment<T>,
+    ws: &mut Data<T>,
+    rot: &Matrix3<T>,
+    qj: &[T],
+    v: &[T],
+    a: &[T],
+    tau: &mut [T],
+) {
+    let v3 = |x: &[T]| Vector3::new(x[0].clone(), x[1].clone(), x[2].clone());
     let (lin, w) = (v3(&v[0..3]), v3(&v[3..6]));
     let (alin, wd) = (v3(&a[0..3]), v3(&a[3..6]));
     // the classical acceleration of O_0 minus gravity, in R_0
-    let vd0 = alin + w.cross(&lin) - rot.tr_mul(&env.gravity);
-    set_base_motion(data, w, wd, vd0);
-    forward_links(model, env, data, &q[7..], &v[6..], &a[6..], &[]);
-    backward_recursion(model, data, &v[6..], &a[6..], &mut tau[6..]);
-    let (f, m) = base_wrench(robot, data, env);
-    tau[..3].copy_from_slice(f.as_slice());
-    tau[3..6].copy_from_slice(m.as_slice());
+    let g0 = name3(rot.tr_mul(&env.gravity), "G", 0);
+    let vd0 = name3(alin + w.cross(&lin) - g0, "VP", 0);
+    set_base_motion(ws, w, wd, vd0);
+    forward_links(model, env, ws, qj, &v[6..], &a[6..], &[]);
+    backward_recursion(model, ws, &v[6..], &a[6..], &mut tau[6..]);
+    let (f, m) = base_wrench(model, base, env, ws);
+    let [[f0, f1, f2]] = f.data.0;
+    let [[m0, m1, m2]] = m.data.0;
+    for (t, x) in tau.iter_mut().zip([f0, f1, f2, m0, m1, m2]) {
+        *t = x;
+    }
 }
 
 /// The wrench the base needs after the recursion: its own body's Newton–Euler wrench
-/// (eqs 10.7–10.8 at link 0, with the external wrenches of the links fixed on it) plus the
-/// wrenches its children exert on it (eqs 10.10–10.11).
-fn base_wrench(
-    robot: &Robot,
-    data: &Data,
-    env: &crate::Environment,
-) -> (Vector3<f64>, Vector3<f64>) {
-    let base = base_of(robot);
+/// (eqs 10.7–10.8 at link 0 in the product form of the links, with the external wrenches of the
+/// links fixed on it) plus the wrenches its children exert on it (eqs 10.10–10.11).
+fn base_wrench<T: DynScalar>(
+    model: &DynModel<T>,
+    base: &FloatingBase<T>,
+    env: &Environment<T>,
+    ws: &Data<T>,
+) -> (Vector3<T>, Vector3<T>) {
     let l = &base.body;
-    let (w, wd, vd) = (data.w[0], data.wd[0], data.vd[0]);
-    let mut f = vd * l.mass + wd.cross(&l.ms) + w.cross(&w.cross(&l.ms));
-    let mut m = l.inertia * wd + w.cross(&(l.inertia * w)) + l.ms.cross(&vd);
+    let (w, wd, vd, u) = (&ws.w[0], &ws.wd[0], &ws.vd[0], &ws.u[0]);
+    let (p, sq) = w_products(w);
+    let f = vd * l.mass.clone() + u * &l.ms;
+    let m = euler_moment(&l.inertia, &l.inertia_diff, wd, &p, &sq, u) + l.ms.cross(vd);
+    let (mut f, mut m) = (name3(f, "F", 0), name3(m, "No", 0));
     for fl in &base.attached {
         if let Some((fh, mh)) = folded_wrench(fl, env) {
             f += fh;
             m += mh;
         }
     }
-    let model = robot.dynamic();
     for j in 1..=model.nl {
-        if model.frame(j).ant == 0 {
-            let fi = data.rot[j] * data.f[j];
-            m += data.rot[j] * data.m[j] + data.pos[j].cross(&fi);
-            f += fi;
+        let fr = model.frame(j);
+        if fr.ant != 0 {
+            continue;
         }
+        let n = if T::NAMED { model.wrench_link(j) } else { j };
+        let fi = name3(fr.rot_mul(&ws.rot[j], &ws.f[j]), "FDI", n);
+        let mi = name3(
+            fr.rot_mul(&ws.rot[j], &ws.m[j]) + ws.pos[j].cross(&fi),
+            "NDI",
+            n,
+        );
+        f += fi;
+        m += mi;
     }
     (f, m)
 }

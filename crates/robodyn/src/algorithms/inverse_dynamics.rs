@@ -27,7 +27,7 @@ fn cross_z<T: DynScalar>(w: &Vector3<T>, s: &T) -> Vector3<T> {
 /// Naming hook of the customized symbolic model: component c of vector `v` of link j becomes
 /// `<prefix><c><j>` (SYMORO's `WI12`, `VP32`...). A no-op for `f64` (`T::NAMED` is false).
 #[inline(always)]
-fn name3<T: DynScalar>(v: Vector3<T>, prefix: &str, j: usize) -> Vector3<T> {
+pub(crate) fn name3<T: DynScalar>(v: Vector3<T>, prefix: &str, j: usize) -> Vector3<T> {
     if !T::NAMED {
         return v;
     }
@@ -42,7 +42,7 @@ fn name3<T: DynScalar>(v: Vector3<T>, prefix: &str, j: usize) -> Vector3<T> {
 /// Products of the components of w: (w_y w_z, w_x w_z, w_x w_y) and (w_x^2, w_y^2, w_z^2).
 /// Shared by jU_j and the Euler moment; the customized model names them `T<k>` when shared.
 #[inline]
-fn w_products<T: DynScalar>(w: &Vector3<T>) -> (Vector3<T>, Vector3<T>) {
+pub(crate) fn w_products<T: DynScalar>(w: &Vector3<T>) -> (Vector3<T>, Vector3<T>) {
     let (x, y, z) = (w.x.clone(), w.y.clone(), w.z.clone());
     (
         Vector3::new(
@@ -97,7 +97,7 @@ fn u_matrix<T: DynScalar>(
 /// w_y^2 - w_z^2 is a difference of the squares `sq`. Fifteen multiplications instead of the 24
 /// of J wd + w x (J w); with base parameters (YY = 0) the differences of moments mostly vanish.
 #[inline]
-fn euler_moment<T: DynScalar>(
+pub(crate) fn euler_moment<T: DynScalar>(
     inertia: &Matrix3<T>,
     diff: &Vector3<T>,
     wd: &Vector3<T>,

@@ -16,6 +16,7 @@
 
 mod closed;
 mod derivatives;
+mod floating;
 mod geometric;
 mod linear;
 mod parallel_links;
@@ -23,6 +24,7 @@ mod parallel_links;
 pub use closed::constant_g;
 use closed::{closed_form, closed_torques, closed_w, ClosedForm};
 pub use derivatives::BLOCKS as DERIVATIVE_BLOCKS;
+pub use floating::{BASE_ACCELERATION, BASE_QUATERNION, BASE_VELOCITY, BASE_WRENCH};
 pub use geometric::{Frames, DGM_OUTPUTS};
 pub use parallel_links::parallel_links;
 
@@ -33,7 +35,7 @@ use crate::algorithms::inverse_dynamics::{
 use crate::algorithms::regressor::ZeroParameters;
 use crate::data::Data;
 use crate::error::{Error, Item, Result};
-use crate::model::{DynModel, RobotDescription, STANDARD_PARAMETERS};
+use crate::model::{DynModel, FloatingBase, RobotDescription, STANDARD_PARAMETERS};
 use crate::scalar::DynScalar as _;
 use nalgebra::DMatrix;
 use robodyn_symbolic::program::{name_value, record};
@@ -176,7 +178,9 @@ fn ident(s: &str) -> String {
 }
 
 /// The symbolic model: DynModel<Expr> with the options applied.
-fn symbolic_model(desc: &RobotDescription, opt: &GenOptions) -> Result<DynModel<Expr>> {
+/// The symbolic model and, for a floating base, link 0's 13 standard parameters (as the
+/// options make them: symbols, numbers, zeros).
+fn symbolic_model(desc: &RobotDescription, opt: &GenOptions) -> Result<SymbolicModel> {
     let env = |s: &str| desc.symbols.get(s).copied();
     // symbols replaced by their values, exact constants (pi/2) kept exact
     let numeric = |e: &Expr, item: &dyn Fn() -> Item| -> Result<Expr> {
@@ -209,7 +213,7 @@ fn symbolic_model(desc: &RobotDescription, opt: &GenOptions) -> Result<DynModel<
         }
     };
     let mut link_errors = Vec::new();
-    let link = |j: usize, k: usize, e: &Expr| -> Expr {
+    let mut link = |j: usize, k: usize, e: &Expr| -> Expr {
         if k >= 13 {
             // external wrench as given in the description
             return if opt.numeric {
@@ -266,12 +270,22 @@ fn symbolic_model(desc: &RobotDescription, opt: &GenOptions) -> Result<DynModel<
             Expr::symbol(full)
         }
     };
-    let model = DynModel::build(desc, &mut geo, link);
+    let model = DynModel::build(desc, &mut geo, &mut link);
+    let link0 = desc
+        .floating_base
+        .as_ref()
+        .map(|l| std::array::from_fn(|k| link(0, k, &l.params[k])));
     if let Some(e) = errors.into_iter().chain(link_errors).next() {
         return Err(e);
     }
-    Ok(model)
+    Ok((model, link0))
 }
+
+/// A symbolic model and its floating base's link 0 parameters.
+type SymbolicModel = (
+    DynModel<Expr>,
+    Option<[Expr; crate::model::PARAMS_PER_LINK]>,
+);
 
 /// Symmetric links (Table 10.3, simplified case): XY, XZ, YZ, MX, MY of every link are zero.
 fn symmetric_zeros(name: &str) -> Option<Expr> {
@@ -356,7 +370,7 @@ pub fn generate_with_progress(
     progress: &mut dyn FnMut(&str),
 ) -> Result<Program> {
     crate::model::validate_structure(desc)?;
-    crate::model::require_fixed_base(desc, "code generation")?;
+    floating::check(desc, opt)?;
     let geometric = matches!(
         opt.model,
         ModelKind::Dgm(_) | ModelKind::Jacobian(_) | ModelKind::W
@@ -365,7 +379,9 @@ pub fn generate_with_progress(
         desc.require_no_motor_drive_parameters("code generation with rotor inertia or friction")?;
     }
     progress("building the symbolic model");
-    let model = symbolic_model(desc, opt)?;
+    let (model, link0) = symbolic_model(desc, opt)?;
+    // a floating base's body: link 0 with the links fixed on it (before the folding drops them)
+    let base = link0.map(|p| FloatingBase::new(p, &model));
     let nl = desc.nl;
     let joints = desc.movable_joints();
     let closed = matches!(opt.model, ModelKind::Closed | ModelKind::W);
@@ -414,8 +430,12 @@ pub fn generate_with_progress(
         nl,
         joints.len()
     ));
-    let (outputs, assignments) = record(&reserved_names(desc, opt), || {
-        record_model(desc, &model, opt, &form, &shared)
+    let (outputs, assignments) = record(&reserved_names(desc, opt), || match &base {
+        Some(base) => {
+            let (q, qd, qdd) = joint_symbols(&model);
+            Ok(floating::record_idm(&model, base, &q, &qd, &qdd))
+        }
+        None => record_model(desc, &model, opt, &form, &shared),
     });
     let mut outputs = outputs?;
     let mut assignments = assignments;
@@ -427,6 +447,9 @@ pub fn generate_with_progress(
             derivatives::derivative_program(assignments, outputs, a_low, &frames);
     }
     let mut description = describe(desc, opt, kinematic);
+    if base.is_some() {
+        description.extend(floating::describe());
+    }
     if closed {
         description.extend(form.describe(nl));
     } else if desc.nj > desc.nl {
@@ -442,7 +465,11 @@ pub fn generate_with_progress(
             .clone()
             .unwrap_or_else(|| format!("{}_{}", ident(&desc.name), opt.model.name())),
         description,
-        inputs: joint_inputs(&joints, opt.model),
+        inputs: if base.is_some() {
+            floating::inputs(&joints)
+        } else {
+            joint_inputs(&joints, opt.model)
+        },
         assignments,
         outputs,
     };
@@ -481,6 +508,9 @@ fn reserved_names(desc: &RobotDescription, opt: &GenOptions) -> Vec<String> {
     if let Some(b) = &opt.base {
         reserved.extend(b.grouped.iter().map(|g| g.name.clone()));
     }
+    if desc.floating_base.is_some() {
+        reserved.extend(floating::reserved_names());
+    }
     reserved
 }
 
@@ -513,6 +543,16 @@ fn joint_inputs(joints: &[usize], model: ModelKind) -> Vec<InputGroup> {
     inputs
 }
 
+/// The joint symbols `q<j>`, `QP<j>`, `QDP<j>` of a model's tree arrays (j the frame number).
+fn joint_symbols(model: &DynModel<Expr>) -> (Vec<Expr>, Vec<Expr>, Vec<Expr>) {
+    let sym = |kind: &str| -> Vec<Expr> {
+        (1..=model.nl)
+            .map(|k| Expr::symbol(joint_symbol(kind, model.wrench_link(k))))
+            .collect()
+    };
+    (sym("q"), sym("QP"), sym("QDP"))
+}
+
 /// Run the model's recursions on symbols (inside a recording): its outputs. For the tree models
 /// `model` is folded (link k is the k-th movable joint); for the closed ones it has every frame
 /// (tree arrays indexed by frame number). Either way `wrench_link` gives the frame number.
@@ -526,10 +566,7 @@ fn record_model(
     let nl = model.nl;
     // frame number of tree-array entry k
     let frame = |k: usize| model.wrench_link(k + 1);
-    let sym = |kind: &str, k: usize| Expr::symbol(joint_symbol(kind, frame(k)));
-    let q: Vec<Expr> = (0..nl).map(|k| sym("q", k)).collect();
-    let qd: Vec<Expr> = (0..nl).map(|k| sym("QP", k)).collect();
-    let qdd: Vec<Expr> = (0..nl).map(|k| sym("QDP", k)).collect();
+    let (q, qd, qdd) = joint_symbols(model);
     let outputs = |prefix: &str, tau: &[Expr]| -> Vec<Assignment> {
         (0..nl)
             .filter(|&k| model.frame(k + 1).joint.is_movable())
@@ -660,8 +697,9 @@ fn add_parameter_inputs(prog: &mut Program) {
 
 /// The values of a program's parameters `p`, by name in the order of its header, from the
 /// robot description it was generated from (with the same options): the file's symbol values,
-/// the standard parameters (`XX3`: link 3's entry) and the grouped base parameters of
-/// `opt.base` (`XXR2`: its grouping expression over the standard parameters and the geometry).
+/// the standard parameters (`XX3`: link 3's entry; `XX0`: a floating base's link 0) and the
+/// grouped base parameters of `opt.base` (`XXR2`: its grouping expression over the standard
+/// parameters and the geometry).
 /// `None` for a parameter without a numeric value (a symbol the file leaves free). Empty for a
 /// program without parameters (`--numeric`).
 pub fn parameter_values(
@@ -673,7 +711,12 @@ pub fn parameter_values(
     let standard = |s: &str| -> Option<Expr> {
         let (p, j) = split_param(s)?;
         let k = STANDARD_PARAMETERS.iter().position(|&x| x == p)?;
-        Some(desc.links.get(j.checked_sub(1)?)?.params[k].clone())
+        // link 0: a floating base's body
+        let link = match j {
+            0 => desc.floating_base.as_ref()?,
+            j => desc.links.get(j - 1)?,
+        };
+        Some(link.params[k].clone())
     };
     let value = |name: &str| -> Option<f64> {
         if let Some(v) = symbol(name) {

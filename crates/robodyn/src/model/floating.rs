@@ -4,6 +4,7 @@
 //! free-flyer convention (docs/models/floating_base.md).
 
 use super::{inertia_to_antecedent, DynModel, FoldedLink, LinkConstants};
+use crate::scalar::DynScalar;
 use nalgebra::{Matrix3, Vector3};
 
 /// What moves the base.
@@ -60,59 +61,62 @@ pub fn require_fixed_base(desc: &super::RobotDescription, what: &str) -> crate::
     Ok(())
 }
 
-/// The numeric floating base: the body of link 0 with every link rigidly attached to it
-/// (through fixed frames only) folded in, and those links (for their external wrenches).
+/// The floating base: the body of link 0 with every link rigidly attached to it (through fixed
+/// frames only) folded in, and those links (for their external wrenches). Generic over the
+/// scalar: the numeric robot's (`f64`, [`crate::Robot::floating_base`]) and the customized
+/// symbolic model's (`Expr`, the generated floating inverse dynamic model).
 #[derive(Clone, Debug)]
-pub struct FloatingBase {
+pub struct FloatingBase<T: DynScalar = f64> {
     /// Inertial parameters of the base body about O_0 in R_0 (link 0 and the links fixed on
     /// it); its `ia`, `fs`, `fv` are zero.
-    pub body: LinkConstants<f64>,
+    pub body: LinkConstants<T>,
     /// The description links fixed on the base (host 0), with their placement in R_0.
-    pub attached: Vec<FoldedLink<f64>>,
+    pub attached: Vec<FoldedLink<T>>,
 }
 
-impl FloatingBase {
-    /// From link 0's 13 standard parameters (IA, FS, FV ignored) and the full numeric model
-    /// (every frame), whose links fixed on the base are folded into the body.
-    pub(crate) fn new(link0: [f64; super::PARAMS_PER_LINK], numeric: &DynModel<f64>) -> Self {
+impl<T: DynScalar> FloatingBase<T> {
+    /// From link 0's 13 standard parameters (IA, FS, FV ignored) and the full model (every
+    /// frame, not folded), whose links fixed on the base are folded into the body by the exact
+    /// rigid-body transfer ([`inertia_to_antecedent`]).
+    pub fn new(link0: [T; super::PARAMS_PER_LINK], model: &DynModel<T>) -> Self {
         let mut p = link0;
-        p[super::param::IA] = 0.0;
-        p[super::param::FS] = 0.0;
-        p[super::param::FV] = 0.0;
+        p[super::param::IA] = T::zero();
+        p[super::param::FS] = T::zero();
+        p[super::param::FV] = T::zero();
         let mut body = LinkConstants::new(p);
-        let nl = numeric.nl;
+        let nl = model.nl;
         // placement in R_0 of the fixed frames whose chain of antecedents ends on the base
-        let mut place: Vec<Option<(Matrix3<f64>, Vector3<f64>)>> = vec![None; nl + 1];
+        let mut place: Vec<Option<(Matrix3<T>, Vector3<T>)>> = vec![None; nl + 1];
         place[0] = Some((Matrix3::identity(), Vector3::zeros()));
         let mut attached = Vec::new();
         for j in 1..=nl {
-            let fr = numeric.frame(j);
+            let fr = model.frame(j);
             if fr.joint.is_movable() {
                 continue;
             }
-            let Some((ra, pa)) = place[fr.ant] else {
+            let Some((ra, pa)) = &place[fr.ant] else {
                 continue;
             };
-            let (r, p) = fr.transform(&0.0);
-            let (rot, pos) = (ra * r, pa + ra * p);
-            let l = numeric.link(j);
+            let (r, p) = fr.transform(&T::zero());
+            let (rot, pos) = (ra * &r, pa + ra * &p);
+            let l = model.link(j);
             let (jj, ms) = inertia_to_antecedent(&rot, &pos, &l.inertia, &l.ms, &l.mass);
             body.inertia += jj;
             body.ms += ms;
-            body.mass += l.mass;
+            body.mass += l.mass.clone();
             attached.push(FoldedLink {
                 host: 0,
                 link: j,
-                rot,
-                pos,
+                rot: rot.clone(),
+                pos: pos.clone(),
             });
             place[j] = Some((rot, pos));
         }
         let i = &body.inertia;
         body.inertia_diff = Vector3::new(
-            i[(2, 2)] - i[(1, 1)],
-            i[(0, 0)] - i[(2, 2)],
-            i[(1, 1)] - i[(0, 0)],
+            i[(2, 2)].clone() - i[(1, 1)].clone(),
+            i[(0, 0)].clone() - i[(2, 2)].clone(),
+            i[(1, 1)].clone() - i[(0, 0)].clone(),
         );
         FloatingBase { body, attached }
     }
