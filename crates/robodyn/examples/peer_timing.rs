@@ -29,8 +29,8 @@ use robodyn::algorithms::kinematics::center_of_mass_jacobian_from_q_into;
 use robodyn::model::param;
 use robodyn::{
     direct_dynamics_into, frame_jacobian_from_q_into, frame_jacobian_into, inertia_matrix_into,
-    inverse_dynamics_into, joint_jacobians_into, Data, Environment, FrameId, KinematicsData, Method,
-    Reference, Robot,
+    inverse_dynamics_into, joint_jacobians_into, Data, Environment, FrameId, KinematicsData,
+    Method, Reference, Robot,
 };
 use std::fmt::Write as _;
 use std::hint::black_box;
@@ -314,7 +314,11 @@ fn main() -> Result<(), Error> {
     let mut kin = if o.floating {
         None
     } else {
-        Some(Kinematics::new(&robot, Path::new(&args[2]), o.tip.as_deref())?)
+        Some(Kinematics::new(
+            &robot,
+            Path::new(&args[2]),
+            o.tip.as_deref(),
+        )?)
     };
     let mut text = String::new();
     for s in &states {
@@ -420,7 +424,13 @@ fn time_dynamics(robot: &Robot, env: &Environment, dy: &mut Dynamics, st: &[Stat
 }
 
 /// Times the Jacobians, the centre of mass's Jacobian and the derivatives (fixed base).
-fn time_kinematics(robot: &Robot, env: &Environment, k: &mut Kinematics, st: &[State], o: &Options) {
+fn time_kinematics(
+    robot: &Robot,
+    env: &Environment,
+    k: &mut Kinematics,
+    st: &[State],
+    o: &Options,
+) {
     let (samples, target_us) = (o.samples, o.target_us);
     let Kinematics {
         kin,

@@ -4,6 +4,7 @@
     python3 crates/robodyn/benches/peers/ab.py --base <commit> [--rounds 21] [--robots ur5,panda,talos]
                                                (floating robots: talos_ff,hyq,solo12, dynamics only)
                                                [--base-exe <peer_timing built at that commit>]
+                                               [--this-exe <peer_timing built in this tree>]
 
 Why: a refactoring must not slow the kernels, and on a shared VM whose speed changes by up to 2x
 within seconds only back-to-back pairs can show it. What it does:
@@ -52,6 +53,7 @@ def main():
     ap = peers.arg_parser(__doc__, "ur5,panda,talos")
     ap.add_argument("--base", required=True, help="the commit to compare against")
     ap.add_argument("--base-exe", help="a peer_timing binary already built at --base (skips its build)")
+    ap.add_argument("--this-exe", help="a peer_timing binary already built in this tree (skips its build)")
     args = ap.parse_args()
     import pinocchio as pin
     import numpy as np
@@ -62,7 +64,7 @@ def main():
     print(f"building peer_timing at {args.base} and in this tree...", flush=True)
     exes = {
         "base": args.base_exe or build(base_tree(args.base), os.path.join(peers.BUILD, "ab-base-target")),
-        "this": build(peers.ROOT, os.path.join(peers.BUILD, "cargo")),
+        "this": args.this_exe or build(peers.ROOT, os.path.join(peers.BUILD, "cargo")),
     }
     files = {}
     for key in robots:

@@ -118,7 +118,7 @@ int main(int argc, char** argv) {
       out << "\ncrba";
       data.M.setZero();
       pinocchio::crba(model, data, s.q, Convention::LOCAL);
-      // which triangle crba fills (printed once; the other one is left as it was: zero here)
+      // whether crba writes below the diagonal (printed once; M was zeroed before)
       if (&s == &states[0])
         std::printf("crba_fills %s\n",
                     data.M.triangularView<Eigen::StrictlyLower>().toDenseMatrix().isZero(0)

@@ -19,8 +19,9 @@ What it does (build products in target/peers/):
 3. Builds pinocchio_peer (header-only Pinocchio, g++ -O3 -march=native, once) and robodyn's
    `peer_timing` example (cargo --release with RUSTFLAGS=-Ctarget-cpu=native).
 4. Both programs write their results on every state (floating robots: the dynamics only, rnea,
-   crba, aba and A^-1(tau - H); Pinocchio's crba fills the upper triangle, the lower one is
-   copied from it, robodyn returns the full matrix); the agreement (max abs and relative
+   crba, aba and A^-1(tau - H); Pinocchio's crba fills the upper triangle (and, with a free
+   flyer, the whole 6 x 6 base block), its strict lower triangle is copied from the upper one,
+   robodyn returns the full matrix); the agreement (max abs and relative
    difference per algorithm) is printed; a disagreement above 1e-9 (relative) stops the run.
 5. Interleaved rounds pinned to one core (`taskset -c 1`): in each round, per robot, Pinocchio then
    robodyn (order swapped every other round); each program prints the median over samples of ns
@@ -305,8 +306,10 @@ def main():
         pres = os.path.join(BUILD, f"{key}.pin.results")
         out = run([pin_exe, mfile, sfile, pres, "--samples", "1", "--target-us", "1"], capture_output=True).stdout
         triangle = next(l.split()[1] for l in out.splitlines() if l.startswith("crba_fills "))
-        print(f"  {ROBOTS[key][0]}: Pinocchio's crba fills the {triangle} triangle"
-              + (" (the lower one copied from it for the check)" if triangle == "upper" else ""))
+        print(f"  {ROBOTS[key][0]}: Pinocchio's crba fills "
+              + ("the upper triangle only" if triangle == "upper" else
+                 "the upper triangle and part of the lower one (the free flyer's 6 x 6 block)")
+              + "; the strict lower triangle is copied from the upper one on its side")
         merged_too = args.merged and not ROBOTS[key][2]
         for label, path in [("robodyn", urdf)] + ([("merged", merged)] if merged_too else []):
             rres = os.path.join(BUILD, f"{key}.{label}.results")
