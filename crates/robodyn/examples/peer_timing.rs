@@ -12,6 +12,11 @@
 //! loops over all states, repeated so that it lasts about T microseconds; the median over the
 //! samples is printed (the same protocol as `pinocchio_peer.cpp`).
 //!
+//! With `--floating`, the URDF's root link becomes a free-flyer base (Pinocchio's
+//! `JointModelFreeFlyer` root): the states then hold q (nq = 7 + N), v, a, tau (nv = 6 + N), the
+//! first name of the states file is Pinocchio's root joint, and only the dynamics (rnea, crba,
+//! aba, composite) are written and timed.
+//!
 //! `peer_timing --batch URDF N` times `inverse_dynamics_batch` on N random states with a rayon
 //! pool of 1 and of 2 threads, 15 pairs run back to back, and prints the median ratio.
 
@@ -24,8 +29,8 @@ use robodyn::algorithms::kinematics::center_of_mass_jacobian_from_q_into;
 use robodyn::model::param;
 use robodyn::{
     direct_dynamics_into, frame_jacobian_from_q_into, frame_jacobian_into, inertia_matrix_into,
-    inverse_dynamics_into, joint_jacobians_into, Data, FrameId, KinematicsData, Method, Reference,
-    Robot,
+    inverse_dynamics_into, joint_jacobians_into, Data, Environment, FrameId, KinematicsData,
+    Method, Reference, Robot,
 };
 use std::fmt::Write as _;
 use std::hint::black_box;
@@ -45,9 +50,13 @@ struct State {
     tau: Vec<f64>,
 }
 
-/// The robot with rotor inertia and friction set to zero.
-fn load_robot(path: &Path) -> Result<Robot, Error> {
-    let robot = robodyn::io::load(path)?;
+/// The robot with rotor inertia and friction set to zero (a free-flyer base if `floating`).
+fn load_robot(path: &Path, floating: bool) -> Result<Robot, Error> {
+    let options = match floating {
+        true => robodyn::io::LoadOptions::floating(),
+        false => robodyn::io::LoadOptions::default(),
+    };
+    let robot = robodyn::io::load_with_options(path, &Default::default(), &options)?;
     let mut k = robot.standard_parameters();
     for link in k.chunks_mut(13) {
         link[param::IA] = 0.0;
@@ -78,47 +87,78 @@ fn joint_frames(robot: &Robot, path: &Path) -> Result<Vec<FrameId>, Error> {
     Ok(frames.collect::<robodyn::Result<_>>()?)
 }
 
-/// States file: a line `names <joint>...`, then one line per state: q, v, a, tau (nv each).
-fn read_states(robot: &Robot, path: &Path) -> Result<(Vec<usize>, Vec<State>), Error> {
+/// Where each entry of the states file's q and v vectors goes in robodyn's q (nq) and v (nv):
+/// the base entries (floating: 7 and 6, in the same convention) first, then the joints by name.
+struct Layout {
+    q: Vec<usize>,
+    v: Vec<usize>,
+}
+
+impl Layout {
+    fn new(robot: &Robot, names: &[&str]) -> Result<Layout, Error> {
+        let joints = if robot.is_floating() {
+            // Pinocchio's first joint is the free flyer (`root_joint`): robodyn's base
+            let root = names.first().ok_or("no joint in the states file")?;
+            if robot.coordinates().index_of(root).is_some() {
+                return Err(format!("{root} is a movable joint, not the free-flyer root").into());
+            }
+            &names[1..]
+        } else {
+            names
+        };
+        let idx = joint_indices(robot, joints)?;
+        if idx.len() != robot.dof() {
+            let n = idx.len();
+            return Err(format!("{n} joints in the states, robodyn has {}", robot.dof()).into());
+        }
+        let (bq, bv) = (robot.nq() - robot.dof(), robot.nv() - robot.dof());
+        let map = |b: usize| (0..b).chain(idx.iter().map(|i| b + i)).collect();
+        Ok(Layout {
+            q: map(bq),
+            v: map(bv),
+        })
+    }
+}
+
+/// States file: a line `names <joint>...`, then one line per state: q (nq), v, a, tau (nv each).
+fn read_states(robot: &Robot, path: &Path) -> Result<(Layout, Vec<State>), Error> {
     let text = std::fs::read_to_string(path)?;
     let mut lines = text.lines();
     let header = lines.next().ok_or("empty states file")?;
     let names: Vec<&str> = header.split_whitespace().skip(1).collect();
-    let idx = joint_indices(robot, &names)?;
-    let nv = idx.len();
-    if nv != robot.dof() {
-        return Err(format!("{nv} joints in the states, robodyn has {}", robot.dof()).into());
-    }
+    let layout = Layout::new(robot, &names)?;
+    let (nq, nv) = (robot.nq(), robot.nv());
     let mut states = Vec::new();
     for line in lines.filter(|l| !l.trim().is_empty()) {
         let x: Vec<f64> = line
             .split_whitespace()
             .map(str::parse)
             .collect::<Result<_, _>>()?;
-        if x.len() != 4 * nv {
-            return Err(format!("state line with {} numbers, {} expected", x.len(), 4 * nv).into());
+        if x.len() != nq + 3 * nv {
+            let want = nq + 3 * nv;
+            return Err(format!("state line with {} numbers, {want} expected", x.len()).into());
         }
-        let scatter = |part: usize| {
-            let mut v = vec![0.0; nv];
-            for (k, &i) in idx.iter().enumerate() {
-                v[i] = x[part * nv + k];
+        let scatter = |from: usize, map: &[usize]| {
+            let mut v = vec![0.0; map.len()];
+            for (k, &i) in map.iter().enumerate() {
+                v[i] = x[from + k];
             }
             v
         };
         states.push(State {
-            q: scatter(0),
-            qd: scatter(1),
-            qdd: scatter(2),
-            tau: scatter(3),
+            q: scatter(0, &layout.q),
+            qd: scatter(nq, &layout.v),
+            qdd: scatter(nq + nv, &layout.v),
+            tau: scatter(nq + 2 * nv, &layout.v),
         });
     }
-    Ok((idx, states))
+    Ok((layout, states))
 }
 
 /// `--batch URDF N`: batch inverse dynamics of N random states on 1 and 2 threads.
 fn batch(path: &Path, rows: usize) -> Result<(), Error> {
     use rand::Rng;
-    let robot = load_robot(path)?;
+    let robot = load_robot(path, false)?;
     let n = robot.dof();
     let mut r = robodyn_testing::rng(1);
     let mut v = |s: f64| {
@@ -167,150 +207,272 @@ fn batch(path: &Path, rows: usize) -> Result<(), Error> {
     Ok(())
 }
 
+/// The options after URDF STATES RESULTS.
+struct Options {
+    samples: usize,
+    target_us: f64,
+    /// The frame of the kinematics' comparison: the last joint's child link (its frame is the
+    /// joint's frame in a URDF, Pinocchio's joint frame); default the last joint's own frame.
+    tip: Option<String>,
+    floating: bool,
+}
+
+impl Options {
+    fn parse(args: &[String]) -> Result<Options, Error> {
+        let mut o = Options {
+            samples: 21,
+            target_us: 400.0,
+            tip: None,
+            floating: false,
+        };
+        let mut it = args.iter();
+        while let Some(k) = it.next() {
+            if k == "--floating" {
+                o.floating = true;
+                continue;
+            }
+            let v = it.next().ok_or_else(|| format!("{k} needs a value"))?;
+            match k.as_str() {
+                "--samples" => o.samples = v.parse()?,
+                "--target-us" => o.target_us = v.parse()?,
+                "--tip" => o.tip = Some(v.clone()),
+                _ => return Err(format!("unknown option {k}").into()),
+            }
+        }
+        Ok(o)
+    }
+}
+
+/// The dynamics' buffers: the per-call data, A and an nv vector.
+struct Dynamics {
+    data: Data,
+    a: DMatrix<f64>,
+    out: Vec<f64>,
+}
+
+impl Dynamics {
+    fn new(robot: &Robot) -> Dynamics {
+        let nv = robot.nv();
+        Dynamics {
+            data: Data::new(robot),
+            a: DMatrix::zeros(nv, nv),
+            out: vec![0.0; nv],
+        }
+    }
+}
+
+/// The kinematics' and derivatives' buffers (fixed base only) and the frames they are read at.
+struct Kinematics {
+    kin: KinematicsData,
+    jac: DMatrix<f64>,
+    jcom: DMatrix<f64>,
+    dd: DerivativesData,
+    di: IdmDerivatives,
+    da: DdmDerivatives,
+    frames: Vec<FrameId>,
+    tip: FrameId,
+}
+
+impl Kinematics {
+    fn new(robot: &Robot, states: &Path, tip: Option<&str>) -> Result<Kinematics, Error> {
+        let n = robot.dof();
+        let frames = joint_frames(robot, states)?;
+        let tip = match tip {
+            Some(name) => robot.frame_id(name)?,
+            None => *frames.last().ok_or("no joint")?,
+        };
+        Ok(Kinematics {
+            kin: KinematicsData::new(robot),
+            jac: DMatrix::zeros(6, n),
+            jcom: DMatrix::zeros(3, n),
+            dd: DerivativesData::new(robot),
+            di: IdmDerivatives::new(robot),
+            da: DdmDerivatives::new(robot),
+            frames,
+            tip,
+        })
+    }
+}
+
 fn main() -> Result<(), Error> {
     let args: Vec<String> = std::env::args().collect();
     if args.len() == 4 && args[1] == "--batch" {
         return batch(Path::new(&args[2]), args[3].parse()?);
     }
     if args.len() < 4 {
-        return Err("usage: peer_timing URDF STATES RESULTS [--samples N] [--target-us T]".into());
+        return Err(
+            "usage: peer_timing URDF STATES RESULTS [--samples N] [--target-us T] [--tip FRAME] \
+             [--floating]"
+                .into(),
+        );
     }
-    let (mut samples, mut target_us) = (21usize, 400.0);
-    // the frame of the kinematics' comparison: the last joint's child link (its frame is the
-    // joint's frame in a URDF, Pinocchio's joint frame); default the last joint's own frame
-    let mut tip_name: Option<String> = None;
-    for kv in args[4..].chunks(2) {
-        match (kv[0].as_str(), kv.get(1)) {
-            ("--samples", Some(v)) => samples = v.parse()?,
-            ("--target-us", Some(v)) => target_us = v.parse()?,
-            ("--tip", Some(v)) => tip_name = Some(v.clone()),
-            _ => return Err(format!("unknown option {}", kv[0]).into()),
-        }
-    }
-    let robot = load_robot(Path::new(&args[1]))?;
-    let (idx, states) = read_states(&robot, Path::new(&args[2]))?;
-    let n = robot.dof();
+    let o = Options::parse(&args[4..])?;
+    let robot = load_robot(Path::new(&args[1]), o.floating)?;
+    let (layout, states) = read_states(&robot, Path::new(&args[2]))?;
     let env = robot.environment().clone();
-    let mut data = Data::new(&robot);
-    let mut a = DMatrix::zeros(n, n);
-    let mut out = vec![0.0; n];
-    let (cmp, aba) = (Method::Composite, Method::ArticulatedBody);
-    let frames = joint_frames(&robot, Path::new(&args[2]))?;
-    let tip = match &tip_name {
-        Some(name) => robot.frame_id(name)?,
-        None => *frames.last().ok_or("no joint")?,
-    };
-    let mut kin = KinematicsData::new(&robot);
-    let (mut jac, mut jcom) = (DMatrix::zeros(6, n), DMatrix::zeros(3, n));
-    let mut dd = DerivativesData::new(&robot);
-    let (mut di, mut da) = (IdmDerivatives::new(&robot), DdmDerivatives::new(&robot));
-
-    let mut text = String::new();
-    let put = |text: &mut String, tag: &str, v: &[f64]| {
-        text.push_str(tag);
-        for &i in &idx {
-            write!(text, " {:e}", v[i]).unwrap();
-        }
-        text.push('\n');
-    };
-    for s in &states {
-        inverse_dynamics_into(&robot, &mut data, &env, &s.q, &s.qd, &s.qdd, &mut out)?;
-        put(&mut text, "rnea", &out);
-        inertia_matrix_into(&robot, &mut data, &s.q, &mut a)?;
-        text.push_str("crba");
-        for &r in &idx {
-            for &c in &idx {
-                write!(text, " {:e}", a[(r, c)])?;
-            }
-        }
-        text.push('\n');
-        direct_dynamics_into(&robot, &mut data, &env, &s.q, &s.qd, &s.tau, aba, &mut out)?;
-        put(&mut text, "aba", &out);
-        direct_dynamics_into(&robot, &mut data, &env, &s.q, &s.qd, &s.tau, cmp, &mut out)?;
-        put(&mut text, "composite", &out);
-        frame_jacobian_from_q_into(&robot, &mut kin, &s.q, &tip, Reference::Local, &mut jac)?;
-        put_matrix(&mut text, "jac", &jac, &idx, &[]);
-        // G and its Jacobian from q in one pass pair (Pinocchio's jacobianCenterOfMass gives
-        // both); G checked against center_of_mass after a full forward pass
-        let g = center_of_mass_jacobian_from_q_into(&robot, &mut kin, &s.q, None, &mut jcom)?;
-        let g_fk = robodyn::algorithms::kinematics::center_of_mass(
+    let mut dy = Dynamics::new(&robot);
+    let mut kin = if o.floating {
+        None
+    } else {
+        Some(Kinematics::new(
             &robot,
-            &mut kin_motion(&robot, s)?,
-            None,
-        )?;
-        if (g - g_fk.position).amax() > 1e-12 {
-            return Err(
-                format!("G from q {g} differs from center_of_mass {}", g_fk.position).into(),
-            );
+            Path::new(&args[2]),
+            o.tip.as_deref(),
+        )?)
+    };
+    let mut text = String::new();
+    for s in &states {
+        write_dynamics(&robot, &env, &mut dy, s, &layout.v, &mut text)?;
+        if let Some(k) = &mut kin {
+            write_kinematics(&robot, &env, k, s, &layout.v, &mut text)?;
         }
-        put_matrix(&mut text, "com", &jcom, &idx, g.as_slice());
-        inverse_dynamics_derivatives_into(&robot, &mut dd, &env, &s.q, &s.qd, &s.qdd, &mut di)?;
-        put_squares(&mut text, "drnea", &[&di.dtau_dq, &di.dtau_dqd], &idx);
-        direct_dynamics_derivatives_into(&robot, &mut dd, &env, &s.q, &s.qd, &s.tau, &mut da)?;
-        put_squares(&mut text, "daba", &[&da.dqdd_dq, &da.dqdd_dqd], &idx);
     }
     std::fs::write(&args[3], text)?;
+    time_dynamics(&robot, &env, &mut dy, &states, &o);
+    if let Some(k) = &mut kin {
+        time_kinematics(&robot, &env, k, &states, &o);
+    }
+    Ok(())
+}
 
-    time("rnea", &states, samples, target_us, |s| {
-        inverse_dynamics_into(
-            &robot,
-            &mut data,
-            &env,
-            black_box(&s.q),
-            &s.qd,
-            &s.qdd,
-            &mut out,
-        )
-        .unwrap();
+/// `tag`, then the nv vector in the states' order.
+fn put(text: &mut String, tag: &str, v: &[f64], idx: &[usize]) {
+    text.push_str(tag);
+    for &i in idx {
+        write!(text, " {:e}", v[i]).unwrap();
+    }
+    text.push('\n');
+}
+
+/// The results of rnea, crba (full A), aba and the composite direct model at one state.
+fn write_dynamics(
+    robot: &Robot,
+    env: &Environment,
+    dy: &mut Dynamics,
+    s: &State,
+    idx: &[usize],
+    text: &mut String,
+) -> Result<(), Error> {
+    let (cmp, aba) = (Method::Composite, Method::ArticulatedBody);
+    let (data, out) = (&mut dy.data, &mut dy.out);
+    inverse_dynamics_into(robot, data, env, &s.q, &s.qd, &s.qdd, out)?;
+    put(text, "rnea", out, idx);
+    inertia_matrix_into(robot, data, &s.q, &mut dy.a)?;
+    put_squares(text, "crba", &[&dy.a], idx);
+    direct_dynamics_into(robot, data, env, &s.q, &s.qd, &s.tau, aba, out)?;
+    put(text, "aba", out, idx);
+    direct_dynamics_into(robot, data, env, &s.q, &s.qd, &s.tau, cmp, out)?;
+    put(text, "composite", out, idx);
+    Ok(())
+}
+
+/// The results of the frame Jacobian, the centre of mass's Jacobian and the derivatives at one
+/// state (fixed base).
+fn write_kinematics(
+    robot: &Robot,
+    env: &Environment,
+    k: &mut Kinematics,
+    s: &State,
+    idx: &[usize],
+    text: &mut String,
+) -> Result<(), Error> {
+    let tip = &k.tip;
+    frame_jacobian_from_q_into(robot, &mut k.kin, &s.q, tip, Reference::Local, &mut k.jac)?;
+    put_matrix(text, "jac", &k.jac, idx, &[]);
+    // G and its Jacobian from q in one pass pair (Pinocchio's jacobianCenterOfMass gives
+    // both); G checked against center_of_mass after a full forward pass
+    let g = center_of_mass_jacobian_from_q_into(robot, &mut k.kin, &s.q, None, &mut k.jcom)?;
+    let g_fk =
+        robodyn::algorithms::kinematics::center_of_mass(robot, &mut kin_motion(robot, s)?, None)?;
+    if (g - g_fk.position).amax() > 1e-12 {
+        let p = g_fk.position;
+        return Err(format!("G from q {g} differs from center_of_mass {p}").into());
+    }
+    put_matrix(text, "com", &k.jcom, idx, g.as_slice());
+    let (dd, di, da) = (&mut k.dd, &mut k.di, &mut k.da);
+    inverse_dynamics_derivatives_into(robot, dd, env, &s.q, &s.qd, &s.qdd, di)?;
+    put_squares(text, "drnea", &[&di.dtau_dq, &di.dtau_dqd], idx);
+    direct_dynamics_derivatives_into(robot, dd, env, &s.q, &s.qd, &s.tau, da)?;
+    put_squares(text, "daba", &[&da.dqdd_dq, &da.dqdd_dqd], idx);
+    Ok(())
+}
+
+/// Times rnea, crba (full A), aba and the composite direct model.
+fn time_dynamics(robot: &Robot, env: &Environment, dy: &mut Dynamics, st: &[State], o: &Options) {
+    let (samples, target_us) = (o.samples, o.target_us);
+    let (cmp, aba) = (Method::Composite, Method::ArticulatedBody);
+    let Dynamics { data, a, out } = dy;
+    time("rnea", st, samples, target_us, |s| {
+        let q = black_box(&s.q);
+        inverse_dynamics_into(robot, data, env, q, &s.qd, &s.qdd, out).unwrap();
         black_box(&out);
     });
-    time("crba_full", &states, samples, target_us, |s| {
-        inertia_matrix_into(&robot, &mut data, black_box(&s.q), &mut a).unwrap();
+    time("crba_full", st, samples, target_us, |s| {
+        inertia_matrix_into(robot, data, black_box(&s.q), a).unwrap();
         black_box(&a);
     });
-    time("aba", &states, samples, target_us, |s| {
+    time("aba", st, samples, target_us, |s| {
         let q = black_box(&s.q);
-        direct_dynamics_into(&robot, &mut data, &env, q, &s.qd, &s.tau, aba, &mut out).unwrap();
+        direct_dynamics_into(robot, data, env, q, &s.qd, &s.tau, aba, out).unwrap();
         black_box(&out);
     });
-    time("composite", &states, samples, target_us, |s| {
+    time("composite", st, samples, target_us, |s| {
         let q = black_box(&s.q);
-        direct_dynamics_into(&robot, &mut data, &env, q, &s.qd, &s.tau, cmp, &mut out).unwrap();
+        direct_dynamics_into(robot, data, env, q, &s.qd, &s.tau, cmp, out).unwrap();
         black_box(&out);
     });
-    time("joint_jacobians", &states, samples, target_us, |s| {
-        joint_jacobians_into(&robot, &mut kin, black_box(&s.q)).unwrap();
+}
+
+/// Times the Jacobians, the centre of mass's Jacobian and the derivatives (fixed base).
+fn time_kinematics(
+    robot: &Robot,
+    env: &Environment,
+    k: &mut Kinematics,
+    st: &[State],
+    o: &Options,
+) {
+    let (samples, target_us) = (o.samples, o.target_us);
+    let Kinematics {
+        kin,
+        jac,
+        jcom,
+        dd,
+        di,
+        da,
+        frames,
+        tip,
+    } = k;
+    time("joint_jacobians", st, samples, target_us, |s| {
+        joint_jacobians_into(robot, kin, black_box(&s.q)).unwrap();
         black_box(&kin);
     });
-    time("all_frame_jacobians", &states, samples, target_us, |s| {
-        joint_jacobians_into(&robot, &mut kin, black_box(&s.q)).unwrap();
-        for f in &frames {
-            frame_jacobian_into(&robot, &kin, f, Reference::World, &mut jac).unwrap();
+    time("all_frame_jacobians", st, samples, target_us, |s| {
+        joint_jacobians_into(robot, kin, black_box(&s.q)).unwrap();
+        for f in frames.iter() {
+            frame_jacobian_into(robot, kin, f, Reference::World, jac).unwrap();
             black_box(&jac);
         }
     });
-    time("frame_jacobian", &states, samples, target_us, |s| {
+    time("frame_jacobian", st, samples, target_us, |s| {
         let q = black_box(&s.q);
-        frame_jacobian_from_q_into(&robot, &mut kin, q, &tip, Reference::Local, &mut jac).unwrap();
+        frame_jacobian_from_q_into(robot, kin, q, tip, Reference::Local, jac).unwrap();
         black_box(&jac);
     });
-    time("com_jacobian", &states, samples, target_us, |s| {
+    time("com_jacobian", st, samples, target_us, |s| {
         let q = black_box(&s.q);
-        let g = center_of_mass_jacobian_from_q_into(&robot, &mut kin, q, None, &mut jcom).unwrap();
+        let g = center_of_mass_jacobian_from_q_into(robot, kin, q, None, jcom).unwrap();
         black_box((&jcom, g));
     });
-    time("rnea_derivatives", &states, samples, target_us, |s| {
+    time("rnea_derivatives", st, samples, target_us, |s| {
         let q = black_box(&s.q);
-        inverse_dynamics_derivatives_into(&robot, &mut dd, &env, q, &s.qd, &s.qdd, &mut di)
-            .unwrap();
+        inverse_dynamics_derivatives_into(robot, dd, env, q, &s.qd, &s.qdd, di).unwrap();
         black_box(&di);
     });
-    time("aba_derivatives", &states, samples, target_us, |s| {
+    time("aba_derivatives", st, samples, target_us, |s| {
         let q = black_box(&s.q);
-        direct_dynamics_derivatives_into(&robot, &mut dd, &env, q, &s.qd, &s.tau, &mut da).unwrap();
+        direct_dynamics_derivatives_into(robot, dd, env, q, &s.qd, &s.tau, da).unwrap();
         black_box(&da);
     });
-    Ok(())
 }
 
 /// `tag`, then each N x N matrix row by row, rows and columns in the states' order.

@@ -1,7 +1,8 @@
 //! The per-call API allocates nothing once its `Data` is built (trees: inverse and direct
-//! dynamics, A, H, the regressor; closed chains: loop closure, inverse and direct dynamics along a
-//! trajectory, once the branch tracker is on the branch): a counting global allocator (counting
-//! only on the calling thread, so the test harness's own threads do not interfere).
+//! dynamics, A, H, the regressor; floating bases: the same over nv; closed chains: loop closure,
+//! inverse and direct dynamics along a trajectory, once the branch tracker is on the branch): a
+//! counting global allocator (counting only on the calling thread, so the test harness's own
+//! threads do not interfere).
 
 use nalgebra::DMatrix;
 use robodyn::algorithms::inverse_dynamics::rnea;
@@ -10,7 +11,10 @@ use robodyn::{
     inertia_matrix_into, inverse_dynamics_into, loop_closure_into, regressor_into, ClosedChain,
     ClosedData, Data, Method,
 };
-use robodyn_testing::{self as testing, random_state, random_tree, TreeOptions};
+use robodyn_testing::{
+    self as testing, random_floating_state, random_floating_tree, random_state, random_tree,
+    TreeOptions,
+};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 use std::path::PathBuf;
@@ -145,6 +149,52 @@ fn checked_tree_functions_allocate_nothing() {
             after - before,
             0,
             "{}: the checked tree functions allocated {} times",
+            robot.name(),
+            after - before
+        );
+    }
+}
+
+/// Floating bases (issue 27): inverse dynamics, both direct methods, A and H over nv = 6 + N
+/// allocate nothing after the `Data` is built (random trees with fixed frames, N = 2, 13, 30).
+#[test]
+fn floating_functions_allocate_nothing() {
+    let mut rng = testing::rng(7);
+    for n in [2, 13, 30] {
+        let robot = random_floating_tree(&mut rng, n, &TreeOptions::default());
+        let m = robot.dof();
+        let nv = robot.nv();
+        let states: Vec<_> = (0..10)
+            .map(|_| random_floating_state(&mut rng, m))
+            .collect();
+        let mut data = Data::new(&robot);
+        let env = robot.environment().clone();
+        let (mut tau, mut qdd, mut h) = (vec![0.0; nv], vec![0.0; nv], vec![0.0; nv]);
+        let mut a = DMatrix::zeros(nv, nv);
+        counter_counts();
+        let before = allocations();
+        let mut checksum = 0.0;
+        for _ in 0..20 {
+            for s in &states {
+                inverse_dynamics_into(&robot, &mut data, &env, &s[0], &s[1], &s[2], &mut tau)
+                    .unwrap();
+                for method in [Method::Composite, Method::ArticulatedBody] {
+                    direct_dynamics_into(
+                        &robot, &mut data, &env, &s[0], &s[1], &tau, method, &mut qdd,
+                    )
+                    .unwrap();
+                }
+                inertia_matrix_into(&robot, &mut data, &s[0], &mut a).unwrap();
+                h_vector_into(&robot, &mut data, &env, &s[0], &s[1], &mut h).unwrap();
+                checksum += qdd.iter().sum::<f64>() + a[(0, 0)] + h[0];
+            }
+        }
+        let after = allocations();
+        assert!(checksum.is_finite());
+        assert_eq!(
+            after - before,
+            0,
+            "{}: the floating functions allocated {} times",
             robot.name(),
             after - before
         );

@@ -2,7 +2,9 @@
 """Paired A/B timing of robodyn's kernels: this tree against another commit. NOT run by CI.
 
     python3 crates/robodyn/benches/peers/ab.py --base <commit> [--rounds 21] [--robots ur5,panda,talos]
+                                               (floating robots: talos_ff,hyq,solo12, dynamics only)
                                                [--base-exe <peer_timing built at that commit>]
+                                               [--this-exe <peer_timing built in this tree>]
 
 Why: a refactoring must not slow the kernels, and on a shared VM whose speed changes by up to 2x
 within seconds only back-to-back pairs can show it. What it does:
@@ -51,6 +53,7 @@ def main():
     ap = peers.arg_parser(__doc__, "ur5,panda,talos")
     ap.add_argument("--base", required=True, help="the commit to compare against")
     ap.add_argument("--base-exe", help="a peer_timing binary already built at --base (skips its build)")
+    ap.add_argument("--this-exe", help="a peer_timing binary already built in this tree (skips its build)")
     args = ap.parse_args()
     import pinocchio as pin
     import numpy as np
@@ -61,23 +64,24 @@ def main():
     print(f"building peer_timing at {args.base} and in this tree...", flush=True)
     exes = {
         "base": args.base_exe or build(base_tree(args.base), os.path.join(peers.BUILD, "ab-base-target")),
-        "this": build(peers.ROOT, os.path.join(peers.BUILD, "cargo")),
+        "this": args.this_exe or build(peers.ROOT, os.path.join(peers.BUILD, "cargo")),
     }
     files = {}
     for key in robots:
-        urdf = peers.urdf_path(prefix, peers.ROBOTS[key][1])
-        model = pin.buildModelFromUrdf(urdf)
+        urdf, model = peers.load_model(pin, prefix, key)
         sfile = os.path.join(peers.BUILD, f"{key}.states")
         peers.write_states(pin, model, sfile)
-        tip = peers.tip_name(model)
-        files[key] = (urdf, sfile, tip)
+        rd_opts = peers.robodyn_options(key, model)
+        files[key] = (urdf, sfile, rd_opts)
         res = {}
         for side, exe in exes.items():
             out = os.path.join(peers.BUILD, f"{key}.ab-{side}.results")
-            peers.run([exe, urdf, sfile, out, "--samples", "1", "--target-us", "1", "--tip", tip],
+            peers.run([exe, urdf, sfile, out, "--samples", "1", "--target-us", "1", *rd_opts],
                       capture_output=True)
             res[side] = peers.read_results(out)
         for alg in ("rnea", "crba", "aba", "composite", "jac", "com"):
+            if alg not in res["base"]:  # a floating robot: the dynamics only
+                continue
             a, b = res["this"][alg], res["base"][alg]
             rel = np.abs(a - b).max() / max(1.0, np.abs(b).max())
             if rel > 1e-12:
@@ -85,8 +89,8 @@ def main():
     opts = ["--samples", str(args.samples)]
 
     def sides(key):
-        urdf, sfile, tip = files[key]
-        return [(side, [exe, urdf, sfile, os.devnull, *opts, "--tip", tip]) for side, exe in exes.items()]
+        urdf, sfile, rd_opts = files[key]
+        return [(side, [exe, urdf, sfile, os.devnull, *opts, *rd_opts]) for side, exe in exes.items()]
 
     times = peers.interleaved(args.rounds, robots, sides)
     print()
@@ -94,7 +98,7 @@ def main():
     print("|---|---|---|---|---|---|")
     for key in robots:
         base, this = times[key]["base"], times[key]["this"]
-        for alg in ALGORITHMS:
+        for alg in (a for a in ALGORITHMS if a in base[0]):
             ratios = [t[alg] / b[alg] for t, b in zip(this, base)]
             slower = sum(r > 1 for r in ratios)
             print(f"| {peers.ROBOTS[key][0]} | {alg} | {statistics.median(b[alg] for b in base):.0f} | "

@@ -45,6 +45,7 @@ inline pinocchio::Model read_model(const std::string& path) {
     else if (type == "PX") id = model.addJoint(parent, pinocchio::JointModelPX(), placement, name);
     else if (type == "PY") id = model.addJoint(parent, pinocchio::JointModelPY(), placement, name);
     else if (type == "PZ") id = model.addJoint(parent, pinocchio::JointModelPZ(), placement, name);
+    else if (type == "FF") id = model.addJoint(parent, pinocchio::JointModelFreeFlyer(), placement, name);
     else if (type == "RU")
       id = model.addJoint(parent, pinocchio::JointModelRevoluteUnaligned(axis), placement, name);
     else if (type == "PU")

@@ -9,6 +9,9 @@
 //
 //   pinocchio_peer MODEL STATES RESULTS [--samples N] [--target-us T]
 //
+// A model whose first joint is a free flyer (run.py's floating robots) has states with q over
+// nq = 7 + n; only the dynamics (rnea, crba, aba, composite) are then written and timed.
+//
 // Writes the results of every algorithm on every state to RESULTS (for the agreement check) and
 // prints `time <algorithm> <median ns per call>` lines: each sample times a loop over all states,
 // repeated so that a sample lasts about T microseconds; the median over the samples is printed.
@@ -46,7 +49,8 @@ struct State {
   VectorXd q, v, a, tau;
 };
 
-static std::vector<State> read_states(const std::string& path, int nv) {
+// q has nq entries (7 + n with a free-flyer root: position, quaternion x y z w), v, a, tau nv.
+static std::vector<State> read_states(const std::string& path, int nq, int nv) {
   std::ifstream in(path);
   if (!in) throw std::runtime_error("cannot read " + path);
   std::string line;
@@ -55,9 +59,9 @@ static std::vector<State> read_states(const std::string& path, int nv) {
   while (std::getline(in, line)) {
     if (line.empty()) continue;
     std::istringstream s(line);
-    State st{VectorXd(nv), VectorXd(nv), VectorXd(nv), VectorXd(nv)};
+    State st{VectorXd(nq), VectorXd(nv), VectorXd(nv), VectorXd(nv)};
     for (VectorXd* x : {&st.q, &st.v, &st.a, &st.tau})
-      for (int k = 0; k < nv; ++k) s >> (*x)[k];
+      for (int k = 0; k < x->size(); ++k) s >> (*x)[k];
     if (!s) throw std::runtime_error("bad state line");
     states.push_back(st);
   }
@@ -99,7 +103,9 @@ int main(int argc, char** argv) {
   Data data(model);
   Eigen::MatrixXd J = Eigen::MatrixXd::Zero(6, model.nv);
   const int nv = model.nv;
-  const std::vector<State> states = read_states(argv[2], nv);
+  const std::vector<State> states = read_states(argv[2], model.nq, nv);
+  // a free-flyer root (nq = nv + 1): the dynamics only (rnea, crba, aba, composite)
+  const bool floating = model.nq != model.nv;
   VectorXd x(nv);
 
   {
@@ -112,6 +118,11 @@ int main(int argc, char** argv) {
       out << "\ncrba";
       data.M.setZero();
       pinocchio::crba(model, data, s.q, Convention::LOCAL);
+      // whether crba writes below the diagonal (printed once; M was zeroed before)
+      if (&s == &states[0])
+        std::printf("crba_fills %s\n",
+                    data.M.triangularView<Eigen::StrictlyLower>().toDenseMatrix().isZero(0)
+                        ? "upper" : "both");
       fill_lower(data);
       for (int r = 0; r < nv; ++r)
         for (int c = 0; c < nv; ++c) out << ' ' << data.M(r, c);
@@ -121,6 +132,10 @@ int main(int argc, char** argv) {
       out << "\ncomposite";
       composite(model, data, s, Convention::LOCAL, x);
       for (int k = 0; k < nv; ++k) out << ' ' << x[k];
+      if (floating) {
+        out << '\n';
+        continue;
+      }
       out << "\njac";
       J.setZero();
       pinocchio::computeFrameJacobian(model, data, s.q, tip, pinocchio::LOCAL, J);
@@ -188,6 +203,10 @@ int main(int argc, char** argv) {
       composite(model, data, s, c, x);
       sink += x[0];
     });
+  }
+  if (floating) {
+    std::fprintf(stderr, "sink %g\n", sink);
+    return 0;
   }
   // kinematics (issue 26): from q each time, as a controller calls them
   time("joint_jacobians", [&](const State& s) {

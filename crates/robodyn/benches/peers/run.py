@@ -3,19 +3,25 @@
 
     pip install pin example-robot-data cmeel-eigen cmeel-urdfdom-headers   # once
     python3 crates/robodyn/benches/peers/run.py [--rounds 5] [--robots ur5,panda,talos]
+    python3 crates/robodyn/benches/peers/run.py --rounds 31 --robots talos_ff,hyq,solo12  # floating
 
 What it does (build products in target/peers/):
 1. Pinocchio's URDF parser (the pip wheel's Python bindings) reads UR5, Panda and Talos (full)
-   from example-robot-data, fixed base, and every joint (parent, type, axis, placement, inertia,
+   from example-robot-data, fixed base, and Talos full, HyQ and Solo12 with a free-flyer root
+   (`JointModelFreeFlyer`; robodyn: `LoadOptions::floating()`), and every joint (parent, type, axis, placement, inertia,
    fixed joints already merged into their parent body) is dumped to `<robot>.model`.
    pinocchio_peer.cpp rebuilds the identical model in C++: the wheel's URDF parser needs urdfdom,
    a shared library built without -march=native, which must not be mixed with -march=native code.
-2. Random states (seed 1): q in [-pi, pi], v in [-2, 2], a in [-5, 5], tau = rnea(q, v, a') for
+2. Random states (seed 1): q in [-pi, pi], v in [-2, 2], a in [-5, 5] (a free flyer: position in
+   [-2, 2], a uniformly random unit quaternion, its v and a as the joints'), tau = rnea(q, v, a') for
    another random a' (so that both direct models must give back a'), written to `<robot>.states`
    with the joint names; both sides read that file (robodyn maps the names onto its frames).
 3. Builds pinocchio_peer (header-only Pinocchio, g++ -O3 -march=native, once) and robodyn's
    `peer_timing` example (cargo --release with RUSTFLAGS=-Ctarget-cpu=native).
-4. Both programs write their results on every state; the agreement (max abs and relative
+4. Both programs write their results on every state (floating robots: the dynamics only, rnea,
+   crba, aba and A^-1(tau - H); Pinocchio's crba fills the upper triangle (and, with a free
+   flyer, the whole 6 x 6 base block), its strict lower triangle is copied from the upper one,
+   robodyn returns the full matrix); the agreement (max abs and relative
    difference per algorithm) is printed; a disagreement above 1e-9 (relative) stops the run.
 5. Interleaved rounds pinned to one core (`taskset -c 1`): in each round, per robot, Pinocchio then
    robodyn (order swapped every other round); each program prints the median over samples of ns
@@ -41,10 +47,14 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.abspath(os.path.join(HERE, "..", "..", "..", ".."))
 BUILD = os.path.join(ROOT, "target", "peers")
 
+# key: (label, URDF under example-robot-data's robots/, free-flyer root)
 ROBOTS = {
-    "ur5": ("UR5", "ur_description/urdf/ur5_robot.urdf"),
-    "panda": ("Panda", "panda_description/urdf/panda.urdf"),
-    "talos": ("Talos full", "talos_data/robots/talos_full_v2.urdf"),
+    "ur5": ("UR5", "ur_description/urdf/ur5_robot.urdf", False),
+    "panda": ("Panda", "panda_description/urdf/panda.urdf", False),
+    "talos": ("Talos full", "talos_data/robots/talos_full_v2.urdf", False),
+    "talos_ff": ("Talos full, floating", "talos_data/robots/talos_full_v2.urdf", True),
+    "hyq": ("HyQ, floating", "hyq_description/robots/hyq_no_sensors.urdf", True),
+    "solo12": ("Solo12, floating", "solo_description/robots/solo12.urdf", True),
 }
 JOINT_TYPES = {
     "JointModelRX": "RX",
@@ -55,6 +65,7 @@ JOINT_TYPES = {
     "JointModelPZ": "PZ",
     "JointModelRevoluteUnaligned": "RU",
     "JointModelPrismaticUnaligned": "PU",
+    "JointModelFreeFlyer": "FF",
 }
 N_STATES = 64
 # Pinocchio's headers need these (its CMake config exports them): joint variants of > 20 types.
@@ -79,6 +90,19 @@ def urdf_path(prefix, rel):
     if not os.path.isfile(p):
         sys.exit(f"{p} missing: pip install example-robot-data")
     return p
+
+
+def load_model(pin, prefix, key):
+    """The URDF's path and Pinocchio's model of it (free-flyer root for the floating robots)."""
+    urdf = urdf_path(prefix, ROBOTS[key][1])
+    if ROBOTS[key][2]:
+        return urdf, pin.buildModelFromUrdf(urdf, pin.JointModelFreeFlyer())
+    return urdf, pin.buildModelFromUrdf(urdf)
+
+
+def robodyn_options(key, model):
+    """peer_timing's options for a robot: --floating, or the frame of the kinematics' rows."""
+    return ["--floating"] if ROBOTS[key][2] else ["--tip", tip_name(model)]
 
 
 def num(x):
@@ -143,7 +167,10 @@ def write_states(pin, model, path, seed=1):
     nv = model.nv
     rows = []
     for _ in range(N_STATES):
-        q = rng.uniform(-math.pi, math.pi, nv)
+        q = rng.uniform(-math.pi, math.pi, model.nq)
+        if model.nq != nv:  # free flyer: position, then a unit quaternion (x, y, z, w)
+            quat = rng.normal(size=4)
+            q[:7] = np.concatenate([rng.uniform(-2, 2, 3), quat / np.linalg.norm(quat)])
         v = rng.uniform(-2, 2, nv)
         a = rng.uniform(-5, 5, nv)
         tau = pin.rnea(model, data, q, v, rng.uniform(-5, 5, nv)).copy()
@@ -194,9 +221,11 @@ def read_results(path):
 
 
 def agreement(pin_res, rd_res):
-    """Max abs and relative differences per algorithm."""
+    """Max abs and relative differences per algorithm (those both programs wrote)."""
     rows = {}
     for alg in ("rnea", "crba", "aba", "composite", "jac", "com", "drnea", "daba"):
+        if alg not in pin_res and alg not in rd_res:
+            continue
         p, r = pin_res[alg], rd_res[alg]
         diff = np.abs(p - r).max()
         rel = diff / max(1.0, np.abs(p).max())
@@ -241,6 +270,7 @@ def arg_parser(doc, robots):
 def main():
     ap = arg_parser(__doc__, "ur5,panda,talos")
     ap.add_argument("--codegen", action="store_true", help="also the generated-code comparison (codegen.py)")
+    ap.add_argument("--robodyn-exe", help="a peer_timing binary already built (skips the cargo build)")
     ap.add_argument("--merged", action="store_true",
                     help="also time robodyn on the URDF rewritten with fixed joints merged (experiment)")
     args = ap.parse_args()
@@ -256,18 +286,17 @@ def main():
         if shutil.which(tool) is None:
             sys.exit(f"{tool} not found")
     pin_exe = build_pinocchio(prefix)
-    rd_exe = build_robodyn()
-    files, tips = {}, {}
+    rd_exe = args.robodyn_exe or build_robodyn()
+    files, rd_opts = {}, {}
     for key in robots:
-        urdf = urdf_path(prefix, ROBOTS[key][1])
-        model = pin.buildModelFromUrdf(urdf)
+        urdf, model = load_model(pin, prefix, key)
         mfile, sfile, merged = (os.path.join(BUILD, f"{key}.{ext}") for ext in ("model", "states", "merged.urdf"))
         dump_model(model, mfile)
         write_states(pin, model, sfile)
-        merged_urdf(pin, model, merged)
-        tip = tip_name(model)
+        if args.merged and not ROBOTS[key][2]:
+            merged_urdf(pin, model, merged)
         files[key] = (urdf, mfile, sfile, model.nv, merged)
-        tips[key] = tip
+        rd_opts[key] = robodyn_options(key, model)
 
     print(f"pinocchio {pin.__version__}; {N_STATES} states per robot; agreement (max |robodyn - pinocchio|, "
           "relative to max(1, max |pinocchio|)):")
@@ -275,10 +304,16 @@ def main():
     for key in robots:
         urdf, mfile, sfile, nv, merged = files[key]
         pres = os.path.join(BUILD, f"{key}.pin.results")
-        run([pin_exe, mfile, sfile, pres, "--samples", "1", "--target-us", "1"], capture_output=True)
-        for label, path in [("robodyn", urdf)] + ([("merged", merged)] if args.merged else []):
+        out = run([pin_exe, mfile, sfile, pres, "--samples", "1", "--target-us", "1"], capture_output=True).stdout
+        triangle = next(l.split()[1] for l in out.splitlines() if l.startswith("crba_fills "))
+        print(f"  {ROBOTS[key][0]}: Pinocchio's crba fills "
+              + ("the upper triangle only" if triangle == "upper" else
+                 "the upper triangle and part of the lower one (the free flyer's 6 x 6 block)")
+              + "; the strict lower triangle is copied from the upper one on its side")
+        merged_too = args.merged and not ROBOTS[key][2]
+        for label, path in [("robodyn", urdf)] + ([("merged", merged)] if merged_too else []):
             rres = os.path.join(BUILD, f"{key}.{label}.results")
-            run([rd_exe, path, sfile, rres, "--samples", "1", "--target-us", "1", "--tip", tips[key]],
+            run([rd_exe, path, sfile, rres, "--samples", "1", "--target-us", "1", *rd_opts[key]],
                 capture_output=True)
             for alg, (d, rel) in agreement(read_results(pres), read_results(rres)).items():
                 flag = "" if rel < 1e-9 else "   <-- DISAGREE"
@@ -291,8 +326,9 @@ def main():
 
     def sides(key):
         urdf, mfile, sfile, _, merged = files[key]
-        out = [("pin", [pin_exe, mfile, sfile, os.devnull, *opts]), ("rd", [rd_exe, urdf, sfile, os.devnull, *opts, "--tip", tips[key]])]
-        if args.merged:
+        out = [("pin", [pin_exe, mfile, sfile, os.devnull, *opts]),
+               ("rd", [rd_exe, urdf, sfile, os.devnull, *opts, *rd_opts[key]])]
+        if args.merged and not ROBOTS[key][2]:
             out.append(("merged", [rd_exe, merged, sfile, os.devnull, *opts]))
         return out
 
@@ -323,6 +359,8 @@ def main():
             ("DDM derivatives dqdd/dq, dqdd/dv, A^-1 (computeABADerivatives)", "aba_derivatives",
              ["aba_derivatives"]),
         ]:
+            if rname not in rd[0]:  # a floating robot: the dynamics only
+                continue
             rm, rs = stat(rd, rname)
             best = min(pnames, key=lambda n: stat(pn, n)[0])
             pm, ps = stat(pn, best)
@@ -332,7 +370,8 @@ def main():
             # are robust to the VM's speed changing between rounds
             ratios = [a[rname] / b[best] for a, b in zip(rd, pn)]
             rmed = statistics.median(ratios)
-            cols = f" {stat(rdm, rname)[0]:.0f} | {stat(rdm, rname)[0] / pm:.2f} |" if args.merged else ""
+            cols = f" {stat(rdm, rname)[0]:.0f} | {stat(rdm, rname)[0] / pm:.2f} |" if rdm else (
+                " - | - |" if args.merged else "")
             print(f"| {ROBOTS[key][0]} ({nv}) | {label} | {rm:.0f} | {pm:.0f} ({variant}) | "
                   f"{rmed:.2f} ({min(ratios):.2f}-{max(ratios):.2f}) | {rs:.0f}% / {ps:.0f}% |{cols}")
     if args.codegen:

@@ -20,7 +20,7 @@ use crate::algorithms::direct_dynamics::{
     aba_accelerations, aba_articulated, aba_links, body_inertia_and_bias, ltdl_factor, ltdl_solve,
     Method,
 };
-use crate::algorithms::inertia_matrix::{composite_inertia_matrix, transport};
+use crate::algorithms::inertia_matrix::{composite_inertia_block, transport};
 use crate::algorithms::inverse_dynamics::{
     backward_recursion, euler_moment, folded_wrench, forward_links, name3, set_base_motion,
     w_products,
@@ -238,14 +238,28 @@ pub(crate) fn h_vector_into(
 /// the column wrenches of every joint carried to R_0 (`data.col`, by preorder position), and the
 /// base block (the 6 x 6 composite inertia of the whole robot about O_0 in R_0) returned.
 pub(crate) fn composite_blocks(robot: &Robot, data: &mut Data, q: &[f64]) -> Matrix6<f64> {
-    let model = robot.dynamic();
-    let n = model.nl;
+    let n = robot.dof();
     let mut ajj = std::mem::replace(&mut data.a_dyn, DMatrix::zeros(0, 0));
     if ajj.shape() != (n, n) {
         ajj = DMatrix::zeros(n, n);
     }
-    composite_inertia_matrix(model, data, &q[7..], &mut ajj);
+    let abb = composite_blocks_into(robot, data, q, ajj.as_mut_slice(), n);
     data.a_dyn = ajj;
+    abb
+}
+
+/// [`composite_blocks`] with A_jj written into the column-major block `ajj` (entry (r, c) at
+/// `ajj[r + c ld]`): the joint block of the nv x nv matrix itself.
+fn composite_blocks_into(
+    robot: &Robot,
+    data: &mut Data,
+    q: &[f64],
+    ajj: &mut [f64],
+    ld: usize,
+) -> Matrix6<f64> {
+    let model = robot.dynamic();
+    let n = model.nl;
+    composite_inertia_block(model, data, &q[7..], ajj, ld);
     let body = &base_of(robot).body;
     let (mut jc, mut msc, mut mc) = (body.inertia, body.ms, body.mass);
     for k in 1..=n {
@@ -310,16 +324,16 @@ pub(crate) fn inertia_matrix_into(
             format!("{nv} x {nv}: nv = 6 + {}", robot.dof()),
         ));
     }
-    let n = robot.dof();
-    let abb = composite_blocks(robot, data, q);
-    gather_base_rows(robot, data);
+    let model = robot.dynamic();
+    let abb = composite_blocks_into(robot, data, q, &mut a.as_mut_slice()[6 + 6 * nv..], nv);
     a.fixed_view_mut::<6, 6>(0, 0).copy_from(&abb);
-    a.view_mut((6, 6), (n, n)).copy_from(&data.a_dyn);
-    for c in 0..6 {
-        for k in 0..n {
-            let x = data.base_rows[c * n + k];
-            a[(c, 6 + k)] = x;
-            a[(6 + k, c)] = x;
+    // the base rows and columns: the column wrenches in R_0, by preorder position
+    for (p, &link) in model.index.preorder.iter().enumerate() {
+        let k = 5 + link;
+        for c in 0..6 {
+            let x = data.col[c][p];
+            a[(c, k)] = x;
+            a[(k, c)] = x;
         }
     }
     check_finite_matrix("A", a)

@@ -80,13 +80,32 @@ pub fn composite_inertia_matrix<T: DynScalar>(
 ) {
     let n = model.nl;
     assert_eq!(a.shape(), (n, n), "A must be NL x NL");
+    composite_inertia_block(model, ws, q, a.as_mut_slice(), n);
+}
+
+/// [`composite_inertia_matrix`] into an NL x NL column-major block of a larger matrix: entry
+/// (r, c) at `a[r + c ld]` (`ld` >= NL, the larger matrix's row count). A floating robot's
+/// joint block is written in place in its nv x nv matrix this way (no copy).
+pub(crate) fn composite_inertia_block<T: DynScalar>(
+    model: &DynModel<T>,
+    ws: &mut Data<T>,
+    q: &[T],
+    a: &mut [T],
+    ld: usize,
+) {
+    let n = model.nl;
     let idx = &model.index;
     link_placements(model, ws, q);
-    let a = a.as_mut_slice();
     if !idx.serial {
         // entries of unrelated joints (and of fixed frames) are zero; a serial chain writes all
-        // (on the contiguous slice: nalgebra's `fill` walks a strided iterator, 5x slower)
-        a.fill(T::zero());
+        // (on contiguous slices: nalgebra's `fill` walks a strided iterator, 5x slower)
+        if ld == n {
+            a[..n * n].fill(T::zero());
+        } else {
+            a.chunks_mut(ld)
+                .take(n)
+                .for_each(|c| c[..n].fill(T::zero()));
+        }
     }
     for k in (1..=n).rev() {
         let fr = model.frame(k);
@@ -116,12 +135,12 @@ pub fn composite_inertia_matrix<T: DynScalar>(
                 &c[2]
             };
             let r = k - 1;
-            a[r + r * n] = proj[s].clone() + model.link(k).ia.clone();
+            a[r + r * ld] = proj[s].clone() + model.link(k).ia.clone();
             for p in s + 1..e {
                 let col = idx.preorder[p] - 1;
                 let v = proj[p].clone();
-                a[r + col * n] = v.clone();
-                a[col + r * n] = v;
+                a[r + col * ld] = v.clone();
+                a[col + r * ld] = v;
             }
         }
         add_to_antecedent(model, ws, k);
