@@ -311,8 +311,15 @@ fn symbolic_matches_numeric(robot: &Robot, nb: &NumericBase, what: &str) {
     let kv: Vec<Option<f64>> = k.iter().map(|&x| Some(x)).collect();
     let by_rules = sb.values(desc, &kv);
     let by_numeric = nb.base_values(&k);
-    for (r, (s, n)) in by_rules.iter().zip(&by_numeric).enumerate() {
+    // the numerical base keeps link 0 first, the rules list it in K order: match by index
+    for (r, s) in by_rules.iter().enumerate() {
         let s = s.unwrap_or_else(|| panic!("{what}: base parameter {r} has no value"));
+        let at = nb
+            .base
+            .iter()
+            .position(|&b| b == sb.base[r])
+            .expect("same set");
+        let n = &by_numeric[at];
         assert!(
             (s - n).abs() <= 1e-9 * n.abs().max(1.0),
             "{what}: {} = {s} by the rules, {n} numerically",
