@@ -9,7 +9,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use robodyn::algorithms::base_parameters::{base_columns, standard_columns};
 use robodyn::algorithms::regressor::{
-    regressor_into, Friction, ParameterSelection, RotorMode, ZeroParameters, PARAMS_PER_LINK,
+    parameter_count, regressor_into, Friction, ParameterSelection, RotorMode, ZeroParameters,
 };
 use robodyn::batch::for_each_row;
 use robodyn::KinematicsData;
@@ -717,10 +717,11 @@ impl Robot {
         self.model().assembly()
     }
 
-    /// Standard parameters K (13 per link: XX XY XZ YY YZ ZZ MX MY MZ M IA FS FV), numbers.
+    /// Standard parameters K (13 per link: XX XY XZ YY YZ ZZ MX MY MZ M IA FS FV), numbers;
+    /// a floating robot's link 0 (XX0 .. M0) after the links: the columns of `regressor`.
     #[getter]
     fn standard_parameters(&self) -> Vec<f64> {
-        self.model().standard_parameters()
+        robodyn::algorithms::regressor::regressor_parameters(&self.model())
     }
 
     /// Names of the standard parameters (the robot file's own names), in K order.
@@ -728,7 +729,7 @@ impl Robot {
     fn parameter_names(&self) -> Vec<String> {
         let r = self.model();
         let names = robodyn::algorithms::base_parameters::ParameterNames::of(r.description());
-        (0..PARAMS_PER_LINK * r.nl())
+        (0..parameter_count(&r))
             .map(|k| names.name(k).to_string())
             .collect()
     }
@@ -1028,7 +1029,6 @@ impl Robot {
         seed: u64,
     ) -> PyResult<Vec<String>> {
         let robot = self.model();
-        fixed_base_only(&robot, "Robot.regressor_columns")?;
         Ok(self.columns(&robot, columns, friction, rotor, seed)?.1)
     }
 
@@ -1036,7 +1036,9 @@ impl Robot {
     /// (v, a: Pinocchio's names): shape (nq, p) for one state, stacked (N nq, p) for N states
     /// (state after state); its columns are `regressor_columns(columns, ...)`, the standard
     /// parameters (K, 13 per link) or the base parameters; entries in N m (N) per unit of the
-    /// parameter. friction=False leaves out the FS, FV columns. out: as for idm.
+    /// parameter. friction=False leaves out the FS, FV columns. out: as for idm. A floating
+    /// robot: q (nq,), v and a (nv,), Phi (nv, p) with the base wrench's 6 rows first and link
+    /// 0's columns XX0 .. M0 after the links' (columns="base": the numerical base set).
     #[pyo3(signature = (q, qd=None, qdd=None, columns="standard", friction=true, rotor="actuated", seed=1, *, v=None, a=None, out=None))]
     #[allow(clippy::too_many_arguments)]
     fn regressor<'py>(
@@ -1057,19 +1059,18 @@ impl Robot {
         let qdd = alias("qdd", qdd, "a", a)?;
         let models = self.models();
         let robot = &models.full;
-        fixed_base_only(robot, "Robot.regressor")?;
         // its IA, FS, FV columns are joint-side: with motors' values Phi K is not idm
         robot.require_no_motor_drives("Robot.regressor").py()?;
         let (cols, _) = self.columns(robot, columns, friction, rotor, seed)?;
-        let n = robot.dof();
-        let nk = PARAMS_PER_LINK * robot.nl();
+        let n = robot.nv();
+        let nk = parameter_count(robot);
         let call = Call {
             inputs: &[("q", Some(q)), ("qd", qd), ("qdd", qdd)],
             one: &[n, cols.len()],
             stacked: true,
             out,
         };
-        self.eval(py, &models, robot, call, |r, w, x, o| {
+        self.eval_state(py, &models, robot, call, |r, w, x, o| {
             let (data, phi) = w.split(n, nk);
             regressor_into(r, data, r.environment(), x[0], x[1], x[2], phi)?;
             copy_rows(&w.m, &cols, o);
@@ -1092,7 +1093,6 @@ impl Robot {
         zeros: Option<&str>,
         seed: u64,
     ) -> PyResult<crate::models::BaseParameters> {
-        fixed_base_only(&self.model(), "Robot.base_parameters")?;
         crate::models::base_parameters(py, self, method, friction, rotor, zeros, seed)
     }
 

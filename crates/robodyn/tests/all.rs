@@ -67,6 +67,8 @@ mod finite_results;
 mod fixed_frames;
 #[path = "floating_base.rs"]
 mod floating_base;
+#[path = "floating_base_parameters.rs"]
+mod floating_base_parameters;
 #[path = "floating_centroidal.rs"]
 mod floating_centroidal;
 #[path = "floating_kinematics.rs"]

@@ -122,6 +122,7 @@ pub fn run(a: Args) -> CliResult {
         let missing: Vec<String> = desc
             .links
             .iter()
+            .chain(&desc.floating_base)
             .flat_map(|l| l.params.iter())
             .zip(&values)
             .filter(|(_, v)| v.is_none())

@@ -6,15 +6,20 @@
 //! the rows are those of the actuated joints: Gamma_cl = G^T Phi K + G^T Gamma_e (eq 10.40). With
 //! `--base` a closed chain uses the numerical base set when the symbolic rules do not handle
 //! every loop (the numerical method is then the arbiter).
+//!
+//! A floating robot (`--floating` for a URDF): states of nq = 7 + N, nv = 6 + N values, the base
+//! columns first (as `simulate` writes them), nv rows per state (a `row` column: 0..5 the base
+//! wrench fx fy fz mx my mz, joint 0; then the joints) and the columns of the links' parameters
+//! then link 0's (`XX0` .. `M0`); `--base`: the numerical base set (on the full nv rows).
 
 use crate::common::{
     chunk_states, in_table, warn_conditioning, CliResult, NamesArg, Phases, RobotArgs, TableOutput,
     TableWriter, TimingsArg,
 };
-use crate::states::{CarryArg, Chunk, StateInput, StateRequest};
+use crate::states::{base_columns3, CarryArg, Chunk, StateInput, StateRequest};
 use robodyn::algorithms::base_parameters::{base_columns, standard_columns};
 use robodyn::algorithms::regressor::{
-    Friction, ParameterSelection, RotorMode, ZeroParameters, PARAMS_PER_LINK,
+    parameter_count, Friction, ParameterSelection, RotorMode, ZeroParameters,
 };
 use robodyn::{closed_regressor_into, regressor_batch, ClosedChain, ClosedData, Coordinates};
 use std::path::PathBuf;
@@ -49,7 +54,6 @@ pub struct Args {
 pub fn run(a: Args) -> CliResult {
     let mut t = Phases::start(a.timings);
     let robot = a.robot.load()?;
-    crate::common::fixed_base_only(&robot, "regressor")?;
     // its IA, FS, FV columns are joint-side: with motors' values the product W K is not the IDM
     crate::common::refuse_motor_drives(&robot, &a.robot.robot, "robodyn regressor")?;
     // a literal 0 in a SYMORO file means the parameter does not exist (docs/robot-format.md)
@@ -89,10 +93,16 @@ pub fn run(a: Args) -> CliResult {
         names: a.names,
         what: "joints",
         carry: &a.carry.carry,
-        base: Default::default(),
+        base: base_columns3(&robot, ["q", "qd", "qdd"]),
     })?;
-    let headers = input.headers_with(
+    let floating = robot.is_floating();
+    let first: &[&str] = if floating {
+        &["state", "row", "joint", "tau_e"]
+    } else {
         &["state", "joint", "tau_e"]
+    };
+    let headers = input.headers_with(
+        &first
             .iter()
             .map(|s| s.to_string())
             .chain(columns.names.iter().cloned())
@@ -102,11 +112,13 @@ pub fn run(a: Args) -> CliResult {
         out: a.out.writer(headers)?,
         coords,
         indices: &columns.indices,
-        cols: PARAMS_PER_LINK * robot.nl(),
+        cols: parameter_count(&robot),
+        floating,
         row: Vec::new(),
     };
     t.lap("read");
     match &chain {
+        None if floating => floating_rows(&robot, &mut input, &mut rows, &mut t)?,
         None => tree_rows(&robot, &mut input, &mut rows, &mut t)?,
         Some(c) => closed_rows(c, &mut input, &mut rows, &mut t)?,
     }
@@ -156,6 +168,46 @@ fn tree_rows(
     Ok(())
 }
 
+/// Floating robots: one state at a time (q of nq, v and a of nv values), nv rows each; the
+/// library refuses external wrenches there, so tau_e is 0.
+fn floating_rows(
+    robot: &robodyn::Robot,
+    input: &mut StateInput,
+    rows: &mut Rows,
+    t: &mut Phases,
+) -> CliResult {
+    let (nq, nv) = (robot.nq(), robot.nv());
+    let nc = input.carried_headers().len();
+    let (mut data, mut chunk) = (robodyn::Data::new(robot), Chunk::default());
+    let mut phi = nalgebra::DMatrix::zeros(nv, rows.cols);
+    let tau_e = vec![0.0; nv];
+    while input.next_chunk(chunk_states(nq + 2 * nv + nc), &mut chunk)? {
+        t.lap("read");
+        for s in 0..chunk.count {
+            let number = chunk.first + s;
+            let x = [
+                &chunk.x[0][s * nq..(s + 1) * nq],
+                &chunk.x[1][s * nv..(s + 1) * nv],
+                &chunk.x[2][s * nv..(s + 1) * nv],
+            ];
+            robodyn::regressor_into(
+                robot,
+                &mut data,
+                robot.environment(),
+                x[0],
+                x[1],
+                x[2],
+                &mut phi,
+            )
+            .map_err(|e| e.in_row(number))?;
+            t.lap("model");
+            rows.state(number, chunk.carried(s, nc), &tau_e, |k, c| phi[(k, c)])?;
+            t.lap("write");
+        }
+    }
+    Ok(())
+}
+
 /// Closed chains: one state at a time on the branch tracker (from the robot's assembly):
 /// G^T Phi and G^T Gamma_e, actuated-joint order (10.40).
 fn closed_rows(
@@ -194,8 +246,10 @@ struct Rows<'a> {
     coords: &'a Coordinates,
     /// The columns of Phi written (standard or base parameters).
     indices: &'a [usize],
-    /// Columns of Phi (13 per link).
+    /// Columns of Phi (13 per link, then a floating base's 10).
     cols: usize,
+    /// nv rows per state (the base's 6 first, joint 0), a `row` column in front of `joint`.
+    floating: bool,
     row: Vec<f64>,
 }
 
@@ -209,11 +263,24 @@ impl Rows<'_> {
         tau_e: &[f64],
         phi: impl Fn(usize, usize) -> f64,
     ) -> CliResult {
-        for (k, &tau_e) in tau_e.iter().take(self.coords.len()).enumerate() {
+        let (base, n) = if self.floating {
+            (6, 6 + self.coords.len())
+        } else {
+            (0, self.coords.len())
+        };
+        for (k, &tau_e) in tau_e.iter().take(n).enumerate() {
             self.row.clear();
             self.row.extend_from_slice(carried);
-            self.row
-                .extend([number as f64, self.coords.frame(k) as f64, tau_e]);
+            self.row.push(number as f64);
+            if self.floating {
+                self.row.push(k as f64);
+            }
+            let joint = if k < base {
+                0
+            } else {
+                self.coords.frame(k - base)
+            };
+            self.row.extend([joint as f64, tau_e]);
             self.row.extend(self.indices.iter().map(|&c| phi(k, c)));
             self.out.row(Some(number), &self.row, None)?;
         }

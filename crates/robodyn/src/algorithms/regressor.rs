@@ -21,8 +21,10 @@ use crate::model::{
 };
 use nalgebra::{DMatrix, Matrix3, SMatrix, Vector3};
 
+use super::floating_base::v3;
 use super::inverse_dynamics::{
-    add_folded_wrenches, check_state, forward_pass, on_tree_arrays, tree_vector_map, State,
+    add_folded_wrenches, check_state, forward_links, forward_pass, on_tree_arrays, set_base_motion,
+    tree_vector_map, State,
 };
 
 pub use crate::model::{RotorMode, PARAMS_PER_LINK};
@@ -229,7 +231,23 @@ pub fn tree_regressor(
     assert_eq!(phi.shape(), (nl, PARAMS_PER_LINK * nl), "regressor size");
     forward_pass(model, env, ws, q, qd, qdd, &[]);
     phi.as_mut_slice().fill(0.0); // contiguous: nalgebra's `fill` walks a strided iterator
-    for j in 1..=nl {
+    link_columns(model, ws, qd, qdd, phi, 0, false);
+}
+
+/// The columns of links 1..NL of Phi after the forward recursion: Y_j of every link carried to
+/// its ancestors (rows `r0 + k - 1`), then IA_j, FS_j, FV_j in row `r0 + j - 1`. `to_base`
+/// (a floating base): Y_j is carried on into R_0 and written in rows 0..6 (the base wrench:
+/// force, moment about O_0).
+fn link_columns(
+    model: &DynModel<f64>,
+    ws: &Data,
+    qd: &[f64],
+    qdd: &[f64],
+    phi: &mut DMatrix<f64>,
+    r0: usize,
+    to_base: bool,
+) {
+    for j in 1..=model.nl {
         let mut y = link_wrench_map(&ws.w[j], &ws.wd[j], &ws.vd[j]);
         let col = PARAMS_PER_LINK * (j - 1);
         let mut k = j;
@@ -242,11 +260,11 @@ pub fn tree_regressor(
             };
             if let Some(r) = row {
                 for c in 0..10 {
-                    phi[(k - 1, col + c)] = y[(r, c)];
+                    phi[(r0 + k - 1, col + c)] = y[(r, c)];
                 }
             }
             let i = fr.ant;
-            if i == 0 {
+            if i == 0 && !to_base {
                 break;
             }
             // (10.10)–(10.11): iF = iA_k kF, iM = iA_k kM + iP_k x iF
@@ -258,21 +276,104 @@ pub fn tree_regressor(
                 y.fixed_view_mut::<3, 1>(0, c).copy_from(&f);
                 y.fixed_view_mut::<3, 1>(3, c).copy_from(&m);
             }
+            if i == 0 {
+                phi.view_mut((0, col), (6, 10)).copy_from(&y);
+                break;
+            }
             k = i;
         }
         if model.frame(j).joint.is_movable() {
             let s = qd[j - 1];
-            phi[(j - 1, col + 10)] = qdd[j - 1];
-            phi[(j - 1, col + 11)] = if s > 0.0 {
+            phi[(r0 + j - 1, col + 10)] = qdd[j - 1];
+            phi[(r0 + j - 1, col + 11)] = if s > 0.0 {
                 1.0
             } else if s < 0.0 {
                 -1.0
             } else {
                 0.0
             };
-            phi[(j - 1, col + 12)] = s;
+            phi[(r0 + j - 1, col + 12)] = s;
         }
     }
+}
+
+/// Number of regressor columns (standard parameters) of a floating base's own body (link 0):
+/// XX0 XY0 XZ0 YY0 YZ0 ZZ0 MX0 MY0 MZ0 M0 (no drive parameter).
+pub const BASE_LINK_PARAMETERS: usize = 10;
+
+/// Number of standard parameters in K (regressor columns) of `robot`: 13 NL, plus the 10 of
+/// link 0 (after the links' 13 NL) for a floating base.
+pub fn parameter_count(robot: &Robot) -> usize {
+    PARAMS_PER_LINK * robot.nl()
+        + if robot.is_floating() {
+            BASE_LINK_PARAMETERS
+        } else {
+            0
+        }
+}
+
+/// The standard parameters K of the regressor's columns ([`parameter_count`] entries): 13 per
+/// link (link 1 first, [`Robot::standard_parameters`]), then for a floating base link 0's 10
+/// (XX0 ... M0 of the description's base link, the links fixed on it not folded in: they are
+/// links of K).
+pub fn regressor_parameters(robot: &Robot) -> Vec<f64> {
+    let mut k = robot.standard_parameters();
+    if let Some(l) = &robot.description().floating_base {
+        for e in &l.params[..BASE_LINK_PARAMETERS] {
+            k.push(robot.value(e).expect("validated"));
+        }
+    }
+    k
+}
+
+/// The floating base's motion (in R_0) for the regressor: twist `v` = (v_0, w_0) and its
+/// derivative `a`, and wR_0.
+#[derive(Clone, Copy, Debug)]
+pub struct FloatingBaseState<'a> {
+    /// wR_0, the base orientation in the world.
+    pub rot: &'a Matrix3<f64>,
+    /// v_0 (3), w_0 (3), in R_0.
+    pub v: &'a [f64],
+    /// The derivative of `v`.
+    pub a: &'a [f64],
+}
+
+/// Regressor of a floating tree on tree arrays, ((6 + NL) x (13 NL + 10)), written into `phi`,
+/// such that Phi K = [base wrench (force, moment about O_0, in R_0); Gamma_tr] (no external
+/// wrench; `env`'s gravity in the world): the kernel. Columns: link 1..NL (13 each) then link
+/// 0's 10 ([`BASE_LINK_PARAMETERS`]). The base is the root of the recursion with the motion
+/// [w_0, wd_0, a_0 + w_0 x v_0 - R' g], as the floating inverse dynamics.
+///
+/// # Panics
+/// If `phi` is not (6 + NL) x (13 NL + 10) or the base slices have fewer than 6 entries.
+#[allow(clippy::too_many_arguments)]
+pub fn floating_tree_regressor(
+    model: &DynModel<f64>,
+    ws: &mut Data,
+    env: &Environment,
+    base: FloatingBaseState<'_>,
+    q: &[f64],
+    qd: &[f64],
+    qdd: &[f64],
+    phi: &mut DMatrix<f64>,
+) {
+    let nl = model.nl;
+    let cols = PARAMS_PER_LINK * nl;
+    assert_eq!(
+        phi.shape(),
+        (6 + nl, cols + BASE_LINK_PARAMETERS),
+        "regressor size"
+    );
+    let (lin, w) = (v3(&base.v[0..3]), v3(&base.v[3..6]));
+    let (alin, wd) = (v3(&base.a[0..3]), v3(&base.a[3..6]));
+    let vd0 = alin + w.cross(&lin) - base.rot.tr_mul(&env.gravity);
+    set_base_motion(ws, w, wd, vd0);
+    forward_links(model, env, ws, q, qd, qdd, &[]);
+    phi.as_mut_slice().fill(0.0);
+    link_columns(model, ws, qd, qdd, phi, 6, true);
+    let y0 = link_wrench_map(&w, &wd, &vd0);
+    phi.view_mut((0, cols), (6, BASE_LINK_PARAMETERS))
+        .copy_from(&y0);
 }
 
 /// Gamma_e on tree arrays: torques of the tree joints produced by the external wrenches of
@@ -328,6 +429,12 @@ pub fn closed_chain_regressor(g: &DMatrix<f64>, phi: &DMatrix<f64>) -> Result<DM
 /// Regressor Phi (N x 13 NL: rows over the movable joints, columns the standard parameters K,
 /// 13 per link, link 1 first) into `phi`, such that Gamma = Phi K + Gamma_e under `env`
 /// (gravity, base motion). `q`, `qd`, `qdd` over the movable joints. Allocation-free.
+///
+/// A floating robot (docs/models/floating_base.md): `q` (nq), `qd` = v and `qdd` = a (nv), and
+/// Phi is nv x (13 NL + 10): rows the base wrench (force, moment about O_0, in R_0) then the
+/// joints, columns the links' 13 NL parameters then link 0's 10 (XX0 ... M0, see
+/// [`parameter_count`]), so that Phi K = the floating inverse model's nv forces (an external
+/// wrench is refused: its Gamma_e over the base rows is not available yet).
 #[allow(clippy::too_many_arguments)]
 pub fn regressor_into(
     robot: &Robot,
@@ -338,6 +445,9 @@ pub fn regressor_into(
     qdd: &[f64],
     phi: &mut DMatrix<f64>,
 ) -> Result<()> {
+    if robot.is_floating() {
+        return floating_regressor_into(robot, data, env, q, qd, qdd, phi);
+    }
     check_state(robot, data, ["q", "qd", "qdd"], [q, qd, qdd])?;
     env.check(robot.nl())?;
     let c = robot.coordinates();
@@ -365,6 +475,69 @@ pub fn regressor_into(
         }
         data.phi = full;
     });
+    crate::error::check_finite_matrix("Phi", phi)
+}
+
+/// [`regressor_into`] for a floating robot: the floating state's checks (nq, nv, the
+/// quaternion), then [`floating_tree_regressor`] on the tree arrays, rows gathered to the base
+/// and the movable joints.
+#[allow(clippy::too_many_arguments)]
+fn floating_regressor_into(
+    robot: &Robot,
+    data: &mut Data,
+    env: &Environment,
+    q: &[f64],
+    v: &[f64],
+    a: &[f64],
+    phi: &mut DMatrix<f64>,
+) -> Result<()> {
+    let vs = [("qd", v), ("qdd", a)];
+    let nv = robot.nv();
+    let rot = super::floating_base::check_state(robot, data, Some(env), q, &vs, ("Phi", nv))?;
+    let (nl, cols) = (robot.nl(), parameter_count(robot));
+    if phi.shape() != (nv, cols) {
+        return Err(Error::dimension(
+            "Phi",
+            nv * cols,
+            phi.len(),
+            format!(
+                "{nv} x {cols} (nv = 6 + {} rows; 13 standard parameters per link, then link \
+                 0's 10)",
+                robot.dof()
+            ),
+        ));
+    }
+    if env.has_wrenches() {
+        return Err(Error::Input(
+            "the regressor of a floating robot with external wrenches is not supported yet \
+             (their part of the base wrench is not computed): remove the wrenches"
+                .into(),
+        ));
+    }
+    let model = robot.numeric();
+    let c = robot.coordinates();
+    let base = FloatingBaseState {
+        rot: &rot,
+        v: &v[..6],
+        a: &a[..6],
+    };
+    on_tree_arrays(
+        robot,
+        data,
+        [&q[7..], &v[6..], &a[6..]],
+        |data, q, qd, qdd| {
+            let mut full = std::mem::replace(&mut data.phi, DMatrix::zeros(0, 0));
+            if full.shape() != (6 + nl, cols) {
+                full = DMatrix::zeros(6 + nl, cols); // first call only
+            }
+            floating_tree_regressor(model, data, env, base, q, qd, qdd, &mut full);
+            phi.rows_mut(0, 6).copy_from(&full.rows(0, 6));
+            for (r, &j) in c.frames().iter().enumerate() {
+                phi.row_mut(6 + r).copy_from(&full.row(5 + j));
+            }
+            data.phi = full;
+        },
+    );
     crate::error::check_finite_matrix("Phi", phi)
 }
 
@@ -427,7 +600,8 @@ pub fn wrench_torques_into(
     )
 }
 
-/// The regressor (N x 13 NL) at one state with the robot's environment; allocates.
+/// The regressor (N x 13 NL; nv x (13 NL + 10) for a floating robot, see [`regressor_into`]) at
+/// one state with the robot's environment; allocates.
 ///
 /// # Example
 ///
@@ -449,7 +623,7 @@ pub fn wrench_torques_into(
 /// ```
 pub fn regressor(robot: &Robot, q: &[f64], qd: &[f64], qdd: &[f64]) -> Result<DMatrix<f64>> {
     let mut data = Data::new(robot);
-    let mut phi = DMatrix::zeros(robot.dof(), PARAMS_PER_LINK * robot.nl());
+    let mut phi = DMatrix::zeros(robot.nv(), parameter_count(robot));
     regressor_into(robot, &mut data, robot.environment(), q, qd, qdd, &mut phi)?;
     Ok(phi)
 }

@@ -6,7 +6,7 @@ use super::{
     numeric_base_parameters, symbolic_base_parameters, ClosedChainSampler, NumericOptions,
     ParameterNames,
 };
-use crate::algorithms::regressor::ParameterSelection;
+use crate::algorithms::regressor::{parameter_count, ParameterSelection, PARAMS_PER_LINK};
 use crate::error::Result;
 use crate::model::Robot;
 
@@ -22,10 +22,12 @@ pub struct RegressorColumns {
 }
 
 /// The regressor columns of the standard parameters selected by `selection` (absent ones left
-/// out), named with the robot file's own parameter names.
+/// out), then a floating base's 10 (K indices 13 NL.., `XX0` .. `M0`), named with the robot
+/// file's own parameter names.
 pub fn standard_columns(robot: &Robot, selection: &ParameterSelection) -> RegressorColumns {
     let names = ParameterNames::of(robot.description());
-    let indices = selection.columns();
+    let mut indices = selection.columns();
+    indices.extend(PARAMS_PER_LINK * robot.nl()..parameter_count(robot));
     RegressorColumns {
         names: indices.iter().map(|&i| names.name(i).to_string()).collect(),
         indices,
@@ -58,20 +60,13 @@ pub fn base_columns(
             seed,
         };
         let mut sampler = ClosedChainSampler::new(robot)?;
-        let nb = numeric_base_parameters(robot, &mut sampler, &opt)?;
-        let (indices, names) = (0..nb.count())
-            .map(|r| (nb.base[r], name(nb.base[r], nb.is_regrouped(r))))
-            .unzip();
-        return Ok(RegressorColumns {
-            indices,
-            names,
-            note: Some(format!(
-                "{}: the symbolic rules do not handle the loop(s) cut at joint(s) {:?}; the \
-                 columns are the numerical method's base parameters (the arbiter)",
-                robot.name(),
-                sb.unhandled_loops
-            )),
-        });
+        let note = format!(
+            "{}: the symbolic rules do not handle the loop(s) cut at joint(s) {:?}; the \
+             columns are the numerical method's base parameters (the arbiter)",
+            robot.name(),
+            sb.unhandled_loops
+        );
+        return numeric_columns(robot, &name, opt, &mut sampler, note);
     }
     let (indices, names) = (0..sb.count())
         .map(|r| (sb.base[r], name(sb.base[r], sb.is_regrouped(r))))
@@ -80,5 +75,24 @@ pub fn base_columns(
         indices,
         names,
         note: None,
+    })
+}
+
+/// The columns of the numerical method's base parameters, with `note`.
+fn numeric_columns(
+    robot: &Robot,
+    name: &dyn Fn(usize, bool) -> String,
+    opt: NumericOptions,
+    sampler: &mut dyn super::Sampler,
+    note: String,
+) -> Result<RegressorColumns> {
+    let nb = numeric_base_parameters(robot, sampler, &opt)?;
+    let (indices, names) = (0..nb.count())
+        .map(|r| (nb.base[r], name(nb.base[r], nb.is_regrouped(r))))
+        .unzip();
+    Ok(RegressorColumns {
+        indices,
+        names,
+        note: Some(note),
     })
 }

@@ -16,14 +16,18 @@ use std::collections::{BTreeSet, HashMap};
 pub struct ParameterNames {
     names: Vec<String>,
     grouped: Vec<String>,
+    /// NL (a floating base's link 0 comes after the links in K: indices 13 NL..).
+    nl: usize,
 }
 
-/// Canonical name of standard parameter `k` (K index): `XX1`, ..., `FV<NL>`.
-fn canonical(k: usize) -> String {
+/// Canonical name of standard parameter `k` (K index) of a robot with `nl` links: `XX1`, ...,
+/// `FV<NL>`, then a floating base's `XX0` ... `M0`.
+fn canonical(k: usize, nl: usize) -> String {
+    let link = k / PARAMS_PER_LINK;
     format!(
         "{}{}",
         STANDARD_PARAMETERS[k % PARAMS_PER_LINK],
-        k / PARAMS_PER_LINK + 1
+        if link == nl { 0 } else { link + 1 }
     )
 }
 
@@ -47,26 +51,30 @@ fn unique(mut name: String, used: &BTreeSet<String>, taken: &BTreeSet<String>) -
 impl ParameterNames {
     /// The canonical names `XX1`...`FV<nl>` and `XXR1`...`FVR<nl>`.
     pub fn standard(nl: usize) -> ParameterNames {
-        let names: Vec<String> = (0..PARAMS_PER_LINK * nl).map(canonical).collect();
+        let names: Vec<String> = (0..PARAMS_PER_LINK * nl)
+            .map(|k| canonical(k, nl))
+            .collect();
         let grouped = names
             .iter()
             .enumerate()
             .map(|(k, n)| grouped_of(STANDARD_PARAMETERS[k % PARAMS_PER_LINK], n))
             .collect();
-        ParameterNames { names, grouped }
+        ParameterNames { names, grouped, nl }
     }
 
     /// The names `desc` gives its parameters: a parameter written as a single symbol keeps that
     /// symbol (the first one only, if a symbol names two parameters); any other (a number, a
     /// literal 0, an expression) takes its canonical name unless the file uses that name for
-    /// something else.
+    /// something else. A floating base's link 0 follows the links (K indices 13 NL..).
     pub fn of(desc: &RobotDescription) -> ParameterNames {
         let mut used: BTreeSet<String> = desc.symbols.keys().cloned().collect();
         used.extend(desc.used_symbols());
-        let n = PARAMS_PER_LINK * desc.nl;
+        let nl = desc.nl;
+        let links: Vec<_> = desc.links.iter().chain(&desc.floating_base).collect();
+        let n = PARAMS_PER_LINK * links.len();
         let own: Vec<Option<String>> = (0..n)
             .map(|k| {
-                desc.links[k / PARAMS_PER_LINK].params[k % PARAMS_PER_LINK]
+                links[k / PARAMS_PER_LINK].params[k % PARAMS_PER_LINK]
                     .as_symbol()
                     .map(str::to_string)
             })
@@ -83,7 +91,7 @@ impl ParameterNames {
         }
         for k in 0..n {
             if names[k].is_empty() {
-                names[k] = unique(canonical(k), &used, &taken);
+                names[k] = unique(canonical(k, nl), &used, &taken);
                 taken.insert(names[k].clone());
             }
         }
@@ -97,12 +105,12 @@ impl ParameterNames {
             taken.insert(g.clone());
             grouped.push(g);
         }
-        ParameterNames { names, grouped }
+        ParameterNames { names, grouped, nl }
     }
 
-    /// Number of links.
+    /// Number of links (NL, without a floating base's link 0).
     pub fn nl(&self) -> usize {
-        self.names.len() / PARAMS_PER_LINK
+        self.nl
     }
 
     /// Name of standard parameter `k` (K index).
@@ -117,13 +125,19 @@ impl ParameterNames {
 
     /// Whether the names differ from the canonical `XX1`... (the file has its own).
     pub fn is_canonical(&self) -> bool {
-        *self == ParameterNames::standard(self.nl())
+        let s = ParameterNames::standard(self.nl);
+        self.names
+            .iter()
+            .enumerate()
+            .all(|(k, n)| *n == canonical(k, self.nl))
+            && self.grouped[..s.grouped.len()] == s.grouped[..]
     }
 
     /// `e` (over the canonical symbols) with the canonical symbols replaced by these names.
     pub fn rename(&self, e: &Expr) -> Expr {
-        let map: HashMap<String, usize> =
-            (0..self.names.len()).map(|k| (canonical(k), k)).collect();
+        let map: HashMap<String, usize> = (0..self.names.len())
+            .map(|k| (canonical(k, self.nl), k))
+            .collect();
         e.substitute(&|s: &str| map.get(s).map(|&k| Expr::symbol(self.names[k].clone())))
     }
 }

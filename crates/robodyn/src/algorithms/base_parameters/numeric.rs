@@ -31,7 +31,8 @@
 //! <= tol), so both methods name the same base parameters.
 
 use super::super::regressor::{
-    closed_chain_regressor, tree_regressor, ParameterSelection, PARAMS_PER_LINK,
+    closed_chain_regressor, floating_tree_regressor, parameter_count, tree_regressor,
+    FloatingBaseState, ParameterSelection, PARAMS_PER_LINK,
 };
 use super::names::ParameterNames;
 use crate::data::Data;
@@ -492,17 +493,24 @@ pub fn numeric_base_parameters(
     sampler: &mut dyn Sampler,
     opt: &NumericOptions,
 ) -> Result<NumericBase> {
-    robot.require_fixed_base("the numerical base parameters")?;
     let sel = &opt.selection;
     let nl = robot.nl();
+    if robot.is_floating() && !robot.is_tree() {
+        return Err(Error::Input(format!(
+            "{}: the numerical base parameters of a floating robot with closed loops are not \
+             supported yet",
+            robot.name()
+        )));
+    }
     if sel.rotor.len() != nl || sel.friction.len() != nl {
         return Err(Error::Input(format!(
             "the parameter selection has {} entries, the robot has NL = {nl} links",
             sel.rotor.len()
         )));
     }
-    let columns = sel.columns();
-    let all = observed_columns(sel, nl);
+    let mut columns = sel.columns();
+    columns.extend(base_link_columns(robot));
+    let all = observed_columns(robot, sel);
     check_observation_size(robot, opt, all.len())?;
     // 1. W
     let Observation {
@@ -511,12 +519,20 @@ pub fn numeric_base_parameters(
         samples,
         tree_rows,
     } = observation_matrix(robot, sampler, opt, &all, columns.len())?;
+    let offset = if robot.is_floating() { 6 } else { 0 };
     // 2.-3. no-effect columns, the others scaled to unit norm
     let scaled = scale_columns(&mut w, &all, sel);
-    let r_all = staircase_r(w, &scaled.live, &all, rows, samples, tree_rows);
+    let stairs = Stairs {
+        rows,
+        samples,
+        tree_rows,
+        offset,
+        nl,
+    };
+    let r_all = staircase_r(w, &scaled.live, &all, &stairs);
     let (singular_values, tol) = rank_tolerance(&r_all, scaled.n_present)?;
     // 4. ordered selection among the existing columns and the absent ones in their span
-    let candidates = span_candidates(&r_all, &scaled, &all, rows, tol);
+    let candidates = span_candidates(&r_all, &scaled, &all, &stairs, tol);
     let (kept, dep) = ordered_selection(&r_all, &candidates, scaled.n_present, tol);
     // 5. beta and the rank certificate
     let g = grouping(robot, &r_all, &kept, &dep, tol)?;
@@ -548,13 +564,53 @@ pub fn numeric_base_parameters(
     })
 }
 
-/// W's columns (K indices): the existing parameters of the selection (K order), then its absent
-/// ones.
-fn observed_columns(sel: &ParameterSelection, nl: usize) -> Vec<usize> {
-    (0..PARAMS_PER_LINK * nl)
-        .filter(|&i| sel.slot(i) && !sel.absent.contains(&i))
+/// W's columns (K indices): a floating base's 10 parameters (link 0 first in the ordered
+/// selection: it moves freely, so its own parameters are all identifiable and the links'
+/// group into it), the existing parameters of the selection (K order), then its absent ones.
+fn observed_columns(robot: &Robot, sel: &ParameterSelection) -> Vec<usize> {
+    let nl = robot.nl();
+    base_link_columns(robot)
+        .chain((0..PARAMS_PER_LINK * nl).filter(|&i| sel.slot(i) && !sel.absent.contains(&i)))
         .chain((0..PARAMS_PER_LINK * nl).filter(|&i| sel.slot(i) && sel.absent.contains(&i)))
         .collect()
+}
+
+/// K indices of a floating base's own parameters (13 NL .. 13 NL + 10, after the links'), none
+/// for a fixed base.
+fn base_link_columns(robot: &Robot) -> std::ops::Range<usize> {
+    let start = PARAMS_PER_LINK * robot.nl();
+    start..parameter_count(robot)
+}
+
+/// The shape of W: its rows, and a tree's row blocks (by base row and joint, then sample).
+struct Stairs {
+    rows: usize,
+    samples: usize,
+    tree_rows: bool,
+    /// Base rows before the joints' blocks: 6 for a floating base.
+    offset: usize,
+    nl: usize,
+}
+
+impl Stairs {
+    /// The link of K index `i` (0 for a floating base's own parameters).
+    fn link(&self, i: usize) -> usize {
+        if i >= PARAMS_PER_LINK * self.nl {
+            0
+        } else {
+            i / PARAMS_PER_LINK + 1
+        }
+    }
+
+    /// Position of K index `i` in the ordered selection: link 0 (a floating base) first, then
+    /// K order.
+    fn order(&self, i: usize) -> usize {
+        if i >= PARAMS_PER_LINK * self.nl {
+            i - PARAMS_PER_LINK * self.nl
+        } else {
+            i + PARAMS_PER_LINK
+        }
+    }
 }
 
 /// The columns of W after steps 2 and 3.
@@ -612,20 +668,15 @@ fn scale_columns(w: &mut Mat<f64>, all: &[usize], sel: &ParameterSelection) -> S
 
 /// R of the unpivoted QR of the scaled live columns of W (W consumed): a tree's W is a staircase
 /// (rows by joint), its column c zero below the rows of its link.
-fn staircase_r(
-    mut w: Mat<f64>,
-    live: &[usize],
-    all: &[usize],
-    rows: usize,
-    samples: usize,
-    tree_rows: bool,
-) -> Mat<f64> {
+fn staircase_r(mut w: Mat<f64>, live: &[usize], all: &[usize], st: &Stairs) -> Mat<f64> {
+    let rows = st.rows;
     let mut a = w.as_mut().subcols_mut(0, live.len());
     let mut last = Vec::with_capacity(live.len());
     let mut running = 0;
     for &c in live {
-        let lr = if tree_rows {
-            (all[c] / PARAMS_PER_LINK + 1) * samples - 1
+        // link j's column is zero below the block of joint j (the base's below the base rows)
+        let lr = if st.tree_rows {
+            (st.offset + st.link(all[c])) * st.samples - 1
         } else {
             rows - 1
         };
@@ -663,9 +714,10 @@ fn span_candidates(
     r_all: &Mat<f64>,
     scaled: &ScaledColumns,
     all: &[usize],
-    rows: usize,
+    st: &Stairs,
     tol: f64,
 ) -> Vec<usize> {
+    let rows = st.rows;
     let (live, n_present) = (&scaled.live, scaled.n_present);
     let mut c: Vec<usize> = (0..live.len())
         .filter(|&k| {
@@ -678,7 +730,7 @@ fn span_candidates(
             }
         })
         .collect();
-    c.sort_by_key(|&k| all[live[k]]);
+    c.sort_by_key(|&k| st.order(all[live[k]]));
     c
 }
 
@@ -716,14 +768,15 @@ fn ordered_selection(
 /// N <= NL rows per sample, so rows <= max(target + NL, 20 NL); phi (NL x 13 NL) counts too.
 fn check_observation_size(robot: &Robot, opt: &NumericOptions, ncols: usize) -> Result<()> {
     let nl = robot.nl();
+    let per = robot.nv().max(nl);
     let bound_rows = opt
         .samples
-        .map(|s| s.saturating_mul(nl))
+        .map(|s| s.saturating_mul(per))
         .unwrap_or_else(|| {
             (3 * ncols)
                 .min(3000.max(ncols + ncols / 4))
-                .saturating_add(nl)
-                .max(20 * nl)
+                .saturating_add(per)
+                .max(20 * per)
         });
     let bytes = bound_rows
         .saturating_mul(ncols.max(1))
@@ -769,10 +822,11 @@ fn observation_matrix(
     let mut rng = crate::sampling::rng(opt.seed);
     let model = robot.numeric();
     let mut ws = Data::new(robot);
-    let mut phi = DMatrix::zeros(nl, PARAMS_PER_LINK * nl);
+    let offset = if robot.is_floating() { 6 } else { 0 };
+    let mut phi = DMatrix::zeros(offset + nl, parameter_count(robot));
     // the first sample fixes N (rows per sample)
     let first = sampler.sample(robot, &mut rng)?;
-    let n_rows_per = first.g.as_ref().map_or(nl, |g| g.ncols()).max(1);
+    let n_rows_per = first.g.as_ref().map_or(offset + nl, |g| g.ncols()).max(1);
     let samples = sample_count(opt, n_columns, n_rows_per);
     let rows = samples * n_rows_per;
     let tree_rows = first.g.is_none();
@@ -788,7 +842,19 @@ fn observation_matrix(
                 "the sampler returned a state of the wrong size (NL = {nl} expected)"
             )));
         }
-        tree_regressor(model, &mut ws, &model.env, &s.q, &s.qd, &s.qdd, &mut phi);
+        if robot.is_floating() {
+            let [rot, v, a] = random_base_motion(&mut rng);
+            let base = FloatingBaseState {
+                rot: &nalgebra::Matrix3::from_column_slice(&rot),
+                v: &v,
+                a: &a,
+            };
+            floating_tree_regressor(
+                model, &mut ws, &model.env, base, &s.q, &s.qd, &s.qdd, &mut phi,
+            );
+        } else {
+            tree_regressor(model, &mut ws, &model.env, &s.q, &s.qd, &s.qdd, &mut phi);
+        }
         let block = match &s.g {
             Some(g) => closed_chain_regressor(g, &phi)?,
             None => phi.clone(),
@@ -822,6 +888,17 @@ fn observation_matrix(
         samples,
         tree_rows,
     })
+}
+
+/// A random motion of a floating base for W: its orientation (column-major rotation matrix:
+/// the regressor in R_0 sees it through the direction of gravity only), twist in [-2, 2] and
+/// its derivative in [-5, 5].
+fn random_base_motion(rng: &mut dyn RngCore) -> [Vec<f64>; 3] {
+    let mut v =
+        |s: f64, n: usize| -> Vec<f64> { (0..n).map(|_| rng.random_range(-s..s)).collect() };
+    let axis = v(std::f64::consts::PI, 3);
+    let rot = nalgebra::Rotation3::new(nalgebra::Vector3::new(axis[0], axis[1], axis[2]));
+    [rot.matrix().as_slice().to_vec(), v(2.0, 6), v(5.0, 6)]
 }
 
 /// beta and the rank certificate of step 5.

@@ -54,11 +54,13 @@ pub struct Summary {
     pub comparison: Option<MethodComparison>,
 }
 
-/// Numeric standard parameters of a description, K order (None where a symbol has no value).
+/// Numeric standard parameters of a description, K order (None where a symbol has no value);
+/// a floating base's link 0 after the links (K indices 13 NL..).
 pub fn standard_values(desc: &RobotDescription) -> Vec<Option<f64>> {
     let env = |s: &str| desc.symbols.get(s).copied();
     desc.links
         .iter()
+        .chain(&desc.floating_base)
         .flat_map(|l| {
             l.params
                 .iter()
@@ -219,10 +221,17 @@ impl Summary {
         let mut rows = vec![std::iter::once("j".to_string())
             .chain(cols.iter().map(|&p| format!("{}j", STANDARD_PARAMETERS[p])))
             .collect()];
-        for j in 1..=self.nl {
+        // a floating base's link 0 (K indices 13 NL..) first
+        let floating = self
+            .columns
+            .last()
+            .is_some_and(|&c| c >= PARAMS_PER_LINK * self.nl);
+        let links = (!floating as usize)..=self.nl;
+        for j in links {
             let mut row = vec![j.to_string()];
             for &p in &cols {
-                let idx = PARAMS_PER_LINK * (j - 1) + p;
+                let first = if j == 0 { self.nl } else { j - 1 };
+                let idx = PARAMS_PER_LINK * first + p;
                 row.push(match self.base.iter().find(|b| b.index == idx) {
                     Some(b) => b.name.clone(),
                     None if self.columns.binary_search(&idx).is_ok() => "0".into(),
@@ -274,14 +283,22 @@ pub fn base_robot(
     values: &[f64],
 ) -> Result<RobotDescription> {
     let mut d = desc.clone();
-    for l in d.links.iter_mut() {
+    for l in d.links.iter_mut().chain(d.floating_base.as_mut()) {
         for e in l.params.iter_mut() {
             *e = Expr::zero();
         }
     }
-    let names = ParameterNames::standard(desc.nl);
+    let names = if desc.floating_base.is_some() {
+        ParameterNames::of(desc)
+    } else {
+        ParameterNames::standard(desc.nl)
+    };
     for (&i, &v) in base.iter().zip(values) {
-        let (j, p) = (i / PARAMS_PER_LINK + 1, i % PARAMS_PER_LINK);
+        // a floating base's link 0 after the links (K indices 13 NL..)
+        let (j, p) = (
+            (i / PARAMS_PER_LINK + 1) % (desc.nl + 1),
+            i % PARAMS_PER_LINK,
+        );
         if matches!(p, param::M | param::IA | param::FS | param::FV) && v < 0.0 {
             return Err(Error::invalid(
                 Item::Link(j, Some(STANDARD_PARAMETERS[p].into())),
@@ -293,7 +310,10 @@ pub fn base_robot(
                 ),
             ));
         }
-        d.links[j - 1].params[p] = Expr::num(v);
+        match (j, d.floating_base.as_mut()) {
+            (0, Some(l)) => l.params[p] = Expr::num(v),
+            _ => d.links[j - 1].params[p] = Expr::num(v),
+        }
     }
     d.name = format!("{} (base parameters)", desc.name);
     d.notes.push(

@@ -44,7 +44,7 @@ use nalgebra::{Matrix3, Vector3};
 use robodyn_symbolic::{Expr, Node};
 use std::collections::{BTreeMap, BTreeSet};
 
-use super::super::regressor::{ParameterSelection, PARAMS_PER_LINK};
+use super::super::regressor::{ParameterSelection, BASE_LINK_PARAMETERS, PARAMS_PER_LINK};
 use super::names::ParameterNames;
 use crate::model::param::{IA, M, MX, MY, MZ, XX, XY, XZ, YY, YZ, ZZ};
 
@@ -148,7 +148,13 @@ fn drop_float_noise(e: Expr, target: usize, desc: &RobotDescription, scale: f64)
     let nl = desc.nl;
     let power = |k: usize| {
         let j = k / PARAMS_PER_LINK + 1;
-        length_power(k % PARAMS_PER_LINK, desc.frame(j).joint)
+        // a floating base's link 0 (K indices 13 NL..) has no drive parameter
+        let joint = if j > nl {
+            JointType::Fixed
+        } else {
+            desc.frame(j).joint
+        };
+        length_power(k % PARAMS_PER_LINK, joint)
     };
     let n_target = power(target);
     let env = |s: &str| Some(symbol_value(desc, s));
@@ -210,11 +216,15 @@ impl SymbolicBase {
     }
 }
 
-/// Index in K of a standard parameter symbol such as `XX2`, `IA1`.
+/// Index in K of a standard parameter symbol such as `XX2`, `IA1`; a floating base's `XX0` ..
+/// `M0` after the links' (13 NL + p).
 pub fn standard_index(name: &str, nl: usize) -> Option<usize> {
     let split = name.find(|c: char| c.is_ascii_digit())?;
     let (p, j) = name.split_at(split);
     let pi = STANDARD_PARAMETERS.iter().position(|&x| x == p)?;
+    if j == "0" {
+        return (pi < BASE_LINK_PARAMETERS).then_some(PARAMS_PER_LINK * nl + pi);
+    }
     let j: usize = j.parse().ok()?;
     (j >= 1 && j <= nl).then(|| PARAMS_PER_LINK * (j - 1) + pi)
 }
@@ -353,6 +363,9 @@ const JIDX: [(usize, usize); 6] = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2
 struct State {
     kr: Vec<[Expr; PARAMS_PER_LINK]>,
     alive: Vec<[bool; PARAMS_PER_LINK]>,
+    /// A floating base's link 0 (its 10 inertial parameters, every one a base parameter):
+    /// what is grouped into link 0 lands here; None for a fixed base (no effect there).
+    base: Option<[Expr; BASE_LINK_PARAMETERS]>,
 }
 
 impl State {
@@ -364,8 +377,16 @@ impl State {
         self.kr[j - 1][p] = Expr::zero();
     }
     fn add(&mut self, j: usize, p: usize, e: Expr) {
-        if j == 0 || e.is_zero() {
-            return; // grouped into the base: no effect
+        if e.is_zero() {
+            return;
+        }
+        if j == 0 {
+            // grouped into a floating base's link 0; into a fixed base: no effect
+            if let Some(b) = self.base.as_mut() {
+                let cur = b[p].clone();
+                b[p] = cur + e;
+            }
+            return;
         }
         if !self.alive[j - 1][p] {
             // grouped into an eliminated parameter: no effect
@@ -740,8 +761,15 @@ pub fn symbolic_base_parameters(
     desc: &RobotDescription,
     sel: &ParameterSelection,
 ) -> Result<SymbolicBase> {
-    crate::model::require_fixed_base(desc, "the symbolic base parameters")?;
     let nl = desc.nl;
+    let floating = desc.floating_base.is_some();
+    if floating && desc.nj != nl {
+        return Err(Error::Input(format!(
+            "{}: the symbolic base parameters of a floating robot with closed loops are not \
+             supported yet",
+            desc.name
+        )));
+    }
     if sel.rotor.len() != nl || sel.friction.len() != nl {
         return Err(Error::Input(format!(
             "the parameter selection has {} entries, the robot has NL = {nl} links",
@@ -750,7 +778,11 @@ pub fn symbolic_base_parameters(
     }
     check_geometry_names(desc)?;
     let ctx = Context::new(desc)?;
-    let mut s = State::new(nl, sel);
+    let mut s = State::new(nl, sel, floating);
+    if floating {
+        floating_rules(&ctx, &mut s);
+        return Ok(s.finish(desc, sel, Vec::new(), &[]));
+    }
     rotor_inertias(&ctx, &mut s);
     let mut parallelograms = Vec::new();
     let mut unhandled_loops = Vec::new();
@@ -787,6 +819,23 @@ pub fn symbolic_base_parameters(
     Ok(s.finish(desc, sel, unhandled_loops, &parallelograms))
 }
 
+/// The rules of a floating base (a tree): link 0 moves freely (6 degrees of freedom), so every
+/// link follows the general rules of the links beyond r2 and none of the special rules of the
+/// links next to a fixed base apply (rules 3–7, the rotor inertias grouped into ZZ_j or M_j:
+/// w_j . z_j = qd_j never holds identically, the base rotates). For j = n..1: Theorem 10.1
+/// (revolute: YY_j into XX_j, YY_j MZ_j M_j into a(j)), Theorem 10.2 (prismatic: J_j into
+/// J_a(j)), a fixed frame's ten parameters into a(j); what reaches a(j) = 0 lands on link 0's
+/// ten parameters, which are all base parameters.
+fn floating_rules(ctx: &Context, s: &mut State) {
+    for j in (1..=ctx.desc.nl).rev() {
+        match ctx.joint(j) {
+            JointType::Revolute => theorem_10_1(ctx, j, false, s),
+            JointType::Prismatic => theorem_10_2(ctx, j, s),
+            JointType::Fixed => fixed_frame(ctx, j, s),
+        }
+    }
+}
+
 /// The standard parameter symbols (`XX2`, `M3`...) are the unknowns of the equations: a
 /// geometric symbol of the same name would make the equations ambiguous.
 fn check_geometry_names(desc: &RobotDescription) -> Result<()> {
@@ -811,7 +860,7 @@ fn check_geometry_names(desc: &RobotDescription) -> Result<()> {
 }
 
 impl State {
-    fn new(nl: usize, sel: &ParameterSelection) -> State {
+    fn new(nl: usize, sel: &ParameterSelection, floating: bool) -> State {
         let index = |j: usize, p: usize| PARAMS_PER_LINK * (j - 1) + p;
         State {
             kr: (1..=nl)
@@ -829,6 +878,7 @@ impl State {
             alive: (1..=nl)
                 .map(|j| std::array::from_fn(|p| sel.slot(index(j, p))))
                 .collect(),
+            base: floating.then(|| std::array::from_fn(|p| sym(0, p))),
         }
     }
 
@@ -841,31 +891,42 @@ impl State {
         parallelograms: &[(Parallelogram, crate::model::ClosedLoop)],
     ) -> SymbolicBase {
         let nl = self.kr.len();
-        let columns = sel.columns();
+        let mut columns = sel.columns();
+        // a floating base's link 0 after the links (K indices 13 NL..)
+        let link0 = self.base.as_ref().map_or(0, |_| BASE_LINK_PARAMETERS);
+        columns.extend((0..link0).map(|p| PARAMS_PER_LINK * nl + p));
         let mut base = Vec::new();
         let mut equations = Vec::new();
         let mut used = BTreeSet::new();
         let mut dropped_float_terms = 0;
         let scale = length_scale(desc);
-        for j in 1..=nl {
-            for p in 0..PARAMS_PER_LINK {
-                if !self.alive[j - 1][p] {
-                    continue;
-                }
-                let target = PARAMS_PER_LINK * (j - 1) + p;
-                let (e, dropped) = drop_float_noise(self.get(j, p).expand(), target, desc, scale);
-                dropped_float_terms += dropped;
-                if e.is_zero() {
-                    continue;
-                }
-                for name in e.symbols() {
-                    if let Some(k) = standard_index(&name, nl) {
-                        used.insert(k);
-                    }
-                }
-                base.push(PARAMS_PER_LINK * (j - 1) + p);
-                equations.push(e);
+        let params = (1..=nl)
+            .flat_map(|j| (0..PARAMS_PER_LINK).map(move |p| (j, p)))
+            .chain((0..link0).map(|p| (0, p)));
+        for (j, p) in params {
+            let target = if j == 0 {
+                PARAMS_PER_LINK * nl + p
+            } else if self.alive[j - 1][p] {
+                PARAMS_PER_LINK * (j - 1) + p
+            } else {
+                continue;
+            };
+            let current = match (j, &self.base) {
+                (0, Some(b)) => b[p].clone(),
+                _ => self.get(j, p),
+            };
+            let (e, dropped) = drop_float_noise(current.expand(), target, desc, scale);
+            dropped_float_terms += dropped;
+            if e.is_zero() {
+                continue;
             }
+            for name in e.symbols() {
+                if let Some(k) = standard_index(&name, nl) {
+                    used.insert(k);
+                }
+            }
+            base.push(target);
+            equations.push(e);
         }
         let baseset: BTreeSet<usize> = base.iter().copied().collect();
         let grouped = columns
