@@ -265,22 +265,6 @@ impl NamesArg {
     }
 }
 
-/// The refusal of a command (`what`, e.g. "the kinematics commands (fk, jacobian, com)") that
-/// does not support floating robots yet; Ok for a fixed or mobile base.
-pub fn fixed_base_only(robot: &robodyn::Robot, what: &str) -> CliResult<()> {
-    if robot.is_floating() {
-        return Err(format!(
-            "{what}: robot `{}` has a floating base, not supported there yet; the \
-             commands of floating robots are idm, ddm, inertia, fk, jacobian, com (states \
-             of nq = 7 + {n} and nv = 6 + {n} values, the base first), simulate and info",
-            robot.name(),
-            n = robot.dof()
-        )
-        .into());
-    }
-    Ok(())
-}
-
 /// The branch tracker of a closed chain: from `--guess` (q_p at the first q_a) when given, else
 /// the robot's assembly.
 pub fn start_branch(

@@ -197,11 +197,12 @@ fn floating_states_are_checked_and_unsupported_functions_refuse() {
     inverse_dynamics_into(&robot, &mut data, env, &q, &v, &a, &mut tau).unwrap();
     inverse_dynamics_into(&robot, &mut data, env, &near, &v, &a, &mut t2).unwrap();
     assert!(max_gap(&t2, &tau) < 1e-12);
-    // functions without floating support refuse (not a fixed-base number)
+    // the regressor takes nq / nv states (tests/floating_base_parameters.rs): joints alone are
+    // not one; functions without floating support refuse (not a fixed-base number)
     let e = robodyn::regressor(&robot, &q[7..], &v[6..], &a[6..])
         .unwrap_err()
         .to_string();
-    assert!(e.contains("floating base"), "{e}");
+    assert!(e.contains("nq = 7 + "), "{e}");
     let e = robodyn::ClosedChain::new(&robot).unwrap_err().to_string();
     assert!(e.contains("floating base"), "{e}");
     // the kinematics take nq / nv states (tests/floating_kinematics.rs): joints alone are not one
