@@ -282,7 +282,7 @@ fn merges_of_other_robots_or_options_are_refused() {
     assert!(e.contains("geometry"), "{e}");
     // other row options
     let other = Options {
-        bandwidth: 10.0,
+        bandwidth: 5.0,
         ..Options::default()
     };
     let lc = log(&scara, 3, 2.0);

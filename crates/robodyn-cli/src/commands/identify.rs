@@ -76,7 +76,7 @@ pub struct Args {
     pub essential_tolerance: f64,
     /// Joint-space bandwidth of the robot's dynamics (Hz): the filter and decimation defaults
     /// follow from it.
-    #[arg(long, default_value_t = robodyn::identification::DEFAULT_BANDWIDTH, value_parser = positive)]
+    #[arg(long, default_value_t = 10.0, value_parser = positive)]
     pub bandwidth: f64,
     /// Cut-off of the zero-phase position low-pass (Hz; default 10 x bandwidth, at most 0.4 x
     /// the sample rate).
@@ -85,8 +85,7 @@ pub struct Args {
     /// Order of the position low-pass.
     #[arg(long, default_value_t = 4)]
     pub filter_order: usize,
-    /// Decimation factor (default floor(0.8 fs / (40 bandwidth)): the decimation low-pass at
-    /// twice the position cut-off).
+    /// Decimation factor (default floor(0.8 fs / (4 bandwidth))).
     #[arg(long)]
     pub decimation: Option<usize>,
     /// Samples dropped at each end (default: the settling time of the position filter).
@@ -102,10 +101,10 @@ pub struct Args {
     #[arg(long, allow_hyphen_values = true)]
     pub gains: Option<String>,
     /// Leave out a joint's rows where |qd_j| is below this (rad/s or m/s).
-    #[arg(long, default_value_t = robodyn::identification::DEFAULT_MIN_SPEED, value_parser = non_negative)]
+    #[arg(long, default_value_t = 0.0, value_parser = non_negative)]
     pub min_speed: f64,
     /// Dead band of the Coulomb friction's sign (rad/s or m/s): sign(qd) is 0 where |qd| is at
-    /// most this (default 3e-3 when qd is differentiated from the positions, 0 when the log
+    /// most this (default 1e-3 when qd is differentiated from the positions, 0 when the log
     /// gives qd).
     #[arg(long, value_parser = non_negative)]
     pub coulomb_band: Option<f64>,

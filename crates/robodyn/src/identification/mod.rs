@@ -145,15 +145,13 @@ pub struct Options {
     pub consistency_solver: consistency::Solver,
     /// Reduce to the essential parameters (None: keep every base parameter).
     pub essential: Option<EssentialOptions>,
-    /// Joint-space bandwidth of the robot's dynamics (Hz, default [`DEFAULT_BANDWIDTH`]);
-    /// defaults follow from it.
+    /// Joint-space bandwidth of the robot's dynamics (Hz); defaults follow from it.
     pub bandwidth: f64,
     /// Low-pass of the positions: cut-off (Hz, default 10 x bandwidth, at most 0.4 fs), order.
     pub cutoff: Option<f64>,
     /// Order of the position low-pass (Butterworth, applied forward and backward; default 4).
     pub filter_order: usize,
-    /// Decimation factor (default: floor(0.8 fs / (40 bandwidth)), at least 1: the decimation
-    /// low-pass at 20 x bandwidth or more, twice the position cut-off).
+    /// Decimation factor (default: floor(0.8 fs / (4 bandwidth)), at least 1).
     pub decimation: Option<usize>,
     /// Samples dropped at each end (default: the settling of the position filter).
     pub border: Option<usize>,
@@ -163,8 +161,7 @@ pub struct Options {
     pub use_log_derivatives: bool,
     /// Drive gains (currents to torques), per motor.
     pub gains: Option<Vec<f64>>,
-    /// A joint's row is left out where |qd_j| is below this (rad/s or m/s; default
-    /// [`DEFAULT_MIN_SPEED`]).
+    /// A joint's row is left out where |qd_j| is below this (rad/s or m/s; default 0: none).
     pub min_speed: f64,
     /// IDIM-IV: iterations and the bandwidth of the tracking loop of the simulation (Hz).
     pub iv_iterations: usize,
@@ -182,19 +179,9 @@ pub struct Options {
 
 /// Default dead band of the Coulomb sign where the velocities are estimated (rad/s or m/s):
 /// below it an estimated velocity is taken as rest, sign 0, instead of a sign drawn by the
-/// noise of the differentiated positions (chosen by cross-validation on the TX40 log:
-/// docs/models/identification.md).
-pub const DEFAULT_COULOMB_BAND: f64 = 3e-3;
-
-/// Default joint-space bandwidth of the robot's dynamics (Hz): the position cut-off (10 x) and
-/// the decimation (low-pass at 20 x) follow from it (chosen by cross-validation on the TX40
-/// log: docs/models/identification.md).
-pub const DEFAULT_BANDWIDTH: f64 = 5.0;
-
-/// Default minimum speed (rad/s or m/s): a joint's rows where |qd_j| is below it are left out of
-/// the fit, where sign(qd_j) of the Coulomb friction is least certain (chosen by
-/// cross-validation on the TX40 log: docs/models/identification.md).
-pub const DEFAULT_MIN_SPEED: f64 = 5e-3;
+/// noise of the differentiated positions (measured on the TX40 log: docs/models/
+/// identification.md).
+pub const DEFAULT_COULOMB_BAND: f64 = 1e-3;
 
 impl Options {
     /// Check every number of the options (positive bandwidths and cut-off, a filter order of 1
@@ -288,7 +275,7 @@ impl Default for Options {
             standard: false,
             consistency_solver: consistency::Solver::default(),
             essential: None,
-            bandwidth: DEFAULT_BANDWIDTH,
+            bandwidth: 10.0,
             cutoff: None,
             filter_order: 4,
             decimation: None,
@@ -296,7 +283,7 @@ impl Default for Options {
             validation: Some((0.8, 1.0)),
             use_log_derivatives: true,
             gains: None,
-            min_speed: DEFAULT_MIN_SPEED,
+            min_speed: 0.0,
             iv_iterations: 8,
             iv_bandwidth: None,
             keep_validation_rows: false,
@@ -596,7 +583,7 @@ pub fn processing(summary: &LogSummary, opt: &Options) -> Result<(Processing, Pr
     };
     let nd = opt
         .decimation
-        .unwrap_or_else(|| ((0.8 * fs / (40.0 * bw)).floor() as usize).max(1));
+        .unwrap_or_else(|| ((0.8 * fs / (4.0 * bw)).floor() as usize).max(1));
     let decimation_filter = if nd > 1 {
         Some(Butterworth::lowpass(8, 0.8 * fs / (2.0 * nd as f64), fs)?)
     } else {
