@@ -281,7 +281,14 @@ fn wrong_states_and_other_commands_are_refused_clearly() {
     assert!(e.contains("give --q") && e.contains("quaternion"), "{e}");
     // commands without floating support say so (never a fixed-base answer)
     for args in [
-        vec!["ik", rx.as_str(), "--frame", "6", "--pose", "0.2,0,0.5,0,0,0"],
+        vec![
+            "ik",
+            rx.as_str(),
+            "--frame",
+            "6",
+            "--pose",
+            "0.2,0,0.5,0,0,0",
+        ],
         vec!["generate", rx.as_str(), "--model", "inertia"],
     ] {
         let e = fail(&args);

@@ -15,8 +15,8 @@ use robodyn::algorithms::inverse_geometry::{
 };
 use robodyn::algorithms::kinematics::{
     center_of_mass, center_of_mass_jacobian_into, forward_kinematics_into,
-    frame_classical_acceleration, frame_jacobian_into, frame_jacobian_time_variation_into, frame_placement, frame_velocity,
-    placements_into, total_mass, Motion, Reference,
+    frame_classical_acceleration, frame_jacobian_into, frame_jacobian_time_variation_into,
+    frame_placement, frame_velocity, placements_into, total_mass, Motion, Reference,
 };
 use robodyn::error::check_finite_result;
 
