@@ -200,7 +200,6 @@ def test_state_sizes_and_names():
 @pytest.mark.parametrize(
     "call, name",
     [
-        (lambda r, q: r.regressor(q), "Robot.regressor"),
         (lambda r, q: r.idm_derivatives(q), "Robot.idm_derivatives"),
         (lambda r, q: r.ddm_derivatives(q), "Robot.ddm_derivatives"),
     ],
@@ -408,3 +407,34 @@ def test_generated_floating_idm_equals_idm():
     for model in ["inertia", "h", "ddm", "idm_derivatives"]:
         with pytest.raises(robodyn.InputError, match="floating base"):
             robot.generate(model=model)
+
+
+def test_floating_regressor_and_base_parameters():
+    """The regressor of a floating robot (nv rows: the base wrench then the joints; link 0's ten
+    columns after the links') times the standard parameters is the inverse model, a different
+    recursion; the base parameters by both methods agree, link 0's ten are all in the base set,
+    and the base columns times their values give the same torques."""
+    robot = rx90float()
+    rng = np.random.default_rng(31)
+    k = np.asarray(robot.standard_parameters)
+    names = robot.parameter_names
+    assert len(k) == 13 * robot.dof + 10 and names[-10:] == ["XX0", "XY0", "XZ0", "YY0", "YZ0", "ZZ0", "MX0", "MY0", "MZ0", "M0"]
+    sym = robot.base_parameters(method="symbolic")
+    num = robot.base_parameters(method="numeric")
+    assert len(sym) == len(num) == 70 and sorted(sym.indices) == sorted(num.indices)
+    assert set(range(13 * robot.dof, 13 * robot.dof + 10)) <= set(sym.indices)
+    beta = np.array(sym.values, dtype=float)
+    for _ in range(5):
+        q = rng.uniform(-1, 1, robot.nq)
+        q[3:7] /= np.linalg.norm(q[3:7])
+        v, a = rng.uniform(-1, 1, robot.nv), rng.uniform(-1, 1, robot.nv)
+        tau = robot.idm(q, v, a)
+        phi = robot.regressor(q, v, a)
+        assert phi.shape == (robot.nv, len(k))
+        close(phi @ k, tau)
+        # the base columns are the base parameters' in their listed order, for both methods
+        # (the numerical method selects link 0 first but lists it in K order, after the links)
+        base_phi = robot.regressor(q, v, a, columns="base")
+        close(base_phi @ np.array(num.values, dtype=float), tau)
+        close(base_phi @ beta, tau)
+    assert robot.regressor_columns(columns="base") == num.names == sym.names

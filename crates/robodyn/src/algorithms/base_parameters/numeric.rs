@@ -539,14 +539,19 @@ pub fn numeric_base_parameters(
     drop(r_all);
     let (norms, live) = (&scaled.norms, &scaled.live);
     let col = |k: usize| all[live[k]];
+    // reported in K order (a floating base's link 0, selected first, comes after the links as
+    // in K, the symbolic method's list and the regressor's base columns); beta's rows follow
+    let mut rows_k: Vec<usize> = (0..kept.len()).collect();
+    rows_k.sort_by_key(|&x| col(kept[x]));
     let mut beta = DMatrix::zeros(kept.len(), dep.len());
-    for (x, &kc) in kept.iter().enumerate() {
+    for (r, &x) in rows_k.iter().enumerate() {
+        let kc = kept[x];
         for (y, &dc) in dep.iter().enumerate() {
-            beta[(x, y)] = g.beta_s[(x, y)] * norms[live[dc]] / norms[live[kc]];
+            beta[(r, y)] = g.beta_s[(x, y)] * norms[live[dc]] / norms[live[kc]];
         }
     }
     Ok(NumericBase {
-        base: kept.iter().map(|&k| col(k)).collect(),
+        base: rows_k.iter().map(|&x| col(kept[x])).collect(),
         grouped: dep.iter().map(|&k| col(k)).collect(),
         no_effect: scaled.no_effect,
         absent: all
