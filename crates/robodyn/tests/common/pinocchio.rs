@@ -26,20 +26,13 @@ pub fn robot_entry(dir: &Path, name: &str, states: Vec<Value>) -> Value {
 /// Run `tests/data/<script>` (with `crate::common::python`) on `{"robots": robots}` and return
 /// its JSON output; panics when the script fails.
 pub fn run_script(script: &str, robots: Vec<Value>) -> Value {
-    // a directory per call: the tests of one process run the same script at once, each on its
-    // own thread (and each test file has its own copy of this module, so a counter alone would
-    // repeat across files)
-    static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
-    let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-    let thread = format!("{:?}", std::thread::current().id());
-    let thread: String = thread.chars().filter(char::is_ascii_digit).collect();
+    // a directory of its own per call: the tests of one process run the same script at once
     let stem = script.trim_end_matches(".py");
-    let tmp = std::env::temp_dir().join(format!(
-        "robodyn_{stem}_{}_{thread}_{call}",
-        std::process::id()
-    ));
-    std::fs::create_dir_all(&tmp).unwrap();
-    let (inp, outp) = (tmp.join("in.json"), tmp.join("out.json"));
+    let tmp = tempfile::Builder::new()
+        .prefix(&format!("robodyn_{stem}_"))
+        .tempdir()
+        .unwrap();
+    let (inp, outp) = (tmp.path().join("in.json"), tmp.path().join("out.json"));
     std::fs::write(&inp, json!({ "robots": robots }).to_string()).unwrap();
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("tests/data")
@@ -51,9 +44,8 @@ pub fn run_script(script: &str, robots: Vec<Value>) -> Value {
         .status()
         .unwrap();
     assert!(st.success(), "pinocchio script {script} failed");
-    let res: Value = serde_json::from_str(&std::fs::read_to_string(&outp).unwrap()).unwrap();
-    let _ = std::fs::remove_dir_all(&tmp);
-    res
+    // the directory is removed when `tmp` drops
+    serde_json::from_str(&std::fs::read_to_string(&outp).unwrap()).unwrap()
 }
 
 /// robodyn's index (in the movable-joint vectors) of each joint of the script's `joints` list
