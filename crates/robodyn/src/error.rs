@@ -265,17 +265,31 @@ pub fn check_finite_result(what: &str, values: &[f64]) -> Result<()> {
 
 /// [`check_finite_result`] for a matrix: the entry is named `what[row, column]` (0-based).
 pub fn check_finite_matrix(what: &str, m: &nalgebra::DMatrix<f64>) -> Result<()> {
-    // x * 0 is NaN exactly when x is not finite: a branch-free sum over four lanes (it
-    // vectorizes); the search for the entry runs only when that sum is NaN
-    let chunks = m.as_slice().chunks_exact(4);
-    let rest = chunks.remainder().iter().fold(0.0, |a, x| a + x * 0.0);
-    let lanes = chunks.fold([0.0; 4], |mut acc, c| {
-        acc.iter_mut().zip(c).for_each(|(a, x)| *a += x * 0.0);
-        acc
-    });
-    if rest == 0.0 && lanes.iter().all(|p| *p == 0.0) {
+    if all_finite(m.as_slice()) {
         return Ok(());
     }
+    first_non_finite(what, m)
+}
+
+/// No entry is infinite or NaN, by a branch-free sum over 16 lanes (it vectorizes, and the
+/// lanes' independent chains hide the additions' latency): the sum of finite numbers is finite
+/// or overflows (then the entries are searched one by one), and an infinite or NaN entry makes
+/// it infinite or NaN.
+fn all_finite(x: &[f64]) -> bool {
+    let chunks = x.chunks_exact(16);
+    let rest: f64 = chunks.remainder().iter().sum();
+    let lanes = chunks.fold([0.0; 16], |mut acc, c| {
+        acc.iter_mut().zip(c).for_each(|(a, x)| *a += x);
+        acc
+    });
+    if rest.is_finite() && lanes.iter().all(|p| p.is_finite()) {
+        return true;
+    }
+    x.iter().all(|v| v.is_finite())
+}
+
+/// The error of the first non-finite entry of `m`, named `what[row, column]`; Ok when none.
+fn first_non_finite(what: &str, m: &nalgebra::DMatrix<f64>) -> Result<()> {
     match m.as_slice().iter().position(|x| !x.is_finite()) {
         Some(k) => {
             let (r, c) = (k % m.nrows(), k / m.nrows());
@@ -430,3 +444,31 @@ fn not_finite(what: &str, v: &[f64]) -> Error {
 
 /// The result type of the library.
 pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::DMatrix;
+
+    /// Every position of a non-finite entry (in the 16-lane part and in the remainder) is found
+    /// and named; finite entries whose sum overflows are accepted.
+    #[test]
+    fn finite_matrix_check_finds_every_non_finite_entry() {
+        for (r, c) in [(5, 7), (7, 3), (4, 1), (1, 1), (3, 5)] {
+            let base = DMatrix::from_fn(r, c, |i, j| 1e308 * (1.0 + (i + 3 * j) as f64 * 1e-3));
+            assert!(
+                check_finite_matrix("A", &base).is_ok(),
+                "{r} x {c}: overflowing sum"
+            );
+            for k in 0..r * c {
+                for bad in [f64::INFINITY, f64::NEG_INFINITY, f64::NAN] {
+                    let mut m = base.clone();
+                    m.as_mut_slice()[k] = bad;
+                    let e = check_finite_matrix("A", &m).unwrap_err().to_string();
+                    let name = format!("A[{}, {}]", k % r, k / r);
+                    assert!(e.contains(&name), "{r} x {c}, entry {k} = {bad}: {e}");
+                }
+            }
+        }
+    }
+}

@@ -26,7 +26,7 @@ use crate::algorithms::inverse_dynamics::{
     w_products,
 };
 use crate::data::Data;
-use crate::error::{check_finite_matrix, check_finite_result, check_vector, Error, Result};
+use crate::error::{check_finite_result, check_vector, Error, Result};
 use crate::model::{DynModel, Environment, FloatingBase, Robot, QUATERNION_TOLERANCE};
 use crate::scalar::DynScalar;
 use nalgebra::{DMatrix, Matrix3, Matrix6, Quaternion, UnitQuaternion, Vector3, Vector6};
@@ -327,16 +327,22 @@ pub(crate) fn inertia_matrix_into(
     let model = robot.dynamic();
     let abb = composite_blocks_into(robot, data, q, &mut a.as_mut_slice()[6 + 6 * nv..], nv);
     a.fixed_view_mut::<6, 6>(0, 0).copy_from(&abb);
-    // the base rows and columns: the column wrenches in R_0, by preorder position
+    // the base rows and columns: the column wrenches in R_0, by preorder position (column
+    // by column in A's column-major storage)
+    let s = a.as_mut_slice();
     for (p, &link) in model.index.preorder.iter().enumerate() {
-        let k = 5 + link;
-        for c in 0..6 {
-            let x = data.col[c][p];
-            a[(c, k)] = x;
-            a[(k, c)] = x;
+        let k = (5 + link) * nv;
+        for (x, c) in s[k..k + 6].iter_mut().zip(&data.col) {
+            *x = c[p];
         }
     }
-    check_finite_matrix("A", a)
+    for (c, col) in data.col.iter().enumerate() {
+        let base = &mut s[c * nv + 5..(c + 1) * nv];
+        for (&link, x) in model.index.preorder.iter().zip(col) {
+            base[link] = *x;
+        }
+    }
+    crate::error::check_finite_matrix("A", a)
 }
 
 /// Direct dynamics of a floating robot into `qdd` (nv): the base acceleration (derivative of

@@ -85,7 +85,9 @@ pub fn composite_inertia_matrix<T: DynScalar>(
 
 /// [`composite_inertia_matrix`] into an NL x NL column-major block of a larger matrix: entry
 /// (r, c) at `a[r + c ld]` (`ld` >= NL, the larger matrix's row count). A floating robot's
-/// joint block is written in place in its nv x nv matrix this way (no copy).
+/// joint block is written in place in its nv x nv matrix this way (no copy). The entries of
+/// `a` between the block's columns (`a[r + c ld]` for r >= NL, c < NL - 1) may be zeroed: the
+/// caller writes them after.
 pub(crate) fn composite_inertia_block<T: DynScalar>(
     model: &DynModel<T>,
     ws: &mut Data<T>,
@@ -98,13 +100,10 @@ pub(crate) fn composite_inertia_block<T: DynScalar>(
     link_placements(model, ws, q);
     if !idx.serial {
         // entries of unrelated joints (and of fixed frames) are zero; a serial chain writes all
-        // (on contiguous slices: nalgebra's `fill` walks a strided iterator, 5x slower)
-        if ld == n {
-            a[..n * n].fill(T::zero());
-        } else {
-            a.chunks_mut(ld)
-                .take(n)
-                .for_each(|c| c[..n].fill(T::zero()));
+        // (one contiguous fill, the entries between the columns of a block included: one
+        // call instead of one per column; nalgebra's `fill` walks a strided iterator, 5x slower)
+        if n > 0 {
+            a[..(n - 1) * ld + n].fill(T::zero());
         }
     }
     for k in (1..=n).rev() {
@@ -136,11 +135,10 @@ pub(crate) fn composite_inertia_block<T: DynScalar>(
             };
             let r = k - 1;
             a[r + r * ld] = proj[s].clone() + model.link(k).ia.clone();
-            for p in s + 1..e {
-                let col = idx.preorder[p] - 1;
-                let v = proj[p].clone();
+            for (link, v) in idx.preorder[s + 1..e].iter().zip(&proj[s + 1..e]) {
+                let col = link - 1;
                 a[r + col * ld] = v.clone();
-                a[col + r * ld] = v;
+                a[col + r * ld] = v.clone();
             }
         }
         add_to_antecedent(model, ws, k);
