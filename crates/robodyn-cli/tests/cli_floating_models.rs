@@ -379,3 +379,25 @@ fn urdf_made_floating_from_the_command_line() {
         e.stderr
     );
 }
+
+/// `info --floating` shows a URDF's root link as the floating base (link 0, its mass from the
+/// file), as the model commands load it; without the flag the base is fixed; on a .toml file
+/// whose base is fixed the flag is refused as the model commands refuse it.
+#[test]
+fn info_shows_the_floating_base_of_a_urdf() {
+    let urdf = robot("rx90.urdf");
+    let fixed = run(&["info", &urdf]);
+    assert!(fixed.contains("base: fixed"), "{fixed}");
+    let text = run(&["info", &urdf, "--floating"]);
+    let line = text.lines().find(|l| l.starts_with("base: ")).unwrap();
+    assert!(line.starts_with("base: floating (link 0 `"), "{line}");
+    let json = run(&["info", &urdf, "--floating", "--format", "json"]);
+    let v: serde_json::Value = serde_json::from_str(&json).unwrap();
+    assert_eq!(v["base"], "floating", "{json}");
+    let e = robodyn_within(&["info", &robot("rx90.toml"), "--floating"], 30.0);
+    assert!(
+        e.code != Some(0) && e.stderr.contains("floating base is asked for"),
+        "{}",
+        e.stderr
+    );
+}

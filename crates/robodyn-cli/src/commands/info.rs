@@ -15,6 +15,10 @@ pub struct Args {
     /// Output format.
     #[arg(long, value_enum, default_value = "text")]
     pub format: Format,
+    /// Make a URDF's root link the floating base (link 0 of a free-flyer root), as the model
+    /// commands' `--floating` does. A .toml or .par file says it itself.
+    #[arg(long)]
+    pub floating: bool,
 }
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug)]
@@ -26,7 +30,13 @@ pub enum Format {
 }
 
 pub fn run(a: Args) -> CliResult {
-    let (desc, map) = robodyn::io::load_description_mapped(&a.robot)?;
+    let options = if a.floating {
+        robodyn::io::LoadOptions::floating()
+    } else {
+        robodyn::io::LoadOptions::default()
+    };
+    let (desc, map) =
+        robodyn::io::load_description_with_options(&a.robot, &Default::default(), &options)?;
     let s = validate_structure(&desc)?;
     crate::common::print_warnings(&map);
     let text = match a.format {
