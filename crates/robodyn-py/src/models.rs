@@ -18,7 +18,7 @@ use robodyn::algorithms::regressor::{
 use robodyn::codegen::{generate as gen, BaseParameters as GenBase, GenOptions, ModelKind};
 use robodyn::simulation::{
     simulate as sim, Dynamics, Integrator, Recorder, SimOptions, TimeSeries, TorqueInput,
-    TreeDynamics,
+    TreeDynamics, Wrapper,
 };
 use robodyn_symbolic::{emit, Lang};
 use std::collections::HashMap;
@@ -450,47 +450,13 @@ fn call_torque(
     })
 }
 
-/// The calls of a system, delegated; `Callback` and `Interruptible` change `accel`.
-macro_rules! delegate_dynamics {
-    () => {
-        fn dof(&self) -> usize {
-            self.inner.dof()
-        }
-        fn nq(&self) -> usize {
-            self.inner.nq()
-        }
-        fn labels(&self) -> Vec<String> {
-            self.inner.labels()
-        }
-        fn column_names(&self) -> [Vec<String>; 4] {
-            self.inner.column_names()
-        }
-        fn anchor(&mut self, q: &[f64], x: &mut [f64]) -> robodyn::Result<()> {
-            self.inner.anchor(q, x)
-        }
-        fn configuration(&self, x: &[f64], q: &mut [f64]) {
-            self.inner.configuration(x, q)
-        }
-        fn chart_rate(&self, x: &[f64], qd: &[f64], dx: &mut [f64]) {
-            self.inner.chart_rate(x, qd, dx)
-        }
-        fn reanchor(&mut self, x: &mut [f64]) -> bool {
-            self.inner.reanchor(x)
-        }
-        fn energy(&mut self, q: &[f64], qd: &[f64]) -> robodyn::Result<f64> {
-            self.inner.energy(q, qd)
-        }
-        fn extra_columns(&self) -> Vec<String> {
-            self.inner.extra_columns()
-        }
-        fn extra_values(&mut self, q: &[f64], qd: &[f64], out: &mut [f64]) -> robodyn::Result<()> {
-            self.inner.extra_values(q, qd, out)
-        }
-    };
-}
-
-impl Dynamics for Callback<'_> {
-    delegate_dynamics!();
+impl Wrapper for Callback<'_> {
+    fn inner(&self) -> &dyn Dynamics {
+        &*self.inner
+    }
+    fn inner_mut(&mut self) -> &mut dyn Dynamics {
+        &mut *self.inner
+    }
     fn accel(
         &mut self,
         t: f64,
@@ -516,8 +482,13 @@ struct Interruptible<'a> {
     error: Option<PyErr>,
 }
 
-impl Dynamics for Interruptible<'_> {
-    delegate_dynamics!();
+impl Wrapper for Interruptible<'_> {
+    fn inner(&self) -> &dyn Dynamics {
+        &*self.inner
+    }
+    fn inner_mut(&mut self) -> &mut dyn Dynamics {
+        &mut *self.inner
+    }
     fn accel(
         &mut self,
         t: f64,

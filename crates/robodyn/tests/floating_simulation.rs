@@ -232,3 +232,70 @@ fn trajectory_columns_name_the_base() {
     assert!(h.contains(&"base_wz".to_string()) && h.contains(&"base_dwz".to_string()));
     assert!(h.contains(&"base_mz".to_string()) && h.contains(&"angular_momentum_z".to_string()));
 }
+
+/// A [`robodyn::simulation::Wrapper`] that overrides nothing is the system it wraps: the same
+/// trajectory, every column and row bit for bit, for a floating base whose pose is integrated
+/// in a chart (the chart calls reach the inner system through the wrapper), and the same
+/// columns; one that overrides `accel` to add a base wrench changes the motion.
+#[test]
+fn a_wrapper_is_the_system_it_wraps() {
+    use robodyn::simulation::{Dynamics, Wrapper};
+    struct Plain<'a>(TreeDynamics<'a>);
+    impl Wrapper for Plain<'_> {
+        fn inner(&self) -> &dyn Dynamics {
+            &self.0
+        }
+        fn inner_mut(&mut self) -> &mut dyn Dynamics {
+            &mut self.0
+        }
+    }
+    struct Pushed<'a>(TreeDynamics<'a>);
+    impl Wrapper for Pushed<'_> {
+        fn inner(&self) -> &dyn Dynamics {
+            &self.0
+        }
+        fn inner_mut(&mut self) -> &mut dyn Dynamics {
+            &mut self.0
+        }
+        fn accel(
+            &mut self,
+            t: f64,
+            q: &[f64],
+            qd: &[f64],
+            tau: &[f64],
+            qdd: &mut [f64],
+        ) -> robodyn::Result<()> {
+            let mut pushed = tau.to_vec();
+            pushed[0] += 500.0;
+            self.0.accel(t, q, qd, &pushed, qdd)
+        }
+    }
+    let robot = floating_tree(11, 4, [0.0, 0.0, -9.81]);
+    let (q0, v0) = initial_state(&robot, 12);
+    let opts = SimOptions {
+        duration: 0.3,
+        integrator: Integrator::Dopri5 {
+            rtol: 1e-9,
+            atol: 1e-10,
+            h0: None,
+            h_max: None,
+        },
+        output_dt: 0.01,
+        max_steps: None,
+    };
+    let input = TorqueInput::Constant(vec![0.0; robot.nv()]);
+    let mut go = |d: &mut dyn Dynamics| {
+        let mut rec = Recorder::default();
+        simulate(d, &input, &q0, &v0, &opts, &mut rec, &mut |_| {}).unwrap();
+        rec
+    };
+    let plain = go(&mut TreeDynamics::new(&robot, Method::ArticulatedBody));
+    let wrapped = go(&mut Plain(TreeDynamics::new(&robot, Method::ArticulatedBody)));
+    let pushed = go(&mut Pushed(TreeDynamics::new(&robot, Method::ArticulatedBody)));
+    assert_eq!(plain.headers, wrapped.headers);
+    assert!(plain.rows.len() > 20, "{} rows", plain.rows.len());
+    assert_eq!(plain.rows, wrapped.rows, "the wrapper changed the trajectory");
+    let x = |r: &Recorder| r.series("base_x").unwrap();
+    let moved = x(&pushed).last().unwrap() - x(&plain).last().unwrap();
+    assert!(moved.abs() > 1e-3, "the pushed base moved by {moved} more");
+}

@@ -17,6 +17,7 @@ use robodyn::model::param;
 use robodyn::simulation::{
     plot_svg, simulate, ClosedChainDynamics, CsvSink, Dynamics, EnergyBalance, Integrator,
     PlotInfo, Recorder, SimOptions, Tee, TimeSeries, TorqueInput, TrajectorySink, TreeDynamics,
+    Wrapper,
 };
 use robodyn::Method;
 use std::collections::HashMap;
@@ -116,12 +117,12 @@ struct Labelled<'d> {
     extra: Vec<String>,
 }
 
-impl Dynamics for Labelled<'_> {
-    fn dof(&self) -> usize {
-        self.inner.dof()
+impl Wrapper for Labelled<'_> {
+    fn inner(&self) -> &dyn Dynamics {
+        &*self.inner
     }
-    fn nq(&self) -> usize {
-        self.inner.nq()
+    fn inner_mut(&mut self) -> &mut dyn Dynamics {
+        &mut *self.inner
     }
     fn labels(&self) -> Vec<String> {
         self.labels.clone()
@@ -137,36 +138,8 @@ impl Dynamics for Labelled<'_> {
         }
         names
     }
-    fn anchor(&mut self, q: &[f64], x: &mut [f64]) -> robodyn::Result<()> {
-        self.inner.anchor(q, x)
-    }
-    fn configuration(&self, x: &[f64], q: &mut [f64]) {
-        self.inner.configuration(x, q)
-    }
-    fn chart_rate(&self, x: &[f64], qd: &[f64], dx: &mut [f64]) {
-        self.inner.chart_rate(x, qd, dx)
-    }
-    fn reanchor(&mut self, x: &mut [f64]) -> bool {
-        self.inner.reanchor(x)
-    }
-    fn accel(
-        &mut self,
-        t: f64,
-        q: &[f64],
-        qd: &[f64],
-        tau: &[f64],
-        qdd: &mut [f64],
-    ) -> robodyn::Result<()> {
-        self.inner.accel(t, q, qd, tau, qdd)
-    }
-    fn energy(&mut self, q: &[f64], qd: &[f64]) -> robodyn::Result<f64> {
-        self.inner.energy(q, qd)
-    }
     fn extra_columns(&self) -> Vec<String> {
         self.extra.clone()
-    }
-    fn extra_values(&mut self, q: &[f64], qd: &[f64], out: &mut [f64]) -> robodyn::Result<()> {
-        self.inner.extra_values(q, qd, out)
     }
 }
 

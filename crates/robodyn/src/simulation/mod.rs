@@ -132,6 +132,73 @@ pub trait Dynamics {
     }
 }
 
+/// A system built on another ([`Wrapper::inner`]) that changes a few of its calls: a torque
+/// source, relabelled columns, a check for interruption. Every wrapper is a [`Dynamics`] whose
+/// calls go to the inner system unless the wrapper overrides them here: a call added to
+/// [`Dynamics`] reaches the inner system through every wrapper (a wrapper that kept a chart
+/// call's default would integrate a floating base's quaternion as a vector).
+pub trait Wrapper {
+    /// The system wrapped.
+    fn inner(&self) -> &dyn Dynamics;
+    /// The system wrapped, mutably.
+    fn inner_mut(&mut self) -> &mut dyn Dynamics;
+    /// [`Dynamics::accel`]; default the inner system's.
+    fn accel(&mut self, t: f64, q: &[f64], qd: &[f64], tau: &[f64], qdd: &mut [f64]) -> Result<()> {
+        self.inner_mut().accel(t, q, qd, tau, qdd)
+    }
+    /// [`Dynamics::labels`]; default the inner system's.
+    fn labels(&self) -> Vec<String> {
+        self.inner().labels()
+    }
+    /// [`Dynamics::column_names`]; default the inner system's.
+    fn column_names(&self) -> [Vec<String>; 4] {
+        self.inner().column_names()
+    }
+    /// [`Dynamics::extra_columns`]; default the inner system's.
+    fn extra_columns(&self) -> Vec<String> {
+        self.inner().extra_columns()
+    }
+}
+
+impl<W: Wrapper> Dynamics for W {
+    fn dof(&self) -> usize {
+        self.inner().dof()
+    }
+    fn nq(&self) -> usize {
+        self.inner().nq()
+    }
+    fn labels(&self) -> Vec<String> {
+        Wrapper::labels(self)
+    }
+    fn column_names(&self) -> [Vec<String>; 4] {
+        Wrapper::column_names(self)
+    }
+    fn anchor(&mut self, q: &[f64], x: &mut [f64]) -> Result<()> {
+        self.inner_mut().anchor(q, x)
+    }
+    fn configuration(&self, x: &[f64], q: &mut [f64]) {
+        self.inner().configuration(x, q)
+    }
+    fn chart_rate(&self, x: &[f64], qd: &[f64], dx: &mut [f64]) {
+        self.inner().chart_rate(x, qd, dx)
+    }
+    fn reanchor(&mut self, x: &mut [f64]) -> bool {
+        self.inner_mut().reanchor(x)
+    }
+    fn accel(&mut self, t: f64, q: &[f64], qd: &[f64], tau: &[f64], qdd: &mut [f64]) -> Result<()> {
+        Wrapper::accel(self, t, q, qd, tau, qdd)
+    }
+    fn energy(&mut self, q: &[f64], qd: &[f64]) -> Result<f64> {
+        self.inner_mut().energy(q, qd)
+    }
+    fn extra_columns(&self) -> Vec<String> {
+        Wrapper::extra_columns(self)
+    }
+    fn extra_values(&mut self, q: &[f64], qd: &[f64], out: &mut [f64]) -> Result<()> {
+        self.inner_mut().extra_values(q, qd, out)
+    }
+}
+
 /// A tree robot: the coordinates are its movable joints (fixed frames carry no state). The
 /// accelerations come from the checked direct model on the movable-joint vectors
 /// ([`direct_dynamics_into`]), the path of every other consumer.
