@@ -284,7 +284,7 @@ fn a_wrapper_is_the_system_it_wraps() {
         max_steps: None,
     };
     let input = TorqueInput::Constant(vec![0.0; robot.nv()]);
-    let mut go = |d: &mut dyn Dynamics| {
+    let go = |d: &mut dyn Dynamics| {
         let mut rec = Recorder::default();
         simulate(d, &input, &q0, &v0, &opts, &mut rec, &mut |_| {}).unwrap();
         rec
