@@ -1245,6 +1245,15 @@ fn check_rows(stats: &mut Statistics, p: usize) -> Result<usize> {
             1 => "the log".to_string(),
             n => format!("the {n} logs"),
         };
+        let slow: usize = stats.logs.iter().flat_map(|l| &l.slow_rows).sum();
+        if slow > 0 {
+            return Err(Error::Input(format!(
+                "{rows} equations for {p} parameters: {slow} joint rows of {what} were left out \
+                 as slower than the minimum speed {} (rad/s or m/s; the joints barely move: a \
+                 motion that excites them, or a lower minimum speed)",
+                l.min_speed
+            )));
+        }
         return Err(Error::Input(format!(
             "{rows} equations for {p} parameters after decimation (by {}) and border removal \
              ({} samples at each end): {what} ({} samples) is too short",
