@@ -197,6 +197,24 @@ fn two_sigma_coverage_of_the_reported_standard_deviations() {
     );
 }
 
+/// `clean` with white noise of standard deviation `sd` on the positions, without qd, qdd.
+fn noisy_positions(clean: &MemoryLog, sd: f64, seed: u64) -> MemoryLog {
+    let mut r = rng(seed);
+    MemoryLog {
+        name: "noisy positions".into(),
+        samples: clean
+            .samples
+            .iter()
+            .map(|s| RawSample {
+                q: s.q.iter().map(|q| q + sd * gauss(&mut r)).collect(),
+                qd: None,
+                qdd: None,
+                ..s.clone()
+            })
+            .collect(),
+    }
+}
+
 /// Positions with white measurement noise (3e-5 rad at 1 kHz), velocities and accelerations by
 /// filtered central differences (default processing: cut-off 50 Hz, decimation by 4): the
 /// noise in W biases least squares (errors in variables); IDIM-IV, whose instruments come from
@@ -219,21 +237,7 @@ fn iv_removes_the_bias_of_noisy_positions() {
         let mut err = Vec::new();
         let mut std = Vec::new();
         for run in 0..runs {
-            let mut r = rng(500 + run as u64);
-            let log = MemoryLog {
-                name: "noisy positions".into(),
-                samples: clean
-                    .samples
-                    .iter()
-                    .map(|s| RawSample {
-                        t: s.t,
-                        q: s.q.iter().map(|q| q + 3e-5 * gauss(&mut r)).collect(),
-                        y: s.y.clone(),
-                        qd: None,
-                        qdd: None,
-                    })
-                    .collect(),
-            };
+            let log = noisy_positions(&clean, 3e-5, 500 + run as u64);
             let opt = Options {
                 estimator: est,
                 validation: None,
@@ -301,20 +305,7 @@ fn iv_removes_the_bias_of_noisy_positions() {
     assert!(rms(&ri) < 0.8, "IV still biased: RMS {:.2} std", rms(&ri));
     assert!(abs_i < 0.2 * abs_w, "IV errors {abs_i:e} vs WLS {abs_w:e}");
     // ten times the noise: the WLS start of IDIM-IV is not physical, refused in words
-    let mut r = rng(500);
-    let noisier = MemoryLog {
-        name: "noisier positions".into(),
-        samples: clean
-            .samples
-            .iter()
-            .map(|s| RawSample {
-                q: s.q.iter().map(|q| q + 3e-4 * gauss(&mut r)).collect(),
-                qd: None,
-                qdd: None,
-                ..s.clone()
-            })
-            .collect(),
-    };
+    let noisier = noisy_positions(&clean, 3e-4, 500);
     let iv = Options {
         estimator: Estimator::Iv,
         validation: None,
