@@ -139,7 +139,22 @@ fn identify_refuses_bad_input_with_a_reason() {
         s.push_str(&format!("{},0,0,0,0,0,0,0,1,1,0,0,0\n", k as f64 * 0.001));
     }
     std::fs::write(&log, &s).unwrap();
+    // the velocities differentiated from the positions: the default minimum speed leaves out
+    // every row, said so
     let e = fails(&["identify", &rx90, "--data", log.to_str().unwrap()]);
+    assert!(
+        e.contains("0 equations") && e.contains("slower than the minimum speed 0.005"),
+        "{e}"
+    );
+    // every row kept: what they cannot determine
+    let e = fails(&[
+        "identify",
+        &rx90,
+        "--data",
+        log.to_str().unwrap(),
+        "--min-speed",
+        "0",
+    ]);
     assert!(
         e.contains("no effect") || e.contains("rank-deficient"),
         "{e}"

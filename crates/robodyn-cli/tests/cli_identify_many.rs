@@ -119,7 +119,7 @@ fn tx40_halves_merged_equal_the_two_logs_together() {
         "--validation",
         "0.6:0.8",
         "--bandwidth",
-        "5",
+        "10",
     ]);
     assert!(e.contains("bandwidth"), "{e}");
     let e = fails(&[

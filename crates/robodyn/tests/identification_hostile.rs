@@ -192,7 +192,7 @@ fn options_are_checked_before_reading() {
         ),
         (
             Options {
-                min_speed: f64::NAN,
+                min_speed: Some(f64::NAN),
                 ..base.clone()
             },
             "minimum speed",

@@ -96,6 +96,48 @@ fn short_logs_together_give_the_true_parameters() {
         .contains(" logs (chunk0, chunk1, chunk2, ..."));
 }
 
+/// Two different logs of the robot standing still, velocities differentiated from the
+/// positions: the default minimum speed leaves out all their rows. Their statistics are both
+/// empty (the same digest) but not the same log twice: they merge, with a moving log, into the
+/// moving log's estimate (to rounding).
+#[test]
+fn logs_at_rest_merge_without_being_taken_for_the_same_log() {
+    let mut acc = access("scara.toml");
+    let moving = log(&acc, 90, 3.0);
+    let rest = |q0: f64, name: &str| MemoryLog {
+        name: name.into(),
+        samples: (0..500)
+            .map(|k| RawSample {
+                t: k as f64 * 0.004,
+                q: vec![q0, 0.3, 0.1, -0.2],
+                y: vec![1.0, 2.0, -3.0, 0.1],
+                qd: None,
+                qdd: None,
+            })
+            .collect(),
+    };
+    let opt = Options {
+        use_log_derivatives: false,
+        ..ols()
+    };
+    let parts: Vec<Statistics> = [&moving, &rest(0.2, "rest1"), &rest(-0.4, "rest2")]
+        .into_iter()
+        .map(|l| statistics(&mut acc, l, &opt).unwrap())
+        .collect();
+    assert_eq!(parts[1].rows() + parts[2].rows(), 0);
+    assert_eq!(parts[1].digests, parts[2].digests);
+    let merged = identify_from_statistics(&mut acc, &parts, &opt).unwrap();
+    let alone = identify(&mut acc, &moving, &opt).unwrap();
+    for (a, b) in merged.x.iter().zip(&alone.x) {
+        assert!((a - b).abs() <= 1e-9 * b.abs().max(1e-3), "{a} vs {b}");
+    }
+    // the same moving log twice is still refused
+    let e = identify_from_statistics(&mut acc, &[parts[0].clone(), parts[0].clone()], &opt)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("the same log twice"), "{e}");
+}
+
 /// Statistics computed per log, written as JSON and read back, merged: exactly the numbers of
 /// the logs identified together (estimate, std, weights, validation), and the same to 1e-10
 /// in the other merge order. One log's statistics give exactly `identify` of it.
@@ -282,7 +324,7 @@ fn merges_of_other_robots_or_options_are_refused() {
     assert!(e.contains("geometry"), "{e}");
     // other row options
     let other = Options {
-        bandwidth: 5.0,
+        bandwidth: 10.0,
         ..Options::default()
     };
     let lc = log(&scara, 3, 2.0);

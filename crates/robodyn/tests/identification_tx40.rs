@@ -32,9 +32,11 @@ fn tx40() -> Option<(ModelAccess, CsvLog)> {
 
 /// The README's command: WLS, constant offsets, validation on 60..80 % of the log. The real
 /// robot's torques are explained to within the per-joint errors measured when this test was
-/// written (5.0, 7.6, 8.7, 10.5, 10.5, 14.9 % with the default Coulomb dead band) with margin;
-/// the gravity parameter of link 2, MXR2 = MX2 + 0.225 (M3 + M4 + M5 + M6), lies within 10 % of
-/// its value from the URDF's masses (the data set's README: "within a few percent"); friction and
+/// written (6.0, 6.5, 8.6, 9.2, 11.4, 11.0 % with issue 31's defaults) with margin; the gravity
+/// parameter of link 2, MXR2 = MX2 + 0.225 (M3 + M4 + M5 + M6), lies within 15 % of its value
+/// from the URDF's (CAD) masses, 2.40 kg m: it comes out 2.12 with this segment held out and
+/// 2.12 to 2.34 over the five held-out fifths of the log (2.18 to 2.49 with the earlier
+/// defaults), a spread of +-5 % that a tighter bound on one run would not respect; friction and
 /// rotor inertias are positive and well identified; the consistent robot is found.
 #[test]
 fn tx40_real_log() {
@@ -49,7 +51,7 @@ fn tx40_real_log() {
     let pr = &id.processing;
     assert_eq!(pr.samples, 45000);
     assert!((pr.sample_rate - 5000.0).abs() < 1e-6, "{}", pr.sample_rate);
-    assert_eq!(pr.decimation, 100);
+    assert_eq!(pr.decimation, 20);
     eprintln!(
         "TX40: condition {:.2}, relative error {:.2} % (validation {:.2} %)",
         id.condition_number,
@@ -76,7 +78,7 @@ fn tx40_real_log() {
     let k = id.parameters.iter().position(|p| p.name == "MXR2").unwrap();
     let (mx, _) = value("MXR2");
     eprintln!("MXR2 {mx:.4} (URDF masses {:.4})", urdf[k]);
-    assert!((mx / urdf[k] - 1.0).abs() < 0.1);
+    assert!((mx / urdf[k] - 1.0).abs() < 0.15);
     for j in 1..=6 {
         let (fv, fv_std) = value(&format!("FV{j}"));
         let (fs, fs_std) = value(&format!("FS{j}"));
@@ -151,8 +153,9 @@ fn tx40_interior_point_and_clarabel_agree() {
 /// fitted on the first 80 %. With sign(qd) of the differentiated velocity, rounding noise at
 /// rest flipped the Coulomb friction between -FS and +FS: the raw torques of the segment were
 /// predicted with a relative error of 0.439 (a reference with a dead band of 1e-3 rad/s:
-/// 0.23). The default dead band (1e-3 rad/s, where the velocities are estimated) gives 0.244;
-/// the exact sign (band 0) is still available and still gives 0.439.
+/// 0.233). The default processing (dead band 3e-3 rad/s where the velocities are estimated;
+/// issue 31's cross-validated defaults) meets the reference's 0.233; the exact sign (band 0)
+/// is still available and still flips the friction at rest (0.391 with the other defaults).
 #[test]
 fn tx40_coulomb_dead_band_at_rest() {
     let Some((mut acc, log)) = tx40() else { return };
@@ -164,7 +167,10 @@ fn tx40_coulomb_dead_band_at_rest() {
         };
         opt.parameters.offsets = true;
         let id = identify(acc, &log, &opt).unwrap();
-        assert_eq!(id.processing.coulomb_band, band.unwrap_or(1e-3));
+        assert_eq!(
+            id.processing.coulomb_band,
+            band.unwrap_or(robodyn::identification::DEFAULT_COULOMB_BAND)
+        );
         let v = id.validation.unwrap();
         eprintln!(
             "band {band:?}: raw-torque error on 0.8:1 {:.4} (decimated {:.4})",
@@ -174,8 +180,12 @@ fn tx40_coulomb_dead_band_at_rest() {
     };
     let default = raw_error(None, &mut acc);
     let exact = raw_error(Some(0.0), &mut acc);
-    assert!(default < 0.26, "default dead band: {default}");
-    assert!(exact > 0.4, "exact sign: {exact}");
+    assert!(default <= 0.233, "default dead band: {default}");
+    // measured: 0.391 with the exact sign and the other defaults, 1.68 x the default's
+    assert!(
+        exact > 1.5 * default,
+        "exact sign: {exact} (dead band {default})"
+    );
 }
 
 /// The raw log read by its own route (the CSV text split by hand): t and tau1..tau6.
@@ -238,12 +248,14 @@ fn held_out_errors(
 /// log, compared with the raw 5 kHz torques read by another route, give the held-out errors of
 /// the report (the validation's raw-torque errors, from the least-squares factors) to 1e-9,
 /// for both held-out segments; every predicted value is finite, one per sample between the
-/// borders.
+/// borders. The errors meet issue 31's targets (a reference implementation's): global at most
+/// 0.173 on 0.6:0.8 and 0.233 on 0.8:1, each joint on 0.6:0.8 within 1.05 x the reference's.
 #[test]
 fn tx40_predictions_reproduce_held_out_errors() {
     let Some((mut acc, log)) = tx40() else { return };
     let raw = raw_torques(&data().unwrap());
-    for segment in [(0.6, 0.8), (0.8, 1.0)] {
+    let reference_joints = [0.187, 0.154, 0.175, 0.107, 0.394, 0.221];
+    for (segment, target) in [((0.6, 0.8), 0.173), ((0.8, 1.0), 0.233)] {
         let mut opt = Options {
             validation: Some(segment),
             ..Options::default()
@@ -271,6 +283,12 @@ fn tx40_predictions_reproduce_held_out_errors() {
         assert!((global - v.raw_relative_error).abs() < 1e-9);
         for (e, f) in joints.iter().zip(&v.raw_per_joint) {
             assert!((e - f.relative_error).abs() < 1e-9);
+        }
+        assert!(global <= target, "{segment:?}: {global} > {target}");
+        if segment == (0.6, 0.8) {
+            for (j, (e, r)) in joints.iter().zip(reference_joints).enumerate() {
+                assert!(*e <= 1.05 * r, "joint {}: {e} > 1.05 x {r}", j + 1);
+            }
         }
     }
 }

@@ -76,7 +76,7 @@ pub struct Args {
     pub essential_tolerance: f64,
     /// Joint-space bandwidth of the robot's dynamics (Hz): the filter and decimation defaults
     /// follow from it.
-    #[arg(long, default_value_t = 10.0, value_parser = positive)]
+    #[arg(long, default_value_t = robodyn::identification::DEFAULT_BANDWIDTH, value_parser = positive)]
     pub bandwidth: f64,
     /// Cut-off of the zero-phase position low-pass (Hz; default 10 x bandwidth, at most 0.4 x
     /// the sample rate).
@@ -85,7 +85,8 @@ pub struct Args {
     /// Order of the position low-pass.
     #[arg(long, default_value_t = 4)]
     pub filter_order: usize,
-    /// Decimation factor (default floor(0.8 fs / (4 bandwidth))).
+    /// Decimation factor (default: the decimation low-pass, 0.8 x the new Nyquist frequency, at
+    /// twice the position cut-off, or at 10 x bandwidth where the log gives qd, qdd).
     #[arg(long)]
     pub decimation: Option<usize>,
     /// Samples dropped at each end (default: the settling time of the position filter).
@@ -100,11 +101,12 @@ pub struct Args {
     /// Drive gains (torque per ampere), one per motor, when the log has currents i<j>.
     #[arg(long, allow_hyphen_values = true)]
     pub gains: Option<String>,
-    /// Leave out a joint's rows where |qd_j| is below this (rad/s or m/s).
-    #[arg(long, default_value_t = 0.0, value_parser = non_negative)]
-    pub min_speed: f64,
+    /// Leave out a joint's rows where |qd_j| is below this (rad/s or m/s; default 0.005 when qd
+    /// is differentiated from the positions, 0 when the log gives qd).
+    #[arg(long, value_parser = non_negative)]
+    pub min_speed: Option<f64>,
     /// Dead band of the Coulomb friction's sign (rad/s or m/s): sign(qd) is 0 where |qd| is at
-    /// most this (default 1e-3 when qd is differentiated from the positions, 0 when the log
+    /// most this (default 3e-3 when qd is differentiated from the positions, 0 when the log
     /// gives qd).
     #[arg(long, value_parser = non_negative)]
     pub coulomb_band: Option<f64>,

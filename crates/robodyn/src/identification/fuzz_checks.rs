@@ -220,7 +220,7 @@ fn options(data: &[u8]) -> Options {
         gains: b
             .flag()
             .then(|| (0..b.byte() % 4).map(|_| b.float()).collect()),
-        min_speed: b.float(),
+        min_speed: b.maybe_float(),
         // IDIM-IV passes simulate the log: a few are enough to reach every branch
         iv_iterations: usize::from(b.byte() % 4),
         iv_bandwidth: b.maybe_float(),

@@ -145,13 +145,15 @@ pub struct Options {
     pub consistency_solver: consistency::Solver,
     /// Reduce to the essential parameters (None: keep every base parameter).
     pub essential: Option<EssentialOptions>,
-    /// Joint-space bandwidth of the robot's dynamics (Hz); defaults follow from it.
+    /// Joint-space bandwidth of the robot's dynamics (Hz, default [`DEFAULT_BANDWIDTH`]); the
+    /// filter and decimation defaults follow from it.
     pub bandwidth: f64,
     /// Low-pass of the positions: cut-off (Hz, default 10 x bandwidth, at most 0.4 fs), order.
     pub cutoff: Option<f64>,
     /// Order of the position low-pass (Butterworth, applied forward and backward; default 4).
     pub filter_order: usize,
-    /// Decimation factor (default: floor(0.8 fs / (4 bandwidth)), at least 1).
+    /// Decimation factor (default: the decimation low-pass at twice the position cut-off, or
+    /// at 10 x bandwidth where the log gives qd, qdd; see [`default_decimation`]).
     pub decimation: Option<usize>,
     /// Samples dropped at each end (default: the settling of the position filter).
     pub border: Option<usize>,
@@ -161,8 +163,11 @@ pub struct Options {
     pub use_log_derivatives: bool,
     /// Drive gains (currents to torques), per motor.
     pub gains: Option<Vec<f64>>,
-    /// A joint's row is left out where |qd_j| is below this (rad/s or m/s; default 0: none).
-    pub min_speed: f64,
+    /// A joint's row is left out where |qd_j| is below this (rad/s or m/s): None for the
+    /// default, [`DEFAULT_MIN_SPEED`] when the velocities are differentiated from the positions
+    /// (near rest their sign, hence the Coulomb friction's, is uncertain) and 0 (every row)
+    /// when the log gives them.
+    pub min_speed: Option<f64>,
     /// IDIM-IV: iterations and the bandwidth of the tracking loop of the simulation (Hz).
     pub iv_iterations: usize,
     /// Bandwidth of the IDIM-IV tracking loop (Hz; default bandwidth / 4).
@@ -179,9 +184,42 @@ pub struct Options {
 
 /// Default dead band of the Coulomb sign where the velocities are estimated (rad/s or m/s):
 /// below it an estimated velocity is taken as rest, sign 0, instead of a sign drawn by the
-/// noise of the differentiated positions (measured on the TX40 log: docs/models/
-/// identification.md).
-pub const DEFAULT_COULOMB_BAND: f64 = 1e-3;
+/// noise of the differentiated positions (chosen by cross-validation on the TX40 log:
+/// docs/models/identification.md).
+pub const DEFAULT_COULOMB_BAND: f64 = 3e-3;
+
+/// Default minimum speed where the velocities are estimated (rad/s or m/s): a joint's rows
+/// where |qd_j| is below it are left out of the fit, where the sign of its estimated velocity,
+/// hence of its Coulomb friction, is least certain (chosen by cross-validation on the TX40
+/// log: docs/models/identification.md). Where the log gives qd, every row is kept.
+pub const DEFAULT_MIN_SPEED: f64 = 5e-3;
+
+/// Default joint-space bandwidth of the robot's dynamics (Hz): the position cut-off (10 x) and
+/// the decimation ([`default_decimation`]) follow from it (chosen by cross-validation on the
+/// TX40 log: docs/models/identification.md).
+pub const DEFAULT_BANDWIDTH: f64 = 5.0;
+
+/// The band the rows keep, as a multiple of the bandwidth: the default cut-off of the position
+/// low-pass (at most 0.4 fs), and of the decimation low-pass where the log gives qd, qdd.
+const ROW_BAND_PER_BANDWIDTH: f64 = 10.0;
+
+/// The default decimation factor at sample rate `fs` (Hz), the largest whose decimation
+/// low-pass (0.8 x the new Nyquist frequency) is at or above
+///
+/// - twice the position low-pass's cut-off `position_cutoff`, where the velocities are
+///   differentiated from the filtered positions: that filter band-limits the regressor, and the
+///   decimation low-pass, acting on W and the torques alike, keeps that band whole and removes
+///   the torque noise and ripple above it;
+/// - 10 x `bandwidth` where the log gives qd, qdd (`position_cutoff` None): no other filter
+///   band-limits the rows, so the decimation low-pass sets their band, and removes the noise of
+///   measured columns of W above it (motor currents of [`gains`]: noise in W biases least
+///   squares).
+///
+/// At least 1 (no decimation when the log's rate is too low for it).
+pub fn default_decimation(fs: f64, bandwidth: f64, position_cutoff: Option<f64>) -> usize {
+    let fd = position_cutoff.map_or(ROW_BAND_PER_BANDWIDTH * bandwidth, |fc| 2.0 * fc);
+    ((0.8 * fs / (2.0 * fd)).floor() as usize).max(1)
+}
 
 impl Options {
     /// Check every number of the options (positive bandwidths and cut-off, a filter order of 1
@@ -240,7 +278,9 @@ impl Options {
                 );
             }
         }
-        non_negative("the minimum speed (rad/s or m/s)", self.min_speed)?;
+        if let Some(v) = self.min_speed {
+            non_negative("the minimum speed (rad/s or m/s)", v)?;
+        }
         if self.iv_iterations == 0 {
             return Err(Error::Input(
                 "0 IDIM-IV iterations: 1 or more expected".into(),
@@ -275,7 +315,7 @@ impl Default for Options {
             standard: false,
             consistency_solver: consistency::Solver::default(),
             essential: None,
-            bandwidth: 10.0,
+            bandwidth: DEFAULT_BANDWIDTH,
             cutoff: None,
             filter_order: 4,
             decimation: None,
@@ -283,7 +323,7 @@ impl Default for Options {
             validation: Some((0.8, 1.0)),
             use_log_derivatives: true,
             gains: None,
-            min_speed: 0.0,
+            min_speed: None,
             iv_iterations: 8,
             iv_bandwidth: None,
             keep_validation_rows: false,
@@ -578,12 +618,14 @@ pub fn processing(summary: &LogSummary, opt: &Options) -> Result<(Processing, Pr
     let lowpass = if derivatives {
         None
     } else {
-        let fc = opt.cutoff.unwrap_or((10.0 * bw).min(0.4 * fs));
+        let fc = opt
+            .cutoff
+            .unwrap_or((ROW_BAND_PER_BANDWIDTH * bw).min(0.4 * fs));
         Some(Butterworth::lowpass(opt.filter_order, fc, fs)?)
     };
     let nd = opt
         .decimation
-        .unwrap_or_else(|| ((0.8 * fs / (4.0 * bw)).floor() as usize).max(1));
+        .unwrap_or_else(|| default_decimation(fs, bw, lowpass.as_ref().map(|f| f.cutoff)));
     let decimation_filter = if nd > 1 {
         Some(Butterworth::lowpass(8, 0.8 * fs / (2.0 * nd as f64), fs)?)
     } else {
@@ -632,6 +674,9 @@ pub fn processing(summary: &LogSummary, opt: &Options) -> Result<(Processing, Pr
     } else {
         DEFAULT_COULOMB_BAND
     });
+    let min_speed = opt
+        .min_speed
+        .unwrap_or(if derivatives { 0.0 } else { DEFAULT_MIN_SPEED });
     let proc = Processing {
         dt: summary.dt,
         samples,
@@ -642,7 +687,7 @@ pub fn processing(summary: &LogSummary, opt: &Options) -> Result<(Processing, Pr
         border,
         validation,
         gains: opt.gains.clone(),
-        min_speed: opt.min_speed,
+        min_speed,
         coulomb_band,
         validation_row_stride: if opt.keep_validation_rows {
             // the decimated rows of the segment, estimated from its fraction of the log
@@ -666,7 +711,7 @@ pub fn processing(summary: &LogSummary, opt: &Options) -> Result<(Processing, Pr
         border,
         decimation_skip,
         std_inflation,
-        min_speed: opt.min_speed,
+        min_speed,
         coulomb_band,
         fit_samples: 0,
         validation_samples: 0,
@@ -1177,7 +1222,7 @@ fn processing_notes(preport: &ProcessingReport, opt: &Options, transmission: boo
     if total_slow > 0 {
         notes.push(format!(
             "{total_slow} joint rows of the fit left out as slower than the minimum speed {} (per joint {:?})",
-            opt.min_speed, preport.slow_rows
+            preport.min_speed, preport.slow_rows
         ));
     }
     if transmission {
@@ -1200,6 +1245,15 @@ fn check_rows(stats: &mut Statistics, p: usize) -> Result<usize> {
             1 => "the log".to_string(),
             n => format!("the {n} logs"),
         };
+        let slow: usize = stats.logs.iter().flat_map(|l| &l.slow_rows).sum();
+        if slow > 0 {
+            return Err(Error::Input(format!(
+                "{rows} equations for {p} parameters: {slow} joint rows of {what} were left out \
+                 as slower than the minimum speed {} (rad/s or m/s; the joints barely move: a \
+                 motion that excites them, or a lower minimum speed)",
+                l.min_speed
+            )));
+        }
         return Err(Error::Input(format!(
             "{rows} equations for {p} parameters after decimation (by {}) and border removal \
              ({} samples at each end): {what} ({} samples) is too short",

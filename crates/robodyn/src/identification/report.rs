@@ -177,7 +177,8 @@ fn processing_text(id: &Identification) -> String {
     match pr.decimation_filter {
         Some((o, fd)) => s.push_str(&format!(
             "Parallel decimation of W and Y: Butterworth order {o}, cut-off {} Hz (0.8 x the new \
-             Nyquist frequency), then 1 sample in {} (default floor(0.8 fs / (4 x bandwidth)))\n",
+             Nyquist frequency), then 1 sample in {} (default: the low-pass at twice the \
+             position cut-off, or at 10 x bandwidth without it)\n",
             hz(fd),
             pr.decimation
         )),

@@ -179,8 +179,8 @@ pub struct RowOptions {
     pub use_log_derivatives: bool,
     /// Drive gains.
     pub gains: Option<Vec<f64>>,
-    /// Minimum speed of a row.
-    pub min_speed: f64,
+    /// Minimum speed of a row (None: the default).
+    pub min_speed: Option<f64>,
     /// Dead band of the Coulomb sign.
     pub coulomb_band: Option<f64>,
 }
@@ -268,7 +268,10 @@ impl Statistics {
         self.options.check(&other.options, &what)?;
         self.fingerprint.check(&other.fingerprint, &what)?;
         for (k, d) in other.digests.iter().enumerate() {
-            if let Some(m) = self.digests.iter().position(|e| e == d) {
+            // a log without fit rows (every row slower than the minimum speed) adds nothing:
+            // twice it counts nothing twice, and two such logs have the same empty digest
+            let empty = d.iter().all(|v| *v == 0.0);
+            if let Some(m) = self.digests.iter().position(|e| e == d && !empty) {
                 return Err(Error::Input(format!(
                     "{what}: log {} has the rows of {}, already merged: the same log twice \
                      would count its rows twice (standard deviations too small)",
