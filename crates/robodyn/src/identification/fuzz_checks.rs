@@ -286,10 +286,11 @@ mod tests {
             // the log's derivatives, no gains, min speed 0, 2 IV iterations, defaults
             let mut bytes = vec![0, 1, 0, 1, estimator, 0, 3];
             bytes.extend(10000u16.to_le_bytes());
-            bytes.extend([0, 4, 0, 0, 0, 1, 0, 2, 0, 2, 0, 0, 0]);
+            bytes.extend([0, 4, 0, 0, 0, 1, 0, 1, 2, 0, 2, 0, 0, 0]);
             let opt = options(&bytes);
             assert_eq!(opt.bandwidth, 10.0);
             assert_eq!((opt.filter_order, opt.iv_iterations), (4, 2));
+            assert_eq!(opt.min_speed, Some(0.0));
             opt.validate().unwrap();
             check_options(&bytes);
         }
