@@ -14,7 +14,7 @@
 //! canonical chain T = C0 Rz(theta1) C1 ... Rz(theta6) C6 (`chain.rs`); the page
 //! docs/models/inverse_geometry.md derives them.
 
-use super::chain::Chain;
+use super::chain::{wrap_near, Chain};
 use super::transform_of;
 use crate::error::{Error, Result};
 use crate::geometry::Transform;
@@ -413,6 +413,12 @@ pub struct ClosedFormIgm {
     g: Vector3<f64>,
     p6: Vector3<f64>,
     wrist: DotEquation,
+    /// C4r^T C4p (the offset wrist's A4).
+    c4_origin: Vector3<f64>,
+    /// The joints' theta0 (in (-pi, pi]), and whether none has limits (then a solution's joint
+    /// values are only wrapped).
+    theta0: [f64; 6],
+    unlimited: bool,
     /// Whether the spherical wrist's second solution is the mirror (theta4 + pi, -theta5,
     /// theta6 + pi) of the first (`mirror_holds`).
     mirror: bool,
@@ -540,6 +546,9 @@ impl ClosedFormIgm {
             mirror: class == IgmClass::SphericalWrist && mirror_holds(&c4.rot, &chain.c[5].rot),
             g,
             p6,
+            c4_origin: c4.rot.tr_mul(&c4.pos),
+            theta0: std::array::from_fn(|k| chain.theta0[k]),
+            unlimited: chain.unlimited(),
             chain,
         })
     }
@@ -661,10 +670,16 @@ impl ClosedFormIgm {
     fn push(&self, th: &[f64; 6], singular: Singularity, out: &mut IgmSolutions) {
         let mut q = [0.0; 6];
         let mut within = true;
-        for k in 0..6 {
-            let (v, inside) = self.chain.joint_value(k, th[k]);
-            q[k] = v;
-            within &= inside;
+        if self.unlimited {
+            for k in 0..6 {
+                q[k] = wrap_near(th[k] - self.theta0[k]);
+            }
+        } else {
+            for k in 0..6 {
+                let (v, inside) = self.chain.joint_value(k, th[k]);
+                q[k] = v;
+                within &= inside;
+            }
         }
         out.push(IgmSolution {
             q,
@@ -828,12 +843,7 @@ impl ClosedFormIgm {
                 let m6 = self.chain.c[5].rot.tr_mul(&th5.unturn(&self.g));
                 let th6 =
                     angle_between(&m.rot.tr_mul(&z2), &m6, ATAN2_FLOOR).unwrap_or(self.free[5]);
-                let k = self.wrist_k(th5);
-                let tail = Transform {
-                    rot: th6.right_of(&k.rot),
-                    pos: k.pos,
-                };
-                let o4 = m.compose(&tail.inverse()).pos;
+                let o4 = self.a4_origin_x(m, th5, &th6).0;
                 let c1 = &self.chain.c[1];
                 let x2 = c1.rot.tr_mul(&(th1.unturn(&o4) - c1.pos));
                 1.0 - ((x2.norm_squared() - self.arm_k) / 2.0 - a.azbz).abs() / a.rho
@@ -894,11 +904,11 @@ impl ClosedFormIgm {
                 found = self.offset_arm(m, th1, th5, &near);
             }
         }
-        let Some((th6, a4, arm)) = found else {
+        let Some((th6, x4, arm)) = found else {
             return branch;
         };
         // Rz(theta4) = (A3 C3)_r^T (A4)_r: its first column
-        let m1 = self.m1(th1, &a4.rot.column(0).into_owned());
+        let m1 = self.m1(th1, &x4);
         for (th2, th3, s) in arm {
             let n4 = self.a3c3_tr(&th2, &th3, &m1);
             let th4 = atan2(n4.y, n4.x);
@@ -913,16 +923,6 @@ impl ClosedFormIgm {
         branch
     }
 
-    /// K = C4 Rz(theta5) C5, so that A4 = M (K Rz(theta6))^-1.
-    fn wrist_k(&self, th5: &Angle) -> Transform {
-        let (c4, c5) = (&self.chain.c[4], &self.chain.c[5]);
-        let c4r5 = th5.right_of(&c4.rot);
-        Transform {
-            rot: c4r5 * c5.rot,
-            pos: c4.pos + c4r5 * c5.pos,
-        }
-    }
-
     /// A4 = M (C4 Rz5 C5 Rz6)^-1 and the planar arm placing its origin, if it reaches.
     #[allow(clippy::type_complexity)]
     fn offset_arm(
@@ -931,15 +931,22 @@ impl ClosedFormIgm {
         th1: &Angle,
         th5: &Angle,
         th6: &Angle,
-    ) -> Option<(Angle, Transform, [(Angle, Angle, Singularity); 2])> {
-        let k = self.wrist_k(th5);
-        let tail = Transform {
-            rot: th6.right_of(&k.rot),
-            pos: k.pos,
-        };
-        let a4 = m.compose(&tail.inverse());
-        let arm = self.planar(th1, &a4.pos)?;
-        Some((*th6, a4, arm))
+    ) -> Option<(Angle, Vector3<f64>, [(Angle, Angle, Singularity); 2])> {
+        let (o4, x4) = self.a4_origin_x(m, th5, th6);
+        let arm = self.planar(th1, &o4)?;
+        Some((*th6, x4, arm))
+    }
+
+    /// The origin and x axis of A4 = M Rz(theta6)^T K^-1 (K = C4 Rz(theta5) C5), without
+    /// its products: p = K^-1 origin = -C5r^T (Rz(theta5)^T C4r^T C4p + C5p) and K_r^T e_x =
+    /// C5r^T Rz(theta5)^T (C4r^T e_x), then Rz(theta6)^T and M.
+    fn a4_origin_x(&self, m: &Transform, th5: &Angle, th6: &Angle) -> (Vector3<f64>, Vector3<f64>) {
+        let (c4, c5) = (&self.chain.c[4].rot, &self.chain.c[5]);
+        let c4x = Vector3::new(c4[(0, 0)], c4[(0, 1)], c4[(0, 2)]);
+        let v =
+            Matrix3x2::from_columns(&[-(th5.unturn(&self.c4_origin) + c5.pos), th5.unturn(&c4x)]);
+        let w = th6.left_tr_of(&c5.rot.tr_mul(&v));
+        (m.rot * w.column(0) + m.pos, m.rot * w.column(1))
     }
 
     /// At (or near) the offset wrist's singularity, theta6 turns O4 = M_p + M_r Rz(-theta6) p
@@ -947,7 +954,9 @@ impl ClosedFormIgm {
     /// theta6 nearest to `near` that puts O4 within the planar arm's reach (`near` itself when
     /// it does; else a root of the arm's reach boundary, an elbow double root).
     fn reaching_theta6(&self, m: &Transform, th1: &Angle, th5: &Angle, near: &Angle) -> Angle {
-        let p = self.wrist_k(th5).inverse().pos;
+        let p = self
+            .a4_origin_x(&Transform::identity(), th5, &Angle::new(0.0))
+            .0;
         let pxy = Vector3::new(p.x, p.y, 0.0);
         // |O4 - O2|² = |d0|² + |pxy|² + 2 pxy . Rz(theta6) v, d0 the circle's centre from O2
         let d0 = m.pos + m.rot.column(2) * p.z - th1.turn(&self.chain.c[1].pos);
