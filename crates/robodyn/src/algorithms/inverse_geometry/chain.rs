@@ -116,7 +116,7 @@ impl Chain {
                         rot: Matrix3::identity(),
                         pos: Vector3::new(0.0, 0.0, fc.r0),
                     };
-                    chain.theta0.push(fc.theta0);
+                    chain.theta0.push(wrap(fc.theta0));
                     chain
                         .coord
                         .push(robot.coordinates().index_of_frame(j).ok_or_else(|| {
@@ -135,6 +135,13 @@ impl Chain {
         Ok(chain)
     }
 
+    /// Whether no joint of the chain has a limit (every joint value then within them).
+    pub fn unlimited(&self) -> bool {
+        self.limits
+            .iter()
+            .all(|&(lo, hi)| lo == f64::NEG_INFINITY && hi == f64::INFINITY)
+    }
+
     /// Number of joints.
     pub fn n(&self) -> usize {
         self.theta0.len()
@@ -142,19 +149,10 @@ impl Chain {
 
     /// The joint value of angle `theta` of joint k, wrapped to (-pi, pi] and then moved by a
     /// turn into the joint's limits when a turn does; whether it lies within them.
+    #[inline]
     pub fn joint_value(&self, k: usize, theta: f64) -> (f64, bool) {
-        use std::f64::consts::{PI, TAU};
-        let mut q = theta - self.theta0[k];
-        // the angles come from atan2 and acos sums: a few turns at most (rem_euclid otherwise)
-        if q.abs() > 4.0 * TAU {
-            q = q.rem_euclid(TAU);
-        }
-        while q > PI {
-            q -= TAU;
-        }
-        while q <= -PI {
-            q += TAU;
-        }
+        use std::f64::consts::TAU;
+        let q = wrap_near(theta - self.theta0[k]);
         let (lo, hi) = self.limits[k];
         let inside = |x: f64| lo <= x && x <= hi;
         if inside(q) {
@@ -167,4 +165,37 @@ impl Chain {
         }
         (q, false)
     }
+}
+
+/// x wrapped to (-pi, pi], for x = theta - theta0 with theta0 in (-pi, pi] and theta from
+/// atan2 and acos sums (within a turn and a half): one conditional turn, [`wrap`] only beyond.
+#[inline]
+pub(crate) fn wrap_near(x: f64) -> f64 {
+    use std::f64::consts::{PI, TAU};
+    let q = if x > PI {
+        x - TAU
+    } else if x <= -PI {
+        x + TAU
+    } else {
+        x
+    };
+    if -PI < q && q <= PI {
+        q
+    } else {
+        wrap(q)
+    }
+}
+
+/// x wrapped to (-pi, pi] (x itself when it is not finite).
+#[cold]
+fn wrap(x: f64) -> f64 {
+    use std::f64::consts::{PI, TAU};
+    if !x.is_finite() {
+        return x;
+    }
+    let mut q = x.rem_euclid(TAU);
+    if q > PI {
+        q -= TAU;
+    }
+    q
 }

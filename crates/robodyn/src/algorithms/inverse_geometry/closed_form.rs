@@ -14,7 +14,7 @@
 //! canonical chain T = C0 Rz(theta1) C1 ... Rz(theta6) C6 (`chain.rs`); the page
 //! docs/models/inverse_geometry.md derives them.
 
-use super::chain::Chain;
+use super::chain::{wrap_near, Chain};
 use super::transform_of;
 use crate::error::{Error, Result};
 use crate::geometry::Transform;
@@ -31,6 +31,21 @@ pub const CLOSED_FORM_TOLERANCE: f64 = 1e-9;
 /// of the first (`mirror_holds`): the orientation error it brings, well within the 1e-10 the
 /// tests ask of every solution.
 const MIRROR_TOLERANCE: f64 = 1e-13;
+
+/// The smallest length of the xy part of the vectors of an atan2 step (relative, as
+/// [`CLOSED_FORM_TOLERANCE`]) from which the angle is taken from them rather than given its
+/// representative value: between it and the singularity's tolerance the step is marked
+/// singular but still solved, which keeps the pose error at a few roundings (the angle's error,
+/// eps / |xy|, moves the frame by |xy| times it); below it the representative moves the frame
+/// by at most 2 |xy|.
+const ATAN2_FLOOR: f64 = 1e-14;
+
+/// The largest move of the frame (|n_xy| times theta6's move: relative, as
+/// [`CLOSED_FORM_TOLERANCE`]) with which theta6 of the offset wrist near its singularity is
+/// moved to bring O4 into the arm's reach ([`ClosedFormIgm::reaching_theta6`]): a thousand
+/// roundings, what theta6's own error (eps / |n_xy|) moves it by, far below the 1e-10 the
+/// solutions are checked to; a branch needing more is out of reach.
+const NEAR_MOVE: f64 = 1e-12;
 
 /// The class of 6R chain the closed form solves, found from its axes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -212,6 +227,11 @@ struct DotEquation {
     cp: f64,
     sp: f64,
     azbz: f64,
+    /// For unit a and b: 1 - rho - a_z b_z and 1 - rho + a_z b_z, the least of |a - Rz b|² / 2
+    /// and of |a + Rz b|² / 2, from the differences of the parts (exact near 0, where the
+    /// differences of 1 and rho lose their digits): see [`Self::roots_unit`].
+    gap_minus: f64,
+    gap_plus: f64,
 }
 
 impl DotEquation {
@@ -219,13 +239,42 @@ impl DotEquation {
         let x = a.y * b.x - a.x * b.y;
         let y = a.x * b.x + a.y * b.y;
         let rho = (x * x + y * y).sqrt();
+        let dxy = a.xy().norm() - b.xy().norm();
         DotEquation {
             rho,
             phi: atan2(x, y),
             cp: y / rho,
             sp: x / rho,
             azbz: a.z * b.z,
+            gap_minus: (dxy * dxy + (a.z - b.z).powi(2)) / 2.0,
+            gap_plus: (dxy * dxy + (a.z + b.z).powi(2)) / 2.0,
         }
+    }
+
+    /// The roots of a . Rz(theta) b = k for unit a and b and a unit-vector product k, given
+    /// with 1 - k and 1 + k found without cancellation (from the other components of the
+    /// vectors whose product k is): 1 - cos(delta) = ((1 - k) - gap_minus) / rho and 1 +
+    /// cos(delta) = ((1 + k) - gap_plus) / rho, delta from the smaller by 2 asin(sqrt(x / 2)).
+    /// Near a double root (the wrist near its singularity) delta is then exact to a few
+    /// roundings, where acos(Z / rho) loses half the digits (sqrt(eps) ~ 1e-8). `tol` as in
+    /// [`Self::roots`].
+    fn roots_unit(&self, k: f64, one_minus_k: f64, one_plus_k: f64, tol: f64) -> Roots {
+        let rho = self.rho;
+        if rho <= tol {
+            return self.roots(k, tol);
+        }
+        let (m, p) = (one_minus_k - self.gap_minus, one_plus_k - self.gap_plus);
+        if m < -tol || p < -tol {
+            return Roots::None;
+        }
+        let (m, p) = ((m / rho).clamp(0.0, 2.0), (p / rho).clamp(0.0, 2.0));
+        let half = |x: f64| 2.0 * libm::asin((x / 2.0).sqrt());
+        let (delta, cd, sd) = if m <= p {
+            (half(m), 1.0 - m, (m * (2.0 - m)).sqrt())
+        } else {
+            (PI - half(p), p - 1.0, (p * (2.0 - p)).sqrt())
+        };
+        self.pair(delta, cd, sd)
     }
 
     /// theta with a . Rz(theta) b = k; `tol` is the tolerance on Z (units of k) for X = Y = 0
@@ -250,12 +299,17 @@ impl DotEquation {
             cd = cd.signum();
         }
         let delta = libm::acos(cd);
-        // rounding in Z / rho moves a double root by ~sqrt(eps): the roots count as one when
-        // they are within sqrt(CLOSED_FORM_TOLERANCE) of each other (or of a half turn apart)
-        let singular = delta.min(std::f64::consts::PI - delta) <= CLOSED_FORM_TOLERANCE.sqrt();
-        let (cp, sp, phi) = (self.cp, self.sp, self.phi);
         // (1 - c)(1 + c): exact factors near c = ±1, where 1 - c² loses its digits
         let sd = ((1.0 - cd) * (1.0 + cd)).sqrt();
+        self.pair(delta, cd, sd)
+    }
+
+    /// The roots phi ± delta, with cos(delta) = cd and sin(delta) = sd.
+    fn pair(&self, delta: f64, cd: f64, sd: f64) -> Roots {
+        // rounding in Z / rho moves a double root by ~sqrt(eps): the roots count as one when
+        // they are within sqrt(CLOSED_FORM_TOLERANCE) of each other (or of a half turn apart)
+        let singular = delta.min(PI - delta) <= CLOSED_FORM_TOLERANCE.sqrt();
+        let (cp, sp, phi) = (self.cp, self.sp, self.phi);
         let plus = Angle {
             th: phi + delta,
             c: cp * cd - sp * sd,
@@ -283,6 +337,38 @@ fn angle_between(u: &Vector3<f64>, v: &Vector3<f64>, tol: f64) -> Option<Angle> 
         c: c / r,
         s: s / r,
     })
+}
+
+/// [`angle_between`] solved down to `floor` (None below it), and whether u or v is within
+/// `tol` of the z axis (the step singular).
+fn angle_flagged(
+    u: &Vector3<f64>,
+    v: &Vector3<f64>,
+    floor: f64,
+    tol: f64,
+) -> (Option<Angle>, bool) {
+    let singular = u.xy().norm() <= tol || v.xy().norm() <= tol;
+    (angle_between(u, v, floor), singular)
+}
+
+/// 1 - k and 1 + k for k the z component of a unit vector b and s2 = b_x² + b_y²: the one
+/// near 0 as s2 / (1 ± k) (1 - k² = s2), exact where 1 ∓ k cancels.
+fn unit_complements(k: f64, s2: f64) -> (f64, f64) {
+    if k >= 0.0 {
+        (s2 / (1.0 + k), 1.0 + k)
+    } else {
+        (1.0 - k, s2 / (1.0 - k))
+    }
+}
+
+/// The first root of eq = k, with k moved into eq's range when beyond it (None when eq is
+/// degenerate: every theta or none).
+fn mid_root(eq: &DotEquation, k: f64) -> Option<Angle> {
+    let k = k.clamp(eq.azbz - eq.rho, eq.azbz + eq.rho);
+    match eq.roots(k, eq.rho * CLOSED_FORM_TOLERANCE) {
+        Roots::Two(a, _, _) => Some(a),
+        _ => None,
+    }
 }
 
 /// A root pair, a free angle given as `free` (twice), or none.
@@ -327,6 +413,12 @@ pub struct ClosedFormIgm {
     g: Vector3<f64>,
     p6: Vector3<f64>,
     wrist: DotEquation,
+    /// C4r^T C4p (the offset wrist's A4).
+    c4_origin: Vector3<f64>,
+    /// The joints' theta0 (in (-pi, pi]), and whether none has limits (then a solution's joint
+    /// values are only wrapped).
+    theta0: [f64; 6],
+    unlimited: bool,
     /// Whether the spherical wrist's second solution is the mirror (theta4 + pi, -theta5,
     /// theta6 + pi) of the first (`mirror_holds`).
     mirror: bool,
@@ -454,6 +546,9 @@ impl ClosedFormIgm {
             mirror: class == IgmClass::SphericalWrist && mirror_holds(&c4.rot, &chain.c[5].rot),
             g,
             p6,
+            c4_origin: c4.rot.tr_mul(&c4.pos),
+            theta0: std::array::from_fn(|k| chain.theta0[k]),
+            unlimited: chain.unlimited(),
             chain,
         })
     }
@@ -509,10 +604,27 @@ impl ClosedFormIgm {
     }
 
     /// theta1 from the point's component along axis 2, invariant under joints 2, 3 (and 4):
-    /// u2 . Rz(theta1)^T x_M = u2 . x(0).
-    fn theta1(&self, x_m: &Vector3<f64>) -> Option<([Angle; 2], bool)> {
+    /// u2 . Rz(theta1)^T x_M = u2 . x(0); the roots, whether singular, and whether theta1 is
+    /// free (the point on axis 1: its representative value given).
+    fn theta1(&self, x_m: &Vector3<f64>) -> Option<([Angle; 2], bool, bool)> {
         let r = DotEquation::new(x_m, &self.u2).roots(self.u2.dot(&self.point0), self.tol());
-        roots_or(r, self.free[0])
+        let free = matches!(r, Roots::Any);
+        roots_or(r, self.free[0]).map(|(t, s)| (t, s, free))
+    }
+
+    /// The spherical wrist's centre on axis 1 (theta1 free: the arm does not depend on it):
+    /// theta1 turns axis 4 (direction `a` in A1 before Rz(theta1)) about axis 1, and theta5's
+    /// equation g . Rz(theta5) p6 = z . Rz(theta1) a (z: the target's e_z) has roots only for
+    /// some theta1 when the wrist does not reach every angle between axes 4 and 6. The
+    /// representative value when the wrist reaches from there; else the theta1 putting the
+    /// equation mid-range, or as near as theta1 allows (when some theta1 reaches, this one does).
+    fn reaching_theta1(&self, z: &Vector3<f64>, a: &Vector3<f64>) -> Angle {
+        let rep = self.free[0];
+        let (k, w) = (z.dot(&rep.turn(a)), &self.wrist);
+        if (k - w.azbz).abs() <= w.rho {
+            return rep;
+        }
+        mid_root(&DotEquation::new(z, a), w.azbz).unwrap_or(rep)
     }
 
     /// theta2, theta3 of the planar arm placing the point `point3` (fixed in A3) at `x_m`:
@@ -526,9 +638,10 @@ impl ClosedFormIgm {
         let (t3, elbow) = roots_or(self.arm.roots(k, tol2), self.free[2])?;
         Some(t3.map(|th3| {
             let v = c2.rot * th3.turn(b) + c2.pos;
-            let th2 = angle_between(&v, &x2, self.tol());
+            let (th2, shoulder) =
+                angle_flagged(&v, &x2, ATAN2_FLOOR * self.chain.scale, self.tol());
             let singular = Singularity {
-                shoulder: th2.is_none(),
+                shoulder,
                 elbow,
                 wrist: false,
             };
@@ -557,10 +670,16 @@ impl ClosedFormIgm {
     fn push(&self, th: &[f64; 6], singular: Singularity, out: &mut IgmSolutions) {
         let mut q = [0.0; 6];
         let mut within = true;
-        for k in 0..6 {
-            let (v, inside) = self.chain.joint_value(k, th[k]);
-            q[k] = v;
-            within &= inside;
+        if self.unlimited {
+            for k in 0..6 {
+                q[k] = wrap_near(th[k] - self.theta0[k]);
+            }
+        } else {
+            for k in 0..6 {
+                let (v, inside) = self.chain.joint_value(k, th[k]);
+                q[k] = v;
+                within &= inside;
+            }
         }
         out.push(IgmSolution {
             q,
@@ -573,7 +692,7 @@ impl ClosedFormIgm {
     /// theta3), each arm branch the orientation R left to the wrist.
     fn spherical(&self, m: &Transform, out: &mut IgmSolutions) {
         let c_m = m.rot * self.point6 + m.pos;
-        let Some((t1, shoulder)) = self.theta1(&c_m) else {
+        let Some((t1, shoulder, free)) = self.theta1(&c_m) else {
             return;
         };
         // the wrist needs the first and last columns of R = (A3 C3)_r^T M_r
@@ -584,6 +703,16 @@ impl ClosedFormIgm {
             };
             let m1 = self.m1(&th1, &m_xz);
             for (th2, th3, s) in arm {
+                // the point on axis 1: theta1 turns axis 4 only, chosen for the wrist to reach
+                let (th1, m1) = if free {
+                    let c = &self.chain.c;
+                    let a4 = c[1].rot
+                        * th2.turn(&(c[2].rot * th3.turn(&c[3].rot.column(2).into_owned())));
+                    let th1 = self.reaching_theta1(&m.rot.column(2).into_owned(), &a4);
+                    (th1, self.m1(&th1, &m_xz))
+                } else {
+                    (th1, m1)
+                };
                 // R = Rz(theta4) C4 Rz(theta5) C5 Rz(theta6): its columns x and z
                 let r = self.a3c3_tr(&th2, &th3, &m1);
                 let singular = Singularity {
@@ -606,9 +735,11 @@ impl ClosedFormIgm {
         out: &mut IgmSolutions,
     ) {
         let (r0, b): (Vector3<f64>, Vector3<f64>) = (r.column(0).into(), r.column(1).into());
-        let Some((t5, double)) =
-            roots_or(self.wrist.roots(b.z, CLOSED_FORM_TOLERANCE), self.free[4])
-        else {
+        let (one_minus, one_plus) = unit_complements(b.z, b.x * b.x + b.y * b.y);
+        let t5 = self
+            .wrist
+            .roots_unit(b.z, one_minus, one_plus, CLOSED_FORM_TOLERANCE);
+        let Some((t5, double)) = roots_or(t5, self.free[4]) else {
             return;
         };
         let [a1, a2, a3] = *arm;
@@ -638,8 +769,7 @@ impl ClosedFormIgm {
         let (c4, c5) = (&self.chain.c[4], &self.chain.c[5]);
         let c4r5 = th5.right_of(&c4.rot);
         let m5 = c4r5 * self.p6;
-        let th4 = angle_between(&m5, b, CLOSED_FORM_TOLERANCE);
-        let wrist = th4.is_none();
+        let (th4, wrist) = angle_flagged(&m5, b, ATAN2_FLOOR, CLOSED_FORM_TOLERANCE);
         let th4 = th4.unwrap_or(self.free[3]);
         // Rz(theta6) = Q^T R, Q = Rz(theta4) C4 Rz(theta5) C5: its first column
         // (Q^T r0 = C5^T (C4 Rz5)^T Rz4^T r0)
@@ -650,33 +780,106 @@ impl ClosedFormIgm {
 
     /// The offset wrist: W gives theta1, then per theta1 the direction of axis 6 theta5 (two
     /// roots), each root a branch. (The wrist mirror does not serve here: it moves W, which
-    /// is off axis 4, and so the planar arm.)
+    /// is off axis 4, and so the planar arm.) W on axis 1 (theta1 free): its representative
+    /// value, or when no solution follows from it, [`Self::offset_free_theta1`].
     fn offset(&self, m: &Transform, out: &mut IgmSolutions) {
         let w_m = m.rot * self.point6 + m.pos;
-        let Some((t1, shoulder)) = self.theta1(&w_m) else {
+        let Some((t1, shoulder, free)) = self.theta1(&w_m) else {
             return;
         };
-        let z6: Vector3<f64> = m.rot.column(2).into();
+        if free {
+            self.offset_theta1(m, &t1[0], shoulder, out);
+            if out.is_empty() {
+                self.offset_theta1(m, &self.offset_free_theta1(m), shoulder, out);
+            }
+            return;
+        }
         for th1 in t1 {
-            let z2 = th1.turn(&self.u2);
-            // axis 6 against axis 2: e4 . C4 Rz(theta5) C5 e_z = z2 . z6
-            let Some((t5, _)) = roots_or(
-                self.wrist.roots(z2.dot(&z6), CLOSED_FORM_TOLERANCE),
-                self.free[4],
-            ) else {
-                continue;
-            };
-            for th5 in t5 {
-                let b = self.offset_branch(m, &th1, &z2, &th5, shoulder);
-                for (th, singular) in &b.items[..b.len] {
-                    self.push(th, *singular, out);
-                }
+            self.offset_theta1(m, &th1, shoulder, out);
+        }
+    }
+
+    /// W on axis 1: every theta1 of an interval has solutions (theta5's equation and the
+    /// planar arm both within reach), none found in closed form; the theta1 where the nearer
+    /// of the two to its reach limit (relative to its range) is farthest from it, by a scan
+    /// of 32 values refined by 40 golden-section steps.
+    fn offset_free_theta1(&self, m: &Transform) -> Angle {
+        let margin = |t: f64| self.offset_margin(m, &Angle::new(t));
+        let step = std::f64::consts::TAU / 32.0;
+        let t0 = self.free[0].th;
+        let best = (0..32)
+            .map(|i| t0 + step * i as f64)
+            .max_by(|a, b| margin(*a).total_cmp(&margin(*b)))
+            .unwrap_or(t0);
+        let (mut a, mut b) = (best - step, best + step);
+        let g = (5f64.sqrt() - 1.0) / 2.0;
+        for _ in 0..40 {
+            let (x, y) = (b - g * (b - a), a + g * (b - a));
+            if margin(x) >= margin(y) {
+                b = y;
+            } else {
+                a = x;
+            }
+        }
+        Angle::new((a + b) / 2.0)
+    }
+
+    /// The reach margin of theta1 (offset wrist): of theta5's equation and of the planar arm
+    /// (for the better theta5 root), each relative to its range; negative out of reach.
+    fn offset_margin(&self, m: &Transform, th1: &Angle) -> f64 {
+        let z2 = th1.turn(&self.u2);
+        let z6: Vector3<f64> = m.rot.column(2).into();
+        let (w, a) = (&self.wrist, &self.arm);
+        let wrist = 1.0 - (z2.dot(&z6) - w.azbz).abs() / w.rho;
+        let Roots::Two(r1, r2, _) = w.roots(
+            z2.dot(&z6).clamp(w.azbz - w.rho, w.azbz + w.rho),
+            CLOSED_FORM_TOLERANCE,
+        ) else {
+            return wrist;
+        };
+        let arm = [r1, r2]
+            .iter()
+            .map(|th5| {
+                let m6 = self.chain.c[5].rot.tr_mul(&th5.unturn(&self.g));
+                let th6 =
+                    angle_between(&m.rot.tr_mul(&z2), &m6, ATAN2_FLOOR).unwrap_or(self.free[5]);
+                let o4 = self.a4_origin_x(m, th5, &th6).0;
+                let c1 = &self.chain.c[1];
+                let x2 = c1.rot.tr_mul(&(th1.unturn(&o4) - c1.pos));
+                1.0 - ((x2.norm_squared() - self.arm_k) / 2.0 - a.azbz).abs() / a.rho
+            })
+            .fold(f64::NEG_INFINITY, f64::max);
+        wrist.min(arm)
+    }
+
+    /// The solutions of one theta1 of the offset wrist.
+    fn offset_theta1(&self, m: &Transform, th1: &Angle, shoulder: bool, out: &mut IgmSolutions) {
+        let z6: Vector3<f64> = m.rot.column(2).into();
+        let z2 = th1.turn(&self.u2);
+        // axis 6 against axis 2: e4 . C4 Rz(theta5) C5 e_z = z2 . z6, with 1 -+ z2 . z6 from
+        // |z2 -+ z6|² / 2 (exact near the wrist singularity, z6 = ±z2)
+        let t5 = self.wrist.roots_unit(
+            z2.dot(&z6),
+            (z2 - z6).norm_squared() / 2.0,
+            (z2 + z6).norm_squared() / 2.0,
+            CLOSED_FORM_TOLERANCE,
+        );
+        let Some((t5, _)) = roots_or(t5, self.free[4]) else {
+            return;
+        };
+        for th5 in t5 {
+            let b = self.offset_branch(m, th1, &z2, &th5, shoulder);
+            for (th, singular) in &b.items[..b.len] {
+                self.push(th, *singular, out);
             }
         }
     }
 
     /// The solutions of one (theta1, theta5) branch of the offset wrist: theta6 from the
-    /// direction of axis 2 seen from frame 6, then A4 and the planar arm.
+    /// direction of axis 2 seen from frame 6, then A4 and the planar arm. At the wrist
+    /// singularity (axis 6 parallel to axis 2) theta6 only turns O4 about axis 6: its
+    /// representative value, or when the arm does not reach O4 from there,
+    /// [`Self::reaching_theta6`].
     fn offset_branch(
         &self,
         m: &Transform,
@@ -685,26 +888,27 @@ impl ClosedFormIgm {
         th5: &Angle,
         shoulder: bool,
     ) -> OffsetBranch {
-        let (c4, c5) = (&self.chain.c[4], &self.chain.c[5]);
+        let c5 = &self.chain.c[5];
         let mut branch = OffsetBranch::default();
         // axis 2 seen from frame 6: Rz(theta6) n = m6
         let n = m.rot.tr_mul(z2);
         let m6 = c5.rot.tr_mul(&th5.unturn(&self.g));
-        let th6 = angle_between(&n, &m6, CLOSED_FORM_TOLERANCE);
-        let wrist = th6.is_none();
+        let (th6, wrist) = angle_flagged(&n, &m6, ATAN2_FLOOR, CLOSED_FORM_TOLERANCE);
         let th6 = th6.unwrap_or(self.free[5]);
-        // A4 = M (C4 Rz5 C5 Rz6)^-1
-        let c4r5 = th5.right_of(&c4.rot);
-        let tail = Transform {
-            rot: th6.right_of(&(c4r5 * c5.rot)),
-            pos: c4.pos + c4r5 * c5.pos,
-        };
-        let a4 = m.compose(&tail.inverse());
-        let Some(arm) = self.planar(th1, &a4.pos) else {
+        let mut found = self.offset_arm(m, th1, th5, &th6);
+        if found.is_none() {
+            // near the singularity theta6 (eps / |n_xy| off) may leave O4 just out of reach
+            let near = self.reaching_theta6(m, th1, th5, &th6);
+            let moved = (near.s * th6.c - near.c * th6.s).atan2(near.c * th6.c + near.s * th6.s);
+            if n.xy().norm() * moved.abs() <= NEAR_MOVE {
+                found = self.offset_arm(m, th1, th5, &near);
+            }
+        }
+        let Some((th6, x4, arm)) = found else {
             return branch;
         };
         // Rz(theta4) = (A3 C3)_r^T (A4)_r: its first column
-        let m1 = self.m1(th1, &a4.rot.column(0).into_owned());
+        let m1 = self.m1(th1, &x4);
         for (th2, th3, s) in arm {
             let n4 = self.a3c3_tr(&th2, &th3, &m1);
             let th4 = atan2(n4.y, n4.x);
@@ -717,6 +921,65 @@ impl ClosedFormIgm {
             branch.len += 1;
         }
         branch
+    }
+
+    /// A4 = M (C4 Rz5 C5 Rz6)^-1 and the planar arm placing its origin, if it reaches.
+    #[allow(clippy::type_complexity)]
+    fn offset_arm(
+        &self,
+        m: &Transform,
+        th1: &Angle,
+        th5: &Angle,
+        th6: &Angle,
+    ) -> Option<(Angle, Vector3<f64>, [(Angle, Angle, Singularity); 2])> {
+        let (o4, x4) = self.a4_origin_x(m, th5, th6);
+        let arm = self.planar(th1, &o4)?;
+        Some((*th6, x4, arm))
+    }
+
+    /// The origin and x axis of A4 = M Rz(theta6)^T K^-1 (K = C4 Rz(theta5) C5), without
+    /// its products: p = K^-1 origin = -C5r^T (Rz(theta5)^T C4r^T C4p + C5p) and K_r^T e_x =
+    /// C5r^T Rz(theta5)^T (C4r^T e_x), then Rz(theta6)^T and M.
+    fn a4_origin_x(&self, m: &Transform, th5: &Angle, th6: &Angle) -> (Vector3<f64>, Vector3<f64>) {
+        let (c4, c5) = (&self.chain.c[4].rot, &self.chain.c[5]);
+        let c4x = Vector3::new(c4[(0, 0)], c4[(0, 1)], c4[(0, 2)]);
+        let v =
+            Matrix3x2::from_columns(&[-(th5.unturn(&self.c4_origin) + c5.pos), th5.unturn(&c4x)]);
+        let w = th6.left_tr_of(&c5.rot.tr_mul(&v));
+        (m.rot * w.column(0) + m.pos, m.rot * w.column(1))
+    }
+
+    /// At (or near) the offset wrist's singularity, theta6 turns O4 = M_p + M_r Rz(-theta6) p
+    /// (p = K^-1 origin) on a circle about axis 6 (and barely moves the orientation): the
+    /// theta6 nearest to `near` that puts O4 within the planar arm's reach (`near` itself when
+    /// it does; else a root of the arm's reach boundary, an elbow double root).
+    fn reaching_theta6(&self, m: &Transform, th1: &Angle, th5: &Angle, near: &Angle) -> Angle {
+        let p = self
+            .a4_origin_x(&Transform::identity(), th5, &Angle::new(0.0))
+            .0;
+        let pxy = Vector3::new(p.x, p.y, 0.0);
+        // |O4 - O2|² = |d0|² + |pxy|² + 2 pxy . Rz(theta6) v, d0 the circle's centre from O2
+        let d0 = m.pos + m.rot.column(2) * p.z - th1.turn(&self.chain.c[1].pos);
+        let v = m.rot.tr_mul(&d0);
+        // the arm reaches |O4 - O2|² = arm_k + 2 (azbz ± rho)
+        let base = d0.norm_squared() + pxy.norm_squared() - self.arm_k;
+        let (lo, hi) = (
+            self.arm.azbz - self.arm.rho - base / 2.0,
+            self.arm.azbz + self.arm.rho - base / 2.0,
+        );
+        let eq = DotEquation::new(&pxy, &v);
+        let k = pxy.dot(&near.turn(&v)).clamp(lo, hi);
+        match eq.roots(k.clamp(-eq.rho, eq.rho), eq.rho * CLOSED_FORM_TOLERANCE) {
+            Roots::Two(a, b, _) => {
+                let closeness = |x: &Angle| x.c * near.c + x.s * near.s;
+                if closeness(&a) >= closeness(&b) {
+                    a
+                } else {
+                    b
+                }
+            }
+            _ => *near,
+        }
     }
 }
 
