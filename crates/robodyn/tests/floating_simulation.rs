@@ -290,11 +290,20 @@ fn a_wrapper_is_the_system_it_wraps() {
         rec
     };
     let plain = go(&mut TreeDynamics::new(&robot, Method::ArticulatedBody));
-    let wrapped = go(&mut Plain(TreeDynamics::new(&robot, Method::ArticulatedBody)));
-    let pushed = go(&mut Pushed(TreeDynamics::new(&robot, Method::ArticulatedBody)));
+    let wrapped = go(&mut Plain(TreeDynamics::new(
+        &robot,
+        Method::ArticulatedBody,
+    )));
+    let pushed = go(&mut Pushed(TreeDynamics::new(
+        &robot,
+        Method::ArticulatedBody,
+    )));
     assert_eq!(plain.headers, wrapped.headers);
     assert!(plain.rows.len() > 20, "{} rows", plain.rows.len());
-    assert_eq!(plain.rows, wrapped.rows, "the wrapper changed the trajectory");
+    assert_eq!(
+        plain.rows, wrapped.rows,
+        "the wrapper changed the trajectory"
+    );
     let x = |r: &Recorder| r.series("base_x").unwrap();
     let moved = x(&pushed).last().unwrap() - x(&plain).last().unwrap();
     assert!(moved.abs() > 1e-3, "the pushed base moved by {moved} more");
