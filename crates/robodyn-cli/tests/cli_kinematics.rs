@@ -325,3 +325,49 @@ fn state_tables_equal_the_single_states() {
     ]);
     assert!(e.contains("--input"), "{e}");
 }
+
+/// `jacobian --time-variation` is J̇: central differences of the CLI's own J along the motion,
+/// (J(q + h qd) - J(q - h qd)) / 2h, in the three references (fixed base); a closed chain is
+/// refused with the reason.
+#[test]
+fn jacobian_time_variation_equals_differences_of_j() {
+    let file = robot("rx90.urdf");
+    let q = [0.3, -0.7, 0.5, 1.1, -0.4, 0.9];
+    let qd = [0.8, -0.5, 1.2, -0.9, 0.6, 1.4];
+    let h = 1e-5;
+    for reference in ["world", "local", "local_world_aligned"] {
+        let dj = labelled(&run(&[
+            "jacobian",
+            &file,
+            &list(&q),
+            &format!("--qd={}", &list(&qd)[4..]),
+            "--frame",
+            "6",
+            "--reference",
+            reference,
+            "--time-variation",
+        ]))
+        .1;
+        let at = |s: f64| {
+            let x: Vec<f64> = q.iter().zip(&qd).map(|(a, b)| a + s * h * b).collect();
+            jacobian(&file, &x, "6", reference)
+        };
+        let fd = (at(1.0) - at(-1.0)) / (2.0 * h);
+        assert_eq!(dj.shape(), (6, 6));
+        let gap = (&dj - &fd).amax();
+        assert!(
+            gap < 1e-7 * fd.amax().max(1.0),
+            "{reference}: dJ - FD = {gap:e}"
+        );
+        assert!(dj.amax() > 0.1, "{reference}: dJ is not zero here");
+    }
+    let e = fails(&[
+        "jacobian",
+        &robot("sr400.toml"),
+        "--q=0.1,0.2,0.3,0.4,0.5,0.6",
+        "--frame",
+        "6",
+        "--time-variation",
+    ]);
+    assert!(e.contains("closed chain") && e.contains("drift"), "{e}");
+}

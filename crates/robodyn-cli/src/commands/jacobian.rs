@@ -1,13 +1,13 @@
 //! `robodyn jacobian ROBOT --q ... --frame NAME [--reference ...]`: the Jacobian of a frame,
 //! 6 x nv with rows [linear; angular] (Pinocchio's order; a floating base's 6 columns first), in one of the three references of
 //! docs/models/kinematics.md. Closed chains: the Jacobian in the actuated coordinates
-//! J_a = J_tr G on the assembly branch.
+//! J_a = J_tr G on the assembly branch. `--time-variation`: J̇ at --q, --qd instead (trees).
 
 use crate::common::{choices, format_number, write_text, CliResult, TableFormat};
 use crate::kinematic_state::{
     csv_field, joint_names, rows, table_format, CsvTable, Evaluated, StateArgs,
 };
-use robodyn::{frame_jacobian_into, Reference};
+use robodyn::{frame_jacobian_into, frame_jacobian_time_variation_into, Reference};
 use std::path::PathBuf;
 
 #[derive(clap::Args, Debug)]
@@ -22,11 +22,16 @@ pub struct Args {
     #[arg(long, default_value = "local_world_aligned",
           value_parser = choices(&Reference::ALL, Reference::name, Reference::describe))]
     pub reference: Reference,
+    /// Write J̇ = dJ/dt at --q and --qd (Pinocchio's getFrameJacobianTimeVariation) instead
+    /// of J: J̇ qd + J qdd is the frame's classical acceleration in the reference (`fk`'s
+    /// acceleration). Tree robots, fixed or floating base.
+    #[arg(long)]
+    pub time_variation: bool,
     /// Output file (default: standard output).
     #[arg(long)]
     pub output: Option<PathBuf>,
     /// csv: a header of joint names (closed chains: the actuated joints), six rows vx vy vz wx
-    /// wy wz; json: {"frame", "reference", "joints", "J"}.
+    /// wy wz; json: {"frame", "reference", "joints", "J"} ("dJ" with --time-variation).
     #[arg(long, value_enum, default_value = "csv")]
     pub format: TableFormat,
 }
@@ -39,9 +44,10 @@ pub fn run(a: Args) -> CliResult {
     }
     let e = a.state.evaluate()?;
     let f = e.robot.frame_id(&a.frame)?;
-    let (j, joints) = jacobian(&e, &f, a.reference)?;
+    let (j, joints) = jacobian(&e, &f, &a)?;
     let rows = rows(&j);
-    crate::common::check_finite("J", &rows.concat())?;
+    let key = if a.time_variation { "dJ" } else { "J" };
+    crate::common::check_finite(key, &rows.concat())?;
     let text = match a.format {
         TableFormat::Csv => {
             let names: Vec<String> = joints.iter().map(|n| csv_field(n)).collect();
@@ -53,25 +59,37 @@ pub fn run(a: Args) -> CliResult {
             s
         }
         TableFormat::Json => {
-            let v = serde_json::json!({
+            let mut v = serde_json::json!({
                 "frame": a.frame, "reference": a.reference.name(), "joints": joints,
-                "q": e.q, "J": rows,
+                "q": e.q,
             });
+            v[key] = serde_json::json!(rows);
             serde_json::to_string_pretty(&v)? + "\n"
         }
     };
     write_text(a.output.as_deref(), &text)
 }
 
-/// The frame's Jacobian at the evaluated state and the names of its columns: a closed chain's
-/// J_a = J_tr G (G at the state reached on the branch).
+/// The frame's Jacobian (or J̇ with `--time-variation`) at the evaluated state and the names
+/// of its columns: a closed chain's J_a = J_tr G (G at the state reached on the branch).
 fn jacobian(
     e: &Evaluated,
     f: &robodyn::FrameId,
-    reference: Reference,
+    a: &Args,
 ) -> CliResult<(nalgebra::DMatrix<f64>, Vec<String>)> {
     let mut j = nalgebra::DMatrix::zeros(6, e.robot.nv());
-    frame_jacobian_into(&e.robot, &e.data, f, reference, &mut j)?;
+    if a.time_variation {
+        if e.closed.is_some() {
+            return Err(
+                "--time-variation: J̇ of a closed chain's actuated coordinates is not \
+                        given by the CLI (Python's ClosedChain.drift gives J̇_a qd_a)"
+                    .into(),
+            );
+        }
+        frame_jacobian_time_variation_into(&e.robot, &e.data, f, a.reference, &mut j)?;
+        return Ok((j, e.robot.velocity_names()));
+    }
+    frame_jacobian_into(&e.robot, &e.data, f, a.reference, &mut j)?;
     Ok(match &e.closed {
         None => (j, e.robot.velocity_names()),
         Some((chain, g)) => (j * g, chain.coordinates().names().to_vec()),
@@ -91,9 +109,10 @@ fn table(a: &Args, input: &std::path::Path) -> CliResult {
     let (_, out) = a
         .state
         .each_state(input, setup, |(f, out), row, carried, e| {
-            let (j, _) = jacobian(e, f, a.reference)?;
+            let (j, _) = jacobian(e, f, a)?;
+            let key = if a.time_variation { "dJ" } else { "J" };
             for (label, r) in ROWS.iter().zip(rows(&j)) {
-                crate::common::check_finite(&format!("row {row}, J"), &r)?;
+                crate::common::check_finite(&format!("row {row}, {key}"), &r)?;
                 out.line(carried, row, &[label], &r);
             }
             Ok(())
