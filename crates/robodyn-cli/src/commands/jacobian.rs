@@ -38,6 +38,17 @@ pub struct Args {
 
 const ROWS: [&str; 6] = ["vx", "vy", "vz", "wx", "wy", "wz"];
 
+impl Args {
+    /// The matrix written: `J`, or `dJ` with `--time-variation` (the JSON key, error names).
+    fn matrix_name(&self) -> &'static str {
+        if self.time_variation {
+            "dJ"
+        } else {
+            "J"
+        }
+    }
+}
+
 pub fn run(a: Args) -> CliResult {
     if let Some(input) = &a.state.input {
         return table(&a, input);
@@ -46,7 +57,7 @@ pub fn run(a: Args) -> CliResult {
     let f = e.robot.frame_id(&a.frame)?;
     let (j, joints) = jacobian(&e, &f, &a)?;
     let rows = rows(&j);
-    let key = if a.time_variation { "dJ" } else { "J" };
+    let key = a.matrix_name();
     crate::common::check_finite(key, &rows.concat())?;
     let text = match a.format {
         TableFormat::Csv => {
@@ -110,7 +121,7 @@ fn table(a: &Args, input: &std::path::Path) -> CliResult {
         .state
         .each_state(input, setup, |(f, out), row, carried, e| {
             let (j, _) = jacobian(e, f, a)?;
-            let key = if a.time_variation { "dJ" } else { "J" };
+            let key = a.matrix_name();
             for (label, r) in ROWS.iter().zip(rows(&j)) {
                 crate::common::check_finite(&format!("row {row}, {key}"), &r)?;
                 out.line(carried, row, &[label], &r);
