@@ -90,9 +90,16 @@ for (const spec of job.pages) {
       await page.click('#play');
       // until the time has advanced by a tenth of the trajectory (it loops at the end)
       const step = await page.evaluate(() => { const v = window.robodynView; return 0.1 * (v.duration()); });
-      await page.waitForFunction((t) => window.robodynView.time() > t, t0 + step, { timeout: 30000 });
-      const playing = await page.evaluate(() => window.robodynView.playing());
-      await page.click('#play');
+      // and paused in the same turn of the page's loop as the check: a pause clicked from here
+      // arrives frames later, and on a loaded machine the play may have looped back to t0 by then
+      const paused = await page.waitForFunction((t) => {
+        const v = window.robodynView;
+        if (!(v.time() > t)) return false;
+        const playing = v.playing();
+        document.getElementById('play').click();
+        return { playing };
+      }, t0 + step, { timeout: 30000 });
+      const { playing } = await paused.jsonValue();
       const t1 = await page.evaluate(() => window.robodynView.time());
       const sample = await page.evaluate(() => window.robodynView.sample());
       const transforms = await page.evaluate(() => window.robodynView.frameTransforms());
