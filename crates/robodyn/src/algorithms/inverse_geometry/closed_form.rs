@@ -20,7 +20,8 @@ use crate::error::{Error, Result};
 use crate::geometry::Transform;
 use crate::model::Robot;
 use nalgebra::{Matrix3, Matrix3x2, Matrix4, SMatrix, Vector3};
-use std::f64::consts::{FRAC_PI_2, PI};
+use std::f64::consts::PI;
+use wide::f64x4;
 
 /// Relative tolerance of the class detection (parallel axes, concurrent axes) and of the
 /// singularity markers (a root whose equation's discriminant is within it of zero).
@@ -128,20 +129,169 @@ impl IgmSolutions {
     }
 }
 
-/// An angle carried with its cosine and sine, so that no sine or cosine is computed again
-/// from it: the roots of Paul's equations come with theirs (algebraically), and each is an
-/// atan2 or an acos once.
+/// The most angles one target brings: two theta1, each with two (theta2, theta3) and six wrist
+/// angles, or with two (theta5, theta6) and two (theta2, theta3, theta4): 34; 38 when theta1
+/// is free (one per arm branch). 48 leaves room.
+const MAX_ANGLES: usize = 48;
+
+/// The solutions of one target as found: the directions of the distinct angles (each solution
+/// shares some with others), and each solution's six joints as slots into them. The angles'
+/// values are taken at the end, all at once ([`Self::angles`]).
+#[derive(Clone, Copy)]
+struct Found {
+    ys: [f64; MAX_ANGLES],
+    xs: [f64; MAX_ANGLES],
+    n: usize,
+    slots: [[Slot; 6]; 8],
+    singular: [Singularity; 8],
+    len: usize,
+}
+
+/// One joint of a solution: the k-th angle found, as it is, plus a half turn or negated (the
+/// spherical wrist's mirror solution).
+#[derive(Clone, Copy, Default)]
+struct Slot {
+    k: u8,
+    op: SlotOp,
+}
+
+/// See [`Slot`].
+#[derive(Clone, Copy, Default)]
+enum SlotOp {
+    #[default]
+    Same,
+    HalfTurn,
+    Neg,
+}
+
+impl Slot {
+    fn half_turn(self) -> Slot {
+        Slot {
+            op: SlotOp::HalfTurn,
+            ..self
+        }
+    }
+
+    fn neg(self) -> Slot {
+        Slot {
+            op: SlotOp::Neg,
+            ..self
+        }
+    }
+}
+
+impl Found {
+    fn new() -> Found {
+        Found {
+            ys: [0.0; MAX_ANGLES],
+            xs: [0.0; MAX_ANGLES],
+            n: 0,
+            slots: [[Slot::default(); 6]; 8],
+            singular: [Singularity::default(); 8],
+            len: 0,
+        }
+    }
+
+    /// The slot of a new angle, of direction `d`.
+    fn angle(&mut self, d: Direction) -> Slot {
+        let k = self.n;
+        (self.ys[k], self.xs[k]) = (d.y, d.x);
+        self.n += 1;
+        Slot {
+            k: k as u8,
+            op: SlotOp::Same,
+        }
+    }
+
+    fn push(&mut self, slots: [Slot; 6], singular: Singularity) {
+        self.slots[self.len] = slots;
+        self.singular[self.len] = singular;
+        self.len += 1;
+    }
+
+    fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// The angles theta = atan2(y, x), four at a time (`wide`'s atan2: Cephes' rational
+    /// approximation, within 2 ulps), then each solution's joint values (theta - theta0),
+    /// each wrapped to (-pi, pi] or moved by a turn into its limits.
+    fn angles(&self, igm: &ClosedFormIgm) -> IgmSolutions {
+        let th = atan2_all(&self.ys, &self.xs, self.n);
+        let mut out = IgmSolutions::default();
+        for (slots, &singular) in self.slots[..self.len].iter().zip(&self.singular) {
+            let theta = slots.map(|s| {
+                let t = th[usize::from(s.k)];
+                match s.op {
+                    SlotOp::Same => t,
+                    SlotOp::HalfTurn => t + PI,
+                    SlotOp::Neg => -t,
+                }
+            });
+            let (q, within_limits) = igm.joint_values(&theta);
+            out.push(IgmSolution {
+                q,
+                within_limits,
+                singular,
+            });
+        }
+        out
+    }
+}
+
+/// atan2(y_k, x_k) for the first `n` entries, four at a time.
+fn atan2_all(ys: &[f64; MAX_ANGLES], xs: &[f64; MAX_ANGLES], n: usize) -> [f64; MAX_ANGLES] {
+    const LANES: usize = 4;
+    let mut th = [0.0; MAX_ANGLES];
+    for ((t, y), x) in th[..n.next_multiple_of(LANES)]
+        .chunks_exact_mut(LANES)
+        .zip(ys.chunks_exact(LANES))
+        .zip(xs.chunks_exact(LANES))
+    {
+        let y = f64x4::from([y[0], y[1], y[2], y[3]]);
+        let x = f64x4::from([x[0], x[1], x[2], x[3]]);
+        t.copy_from_slice(&y.atan2(x).to_array());
+    }
+    th
+}
+
+/// An angle carried by its cosine and sine: the roots of Paul's equations come with theirs
+/// (algebraically), and the equations downstream need only them. The angle's value is asked of
+/// them once, for every solution at once ([`Found::angles`]).
 #[derive(Clone, Copy, Debug)]
 struct Angle {
-    th: f64,
     c: f64,
     s: f64,
+}
+
+/// An angle given by a direction (x, y) of its plane, not necessarily of unit length: its
+/// value is atan2(y, x), found for all the solutions at once ([`Found::angles`]).
+#[derive(Clone, Copy, Debug)]
+struct Direction {
+    y: f64,
+    x: f64,
 }
 
 impl Angle {
     fn new(th: f64) -> Angle {
         let (s, c) = th.sin_cos();
-        Angle { th, c, s }
+        Angle { c, s }
+    }
+
+    /// Its direction (cos, sin).
+    fn dir(&self) -> Direction {
+        Direction {
+            y: self.s,
+            x: self.c,
+        }
+    }
+
+    /// The angle opposite (-theta).
+    fn neg(&self) -> Angle {
+        Angle {
+            c: self.c,
+            s: -self.s,
+        }
     }
 
     /// Rz(theta) v.
@@ -198,11 +348,12 @@ impl Angle {
     }
 }
 
-/// atan2(y, x) of the `libm` crate (musl's, within an ulp): the solve's ~20 calls to glibc's
-/// correctly rounded atan2 (and its rounding-mode guards) were a third of its time.
-#[inline]
-fn atan2(y: f64, x: f64) -> f64 {
-    libm::atan2(y, x)
+/// How far (rad) a root pair may be from a double root (delta or pi - delta) to be marked
+/// singular: rounding in Z / rho moves a double root by ~sqrt(eps), so the roots count as one
+/// within sqrt([`CLOSED_FORM_TOLERANCE`]) of each other (or of a half turn apart). Tested on
+/// sin(delta), which differs from min(delta, pi - delta) there by its cube / 6 (5e-15 of it).
+fn double_root_tolerance() -> f64 {
+    CLOSED_FORM_TOLERANCE.sqrt()
 }
 
 /// Roots of the type-2 equation X sin(theta) + Y cos(theta) = Z.
@@ -217,13 +368,13 @@ enum Roots {
 }
 
 /// The type-2 equation a . Rz(theta) b = k of Paul's method for fixed a, b: X = a_y b_x -
-/// a_x b_y, Y = a_x b_x + a_y b_y and Z = k - a_z b_z, so that rho = sqrt(X^2 + Y^2), phi =
-/// atan2(X, Y) and its cosine and sine are found once (at model build when a and b are
-/// constants) and each k costs one acos.
+/// a_x b_y, Y = a_x b_x + a_y b_y and Z = k - a_z b_z, so that rho = sqrt(X^2 + Y^2) and the
+/// cosine and sine of phi = atan2(X, Y) are found once (at model build when a and b are
+/// constants) and each k costs a square root: the roots phi ± delta, cos(delta) = Z / rho,
+/// are given by their cosines and sines.
 #[derive(Clone, Copy, Debug)]
 struct DotEquation {
     rho: f64,
-    phi: f64,
     cp: f64,
     sp: f64,
     azbz: f64,
@@ -242,7 +393,6 @@ impl DotEquation {
         let dxy = a.xy().norm() - b.xy().norm();
         DotEquation {
             rho,
-            phi: atan2(x, y),
             cp: y / rho,
             sp: x / rho,
             azbz: a.z * b.z,
@@ -254,10 +404,10 @@ impl DotEquation {
     /// The roots of a . Rz(theta) b = k for unit a and b and a unit-vector product k, given
     /// with 1 - k and 1 + k found without cancellation (from the other components of the
     /// vectors whose product k is): 1 - cos(delta) = ((1 - k) - gap_minus) / rho and 1 +
-    /// cos(delta) = ((1 + k) - gap_plus) / rho, delta from the smaller by 2 asin(sqrt(x / 2)).
-    /// Near a double root (the wrist near its singularity) delta is then exact to a few
-    /// roundings, where acos(Z / rho) loses half the digits (sqrt(eps) ~ 1e-8). `tol` as in
-    /// [`Self::roots`].
+    /// cos(delta) = ((1 + k) - gap_plus) / rho, sin(delta) from the smaller x by
+    /// sqrt(x (2 - x)). Near a double root (the wrist near its singularity) delta is then exact
+    /// to a few roundings, where sqrt(1 - (Z / rho)²) loses half the digits (sqrt(eps) ~ 1e-8).
+    /// `tol` as in [`Self::roots`].
     fn roots_unit(&self, k: f64, one_minus_k: f64, one_plus_k: f64, tol: f64) -> Roots {
         let rho = self.rho;
         if rho <= tol {
@@ -268,13 +418,12 @@ impl DotEquation {
             return Roots::None;
         }
         let (m, p) = ((m / rho).clamp(0.0, 2.0), (p / rho).clamp(0.0, 2.0));
-        let half = |x: f64| 2.0 * libm::asin((x / 2.0).sqrt());
-        let (delta, cd, sd) = if m <= p {
-            (half(m), 1.0 - m, (m * (2.0 - m)).sqrt())
+        let (cd, sd) = if m <= p {
+            (1.0 - m, (m * (2.0 - m)).sqrt())
         } else {
-            (PI - half(p), p - 1.0, (p * (2.0 - p)).sqrt())
+            (p - 1.0, (p * (2.0 - p)).sqrt())
         };
-        self.pair(delta, cd, sd)
+        self.pair(cd, sd)
     }
 
     /// theta with a . Rz(theta) b = k; `tol` is the tolerance on Z (units of k) for X = Y = 0
@@ -293,30 +442,25 @@ impl DotEquation {
             return Roots::None;
         }
         let mut cd = (z / rho).clamp(-1.0, 1.0);
-        // a double root: cos(delta) within a few roundings of ±1 is ±1 (acos would turn that
-        // rounding into delta ~ 1e-8, and the pose error with it)
+        // a double root: cos(delta) within a few roundings of ±1 is ±1 (the sine would turn
+        // that rounding into delta ~ 1e-8, and the pose error with it)
         if 1.0 - cd.abs() <= 4.0 * f64::EPSILON {
             cd = cd.signum();
         }
-        let delta = libm::acos(cd);
         // (1 - c)(1 + c): exact factors near c = ±1, where 1 - c² loses its digits
         let sd = ((1.0 - cd) * (1.0 + cd)).sqrt();
-        self.pair(delta, cd, sd)
+        self.pair(cd, sd)
     }
 
-    /// The roots phi ± delta, with cos(delta) = cd and sin(delta) = sd.
-    fn pair(&self, delta: f64, cd: f64, sd: f64) -> Roots {
-        // rounding in Z / rho moves a double root by ~sqrt(eps): the roots count as one when
-        // they are within sqrt(CLOSED_FORM_TOLERANCE) of each other (or of a half turn apart)
-        let singular = delta.min(PI - delta) <= CLOSED_FORM_TOLERANCE.sqrt();
-        let (cp, sp, phi) = (self.cp, self.sp, self.phi);
+    /// The roots phi ± delta, with cos(delta) = cd and sin(delta) = sd >= 0.
+    fn pair(&self, cd: f64, sd: f64) -> Roots {
+        let singular = sd <= double_root_tolerance();
+        let (cp, sp) = (self.cp, self.sp);
         let plus = Angle {
-            th: phi + delta,
             c: cp * cd - sp * sd,
             s: sp * cd + cp * sd,
         };
         let minus = Angle {
-            th: phi - delta,
             c: cp * cd + sp * sd,
             s: sp * cd - cp * sd,
         };
@@ -332,11 +476,7 @@ fn angle_between(u: &Vector3<f64>, v: &Vector3<f64>, tol: f64) -> Option<Angle> 
     }
     let (c, s) = (u.x * v.x + u.y * v.y, u.x * v.y - u.y * v.x);
     let r = (nu * nv).sqrt();
-    Some(Angle {
-        th: atan2(s, c),
-        c: c / r,
-        s: s / r,
-    })
+    Some(Angle { c: c / r, s: s / r })
 }
 
 /// [`angle_between`] solved down to `floor` (None below it), and whether u or v is within
@@ -591,12 +731,12 @@ impl ClosedFormIgm {
         if !self.c0_identity {
             m = self.c0_inv.compose(&m);
         }
-        let mut out = IgmSolutions::default();
+        let mut found = Found::new();
         match self.class {
-            IgmClass::SphericalWrist => self.spherical(&m, &mut out),
-            IgmClass::OffsetWrist => self.offset(&m, &mut out),
+            IgmClass::SphericalWrist => self.spherical(&m, &mut found),
+            IgmClass::OffsetWrist => self.offset(&m, &mut found),
         }
-        Ok(out)
+        Ok(found.angles(self))
     }
 
     fn tol(&self) -> f64 {
@@ -636,7 +776,7 @@ impl ClosedFormIgm {
         let k = (x2.norm_squared() - self.arm_k) / 2.0;
         let tol2 = self.tol() * self.chain.scale;
         let (t3, elbow) = roots_or(self.arm.roots(k, tol2), self.free[2])?;
-        Some(t3.map(|th3| {
+        let branch = |th3: Angle| {
             let v = c2.rot * th3.turn(b) + c2.pos;
             let (th2, shoulder) =
                 angle_flagged(&v, &x2, ATAN2_FLOOR * self.chain.scale, self.tol());
@@ -646,7 +786,8 @@ impl ClosedFormIgm {
                 wrist: false,
             };
             (th2.unwrap_or(self.free[1]), th3, singular)
-        }))
+        };
+        Some([branch(t3[0]), branch(t3[1])])
     }
 
     /// (A3 C3)_r^T M from m1 = C1_r^T Rz(theta1)^T M (shared by the branches of theta1), for
@@ -667,7 +808,9 @@ impl ClosedFormIgm {
         self.chain.c[1].rot.tr_mul(&th1.left_tr_of(m))
     }
 
-    fn push(&self, th: &[f64; 6], singular: Singularity, out: &mut IgmSolutions) {
+    /// The joint values of the angles `th` of one solution, and whether all lie within the
+    /// limits.
+    fn joint_values(&self, th: &[f64]) -> ([f64; 6], bool) {
         let mut q = [0.0; 6];
         let mut within = true;
         if self.unlimited {
@@ -681,16 +824,12 @@ impl ClosedFormIgm {
                 within &= inside;
             }
         }
-        out.push(IgmSolution {
-            q,
-            within_limits: within,
-            singular,
-        });
+        (q, within)
     }
 
     /// The spherical wrist: the wrist centre gives theta1 and the planar arm (theta2,
     /// theta3), each arm branch the orientation R left to the wrist.
-    fn spherical(&self, m: &Transform, out: &mut IgmSolutions) {
+    fn spherical(&self, m: &Transform, out: &mut Found) {
         let c_m = m.rot * self.point6 + m.pos;
         let Some((t1, shoulder, free)) = self.theta1(&c_m) else {
             return;
@@ -702,16 +841,17 @@ impl ClosedFormIgm {
                 continue;
             };
             let m1 = self.m1(&th1, &m_xz);
+            let slot1 = out.angle(th1.dir());
             for (th2, th3, s) in arm {
                 // the point on axis 1: theta1 turns axis 4 only, chosen for the wrist to reach
-                let (th1, m1) = if free {
+                let (m1, slot1) = if free {
                     let c = &self.chain.c;
                     let a4 = c[1].rot
                         * th2.turn(&(c[2].rot * th3.turn(&c[3].rot.column(2).into_owned())));
                     let th1 = self.reaching_theta1(&m.rot.column(2).into_owned(), &a4);
-                    (th1, self.m1(&th1, &m_xz))
+                    (self.m1(&th1, &m_xz), out.angle(th1.dir()))
                 } else {
-                    (th1, m1)
+                    (m1, slot1)
                 };
                 // R = Rz(theta4) C4 Rz(theta5) C5 Rz(theta6): its columns x and z
                 let r = self.a3c3_tr(&th2, &th3, &m1);
@@ -719,7 +859,8 @@ impl ClosedFormIgm {
                     shoulder: shoulder || s.shoulder,
                     ..s
                 };
-                self.spherical_wrist(&[th1.th, th2.th, th3.th], &r, singular, out);
+                let arm = [slot1, out.angle(th2.dir()), out.angle(th3.dir())];
+                self.spherical_wrist(&arm, &r, singular, out);
             }
         }
     }
@@ -729,10 +870,10 @@ impl ClosedFormIgm {
     /// mirror of the first when [`Self::mirror`] holds and the wrist is not singular.
     fn spherical_wrist(
         &self,
-        arm: &[f64; 3],
+        arm: &[Slot; 3],
         r: &Matrix3x2<f64>,
         s: Singularity,
-        out: &mut IgmSolutions,
+        out: &mut Found,
     ) {
         let (r0, b): (Vector3<f64>, Vector3<f64>) = (r.column(0).into(), r.column(1).into());
         let (one_minus, one_plus) = unit_complements(b.z, b.x * b.x + b.y * b.y);
@@ -743,29 +884,27 @@ impl ClosedFormIgm {
             return;
         };
         let [a1, a2, a3] = *arm;
-        let (first, wrist) = self.wrist_angles(&r0, &b, &t5[0]);
-        let [th4, th5, th6] = first;
-        self.push(
-            &[a1, a2, a3, th4, th5, th6],
-            Singularity { wrist, ..s },
-            out,
-        );
-        let (second, wrist) = if self.mirror && !double && !wrist {
-            ([th4 + PI, -th5, th6 + PI], false)
+        let (first, mut wrist) = self.wrist_angles(&r0, &b, &t5[0]);
+        let [th4, th5, th6] = first.map(|d| out.angle(d));
+        out.push([a1, a2, a3, th4, th5, th6], Singularity { wrist, ..s });
+        let [th4, th5, th6] = if self.mirror && !double && !wrist {
+            [th4.half_turn(), th5.neg(), th6.half_turn()]
         } else {
-            self.wrist_angles(&r0, &b, &t5[1])
+            let (second, w) = self.wrist_angles(&r0, &b, &t5[1]);
+            wrist = w;
+            second.map(|d| out.angle(d))
         };
-        let [th4, th5, th6] = second;
-        self.push(
-            &[a1, a2, a3, th4, th5, th6],
-            Singularity { wrist, ..s },
-            out,
-        );
+        out.push([a1, a2, a3, th4, th5, th6], Singularity { wrist, ..s });
     }
 
     /// theta4 and theta6 of R for one theta5 root (r0 = R e_x, b = R e_z), and whether the
     /// wrist is singular (axes 4 and 6 aligned: theta4 its representative value).
-    fn wrist_angles(&self, r0: &Vector3<f64>, b: &Vector3<f64>, th5: &Angle) -> ([f64; 3], bool) {
+    fn wrist_angles(
+        &self,
+        r0: &Vector3<f64>,
+        b: &Vector3<f64>,
+        th5: &Angle,
+    ) -> ([Direction; 3], bool) {
         let (c4, c5) = (&self.chain.c[4], &self.chain.c[5]);
         let c4r5 = th5.right_of(&c4.rot);
         let m5 = c4r5 * self.p6;
@@ -774,15 +913,18 @@ impl ClosedFormIgm {
         // Rz(theta6) = Q^T R, Q = Rz(theta4) C4 Rz(theta5) C5: its first column
         // (Q^T r0 = C5^T (C4 Rz5)^T Rz4^T r0)
         let u = c4r5.tr_mul(&th4.unturn(r0));
-        let th6 = atan2(c5.rot.column(1).dot(&u), c5.rot.column(0).dot(&u));
-        ([th4.th, th5.th, th6], wrist)
+        let th6 = Direction {
+            y: c5.rot.column(1).dot(&u),
+            x: c5.rot.column(0).dot(&u),
+        };
+        ([th4.dir(), th5.dir(), th6], wrist)
     }
 
     /// The offset wrist: W gives theta1, then per theta1 the direction of axis 6 theta5 (two
     /// roots), each root a branch. (The wrist mirror does not serve here: it moves W, which
     /// is off axis 4, and so the planar arm.) W on axis 1 (theta1 free): its representative
     /// value, or when no solution follows from it, [`Self::offset_free_theta1`].
-    fn offset(&self, m: &Transform, out: &mut IgmSolutions) {
+    fn offset(&self, m: &Transform, out: &mut Found) {
         let w_m = m.rot * self.point6 + m.pos;
         let Some((t1, shoulder, free)) = self.theta1(&w_m) else {
             return;
@@ -806,7 +948,7 @@ impl ClosedFormIgm {
     fn offset_free_theta1(&self, m: &Transform) -> Angle {
         let margin = |t: f64| self.offset_margin(m, &Angle::new(t));
         let step = std::f64::consts::TAU / 32.0;
-        let t0 = self.free[0].th;
+        let t0 = self.theta0[0];
         let best = (0..32)
             .map(|i| t0 + step * i as f64)
             .max_by(|a, b| margin(*a).total_cmp(&margin(*b)))
@@ -853,7 +995,7 @@ impl ClosedFormIgm {
     }
 
     /// The solutions of one theta1 of the offset wrist.
-    fn offset_theta1(&self, m: &Transform, th1: &Angle, shoulder: bool, out: &mut IgmSolutions) {
+    fn offset_theta1(&self, m: &Transform, th1: &Angle, shoulder: bool, out: &mut Found) {
         let z6: Vector3<f64> = m.rot.column(2).into();
         let z2 = th1.turn(&self.u2);
         // axis 6 against axis 2: e4 . C4 Rz(theta5) C5 e_z = z2 . z6, with 1 -+ z2 . z6 from
@@ -867,11 +1009,9 @@ impl ClosedFormIgm {
         let Some((t5, _)) = roots_or(t5, self.free[4]) else {
             return;
         };
+        let slot1 = out.angle(th1.dir());
         for th5 in t5 {
-            let b = self.offset_branch(m, th1, &z2, &th5, shoulder);
-            for (th, singular) in &b.items[..b.len] {
-                self.push(th, *singular, out);
-            }
+            self.offset_branch(m, (th1, slot1), &z2, &th5, shoulder, out);
         }
     }
 
@@ -883,13 +1023,13 @@ impl ClosedFormIgm {
     fn offset_branch(
         &self,
         m: &Transform,
-        th1: &Angle,
+        (th1, slot1): (&Angle, Slot),
         z2: &Vector3<f64>,
         th5: &Angle,
         shoulder: bool,
-    ) -> OffsetBranch {
+        out: &mut Found,
+    ) {
         let c5 = &self.chain.c[5];
-        let mut branch = OffsetBranch::default();
         // axis 2 seen from frame 6: Rz(theta6) n = m6
         let n = m.rot.tr_mul(z2);
         let m6 = c5.rot.tr_mul(&th5.unturn(&self.g));
@@ -905,22 +1045,23 @@ impl ClosedFormIgm {
             }
         }
         let Some((th6, x4, arm)) = found else {
-            return branch;
+            return;
         };
+        let (slot5, slot6) = (out.angle(th5.dir()), out.angle(th6.dir()));
         // Rz(theta4) = (A3 C3)_r^T (A4)_r: its first column
         let m1 = self.m1(th1, &x4);
         for (th2, th3, s) in arm {
             let n4 = self.a3c3_tr(&th2, &th3, &m1);
-            let th4 = atan2(n4.y, n4.x);
+            let th4 = Direction { y: n4.y, x: n4.x };
             let singular = Singularity {
                 shoulder: shoulder || s.shoulder,
                 elbow: s.elbow,
                 wrist,
             };
-            branch.items[branch.len] = ([th1.th, th2.th, th3.th, th4, th5.th, th6.th], singular);
-            branch.len += 1;
+            let (slot2, slot3) = (out.angle(th2.dir()), out.angle(th3.dir()));
+            let slot4 = out.angle(th4);
+            out.push([slot1, slot2, slot3, slot4, slot5, slot6], singular);
         }
-        branch
     }
 
     /// A4 = M (C4 Rz5 C5 Rz6)^-1 and the planar arm placing its origin, if it reaches.
@@ -983,13 +1124,6 @@ impl ClosedFormIgm {
     }
 }
 
-/// The solutions of one (theta1, theta5) branch of the offset wrist (0 or 2).
-#[derive(Clone, Copy, Default)]
-struct OffsetBranch {
-    items: [([f64; 6], Singularity); 2],
-    len: usize,
-}
-
 /// Whether the spherical wrist's second solution is the mirror of the first: (theta4 + pi,
 /// -theta5, theta6 + pi) gives link 6 the orientation (theta4, theta5, theta6) gives it, i.e.
 /// Rz(pi) W(-t) Rz(pi) = W(t) for W(t) = C4r Rz(t) C5r and every t (the wrist centre does not
@@ -997,18 +1131,13 @@ struct OffsetBranch {
 /// alpha5, alpha6 = ±pi/2 and gamma6 = 0 or pi, not for other wrists, which are solved root
 /// by root; [`MIRROR_TOLERANCE`] bounds the mirror's orientation error.
 fn mirror_holds(c4: &Matrix3<f64>, c5: &Matrix3<f64>) -> bool {
-    let half = Angle {
-        th: PI,
-        c: -1.0,
-        s: 0.0,
-    };
+    let half = Angle { c: -1.0, s: 0.0 };
     let w = |t: &Angle| t.right_of(c4) * c5;
-    [(0.0, 1.0, 0.0), (FRAC_PI_2, 0.0, 1.0), (PI, -1.0, 0.0)]
-        .iter()
-        .all(|&(th, c, s)| {
-            let mirrored = half.left_of(&half.right_of(&w(&Angle { th: -th, c, s: -s })));
-            (mirrored - w(&Angle { th, c, s })).amax() <= MIRROR_TOLERANCE
-        })
+    [(1.0, 0.0), (0.0, 1.0), (-1.0, 0.0)].iter().all(|&(c, s)| {
+        let t = Angle { c, s };
+        let mirrored = half.left_of(&half.right_of(&w(&t.neg())));
+        (mirrored - w(&t)).amax() <= MIRROR_TOLERANCE
+    })
 }
 
 fn no_class(robot: &Robot, why: &str) -> Error {
