@@ -2,16 +2,17 @@
 //! differentiating A(q) qdd + H(q, qd) = Gamma at qdd = ddm(q, qd, Gamma) gives
 //! dqdd/dq = -A^-1 dGamma/dq, dqdd/dqd = -A^-1 dGamma/dqd (the inverse model's derivatives at
 //! that qdd) and dqdd/dGamma = A^-1, in four named steps:
-//! 1. `accelerations`: A by composite links, its L'DL factorization (the direct model's own,
-//!    [`ltdl_factor`]) and qdd = A^-1 (Gamma - H);
-//! 2. the inverse model's derivatives at (q, qd, qdd) (`world::idm_derivatives_world`);
+//! 1. `accelerations`: H by Newton–Euler with qdd = 0, A from the world-frame composite
+//!    inertias of that pass's placements (`world::world_inertia_matrix`), its L'DL
+//!    factorization (the direct model's own, [`ltdl_factor`]) and qdd = A^-1 (Gamma - H);
+//! 2. the inverse model's derivatives at (q, qd, qdd) (`world::ddm_rows`): the same world
+//!    terms, with the wrenches of the accelerations qdd added to the pass at qdd = 0;
 //! 3. `inverse_from_factors`: A^-1 from the same factors, down the tree (D17a);
-//! 4. dqdd/dq = -A^-1 dGamma/dq and dqdd/dqd = -A^-1 dGamma/dqd as two matrix products.
+//! 4. dqdd/dq = -A^-1 dGamma/dq and dqdd/dqd = -A^-1 dGamma/dqd, the two products together.
 
-use super::world::idm_derivatives_world;
+use super::world::{ddm_rows, world_inertia_matrix};
 use super::{check_square, DerivativesData, TreeLists};
 use crate::algorithms::direct_dynamics::{ltdl_factor, ltdl_solve};
-use crate::algorithms::inertia_matrix::composite_inertia_matrix;
 use crate::algorithms::inverse_dynamics::{check_state, rnea_with_environment};
 use crate::error::{check_finite_matrix, check_finite_result, Result};
 use crate::model::{DynModel, Environment, Robot};
@@ -44,8 +45,8 @@ impl DdmDerivatives {
     }
 }
 
-/// Step 1: A(q) into `factor`, factored in place (L'DL over the tree), and
-/// qdd = A^-1 (Gamma - H(q, qd)), H by Newton–Euler with qdd = 0 into `h`.
+/// Step 1: H(q, qd) by Newton–Euler with qdd = 0 into `h`, A(q) from the world terms of that
+/// pass into `factor`, factored in place (L'DL over the tree), and qdd = A^-1 (Gamma - H).
 #[allow(clippy::too_many_arguments)]
 fn accelerations(
     model: &DynModel<f64>,
@@ -58,14 +59,15 @@ fn accelerations(
 ) -> Result<()> {
     let DerivativesData {
         data: ws,
+        world,
         factor,
         h,
         zeros,
         ..
     } = data;
-    composite_inertia_matrix(model, ws, q, factor);
-    ltdl_factor(model, factor)?;
     rnea_with_environment(model, ws, env, q, qd, zeros, h);
+    world_inertia_matrix(model, ws, world, env, qd, factor);
+    ltdl_factor(model, factor)?;
     for ((x, t), hk) in qdd.iter_mut().zip(tau).zip(h.iter()) {
         *x = t - hk;
     }
@@ -80,10 +82,11 @@ fn accelerations(
 /// X_ij = delta_ij / D_j - sum over the ancestors a of i of L_ia X_aj      (D17a)
 /// ```
 ///
-/// Column j is computed down from row j; its rows above j are those of X_ja written when
-/// column a < j was done (X is symmetric), and every X_ij is written at (i, j) and (j, i).
-/// Rows outside the subtree of j's topmost movable ancestor are zero (`TreeLists::span`),
-/// skipped. Indices here are 0-based (link k + 1).
+/// Row i is computed for the columns j < i as one combination of the rows of its ancestors
+/// (each stored as its column, X being symmetric: contiguous), then X_ii, and copied into
+/// column i. Rows before i are complete then (their entries beyond the diagonal copied from the
+/// later rows as each was done). Columns outside the subtree of i's topmost movable ancestor
+/// are zero (`TreeLists::span`), skipped. Indices here are 0-based (link k + 1).
 fn inverse_from_factors(
     model: &DynModel<f64>,
     factor: &DMatrix<f64>,
@@ -94,48 +97,60 @@ fn inverse_from_factors(
     let h = factor.as_slice();
     let xs = x.as_mut_slice();
     xs.fill(0.0);
-    for j in 0..n {
-        if !model.index.movable[j + 1] {
+    for i in 0..n {
+        if !model.index.movable[i + 1] {
             continue;
         }
-        for i in j..tree.span[j].1 {
-            if !model.index.movable[i + 1] {
-                continue;
-            }
-            let (l_i, x_j) = (&h[i * n..(i + 1) * n], &xs[j * n..(j + 1) * n]);
-            let carried: f64 = tree.ancestors[i].iter().map(|&a| l_i[a] * x_j[a]).sum();
-            let s = if i == j { 1.0 / h[j * n + j] } else { 0.0 } - carried;
-            xs[i + j * n] = s;
-            xs[j + i * n] = s;
+        let lo = tree.span[i].0;
+        let (done, rest) = xs.split_at_mut(i * n);
+        let xi = &mut rest[lo..i];
+        let l_i = &h[i * n..(i + 1) * n];
+        for &a in &tree.ancestors[i] {
+            let xa = &done[a * n + lo..a * n + i];
+            xi.iter_mut().zip(xa).for_each(|(y, v)| *y -= l_i[a] * v);
+        }
+        let carried: f64 = tree.ancestors[i].iter().map(|&a| l_i[a] * xi[a - lo]).sum();
+        rest[i] = 1.0 / h[i * n + i] - carried;
+        for (j, &v) in (lo..i).zip(&rest[lo..i]) {
+            done[i + j * n] = v;
         }
     }
 }
 
-/// Step 4: `out` = -A^-1 `b`, column by column, skipping the zeros of `b` (a tree's
-/// dGamma/dq has none only between ancestors and descendants) and the rows of A^-1's column k
-/// outside `span[k]` (joints of another subtree of the base: zero). Allocation-free (a dense
-/// product from faer or nalgebra would allocate its packing buffers).
-fn neg_product(
+/// Step 4: `out` = -A^-1 `b` for the two matrices b = dGamma/dq, dGamma/dqd together (one
+/// read of A^-1 for both), column by column, skipping the zeros of `b` (a tree's dGamma/dq and
+/// dGamma/dqd have none only between ancestors and descendants, the same entries) and the
+/// rows of A^-1's column k outside `span[k]` (joints of another subtree of the base: zero).
+/// Allocation-free (a dense product from faer or nalgebra would allocate its packing buffers).
+fn neg_products(
     ainv: &DMatrix<f64>,
     span: &[(usize, usize)],
-    b: &DMatrix<f64>,
-    out: &mut DMatrix<f64>,
+    [b1, b2]: [&DMatrix<f64>; 2],
+    [o1, o2]: [&mut DMatrix<f64>; 2],
 ) {
     let n = ainv.nrows();
     if n == 0 {
         return;
     }
     let a = ainv.as_slice();
-    for (oc, bc) in out
+    let outs = o1
         .as_mut_slice()
         .chunks_exact_mut(n)
-        .zip(b.as_slice().chunks_exact(n))
-    {
-        oc.fill(0.0);
-        for ((ak, &x), &(lo, hi)) in a.chunks_exact(n).zip(bc).zip(span) {
-            if x != 0.0 {
-                let o = &mut oc[lo..hi];
-                o.iter_mut().zip(&ak[lo..hi]).for_each(|(o, y)| *o -= y * x);
+        .zip(o2.as_mut_slice().chunks_exact_mut(n));
+    let bs = b1
+        .as_slice()
+        .chunks_exact(n)
+        .zip(b2.as_slice().chunks_exact(n));
+    for ((c1, c2), (bc1, bc2)) in outs.zip(bs) {
+        c1.fill(0.0);
+        c2.fill(0.0);
+        for (((ak, &x1), &x2), &(lo, hi)) in a.chunks_exact(n).zip(bc1).zip(bc2).zip(span) {
+            if x1 != 0.0 || x2 != 0.0 {
+                let rows = c1[lo..hi].iter_mut().zip(&mut c2[lo..hi]).zip(&ak[lo..hi]);
+                rows.for_each(|((y1, y2), a)| {
+                    *y1 -= a * x1;
+                    *y2 -= a * x2;
+                });
             }
         }
     }
@@ -203,16 +218,14 @@ pub fn direct_dynamics_derivatives_into(
         world,
         dtau,
         factor,
-        h,
         tree,
         ..
     } = data;
-    let state = (q, qd, out.qdd.as_slice());
     let [dq, dqd] = dtau;
-    idm_derivatives_world(model, ws, world, env, state, h, [dq, dqd], None);
+    ddm_rows(model, ws, world, (qd, out.qdd.as_slice()), [dq, dqd]);
     inverse_from_factors(model, factor, tree, &mut out.ainv);
-    neg_product(&out.ainv, &tree.span, dq, &mut out.dqdd_dq);
-    neg_product(&out.ainv, &tree.span, dqd, &mut out.dqdd_dqd);
+    let outs = [&mut out.dqdd_dq, &mut out.dqdd_dqd];
+    neg_products(&out.ainv, &tree.span, [dq, dqd], outs);
     check_finite_matrix("dqdd_dq", &out.dqdd_dq)?;
     check_finite_matrix("dqdd_dqd", &out.dqdd_dqd)?;
     check_finite_matrix("Ainv", &out.ainv)

@@ -4,19 +4,25 @@
 //! then the velocity of the point at O_0; forces: the moment about O_0 first, then the force),
 //! and each entry of an ancestor–descendant pair is then a few dot products of 6-vectors:
 //!
-//! 1. `forward`: placements 0T_j, joint axes S_j, velocities V_j, accelerations A_j (gravity
-//!    as a base acceleration), the pair terms u_j = V_i x S_j and w_j = A_i x S_j + V_i x u_j
-//!    (i the antecedent), each link's spatial inertia I_j, its rate dI_j = V_j x* I_j - I_j V_j x
-//!    and momentum I_j V_j (W1–W5);
-//! 2. `composites`: the sums of I, dI and the momenta over each subtree, and the subtree's
-//!    total wrench F_j from the nominal Newton–Euler pass (W6);
-//! 3. `descendant_rows`: for joint i and each ancestor-or-self j, dGamma_i/dq_j and
+//! 1. `forward_geometry`: placements 0T_j, joint axes S_j, velocities V_j, the pair terms
+//!    u_j = V_i x S_j (i the antecedent), each link's spatial inertia I_j, its rate
+//!    dI_j = V_j x* I_j - I_j V_j x and momentum I_j V_j (W1–W5, the parts free of qdd);
+//!    `forward_accelerations`: accelerations A_j (gravity as a base acceleration) and
+//!    w_j = A_i x S_j + V_i x u_j (W2–W3);
+//! 2. `composite_inertias`: the sums of I, dI and the momenta over each subtree;
+//!    `subtree_wrenches`: the subtree's total wrench F_j from the nominal Newton–Euler pass (W6);
+//! 3. `pair_rows`, for joint i and each ancestor-or-self j: dGamma_i/dq_j and
 //!    dGamma_i/dqd_j (W7–W9);
-//! 4. `ancestor_rows`: for joint j and each strict ancestor i, dGamma_i/dq_j = S_i . g_j and
-//!    dGamma_i/dqd_j = S_i . p_j (W10–W12).
+//! 4. and in the same walk, for j a strict ancestor: dGamma_j/dq_i = S_j . g_i and
+//!    dGamma_j/dqd_i = S_j . p_i (W10–W12).
 //!
 //! The cost is O(N) 6 x 6 products plus four dot products per pair, against one restricted
 //! Newton–Euler pass per column for the kernel of [`super::inverse`].
+//!
+//! The direct model's derivatives use the steps apart ([`world_inertia_matrix`] before qdd is
+//! known, [`ddm_rows`] after), on one nominal pass at qdd = 0: A comes from the composite
+//! inertias of step 2 (A_ij = Ic_i S_i . S_j), and the wrenches of the accelerations qdd are
+//! added to that pass's (Newton–Euler is linear in qdd), so the placements are computed once.
 
 use crate::algorithms::inverse_dynamics::rnea_with_environment;
 use crate::data::Data;
@@ -37,6 +43,11 @@ pub(crate) struct WorldTerms {
     w: Vec<Vector6<f64>>,
     /// I_j, then the composite inertia of j's subtree.
     ic: Vec<Matrix6<f64>>,
+    /// I_j (the direct model's wrenches of the accelerations qdd).
+    link: Vec<Matrix6<f64>>,
+    /// The part of A_j due to qdd (the direct model's), then I_j times it.
+    da: Vec<Vector6<f64>>,
+    y: Vec<Vector6<f64>>,
     /// dI_j, then its sum over j's subtree.
     bc: Vec<Matrix6<f64>>,
     /// I_j V_j, then the subtree's momentum.
@@ -58,6 +69,9 @@ impl WorldTerms {
             u: v6(),
             w: v6(),
             ic: m6(),
+            link: m6(),
+            da: v6(),
+            y: v6(),
             bc: m6(),
             hc: v6(),
             fc: v6(),
@@ -96,8 +110,9 @@ fn skew(v: &Vector3<f64>) -> Matrix3<f64> {
 }
 
 /// The spatial inertia of link j at O_0 in R_0 (W4): [[I_O, [c]x], [[c]x^T, M 1]] with
-/// c = M P + R MS the first moment about O_0 and I_O = R J R^T - M [P]x^2 - [P]x [s]x - [s]x [P]x
-/// (s = R MS) the inertia about O_0.
+/// c = M P + s the first moment about O_0 (s = R MS) and
+/// I_O = R J R^T - M [P]x^2 - [P]x [s]x - [s]x [P]x the inertia about O_0, written with
+/// [a]x [b]x = b a^T - (a . b) 1 as R J R^T + P . (c + s) 1 - c P^T - P s^T.
 fn world_inertia(
     model: &DynModel<f64>,
     j: usize,
@@ -106,13 +121,15 @@ fn world_inertia(
 ) -> Matrix6<f64> {
     let l = model.link(j);
     let s = r * l.ms;
-    let (sp, ss) = (skew(p), skew(&s));
-    let io = r * l.inertia * r.transpose() - sp * sp * l.mass - sp * ss - ss * sp;
-    let c = skew(&(p * l.mass + s));
+    let c = p * l.mass + s;
+    let io = r * l.inertia * r.transpose() + Matrix3::from_diagonal_element(p.dot(&(c + s)))
+        - c * p.transpose()
+        - p * s.transpose();
+    let cx = skew(&c);
     let mut m = Matrix6::zeros();
     m.fixed_view_mut::<3, 3>(0, 0).copy_from(&io);
-    m.fixed_view_mut::<3, 3>(0, 3).copy_from(&c);
-    m.fixed_view_mut::<3, 3>(3, 0).copy_from(&c.transpose());
+    m.fixed_view_mut::<3, 3>(0, 3).copy_from(&cx);
+    m.fixed_view_mut::<3, 3>(3, 0).copy_from(&cx.transpose());
     m.fixed_view_mut::<3, 3>(3, 3)
         .copy_from(&(Matrix3::identity() * l.mass));
     m
@@ -135,19 +152,20 @@ fn inertia_rate(v: &Vector6<f64>, i: &Matrix6<f64>) -> Matrix6<f64> {
     x + x.transpose()
 }
 
-/// Step 1 (W1–W5): the world placements and motions of links 1..N from the nominal pass's
-/// antecedent placements iA_j, iP_j, and the links' inertial terms.
-fn forward(
+/// Step 1 (W1, W3–W5): the world placements, axes and velocities of links 1..N from the
+/// nominal pass's antecedent placements iA_j, iP_j, u_j = V_i x S_j, and the links' inertial
+/// terms. With `qdd` (the inverse model), the accelerations of [`accelerate`] in the same sweep;
+/// without (the direct model, whose qdd comes later), the link inertias I_j are kept instead.
+fn forward_geometry(
     model: &DynModel<f64>,
     ws: &Data,
     t: &mut WorldTerms,
     env: &Environment,
     qd: &[f64],
-    qdd: &[f64],
+    qdd: Option<&[f64]>,
 ) {
-    let b = &env.base;
-    t.v[0] = join(&b.w0, &Vector3::zeros());
-    t.a[0] = join(&b.wp0, &(b.vp0 - env.gravity));
+    t.v[0] = join(&env.base.w0, &Vector3::zeros());
+    t.a[0] = base_acceleration(env);
     for j in 1..=model.nl {
         let fr = model.frame(j);
         let i = fr.ant;
@@ -159,27 +177,57 @@ fn forward(
             JointType::Prismatic => join(&Vector3::zeros(), &z),
             JointType::Fixed => Vector6::zeros(),
         };
-        let (vi, ai) = (t.v[i], t.a[i]);
+        let vi = t.v[i];
         let u = cross_m(&vi, &s);
         let v = vi + s * qd[j - 1];
-        t.a[j] = ai + s * qdd[j - 1] + u * qd[j - 1];
-        t.w[j] = cross_m(&ai, &s) + cross_m(&vi, &u);
         let inertia = world_inertia(model, j, &r, &p);
         t.hc[j] = inertia * v;
         t.bc[j] = inertia_rate(&v, &inertia);
         t.ic[j] = inertia;
         (t.rot[j], t.pos[j], t.s[j], t.u[j], t.v[j]) = (r, p, s, u, v);
+        match qdd {
+            Some(qdd) => accelerate(t, j, i, qd[j - 1], qdd[j - 1]),
+            None => t.link[j] = inertia,
+        }
+    }
+}
+
+/// The acceleration of the base (gravity as a base acceleration) as a motion at O_0.
+fn base_acceleration(env: &Environment) -> Vector6<f64> {
+    join(&env.base.wp0, &(env.base.vp0 - env.gravity))
+}
+
+/// Step 1 (W2–W3) for link j of antecedent i: the acceleration A_j = A_i + S_j qdd_j + u_j qd_j
+/// and the pair term w_j = A_i x S_j + V_i x u_j.
+#[inline(always)]
+fn accelerate(t: &mut WorldTerms, j: usize, i: usize, qd: f64, qdd: f64) {
+    let (s, u, vi, ai) = (t.s[j], t.u[j], t.v[i], t.a[i]);
+    t.a[j] = ai + s * qdd + u * qd;
+    t.w[j] = cross_m(&ai, &s) + cross_m(&vi, &u);
+}
+
+/// Step 1 (W2–W3) after [`forward_geometry`] without qdd: [`accelerate`] over links 1..N.
+fn forward_accelerations(model: &DynModel<f64>, t: &mut WorldTerms, qd: &[f64], qdd: &[f64]) {
+    for j in 1..=model.nl {
+        accelerate(t, j, model.frame(j).ant, qd[j - 1], qdd[j - 1]);
+    }
+}
+
+/// The wrenches I_j dA_j of the accelerations qdd alone (dA_j = dA_i + S_j qdd_j), into `y`:
+/// what a nominal pass at qdd = 0 lacks of the pass at qdd.
+fn acceleration_wrenches(model: &DynModel<f64>, t: &mut WorldTerms, qdd: &[f64]) {
+    for j in 1..=model.nl {
+        let i = model.frame(j).ant;
+        let da = t.da[i] + t.s[j] * qdd[j - 1];
+        t.y[j] = t.link[j] * da;
+        t.da[j] = da;
     }
 }
 
 /// Step 2 (W6): the subtree sums of I, dI and the momenta (children after their antecedent in
-/// frame order, so one reverse sweep), and the subtree wrenches of the nominal pass (about
-/// O_j in R_j there) moved to O_0 in R_0.
-fn composites(model: &DynModel<f64>, ws: &Data, t: &mut WorldTerms) {
+/// frame order, so one reverse sweep).
+fn composite_inertias(model: &DynModel<f64>, t: &mut WorldTerms) {
     for j in (1..=model.nl).rev() {
-        let (r, p) = (&t.rot[j], &t.pos[j]);
-        let f = r * ws.f[j];
-        t.fc[j] = join(&(r * ws.m[j] + p.cross(&f)), &f);
         let i = model.frame(j).ant;
         if i > 0 {
             let (ic, bc, hc) = (t.ic[j], t.bc[j], t.hc[j]);
@@ -190,11 +238,60 @@ fn composites(model: &DynModel<f64>, ws: &Data, t: &mut WorldTerms) {
     }
 }
 
-/// Step 3 (W9–W10): for j an ancestor of i or i itself,
-/// dGamma_i/dq_j = r1_i . w_j + r2_i . u_j and dGamma_i/dqd_j = 2 r1_i . u_j + r2_i . S_j with
-/// r1_i = Ic_i S_i and r2_i = dIc_i^T S_i - S_i x* H_i; and, when asked, the inertia matrix
-/// A_ij = A_ji = r1_i . S_j (composite links in the world frame), Ia_i on its diagonal.
-fn descendant_rows(
+/// Step 2 (W6): the subtree wrenches of the nominal pass (about O_j in R_j there) moved to O_0
+/// in R_0; with `add_y`, plus the subtree sums of `y` ([`acceleration_wrenches`]).
+fn subtree_wrenches(model: &DynModel<f64>, ws: &Data, t: &mut WorldTerms, add_y: bool) {
+    for j in (1..=model.nl).rev() {
+        let (r, p) = (&t.rot[j], &t.pos[j]);
+        let f = r * ws.f[j];
+        t.fc[j] = join(&(r * ws.m[j] + p.cross(&f)), &f);
+        if add_y {
+            let y = t.y[j];
+            t.fc[j] += y;
+            let i = model.frame(j).ant;
+            if i > 0 {
+                t.y[i] += y;
+            }
+        }
+    }
+}
+
+/// A(q) (upper triangle, as [`crate::algorithms::direct_dynamics::ltdl_factor`] reads it) from
+/// the composite inertias: A_ji = Ic_i S_i . S_j for j an ancestor of i or i itself, Ia_i on
+/// the diagonal.
+fn inertia_upper(model: &DynModel<f64>, t: &WorldTerms, a: &mut DMatrix<f64>) {
+    for i in 1..=model.nl {
+        let r1 = t.ic[i] * t.s[i];
+        let mut j = i;
+        while j > 0 {
+            a[(j - 1, i - 1)] = r1.dot(&t.s[j]);
+            j = model.frame(j).ant;
+        }
+        a[(i - 1, i - 1)] += model.link(i).ia;
+    }
+}
+
+/// The per-joint vectors of steps 3–4 for joint i: r1 = Ic_i S_i, r2 = dIc_i^T S_i - S_i x* H_i
+/// (W9–W10), g = S_i x* F_i + Ic_i w_i + dIc_i u_i + u_i x* H_i and
+/// p = 2 Ic_i u_i + dIc_i S_i + S_i x* H_i (W11–W12); dIc is symmetric (X + X^T, W5), so
+/// dIc^T S = dIc S serves r2 and p.
+#[inline(always)]
+fn joint_vectors(t: &WorldTerms, i: usize) -> [Vector6<f64>; 4] {
+    let (ic, bc, s, u, h) = (&t.ic[i], &t.bc[i], &t.s[i], &t.u[i], &t.hc[i]);
+    let (bs, sh) = (bc * s, cross_f(s, h));
+    let r1 = ic * s;
+    let g = cross_f(s, &t.fc[i]) + ic * t.w[i] + bc * u + cross_f(u, h);
+    let p = ic * u * 2.0 + bs + sh;
+    [r1, bs - sh, g, p]
+}
+
+/// Steps 3–4 (W9–W12), one walk per joint i over its ancestors j (and i itself):
+/// dGamma_i/dq_j = r1_i . w_j + r2_i . u_j and dGamma_i/dqd_j = 2 r1_i . u_j + r2_i . S_j
+/// (row i: j and the joints it carries move with q_j, qd_j), and for j != i
+/// dGamma_j/dq_i = S_j . g_i and dGamma_j/dqd_i = S_j . p_i (column i: only i's subtree moves
+/// with q_i, qd_i); when asked, the inertia matrix A_ij = A_ji = r1_i . S_j (composite links in
+/// the world frame), Ia_i on its diagonal.
+fn pair_rows(
     model: &DynModel<f64>,
     t: &WorldTerms,
     dq: &mut DMatrix<f64>,
@@ -202,15 +299,19 @@ fn descendant_rows(
     mut a: Option<&mut DMatrix<f64>>,
 ) {
     for i in 1..=model.nl {
-        let si = &t.s[i];
-        let r1 = t.ic[i] * si;
-        let r2 = t.bc[i].tr_mul(si) - cross_f(si, &t.hc[i]);
+        let [r1, r2, g, p] = joint_vectors(t, i);
         let mut j = i;
         while j > 0 {
-            dq[(i - 1, j - 1)] = r1.dot(&t.w[j]) + r2.dot(&t.u[j]);
-            dqd[(i - 1, j - 1)] = 2.0 * r1.dot(&t.u[j]) + r2.dot(&t.s[j]);
+            let sj = &t.s[j];
+            let (wj, uj) = (&t.w[j], &t.u[j]);
+            dq[(i - 1, j - 1)] = r1.dot(wj) + r2.dot(uj);
+            dqd[(i - 1, j - 1)] = 2.0 * r1.dot(uj) + r2.dot(sj);
+            if j != i {
+                dq[(j - 1, i - 1)] = sj.dot(&g);
+                dqd[(j - 1, i - 1)] = sj.dot(&p);
+            }
             if let Some(a) = a.as_deref_mut() {
-                let x = r1.dot(&t.s[j]);
+                let x = r1.dot(sj);
                 a[(i - 1, j - 1)] = x;
                 a[(j - 1, i - 1)] = x;
             }
@@ -218,28 +319,6 @@ fn descendant_rows(
         }
         if let Some(a) = a.as_deref_mut() {
             a[(i - 1, i - 1)] += model.link(i).ia;
-        }
-    }
-}
-
-/// Step 4 (W11–W12): for i a strict ancestor of j, only j's subtree moves with q_j, qd_j:
-/// dGamma_i/dq_j = S_i . g_j, g_j = S_j x* F_j + Ic_j w_j + dIc_j u_j + u_j x* H_j, and
-/// dGamma_i/dqd_j = S_i . p_j, p_j = 2 Ic_j u_j + dIc_j S_j + S_j x* H_j.
-fn ancestor_rows(
-    model: &DynModel<f64>,
-    t: &WorldTerms,
-    dq: &mut DMatrix<f64>,
-    dqd: &mut DMatrix<f64>,
-) {
-    for j in 1..=model.nl {
-        let (s, u, h) = (&t.s[j], &t.u[j], &t.hc[j]);
-        let g = cross_f(s, &t.fc[j]) + t.ic[j] * t.w[j] + t.bc[j] * u + cross_f(u, h);
-        let p = t.ic[j] * u * 2.0 + t.bc[j] * s + cross_f(s, h);
-        let mut i = model.frame(j).ant;
-        while i > 0 {
-            dq[(i - 1, j - 1)] = t.s[i].dot(&g);
-            dqd[(i - 1, j - 1)] = t.s[i].dot(&p);
-            i = model.frame(i).ant;
         }
     }
 }
@@ -262,17 +341,65 @@ pub(crate) fn idm_derivatives_world(
 ) {
     rnea_with_environment(model, ws, env, q, qd, qdd, tau);
     if !model.index.serial {
-        dtau_dq.as_mut_slice().fill(0.0);
-        dtau_dqd.as_mut_slice().fill(0.0);
         if let Some(a) = a.as_deref_mut() {
             a.as_mut_slice().fill(0.0);
         }
     }
-    forward(model, ws, t, env, qd, qdd);
-    composites(model, ws, t);
-    descendant_rows(model, t, dtau_dq, dtau_dqd, a);
-    ancestor_rows(model, t, dtau_dq, dtau_dqd);
+    forward_geometry(model, ws, t, env, qd, Some(qdd));
+    composite_inertias(model, t);
+    subtree_wrenches(model, ws, t, false);
+    rows(model, t, [dtau_dq, dtau_dqd], a);
+}
+
+/// Steps 3–4 and the viscous friction Fv on dGamma/dqd's diagonal (zeros first unless every
+/// entry is written: a serial chain).
+fn rows(
+    model: &DynModel<f64>,
+    t: &WorldTerms,
+    [dtau_dq, dtau_dqd]: [&mut DMatrix<f64>; 2],
+    a: Option<&mut DMatrix<f64>>,
+) {
+    if !model.index.serial {
+        dtau_dq.as_mut_slice().fill(0.0);
+        dtau_dqd.as_mut_slice().fill(0.0);
+    }
+    pair_rows(model, t, dtau_dq, dtau_dqd, a);
     for k in 1..=model.nl {
         dtau_dqd[(k - 1, k - 1)] += model.link(k).fv;
     }
+}
+
+/// The direct model's first half: after a nominal pass at (q, qd, qdd = 0) in `ws`, steps 1–2
+/// without the accelerations and A(q) from the composite inertias into `a` (its upper
+/// triangle; zeros elsewhere unless a serial chain), for the factorization that gives qdd.
+pub(crate) fn world_inertia_matrix(
+    model: &DynModel<f64>,
+    ws: &Data,
+    t: &mut WorldTerms,
+    env: &Environment,
+    qd: &[f64],
+    a: &mut DMatrix<f64>,
+) {
+    if !model.index.serial {
+        a.as_mut_slice().fill(0.0);
+    }
+    forward_geometry(model, ws, t, env, qd, None);
+    composite_inertias(model, t);
+    inertia_upper(model, t, a);
+}
+
+/// The direct model's second half, after [`world_inertia_matrix`] on the same nominal pass
+/// (qdd = 0): the accelerations at `qdd` and their wrenches added to the pass's, then
+/// dGamma/dq and dGamma/dqd at (q, qd, qdd) by steps 3–4.
+pub(crate) fn ddm_rows(
+    model: &DynModel<f64>,
+    ws: &Data,
+    t: &mut WorldTerms,
+    (qd, qdd): (&[f64], &[f64]),
+    dtau: [&mut DMatrix<f64>; 2],
+) {
+    forward_accelerations(model, t, qd, qdd);
+    acceleration_wrenches(model, t, qdd);
+    subtree_wrenches(model, ws, t, true);
+    rows(model, t, dtau, None);
 }
