@@ -38,7 +38,8 @@ pub struct Data<T: DynScalar = f64> {
     pub(crate) mc: Vec<T>,
     /// Column wrenches of the inertia matrix by component (fx, fy, fz, mx, my, mz), each
     /// indexed by preorder position ([`crate::model::TreeIndex::preorder`]): a subtree's
-    /// columns are contiguous in each, so their transport is a vectorizable loop.
+    /// columns are contiguous in each, so their transport is a vectorizable loop (trees with
+    /// long subtrees, [`crate::model::TreeIndex::short`]).
     pub(crate) col: [Vec<T>; 6],
     /// A(q) (NL x NL), then its L'DL factors.
     pub(crate) a: DMatrix<T>,
@@ -67,6 +68,11 @@ pub struct Data<T: DynScalar = f64> {
     pub(crate) base_rows: Vec<T>,
     pub(crate) h_v: Vec<T>,
     pub(crate) zeros_v: Vec<T>,
+    /// The column wrenches of the inertia matrix as records [fx, fy, fz, mx, my, mz] by
+    /// preorder position, each carried in registers without a slice per component: the layout
+    /// of a floating robot whose carried subtrees are short
+    /// ([`crate::model::TreeIndex::short`], a leg of three joints); empty for other robots.
+    pub(crate) rec: Vec<[T; 6]>,
 }
 
 impl Data<f64> {
@@ -75,6 +81,9 @@ impl Data<f64> {
         let mut d = Data::from_model(robot.numeric());
         let n = robot.dynamic().nl;
         d.a_dyn = DMatrix::zeros(n, n);
+        if robot.is_floating() && robot.dynamic().index.short {
+            d.rec = vec![[0.0; 6]; n + 1];
+        }
         d
     }
 
@@ -172,6 +181,7 @@ impl<T: DynScalar> Data<T> {
             base_rows: vec![T::zero(); 12 * nl],
             h_v: vec![T::zero(); nl + 6],
             zeros_v: vec![T::zero(); nl + 6],
+            rec: Vec::new(),
         }
     }
 

@@ -11,9 +11,7 @@
 //! 3. the momentum is moved to the centre of mass and rotated to the world:
 //!    `h_G = [R h_lin; R (h_ang - c x h_lin)]`, i.e. `A_G = [[R, 0], [-R [c]x, R]] A_0`.
 
-use crate::algorithms::floating_base::{
-    check_state, composite_blocks, dot, gather_base_rows, skew, v3,
-};
+use crate::algorithms::floating_base::{check_state, composite_blocks, dot, skew, v3};
 use crate::data::Data;
 use crate::error::{check_finite_matrix, Error, Result};
 use crate::model::Robot;
@@ -63,7 +61,6 @@ fn momentum_map(
     }
     let rot = check_state(robot, data, None, q, vs, ("v", robot.nv()))?;
     let abb = composite_blocks(robot, data, q);
-    gather_base_rows(robot, data);
     let mass = abb[(0, 0)];
     if mass.is_nan() || mass <= 0.0 {
         return Err(Error::Input(format!(

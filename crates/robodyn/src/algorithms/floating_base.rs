@@ -20,14 +20,16 @@ use crate::algorithms::direct_dynamics::{
     aba_accelerations, aba_articulated, aba_links, body_inertia_and_bias, ltdl_factor, ltdl_solve,
     Method,
 };
-use crate::algorithms::inertia_matrix::{composite_inertia_block, transport};
+use crate::algorithms::inertia_matrix::{carry, composite_inertia_block, composite_records_block};
 use crate::algorithms::inverse_dynamics::{
     backward_recursion, euler_moment, folded_wrench, forward_links, name3, set_base_motion,
     w_products,
 };
 use crate::data::Data;
 use crate::error::{check_finite_result, check_vector, Error, Result};
-use crate::model::{DynModel, Environment, FloatingBase, Robot, QUATERNION_TOLERANCE};
+use crate::model::{
+    DynModel, Environment, FloatingBase, Robot, RotationForm, QUATERNION_TOLERANCE,
+};
 use crate::scalar::DynScalar;
 use nalgebra::{DMatrix, Matrix3, Matrix6, Quaternion, UnitQuaternion, Vector3, Vector6};
 
@@ -235,59 +237,122 @@ pub(crate) fn h_vector_into(
 }
 
 /// The composite links and the base rows of A: the joint block A_jj into `data.a_dyn` (N x N),
-/// the column wrenches of every joint carried to R_0 (`data.col`, by preorder position), and the
-/// base block (the 6 x 6 composite inertia of the whole robot about O_0 in R_0) returned.
+/// the base rows over the joints into `data.base_rows` (row c, c = 0..6, at `c N..(c + 1) N`,
+/// joint-vector order), and the base block (the 6 x 6 composite inertia of the whole robot
+/// about O_0 in R_0) returned.
 pub(crate) fn composite_blocks(robot: &Robot, data: &mut Data, q: &[f64]) -> Matrix6<f64> {
     let n = robot.dof();
     let mut ajj = std::mem::replace(&mut data.a_dyn, DMatrix::zeros(0, 0));
     if ajj.shape() != (n, n) {
         ajj = DMatrix::zeros(n, n);
     }
-    let abb = composite_blocks_into(robot, data, q, ajj.as_mut_slice(), n);
+    joint_block(robot.dynamic(), data, &q[7..], ajj.as_mut_slice(), n);
     data.a_dyn = ajj;
+    let mut rows = std::mem::take(&mut data.base_rows);
+    let abb = base_pass(robot, data, |link, w| {
+        for (c, x) in w.iter().enumerate() {
+            rows[c * n + link - 1] = *x;
+        }
+    });
+    data.base_rows = rows;
     abb
 }
 
-/// [`composite_blocks`] with A_jj written into the column-major block `ajj` (entry (r, c) at
-/// `ajj[r + c ld]`): the joint block of the nv x nv matrix itself.
-fn composite_blocks_into(
+/// The joint block of A (the fixed-base kernel) into `a` (leading dimension `ld`): column
+/// wrenches as records for a tree of short carried subtrees (`data.rec` allocated by
+/// [`Data::new`] then), else by component.
+fn joint_block(model: &DynModel<f64>, data: &mut Data, qj: &[f64], a: &mut [f64], ld: usize) {
+    if records(model, data) {
+        composite_records_block(model, data, qj, a, ld);
+    } else {
+        composite_inertia_block(model, data, qj, a, ld);
+    }
+}
+
+/// The joint kernel keeps the column wrenches as records ([`joint_block`]).
+fn records(model: &DynModel<f64>, data: &Data) -> bool {
+    model.index.short && data.rec.len() > model.nl
+}
+
+/// After the joint kernel ([`composite_inertia_block`]): each child k of the base moved into
+/// the base's composite link, and the column wrenches of its subtree (still in R_k) carried
+/// to R_0, each handed to `put` with its link (the base rows and columns of A, written
+/// where the caller keeps them). Returns the base block: the composite inertia of the whole
+/// robot about O_0 in R_0.
+fn base_pass(robot: &Robot, data: &Data, put: impl FnMut(usize, &[f64; 6])) -> Matrix6<f64> {
+    // the layout the kernel chose
+    if records(robot.dynamic(), data) {
+        base_pass_in(robot, data, |p| data.rec[p], put)
+    } else {
+        let c = &data.col;
+        base_pass_in(
+            robot,
+            data,
+            |p| [c[0][p], c[1][p], c[2][p], c[3][p], c[4][p], c[5][p]],
+            put,
+        )
+    }
+}
+
+/// [`base_pass`] with the column wrench at preorder position p from `cols(p)`.
+#[inline(always)]
+fn base_pass_in(
     robot: &Robot,
-    data: &mut Data,
-    q: &[f64],
-    ajj: &mut [f64],
-    ld: usize,
+    data: &Data,
+    cols: impl Fn(usize) -> [f64; 6],
+    mut put: impl FnMut(usize, &[f64; 6]),
 ) -> Matrix6<f64> {
     let model = robot.dynamic();
-    let n = model.nl;
-    composite_inertia_block(model, data, &q[7..], ajj, ld);
     let body = &base_of(robot).body;
     let (mut jc, mut msc, mut mc) = (body.inertia, body.ms, body.mass);
-    for k in 1..=n {
+    for k in 1..=model.nl {
         let fr = model.frame(k);
         if fr.ant != 0 {
             continue;
         }
-        // the root child's composite link and its subtree's column wrenches, still in R_k
-        let (jk, ms) = fr.inertia_to_antecedent(
-            &data.rot[k],
-            &data.pos[k],
-            &data.jc[k],
-            &data.msc[k],
-            &data.mc[k],
-        );
+        let (rot, pos) = (&data.rot[k], &data.pos[k]);
+        let (jk, ms) =
+            fr.inertia_to_antecedent_inline(rot, pos, &data.jc[k], &data.msc[k], &data.mc[k]);
         jc += jk;
         msc += ms;
         mc += data.mc[k];
         let (s, e) = model.index.subtree[k];
-        transport(fr.form(), &data.rot[k], &data.pos[k], &mut data.col, s, e);
+        let links = &model.index.preorder[s..e];
+        match fr.form() {
+            RotationForm::General => base_columns::<_, 3>(rot, pos, &cols, s, links, &mut put),
+            RotationForm::Axis(0) => base_columns::<_, 0>(rot, pos, &cols, s, links, &mut put),
+            RotationForm::Axis(1) => base_columns::<_, 1>(rot, pos, &cols, s, links, &mut put),
+            RotationForm::Axis(_) => base_columns::<_, 2>(rot, pos, &cols, s, links, &mut put),
+        }
     }
+    base_block(&jc, &msc, mc)
+}
+
+/// The column wrenches at positions s.. (of `links`, in R_k) carried to R_0 through a
+/// rotation of form `Axis(K)` ([`carry`]), one by one into `put`: no write back.
+#[inline(always)]
+fn base_columns<C: Fn(usize) -> [f64; 6], const K: usize>(
+    r: &Matrix3<f64>,
+    p: &Vector3<f64>,
+    cols: &C,
+    s: usize,
+    links: &[usize],
+    put: &mut impl FnMut(usize, &[f64; 6]),
+) {
+    for (q, &link) in links.iter().enumerate() {
+        put(link, &carry::<f64, K>(r, p, &cols(s + q)));
+    }
+}
+
+/// The 6 x 6 spatial inertia [M I, -skew(MS); skew(MS), J] of a composite link.
+fn base_block(jc: &Matrix3<f64>, msc: &Vector3<f64>, mc: f64) -> Matrix6<f64> {
     let mut abb = Matrix6::zeros();
-    let sm = skew(&msc);
+    let sm = skew(msc);
     abb.fixed_view_mut::<3, 3>(0, 0)
         .copy_from(&(Matrix3::identity() * mc));
     abb.fixed_view_mut::<3, 3>(0, 3).copy_from(&(-sm));
     abb.fixed_view_mut::<3, 3>(3, 0).copy_from(&sm);
-    abb.fixed_view_mut::<3, 3>(3, 3).copy_from(&jc);
+    abb.fixed_view_mut::<3, 3>(3, 3).copy_from(jc);
     abb
 }
 
@@ -295,19 +360,9 @@ pub(crate) fn skew(v: &Vector3<f64>) -> Matrix3<f64> {
     Matrix3::new(0.0, -v.z, v.y, v.z, 0.0, -v.x, -v.y, v.x, 0.0)
 }
 
-/// The base rows of A over the joints (after [`composite_blocks`]): row c (c = 0..6) into
-/// `data.base_rows[c N..(c + 1) N]`, joint-vector order.
-pub(crate) fn gather_base_rows(robot: &Robot, data: &mut Data) {
-    let model = robot.dynamic();
-    let n = model.nl;
-    for (p, &link) in model.index.preorder.iter().enumerate() {
-        for c in 0..6 {
-            data.base_rows[c * n + link - 1] = data.col[c][p];
-        }
-    }
-}
-
-/// The inertia matrix of a floating robot into `a` (nv x nv): base block, base rows, joints.
+/// The inertia matrix of a floating robot into `a` (nv x nv): the joint block in place by the
+/// joint kernel, then the base block and the base rows and columns by [`base_pass`], written
+/// straight into A (column v = 5 + link of A: its 6 first rows, and row c's entry v).
 pub(crate) fn inertia_matrix_into(
     robot: &Robot,
     data: &mut Data,
@@ -324,24 +379,16 @@ pub(crate) fn inertia_matrix_into(
             format!("{nv} x {nv}: nv = 6 + {}", robot.dof()),
         ));
     }
-    let model = robot.dynamic();
-    let abb = composite_blocks_into(robot, data, q, &mut a.as_mut_slice()[6 + 6 * nv..], nv);
-    a.fixed_view_mut::<6, 6>(0, 0).copy_from(&abb);
-    // the base rows and columns: the column wrenches in R_0, by preorder position (column
-    // by column in A's column-major storage)
     let s = a.as_mut_slice();
-    for (p, &link) in model.index.preorder.iter().enumerate() {
-        let k = (5 + link) * nv;
-        for (x, c) in s[k..k + 6].iter_mut().zip(&data.col) {
-            *x = c[p];
+    joint_block(robot.dynamic(), data, &q[7..], &mut s[6 + 6 * nv..], nv);
+    let abb = base_pass(robot, data, |link, w| {
+        let v = 5 + link;
+        s[v * nv..v * nv + 6].copy_from_slice(w);
+        for (c, x) in w.iter().enumerate() {
+            s[c * nv + v] = *x;
         }
-    }
-    for (c, col) in data.col.iter().enumerate() {
-        let base = &mut s[c * nv + 5..(c + 1) * nv];
-        for (&link, x) in model.index.preorder.iter().zip(col) {
-            base[link] = *x;
-        }
-    }
+    });
+    a.fixed_view_mut::<6, 6>(0, 0).copy_from(&abb);
     crate::error::check_finite_matrix("A", a)
 }
 
@@ -394,7 +441,6 @@ fn composite_ddm(
     }
     data.h_v = h;
     let abb = composite_blocks(robot, data, q);
-    gather_base_rows(robot, data);
     let mut ajj = std::mem::replace(&mut data.a_dyn, DMatrix::zeros(0, 0));
     let r = ltdl_factor(model, &mut ajj).and_then(|()| {
         let (b, x) = data.base_rows.split_at_mut(6 * n);

@@ -154,6 +154,109 @@ pub(crate) fn composite_inertia_block<T: DynScalar>(
     }
 }
 
+/// [`composite_inertia_block`] for a tree of short carried subtrees
+/// ([`crate::model::TreeIndex::short`], the legs of a quadruped): the same entries of `a`, the
+/// column wrenches kept as records in `ws.rec` instead of `ws.col`. A separate entry point,
+/// so that the component kernel stays as it is.
+pub(crate) fn composite_records_block(
+    model: &DynModel<f64>,
+    ws: &mut Data<f64>,
+    q: &[f64],
+    a: &mut [f64],
+    ld: usize,
+) {
+    let n = model.nl;
+    link_placements(model, ws, q);
+    if !model.index.serial && n > 0 {
+        a[..(n - 1) * ld + n].fill(0.0);
+    }
+    records_pass(model, ws, a, ld);
+}
+
+/// The backward pass of [`composite_inertia_block`] for a tree of short carried subtrees
+/// ([`crate::model::TreeIndex::short`]): the column wrenches as records (`ws.rec`), each
+/// carried in registers ([`carry`]).
+#[inline(never)]
+fn records_pass<T: DynScalar>(model: &DynModel<T>, ws: &mut Data<T>, a: &mut [T], ld: usize) {
+    for k in (1..=model.nl).rev() {
+        let fr = model.frame(k);
+        let (s, e) = model.index.subtree[k];
+        if fr.joint.is_movable() {
+            record_row(model, ws, k, a, ld);
+        }
+        let i = fr.ant;
+        if i == 0 {
+            continue;
+        }
+        // composite link k into its antecedent's (add_to_antecedent, always inlined)
+        let (rot, pos) = (&ws.rot[k], &ws.pos[k]);
+        let (jk, ms) = fr.inertia_to_antecedent_inline(rot, pos, &ws.jc[k], &ws.msc[k], &ws.mc[k]);
+        let mk = ws.mc[k].clone();
+        ws.jc[i] += jk;
+        ws.msc[i] += ms;
+        ws.mc[i] += mk;
+        if s == e {
+            continue;
+        }
+        let (rot, pos, cols) = (&ws.rot[k], &ws.pos[k], &mut ws.rec[s..e]);
+        match fr.form() {
+            RotationForm::General => cols
+                .iter_mut()
+                .for_each(|w| *w = carry::<T, 3>(rot, pos, w)),
+            RotationForm::Axis(0) => cols
+                .iter_mut()
+                .for_each(|w| *w = carry::<T, 0>(rot, pos, w)),
+            RotationForm::Axis(1) => cols
+                .iter_mut()
+                .for_each(|w| *w = carry::<T, 1>(rot, pos, w)),
+            RotationForm::Axis(_) => cols
+                .iter_mut()
+                .for_each(|w| *w = carry::<T, 2>(rot, pos, w)),
+        }
+    }
+}
+
+/// Movable joint k in [`records_pass`], its composite link complete: its column wrench (f, m),
+/// first of its subtree in preorder, then row k of A, the projections on joint k's axis
+/// (moment z, revolute; force z, prismatic) of its subtree's column wrenches.
+#[inline(always)]
+fn record_row<T: DynScalar>(
+    model: &DynModel<T>,
+    ws: &mut Data<T>,
+    k: usize,
+    a: &mut [T],
+    ld: usize,
+) {
+    let (s, e) = model.index.subtree[k];
+    let revolute = model.frame(k).joint == JointType::Revolute;
+    let ms = &ws.msc[k];
+    let w = if revolute {
+        let jz = ws.jc[k].column(2);
+        let (f0, f1) = (-ms.y.clone(), ms.x.clone());
+        [
+            f0,
+            f1,
+            T::zero(),
+            jz[0].clone(),
+            jz[1].clone(),
+            jz[2].clone(),
+        ]
+    } else {
+        let (m0, m1) = (ms.y.clone(), -ms.x.clone());
+        [T::zero(), T::zero(), ws.mc[k].clone(), m0, m1, T::zero()]
+    };
+    let c = if revolute { 5 } else { 2 };
+    let r = k - 1;
+    a[r + r * ld] = w[c].clone() + model.link(k).ia.clone();
+    let cols = &mut ws.rec[s..e];
+    cols[0] = w;
+    for (link, w) in model.index.preorder[s + 1..e].iter().zip(&cols[1..]) {
+        let col = link - 1;
+        a[r + col * ld] = w[c].clone();
+        a[col + r * ld] = w[c].clone();
+    }
+}
+
 /// Carry the column wrenches at preorder positions s..e from R_k to R_a(k) (rotation `rot` =
 /// a(k)A_k of rotation form `form`, origin `pos` = a(k)P_k): f' = R f, m' = R m + P x f'. One
 /// loop over the six component arrays, the form's zeros skipped at compile time
@@ -211,6 +314,32 @@ fn transport_loop<T: DynScalar, const K: usize>(
         fy[q] = g1;
         fz[q] = g2;
     }
+}
+
+/// One wrench (f, m) carried from R_k to R_a(k) through a rotation `r` of form `Axis(K)` (K = 3:
+/// general) and the origin `p`: [R f, R m + p x R f].
+#[inline(always)]
+pub(crate) fn carry<T: DynScalar, const K: usize>(
+    r: &Matrix3<T>,
+    p: &Vector3<T>,
+    w: &[T; 6],
+) -> [T; 6] {
+    let (f, m) = ([&w[0], &w[1], &w[2]], [&w[3], &w[4], &w[5]]);
+    let (g0, g1, g2) = (
+        form_row::<T, K>(r, 0, f),
+        form_row::<T, K>(r, 1, f),
+        form_row::<T, K>(r, 2, f),
+    );
+    let (n0, n1, n2) = (
+        form_row::<T, K>(r, 0, m),
+        form_row::<T, K>(r, 1, m),
+        form_row::<T, K>(r, 2, m),
+    );
+    let (px, py, pz) = (&p.x, &p.y, &p.z);
+    let m0 = n0 + py.clone() * g2.clone() - pz.clone() * g1.clone();
+    let m1 = n1 + pz.clone() * g0.clone() - px.clone() * g2.clone();
+    let m2 = n2 + px.clone() * g1.clone() - py.clone() * g0.clone();
+    [g0, g1, g2, m0, m1, m2]
 }
 
 /// [`transport`] for the customized symbolic model: the wrench of column j carried to link i

@@ -146,6 +146,20 @@ impl<T: DynScalar> FrameConstants<T> {
         inertia_transfer(self.form, r, p, j, ms, mass)
     }
 
+    /// [`Self::inertia_to_antecedent`] always inlined: the passes over short subtrees of the
+    /// inertia matrix (a call per link there costs more than its body, measured).
+    #[inline(always)]
+    pub(crate) fn inertia_to_antecedent_inline(
+        &self,
+        r: &Matrix3<T>,
+        p: &Vector3<T>,
+        j: &Matrix3<T>,
+        ms: &Vector3<T>,
+        mass: &T,
+    ) -> (Matrix3<T>, Vector3<T>) {
+        inertia_transfer_inline(self.form, r, p, j, ms, mass)
+    }
+
     /// jA_i v = (iA_j)^T v for `m` = iA_j of this frame (a vector of R_i expressed in R_j), with
     /// the zeros of its [`RotationForm`] skipped.
     #[inline(always)]
@@ -274,9 +288,18 @@ pub struct TreeIndex {
     /// Every link movable and a(j) = j - 1 (a serial chain): every entry of A is an
     /// ancestor-descendant pair, so the inertia matrix writes all of them.
     pub serial: bool,
+    /// Every subtree the inertia matrix carries to an antecedent (the subtree of a link whose
+    /// antecedent is not the base) has at most [`TreeIndex::SHORT`] movable links: its column
+    /// wrenches are kept as records, not by component (a component loop that short does not
+    /// vectorize and pays a slice per component).
+    pub short: bool,
 }
 
 impl TreeIndex {
+    /// The longest carried subtree of a [`TreeIndex::short`] tree: below four columns (the
+    /// f64 lanes of a 256-bit vector) a component loop runs scalar.
+    pub const SHORT: usize = 3;
+
     /// From the antecedents and joint types of frames 1..NL (`frames[j - 1]`).
     pub fn new<T: DynScalar>(frames: &[FrameConstants<T>], nl: usize) -> TreeIndex {
         let mut movable = vec![false; nl + 1];
@@ -312,12 +335,16 @@ impl TreeIndex {
             }
         }
         let serial = (1..=nl).all(|j| movable[j] && frames[j - 1].ant == j - 1);
+        let short = (1..=nl)
+            .filter(|&j| frames[j - 1].ant != 0)
+            .all(|j| subtree[j].1 - subtree[j].0 <= Self::SHORT);
         TreeIndex {
             movable_parent,
             movable,
             preorder,
             subtree,
             serial,
+            short,
         }
     }
 }
@@ -445,6 +472,19 @@ pub(crate) fn form_col<T: DynScalar, const K: usize>(r: &Matrix3<T>, c: usize, v
 /// being (0, 0, R_k2) for b = k of an `Axis(k)` form, else (R_b0, R_b1, 0).
 #[inline]
 fn inertia_transfer<T: DynScalar>(
+    form: RotationForm,
+    r: &Matrix3<T>,
+    p: &Vector3<T>,
+    j: &Matrix3<T>,
+    ms: &Vector3<T>,
+    mass: &T,
+) -> (Matrix3<T>, Vector3<T>) {
+    inertia_transfer_inline(form, r, p, j, ms, mass)
+}
+
+/// [`inertia_transfer`], always inlined.
+#[inline(always)]
+fn inertia_transfer_inline<T: DynScalar>(
     form: RotationForm,
     r: &Matrix3<T>,
     p: &Vector3<T>,
