@@ -26,7 +26,7 @@ use crate::algorithms::inverse_dynamics::{
     w_products,
 };
 use crate::data::Data;
-use crate::error::{check_finite_result, check_vector, Error, Result};
+use crate::error::{check_finite_matrix, check_finite_result, check_vector, Error, Result};
 use crate::model::{
     DynModel, Environment, FloatingBase, Robot, RotationForm, QUATERNION_TOLERANCE,
 };
@@ -389,7 +389,7 @@ pub(crate) fn inertia_matrix_into(
         }
     });
     a.fixed_view_mut::<6, 6>(0, 0).copy_from(&abb);
-    crate::error::check_finite_matrix("A", a)
+    check_finite_matrix("A", a)
 }
 
 /// Direct dynamics of a floating robot into `qdd` (nv): the base acceleration (derivative of

@@ -256,15 +256,20 @@ fn subtree_wrenches(model: &DynModel<f64>, ws: &Data, t: &mut WorldTerms, add_y:
     }
 }
 
-/// A(q) (upper triangle, as [`crate::algorithms::direct_dynamics::ltdl_factor`] reads it) from
-/// the composite inertias: A_ji = Ic_i S_i . S_j for j an ancestor of i or i itself, Ia_i on
-/// the diagonal.
-fn inertia_upper(model: &DynModel<f64>, t: &WorldTerms, a: &mut DMatrix<f64>) {
+/// A(q) from the composite inertias (composite links in the world frame): A_ji = Ic_i S_i . S_j
+/// for j an ancestor of i or i itself, Ia_i on the diagonal; the upper triangle (as
+/// [`crate::algorithms::direct_dynamics::ltdl_factor`] reads it), and with `mirror` the lower
+/// one too.
+fn inertia_entries(model: &DynModel<f64>, t: &WorldTerms, a: &mut DMatrix<f64>, mirror: bool) {
     for i in 1..=model.nl {
         let r1 = t.ic[i] * t.s[i];
         let mut j = i;
         while j > 0 {
-            a[(j - 1, i - 1)] = r1.dot(&t.s[j]);
+            let x = r1.dot(&t.s[j]);
+            a[(j - 1, i - 1)] = x;
+            if mirror {
+                a[(i - 1, j - 1)] = x;
+            }
             j = model.frame(j).ant;
         }
         a[(i - 1, i - 1)] += model.link(i).ia;
@@ -289,15 +294,8 @@ fn joint_vectors(t: &WorldTerms, i: usize) -> [Vector6<f64>; 4] {
 /// dGamma_i/dq_j = r1_i . w_j + r2_i . u_j and dGamma_i/dqd_j = 2 r1_i . u_j + r2_i . S_j
 /// (row i: j and the joints it carries move with q_j, qd_j), and for j != i
 /// dGamma_j/dq_i = S_j . g_i and dGamma_j/dqd_i = S_j . p_i (column i: only i's subtree moves
-/// with q_i, qd_i); when asked, the inertia matrix A_ij = A_ji = r1_i . S_j (composite links in
-/// the world frame), Ia_i on its diagonal.
-fn pair_rows(
-    model: &DynModel<f64>,
-    t: &WorldTerms,
-    dq: &mut DMatrix<f64>,
-    dqd: &mut DMatrix<f64>,
-    mut a: Option<&mut DMatrix<f64>>,
-) {
+/// with q_i, qd_i).
+fn pair_rows(model: &DynModel<f64>, t: &WorldTerms, dq: &mut DMatrix<f64>, dqd: &mut DMatrix<f64>) {
     for i in 1..=model.nl {
         let [r1, r2, g, p] = joint_vectors(t, i);
         let mut j = i;
@@ -310,15 +308,7 @@ fn pair_rows(
                 dq[(j - 1, i - 1)] = sj.dot(&g);
                 dqd[(j - 1, i - 1)] = sj.dot(&p);
             }
-            if let Some(a) = a.as_deref_mut() {
-                let x = r1.dot(sj);
-                a[(i - 1, j - 1)] = x;
-                a[(j - 1, i - 1)] = x;
-            }
             j = model.frame(j).ant;
-        }
-        if let Some(a) = a.as_deref_mut() {
-            a[(i - 1, i - 1)] += model.link(i).ia;
         }
     }
 }
@@ -337,33 +327,29 @@ pub(crate) fn idm_derivatives_world(
     (q, qd, qdd): (&[f64], &[f64], &[f64]),
     tau: &mut [f64],
     [dtau_dq, dtau_dqd]: [&mut DMatrix<f64>; 2],
-    mut a: Option<&mut DMatrix<f64>>,
+    a: Option<&mut DMatrix<f64>>,
 ) {
     rnea_with_environment(model, ws, env, q, qd, qdd, tau);
-    if !model.index.serial {
-        if let Some(a) = a.as_deref_mut() {
-            a.as_mut_slice().fill(0.0);
-        }
-    }
     forward_geometry(model, ws, t, env, qd, Some(qdd));
     composite_inertias(model, t);
     subtree_wrenches(model, ws, t, false);
-    rows(model, t, [dtau_dq, dtau_dqd], a);
+    rows(model, t, [dtau_dq, dtau_dqd]);
+    if let Some(a) = a {
+        if !model.index.serial {
+            a.as_mut_slice().fill(0.0);
+        }
+        inertia_entries(model, t, a, true);
+    }
 }
 
 /// Steps 3–4 and the viscous friction Fv on dGamma/dqd's diagonal (zeros first unless every
 /// entry is written: a serial chain).
-fn rows(
-    model: &DynModel<f64>,
-    t: &WorldTerms,
-    [dtau_dq, dtau_dqd]: [&mut DMatrix<f64>; 2],
-    a: Option<&mut DMatrix<f64>>,
-) {
+fn rows(model: &DynModel<f64>, t: &WorldTerms, [dtau_dq, dtau_dqd]: [&mut DMatrix<f64>; 2]) {
     if !model.index.serial {
         dtau_dq.as_mut_slice().fill(0.0);
         dtau_dqd.as_mut_slice().fill(0.0);
     }
-    pair_rows(model, t, dtau_dq, dtau_dqd, a);
+    pair_rows(model, t, dtau_dq, dtau_dqd);
     for k in 1..=model.nl {
         dtau_dqd[(k - 1, k - 1)] += model.link(k).fv;
     }
@@ -385,7 +371,7 @@ pub(crate) fn world_inertia_matrix(
     }
     forward_geometry(model, ws, t, env, qd, None);
     composite_inertias(model, t);
-    inertia_upper(model, t, a);
+    inertia_entries(model, t, a, false);
 }
 
 /// The direct model's second half, after [`world_inertia_matrix`] on the same nominal pass
@@ -401,5 +387,5 @@ pub(crate) fn ddm_rows(
     forward_accelerations(model, t, qd, qdd);
     acceleration_wrenches(model, t, qdd);
     subtree_wrenches(model, ws, t, true);
-    rows(model, t, dtau, None);
+    rows(model, t, dtau);
 }
