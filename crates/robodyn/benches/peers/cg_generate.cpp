@@ -1,5 +1,5 @@
-// Pinocchio + CppADCodeGen: writes the C sources of the generated rnea, crba, aba and rnea
-// derivatives of a model
+// Pinocchio + CppADCodeGen: writes the C sources of the generated rnea, crba, aba, rnea
+// derivatives and CppAD's Jacobian of rnea of a model
 // (driven by codegen.py; NOT run by CI).
 //
 //   cg_generate MODEL OUTDIR
@@ -11,7 +11,10 @@
 // in[0] = x (rnea: [q v a], crba: q, aba: [q v tau]) and out[0] = y (rnea: tau, crba: the upper
 // triangle of M row by row, aba: ddq; drnea: [q v a] -> [dtau_dq, dtau_dv, dtau_da], each
 // nv x nv row-major, computeRNEADerivatives traced; Pinocchio's generators run crba and aba in
-// the WORLD convention). codegen.py compiles them with the same flags as robodyn's generated C.
+// the WORLD convention). jrnea is CppAD's Jacobian of rnea, as Pinocchio's
+// `CodeGenRNEA::evalJacobian` (its benchmark's "RNEA partial derivatives code gen"): the function
+// `jrnea_jacobian(in, out, atomics)`, out[0] = d tau / d[q v a], nv x (nq + 2 nv) row-major, by
+// CppAD's dense Jacobian driver (`JacobianADMode::Automatic`, the generator's default). codegen.py compiles them with the same flags as robodyn's generated C.
 
 #include <pinocchio/codegen/cppadcg-algo.hpp>
 
@@ -29,11 +32,11 @@ struct SourcesAccess : CppAD::cg::ModelCSourceGen<double> {
 };
 
 template <class Gen>
-static void emit(Gen& gen, const std::string& dir) {
+static void emit(Gen& gen, const std::string& dir, bool jacobian = false) {
   gen.initLib();
   CppAD::cg::ModelCSourceGen<double>& src = gen.codeGenerator();
-  src.setCreateJacobian(false);
-  src.setCreateForwardZero(true);
+  src.setCreateJacobian(jacobian);
+  src.setCreateForwardZero(!jacobian);
   const auto& sources = (src.*SourcesAccess::get())(CppAD::cg::MultiThreadingType::NONE, nullptr);
   for (const auto& [name, code] : sources) {
     std::ofstream out(dir + "/" + name);
@@ -65,6 +68,11 @@ int main(int argc, char** argv) {
     // computeRNEADerivatives traced: out = [dtau_dq, dtau_dv, dtau_da], each row-major
     pinocchio::CodeGenRNEADerivatives<double> gen(model, "drnea");
     emit(gen, dir);
+  }
+  {
+    // CppAD's Jacobian of rnea: out = d tau / d[q v a], nv x 3 nv row-major (nq = nv here)
+    pinocchio::CodeGenRNEA<double> gen(model, "jrnea");
+    emit(gen, dir, true);
   }
   return 0;
 }

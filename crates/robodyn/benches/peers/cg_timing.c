@@ -1,7 +1,8 @@
 /* Generated code, side by side: Pinocchio + CppADCodeGen against robodyn's `generate --lang c`
  * (driven by codegen.py; NOT run by CI). Linked with, for one robot:
  *   cg_rnea(x, y), cg_crba(x, y), cg_aba(x, y), cg_drnea(x, y)   wrappers of CppADCodeGen's
- *     forward_zero functions (drnea: computeRNEADerivatives traced)
+ *     forward_zero functions (drnea: computeRNEADerivatives traced), cg_jrnea(x, y) of its
+ *     jacobian function (CppAD's Jacobian of rnea, nv x 3 nv row-major)
  *   rd_idm(q, qd, qdd, out), rd_inertia(q, out), rd_ddm(q, qd, gam, out),
  *   rd_idm_derivatives(q, qd, qdd, out)   robodyn's
  * every generated function in its own translation unit, all compiled with the same flags.
@@ -24,6 +25,7 @@ void cg_rnea(const double *x, double *y);
 void cg_crba(const double *x, double *y);
 void cg_aba(const double *x, double *y);
 void cg_drnea(const double *x, double *y);
+void cg_jrnea(const double *x, double *y);
 void rd_idm(const double *q, const double *qd, const double *qdd, double *out);
 void rd_inertia(const double *q, double *out);
 void rd_ddm(const double *q, const double *qd, const double *gam, double *out);
@@ -131,6 +133,12 @@ static void write_results(const char *path) {
           m[b * nv * nv + i * nv + j] = y[b * nv * nv + r * nv + c];
         }
     put(f, "cg_drnea", m, 3 * nv * nv);
+    /* CppAD's Jacobian: row i = d tau_i / d[q v a] */
+    cg_jrnea(x_rnea + s * 3 * nv, y);
+    for (int b = 0; b < 3; ++b)
+      for (int i = 0; i < nv; ++i)
+        for (int j = 0; j < nv; ++j) m[b * nv * nv + i * nv + j] = y[i * 3 * nv + b * nv + j];
+    put(f, "cg_jrnea", m, 3 * nv * nv);
     rd_idm_derivatives(q, qd, rqdd + s * nl, out);
     for (int b = 0; b < 3; ++b)
       for (int i = 0; i < nv; ++i)
@@ -188,6 +196,7 @@ int main(int argc, char **argv) {
   TIME("cg_aba", cg_aba(x_aba + s * 3 * nv, y));
   TIME("rd_ddm_c", rd_ddm(rq + s * nl, rqd + s * nl, rtau + s * nl, out));
   TIME("cg_drnea", cg_drnea(x_rnea + s * 3 * nv, y));
+  TIME("cg_jrnea", cg_jrnea(x_rnea + s * 3 * nv, y));
   TIME("rd_idm_derivatives_c", rd_idm_derivatives(rq + s * nl, rqd + s * nl, rqdd + s * nl, out));
   return 0;
 }

@@ -7,8 +7,9 @@ CppADCodeGen, on UR5 and Panda (fixed base). NOT run by CI.
 
 1. Same models and states as run.py (Pinocchio's URDF parser, dumped; seed 1).
 2. cg_generate.cpp (Pinocchio's CodeGenRNEA / CodeGenCRBA / CodeGenABA / CodeGenRNEADerivatives
-   on CppADCodeGen, built once) writes the C of rnea, crba (upper triangle), aba (WORLD) and of
-   computeRNEADerivatives traced (dtau_dq, dtau_dv, dtau_da) for the robot; robodyn's CLI writes
+   on CppADCodeGen, built once) writes the C of rnea, crba (upper triangle), aba (WORLD), of
+   computeRNEADerivatives traced (dtau_dq, dtau_dv, dtau_da) and of CppAD's Jacobian of rnea
+   (`CodeGenRNEA::evalJacobian`, d tau / d[q v a]) for the robot; robodyn's CLI writes
    `--model idm`, `--model inertia` (lower triangle), `--model ddm` (A^-1 (Gamma - H) with
    L D L' written out) and `--model idm-derivatives` (dGamma/dq, dGamma/dqd, A) with
    `--numeric --no-friction --no-rotor`, in C and in Rust. The operation counts of both sides'
@@ -112,14 +113,15 @@ def build_robot(key, cli, gen, cflags, pin, prefix):
     write_cg_states(sfile, cgstates, model.nv, nl, idx, rank)
     peers.run([gen, mfile, d])
     objs = []
-    for name in ("rnea", "crba", "aba", "drnea"):
+    for name, fun in (("rnea", "forward_zero"), ("crba", "forward_zero"), ("aba", "forward_zero"),
+                      ("drnea", "forward_zero"), ("jrnea", "jacobian")):
         wrapper = os.path.join(d, f"cg_{name}.c")
         with open(wrapper, "w") as fh:
-            fh.write(f'#include "{name}_forward_zero.c"\n'
+            fh.write(f'#include "{name}_{fun}.c"\n'
                      f"void cg_{name}(const double *x, double *y) {{\n"
                      "  const double *in[1] = {x};\n  double *out[1] = {y};\n"
                      "  struct LangCAtomicFun atomics = {0};\n"
-                     f"  {name}_forward_zero(in, out, atomics);\n}}\n")
+                     f"  {name}_{fun}(in, out, atomics);\n}}\n")
         objs.append(wrapper)
     rs = {}
     ops = {}
@@ -149,17 +151,18 @@ def build_robot(key, cli, gen, cflags, pin, prefix):
                os.path.join(HERE, "cg_timing.rs"), "-o", rexe], env=env)
     return {"dir": d, "cgstates": cgstates, "c": cexe, "rs": rexe, "ref": reference(pin, model, sfile),
             "nv": model.nv, "ops": ops,
-            "cg_ops": count_c_ops(os.path.join(d, "drnea_forward_zero.c"))}
+            "cg_ops": count_c_ops(os.path.join(d, "drnea_forward_zero.c"), "drnea_forward_zero"),
+            "jac_ops": count_c_ops(os.path.join(d, "jrnea_jacobian.c"), "jrnea_jacobian")}
 
 
-def count_c_ops(path):
+def count_c_ops(path, fun):
     """(multiplications, additions, function calls) of a CppADCodeGen C function: its binary
     `*` and `/`, binary `+` and `-` (a sign after an operand), and calls, as robodyn counts its
     own generated C (tests/codegen_opcount.rs)."""
     import re
     with open(path) as fh:
         text = fh.read()
-    body = text[text.index("{", text.index("_forward_zero(")):]
+    body = text[text.index("{", text.index(fun + "(")):]
     mul = add = calls = 0
     for line in body.splitlines():
         line = line.strip()
@@ -183,7 +186,7 @@ def check(robot):
     pairs = [("cg_rnea", "rnea"), ("rd_rnea", "rnea"), ("rs_rnea", "rnea"),
              ("cg_crba", "crba"), ("rd_crba", "crba"), ("rs_crba", "crba"),
              ("cg_aba", "aba"), ("rd_ddm", "aba"), ("rs_ddm", "aba"),
-             ("cg_drnea", "drnea"), ("rd_drnea", "drnea"), ("rs_drnea", "drnea")]
+             ("cg_drnea", "drnea"), ("cg_jrnea", "drnea"), ("rd_drnea", "drnea"), ("rs_drnea", "drnea")]
     worst = {}
     for tag, ref in pairs:
         r = robot["ref"][ref]
@@ -214,6 +217,8 @@ def main():
         m, a, c = robot["cg_ops"]
         print(f"    derivative code: robodyn {robot['ops']['rd_idm_derivatives']}; "
               f"CppADCodeGen drnea_forward_zero: {m} multiplications, {a} additions, {c} calls")
+        m, a, c = robot["jac_ops"]
+        print(f"    CppAD's Jacobian of rnea (jrnea_jacobian): {m} multiplications, {a} additions, {c} calls")
     if not ok:
         sys.exit("results disagree: no timing")
     times = peers.interleaved(
@@ -232,7 +237,8 @@ def main():
         for label, rname, cname in [("inverse dynamics (IDM / rnea)", "idm", "cg_rnea"),
                                     ("inertia matrix (crba)", "inertia", "cg_crba"),
                                     ("direct dynamics (robodyn L D L' / cg ABA)", "ddm", "cg_aba"),
-                                    ("IDM derivatives (dq, dv, M)", "idm_derivatives", "cg_drnea")]:
+                                    ("IDM derivatives (dq, dv, M) / computeRNEADerivatives traced", "idm_derivatives", "cg_drnea"),
+                                    ("IDM derivatives (dq, dv, M) / CppAD Jacobian of rnea", "idm_derivatives", "cg_jrnea")]:
             (mc, sc), (mr, sr), (mg, sg) = med(c, f"rd_{rname}_c"), med(rs, f"rd_{rname}_rust"), med(c, cname)
             # ratios per round (C: the same program; Rust: the program run next to it), their
             # median and range, as in run.py
