@@ -586,6 +586,12 @@ impl Expr {
     pub fn func(f: Func, a: Expr) -> Expr {
         if let Some(x) = a.as_f64() {
             if matches!(a.node(), Node::Float(_)) {
+                let k = (x / std::f64::consts::FRAC_PI_4).round();
+                if k.abs() <= 8.0 && (x - k * std::f64::consts::FRAC_PI_4).abs() < 1e-15 * k.abs() {
+                    if let Some(v) = odd_quarter_turn(f, k as i64) {
+                        return v;
+                    }
+                }
                 return Expr::num(f.apply(x));
             }
         }
@@ -641,6 +647,12 @@ impl Expr {
                         }
                         _ => unreachable!(),
                     };
+                }
+                if let Some(v) = a
+                    .multiple_of_quarter_pi()
+                    .and_then(|k| odd_quarter_turn(f, k))
+                {
+                    return v;
                 }
                 Expr::new(Node::Func(f, a))
             }
@@ -698,6 +710,18 @@ impl Expr {
     /// Square root of this expression.
     pub fn sqrt(&self) -> Expr {
         Expr::func(Func::Sqrt, self.clone())
+    }
+
+    /// If the expression is k*pi/4 for an integer k, return k.
+    fn multiple_of_quarter_pi(&self) -> Option<i64> {
+        let (c, rest) = self.split_coefficient();
+        match (c, rest.node()) {
+            (Coef::Rat(r), Node::Pi) => {
+                let k = r.checked_mul(&Rational64::from_integer(4))?;
+                k.is_integer().then(|| k.to_integer())
+            }
+            _ => None,
+        }
     }
 
     /// If the expression is k*pi/2 for an integer k, return k.
@@ -825,6 +849,25 @@ pub const MAX_POWER: i32 = 64;
 
 /// Below this many terms (factors), a sum (product) finds like terms by a linear search.
 const LINEAR_SEARCH: usize = 16;
+
+/// sin, cos or tan of k*pi/4 for an odd k: +-1/sqrt(2) (one number for both, so that
+/// `cos(pi/4)*x - sin(pi/4)*y` shares its factor) or +-1; `None` for an even k (the exact
+/// values of [`Expr::func`]) or another function.
+fn odd_quarter_turn(f: Func, k: i64) -> Option<Expr> {
+    if k % 2 == 0 {
+        return None;
+    }
+    let k = k.rem_euclid(8);
+    let (sin_pos, cos_pos) = (k < 4, k == 1 || k == 7);
+    let h = Expr::num(std::f64::consts::FRAC_1_SQRT_2);
+    let signed = |pos: bool| if pos { h.clone() } else { -h.clone() };
+    match f {
+        Func::Sin => Some(signed(sin_pos)),
+        Func::Cos => Some(signed(cos_pos)),
+        Func::Tan => Some(Expr::int(if sin_pos == cos_pos { 1 } else { -1 })),
+        _ => None,
+    }
+}
 
 /// Numeric coefficient of a term: exact when possible.
 #[derive(Clone, Copy, Debug)]

@@ -138,12 +138,25 @@ fn candidates_of(e: &Expr) -> Vec<Expr> {
     out
 }
 
-/// Recursive greedy factoring of symbols common to terms of sums (see [`Program::factor_sums`]).
-fn factor(e: &Expr) -> Expr {
+/// The magnitude |c| of a numeric coefficient c other than 0 and +-1: terms whose coefficients
+/// are +-c share it as a factor (`c*x - c*y` -> `c*(x - y)`).
+fn magnitude(c: &Expr) -> Option<Expr> {
+    let x = c.as_f64()?;
+    if x == 0.0 || x.abs() == 1.0 {
+        return None;
+    }
+    Some(if x < 0.0 { -c.clone() } else { c.clone() })
+}
+
+/// Recursive greedy factoring of symbols common to terms of sums (see [`Program::factor_sums`]);
+/// with `numbers`, also of numeric coefficients equal up to their sign, and again among the
+/// terms left after each factoring.
+fn factor(e: &Expr, numbers: bool) -> Expr {
+    let rec = |x: &Expr| factor(x, numbers);
     grow(|| match e.node() {
         Node::Add(v) => {
-            let terms: Vec<Expr> = v.iter().map(factor).collect();
-            // symbol factors of each term
+            let terms: Vec<Expr> = v.iter().map(rec).collect();
+            // symbol factors of each term, and its numeric coefficient up to its sign
             let mut freq: HashMap<Expr, usize> = HashMap::new();
             for t in &terms {
                 if let Node::Mul(fs) = t.node() {
@@ -153,6 +166,9 @@ fn factor(e: &Expr) -> Expr {
                             seen.push(f);
                             *freq.entry(f.clone()).or_default() += 1;
                         }
+                    }
+                    if let Some(c) = magnitude(&fs[0]).filter(|_| numbers) {
+                        *freq.entry(c).or_default() += 1;
                     }
                 }
             }
@@ -166,19 +182,24 @@ fn factor(e: &Expr) -> Expr {
             let mut inner = Vec::new();
             let mut rest = Vec::new();
             for t in terms {
-                let has = matches!(t.node(), Node::Mul(fs) if fs.contains(&f));
+                let has = matches!(t.node(), Node::Mul(fs)
+                    if fs.contains(&f) || (numbers && magnitude(&fs[0]).as_ref() == Some(&f)));
                 if has {
                     inner.push(t / f.clone());
                 } else {
                     rest.push(t);
                 }
             }
-            let factored = Expr::product([f, factor(&Expr::sum(inner))]);
-            rest.push(factored);
-            Expr::sum(rest)
+            let factored = Expr::product([f, rec(&Expr::sum(inner))]);
+            if !numbers || rest.len() < 2 {
+                rest.push(factored);
+                return Expr::sum(rest);
+            }
+            // the other terms may share another factor
+            Expr::sum([rec(&Expr::sum(rest)), factored])
         }
-        Node::Mul(v) => Expr::product(v.iter().map(factor)),
-        _ => e.map_children(&factor, &|_| None),
+        Node::Mul(v) => Expr::product(v.iter().map(rec)),
+        _ => e.map_children(&rec, &|_| None),
     })
 }
 
@@ -618,15 +639,22 @@ impl Program {
     }
 
     /// Factor a symbol common to several terms of a sum: `a*x + b*x + c` -> `x*(a + b) + c`
-    /// (saves one multiplication per extra term), greedily, the most frequent factor first.
+    /// (saves one multiplication per extra term), or a numeric coefficient equal up to its sign:
+    /// `k*x - k*y` -> `k*(x - y)`; greedily, the most frequent factor first.
     pub fn factor_sums(&mut self) {
+        self.factor_sums_with(true);
+    }
+
+    /// [`Program::factor_sums`]; without `numbers`, symbols only.
+    fn factor_sums_with(&mut self, numbers: bool) {
         for a in self.assignments.iter_mut().chain(self.outputs.iter_mut()) {
-            a.expr = factor(&a.expr);
+            a.expr = factor(&a.expr, numbers);
         }
     }
 
-    /// All passes: dead assignments, aliases, single-use inlining, then the better (fewer
-    /// operations) of common-subexpression sharing alone or after factoring sums.
+    /// All passes: dead assignments, aliases, single-use inlining, then the best (fewest
+    /// operations) of common-subexpression sharing alone, after factoring the sums' symbols, or
+    /// after factoring their symbols and numeric coefficients.
     pub fn optimize(&mut self) {
         self.optimize_with_progress(&mut |_| {});
     }
@@ -639,19 +667,23 @@ impl Program {
         self.remove_aliases();
         progress("inlining single-use intermediates");
         self.inline_single_use();
-        let mut factored = self.clone();
+        let unshared = self.clone();
         progress("sharing common subexpressions");
         self.share_common_subexpressions();
         self.inline_single_use();
         self.remove_dead();
-        progress("factoring sums, then sharing common subexpressions");
-        factored.factor_sums();
-        factored.share_common_subexpressions();
-        factored.inline_single_use();
-        factored.remove_dead();
-        let (a, b) = (self.count(), factored.count());
-        if b.mul + b.add < a.mul + a.add {
-            *self = factored;
+        // factoring symbols only, or numeric coefficients too: either can share better
+        for numbers in [false, true] {
+            progress("factoring sums, then sharing common subexpressions");
+            let mut factored = unshared.clone();
+            factored.factor_sums_with(numbers);
+            factored.share_common_subexpressions();
+            factored.inline_single_use();
+            factored.remove_dead();
+            let (a, b) = (self.count(), factored.count());
+            if b.mul + b.add < a.mul + a.add {
+                *self = factored;
+            }
         }
         self.name_outputs();
         self.hoist_function_calls();

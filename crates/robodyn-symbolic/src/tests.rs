@@ -246,3 +246,69 @@ fn function_calls_are_hoisted_with_their_dependencies() {
         ["T", "S", "A", "B", "C"]
     );
 }
+
+#[test]
+fn odd_quarter_turns_give_one_number_for_sine_and_cosine() {
+    let h = std::f64::consts::FRAC_1_SQRT_2;
+    // exact arguments and their float spelling (a URDF's rpy) give the same number
+    for (s, v) in [
+        ("cos(pi/4)", h),
+        ("sin(pi/4)", h),
+        ("cos(3*pi/4)", -h),
+        ("sin(3*pi/4)", h),
+        ("sin(-pi/4)", -h),
+        ("cos(-pi/4)", h),
+        ("sin(5*pi/4)", -h),
+        ("cos(7*pi/4)", h),
+        ("cos(0.7853981633974483)", h),
+        ("sin(-0.7853981633974483)", -h),
+    ] {
+        assert_eq!(p(s).as_f64(), Some(v), "{s}");
+    }
+    assert_eq!(p("tan(3*pi/4)").as_f64(), Some(-1.0));
+    // every value agrees with libm's at the rounded argument (a few ulps)
+    for k in [-7, -5, -3, -1, 1, 3, 5, 7] {
+        let x = k as f64 * std::f64::consts::FRAC_PI_4;
+        let e = p(&format!("{k}*pi/4"));
+        let s = Expr::func(crate::Func::Sin, e.clone()).as_f64().unwrap();
+        let c = Expr::func(crate::Func::Cos, e).as_f64().unwrap();
+        assert!(
+            (s - x.sin()).abs() < 1e-15 && (c - x.cos()).abs() < 1e-15,
+            "{k}"
+        );
+    }
+    // a symbol in the argument keeps the function
+    assert_eq!(p("cos(q2 - pi/4)").to_string(), "cos(-pi/4 + q2)");
+}
+
+#[test]
+fn numeric_coefficients_equal_up_to_sign_are_factored() {
+    use crate::{Assignment, Program};
+    let env = |s: &str| match s {
+        "x" => Some(0.7),
+        "y" => Some(-1.3),
+        "z" => Some(0.4),
+        _ => None,
+    };
+    let prog = |e: &str| Program {
+        outputs: vec![Assignment {
+            name: "OUT".into(),
+            expr: p(e),
+        }],
+        ..Program::default()
+    };
+    for (e, mul, add) in [
+        // 3 multiplications -> 1
+        ("0.7071*x - 0.7071*y + 0.7071*z", 1, 2),
+        // x, then 3/2 (or the other way round): 4 multiplications -> 2
+        ("x*y + x*z + 1.5*y - 1.5*z", 2, 3),
+    ] {
+        let mut a = prog(e);
+        let before = a.evaluate(&env).unwrap();
+        a.factor_sums();
+        let n = a.count();
+        assert_eq!((n.mul, n.add), (mul, add), "{e}: {}", a.outputs[0].expr);
+        let after = a.evaluate(&env).unwrap();
+        assert!((after[0] - before[0]).abs() < 1e-15, "{e}");
+    }
+}

@@ -153,6 +153,10 @@ fn example_robot_data_urdfs() {
             .unwrap_or_else(|| panic!("{name} not found under {}", dir.display()));
         let robot = robodyn::io::load(&path).unwrap();
         let sb = check(name, &robot);
-        assert!(sb.dropped_float_terms > 0, "{name}");
+        // the UR arms' URDFs give float noise terms (dropped); every angle of the Panda's is
+        // an exact multiple of pi/4 (its hand turned by -pi/4 included): it has none
+        if name.starts_with("ur") {
+            assert!(sb.dropped_float_terms > 0, "{name}");
+        }
     }
 }

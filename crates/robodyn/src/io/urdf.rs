@@ -109,17 +109,17 @@ pub fn decompose(t: &Iso) -> [f64; 6] {
     [gamma, b, alpha, d, theta, rr]
 }
 
-/// A number as an expression: exact multiples of pi/2 for angles within 1e-12, exact 0 for
-/// lengths below 1e-15.
+/// A number as an expression: exact multiples of pi/4 for angles within 1e-12 (a hand turned
+/// by 45 degrees, as the Panda's), exact 0 for lengths below 1e-15.
 fn num_expr(x: f64, angle: bool) -> Expr {
     if angle {
-        let k = (x / std::f64::consts::FRAC_PI_2).round();
-        if (x - k * std::f64::consts::FRAC_PI_2).abs() < 1e-12 && k.abs() <= 4.0 {
+        let k = (x / std::f64::consts::FRAC_PI_4).round();
+        if (x - k * std::f64::consts::FRAC_PI_4).abs() < 1e-12 && k.abs() <= 8.0 {
             let k = k as i64;
             return if k == 0 {
                 Expr::zero()
             } else {
-                Expr::int(k) * Expr::pi() / Expr::int(2)
+                Expr::int(k) * Expr::pi() / Expr::int(4)
             };
         }
     } else if x.abs() < 1e-15 {
