@@ -125,17 +125,16 @@ impl IgmSolutions {
 }
 
 /// The most angles one target brings (atan2 each): two theta1, each with one delta of theta3's
-/// pair and per arm branch theta2, delta of theta5's pair and up to two (theta4, theta6) (the
-/// spherical wrist: 26; 30 when theta1 is free, one per arm branch), or with one delta of
-/// theta5's pair and per theta5 theta6, the direction of the parallel joints' sum, one delta of
-/// theta3's pair and two theta2 (the offset wrist: 24). 48 leaves room.
+/// pair and per arm branch theta2 and up to two (theta4, theta5, theta6) (the spherical wrist:
+/// 32; 36 when theta1 is free, one per arm branch), or with one delta of theta5's pair and per
+/// theta5 theta6, the direction of the parallel joints' sum, one delta of theta3's pair and two
+/// theta2 (the offset wrist: 24). 48 leaves room.
 const MAX_ANGLES: usize = 48;
 
-/// The most values derived from the angles found ([`Derived`]): per theta1 of the spherical
-/// wrist two theta3 and per arm branch the first theta5 and the mirror's three values or the
-/// second theta5 (20 per target); per theta1 of the offset wrist two theta5 and per theta5 two
-/// theta3 and a theta4 (16). 32 leaves room.
-const MAX_DERIVED: usize = 32;
+/// The most values derived from the angles found ([`Derived`]): per theta1 two theta3 (the
+/// spherical wrist: 4 per target), or two theta5 and per theta5 two theta3 and a theta4 (the
+/// offset wrist: 16). 24 leaves room.
+const MAX_DERIVED: usize = 24;
 
 /// The solutions of one target as found: the directions of the distinct angles (each solution
 /// shares some with others), the values derived from them, and each solution's six joints as
@@ -153,16 +152,51 @@ struct Found {
 }
 
 /// One joint of a solution: the k-th angle found (k < [`MAX_ANGLES`]) or the (k -
-/// [`MAX_ANGLES`])-th value derived.
+/// [`MAX_ANGLES`])-th value derived, as it is, plus a half turn or negated (the spherical
+/// wrist's mirror solution).
 #[derive(Clone, Copy, Default)]
-struct Slot(u8);
+struct Slot {
+    k: u8,
+    op: SlotOp,
+}
 
-/// A value derived from an earlier one (an angle found or a value derived): as it is or
-/// negated, plus an offset (phi of a root pair phi ± delta found by its delta, a half turn of
-/// the spherical wrist's mirror solution, the constant of [`ParallelSum`]).
+/// See [`Slot`].
+#[derive(Clone, Copy, Default)]
+enum SlotOp {
+    #[default]
+    Same,
+    HalfTurn,
+    Neg,
+}
+
+impl Slot {
+    fn new(k: usize) -> Slot {
+        Slot {
+            k: k as u8,
+            op: SlotOp::Same,
+        }
+    }
+
+    fn half_turn(self) -> Slot {
+        Slot {
+            op: SlotOp::HalfTurn,
+            ..self
+        }
+    }
+
+    fn neg(self) -> Slot {
+        Slot {
+            op: SlotOp::Neg,
+            ..self
+        }
+    }
+}
+
+/// A value derived from an angle found: as it is or negated, plus an offset (phi of a root
+/// pair phi ± delta found by its delta, the constant of [`ParallelSum`]).
 #[derive(Clone, Copy, Default)]
 struct Derived {
-    from: Slot,
+    from: u8,
     neg: bool,
     off: Offset,
 }
@@ -170,10 +204,8 @@ struct Derived {
 /// What is added to a [`Derived`] value: an index into [`ClosedFormIgm::offsets`].
 #[derive(Clone, Copy, Default, PartialEq, Eq)]
 enum Offset {
-    #[default]
-    Zero,
-    HalfTurn,
     /// phi of the arm's (theta3) equation.
+    #[default]
     Arm,
     /// phi of the wrist's (theta5) equation.
     Wrist,
@@ -183,7 +215,7 @@ enum Offset {
 }
 
 /// The number of [`Offset`]s.
-const OFFSETS: usize = 5;
+const OFFSETS: usize = 3;
 
 impl Found {
     fn new() -> Found {
@@ -204,25 +236,20 @@ impl Found {
         let k = self.n;
         (self.ys[k], self.xs[k]) = (d.y, d.x);
         self.n += 1;
-        Slot(k as u8)
+        Slot::new(k)
     }
 
-    /// The slot of a new value: `from`'s value, negated when `neg`, plus `off`.
+    /// The slot of a new value: the value of the angle of slot `from`, negated when `neg`, plus
+    /// `off`.
     fn derive(&mut self, from: Slot, neg: bool, off: Offset) -> Slot {
         let k = self.nd;
-        self.derived[k] = Derived { from, neg, off };
+        self.derived[k] = Derived {
+            from: from.k,
+            neg,
+            off,
+        };
         self.nd += 1;
-        Slot((MAX_ANGLES + k) as u8)
-    }
-
-    /// The spherical wrist's mirror of `s`: its value plus a half turn.
-    fn half_turn(&mut self, s: Slot) -> Slot {
-        self.derive(s, false, Offset::HalfTurn)
-    }
-
-    /// The opposite of `s`'s value.
-    fn neg(&mut self, s: Slot) -> Slot {
-        self.derive(s, true, Offset::Zero)
+        Slot::new(MAX_ANGLES + k)
     }
 
     /// The slot of delta of a root pair phi ± delta (a new angle), or of the free angle's
@@ -265,7 +292,7 @@ impl Found {
         let mut th = [0.0; MAX_ANGLES + MAX_DERIVED];
         atan2_all(&self.ys, &self.xs, self.n, &mut th);
         for (j, d) in self.derived[..self.nd].iter().enumerate() {
-            let v = th[usize::from(d.from.0)];
+            let v = th[usize::from(d.from)];
             th[MAX_ANGLES + j] = if d.neg { -v } else { v } + igm.offsets[d.off as usize];
         }
         let mut out = IgmSolutions {
@@ -279,11 +306,21 @@ impl Found {
             .zip(&self.singular)
         {
             let mut theta = [0.0; 6];
-            for (t, s) in theta.iter_mut().zip(slots) {
-                *t = th[usize::from(s.0)];
-            }
             if offset {
+                // the offset wrist's slots are all `Same`
+                for (t, s) in theta.iter_mut().zip(slots) {
+                    *t = th[usize::from(s.k)];
+                }
                 theta[3] = wrap_near(theta[3] - igm.sum.a2 * theta[1] - igm.sum.a3 * theta[2]);
+            } else {
+                for (t, s) in theta.iter_mut().zip(slots) {
+                    let v = th[usize::from(s.k)];
+                    *t = match s.op {
+                        SlotOp::Same => v,
+                        SlotOp::HalfTurn => v + PI,
+                        SlotOp::Neg => -v,
+                    };
+                }
             }
             let (q, within_limits) = igm.joint_values(&theta);
             *o = IgmSolution {
@@ -664,8 +701,8 @@ pub struct ClosedFormIgm {
     /// Whether the spherical wrist's second solution is the mirror (theta4 + pi, -theta5,
     /// theta6 + pi) of the first (`mirror_holds`).
     mirror: bool,
-    /// The value of each [`Offset`] (by its index): 0, pi, phi of the arm's and the wrist's
-    /// equations, and [`ParallelSum`]'s constant.
+    /// The value of each [`Offset`] (by its index): phi of the arm's and the wrist's equations,
+    /// and [`ParallelSum`]'s constant.
     offsets: [f64; OFFSETS],
     /// theta4 of the offset wrist from the sum of the parallel joints.
     sum: ParallelSum,
@@ -796,7 +833,7 @@ impl ClosedFormIgm {
             arm,
             point3,
             wrist,
-            offsets: [0.0, PI, phi_arm, phi_wrist, sum.c],
+            offsets: [phi_arm, phi_wrist, sum.c],
             sum,
             mirror: class == IgmClass::SphericalWrist && mirror_holds(&c4.rot, &chain.c[5].rot),
             g,
@@ -1001,18 +1038,18 @@ impl ClosedFormIgm {
             return;
         };
         let [a1, a2, a3] = *arm;
-        let delta5 = out.delta(&t5);
+        // theta5 by its own atan2 (not phi ± delta): the mirror's needs no second one
         let (first, mut wrist) = self.wrist_angles(&r0, &b, &t5.roots[0]);
         let [th4, th6] = first.map(|d| out.angle(d));
-        let th5 = out.root(&t5, delta5, 0, Offset::Wrist);
+        let th5 = out.angle(t5.roots[0].dir());
         out.push([a1, a2, a3, th4, th5, th6], Singularity { wrist, ..s });
         let [th4, th5, th6] = if self.mirror && !t5.singular && !wrist {
-            [out.half_turn(th4), out.neg(th5), out.half_turn(th6)]
+            [th4.half_turn(), th5.neg(), th6.half_turn()]
         } else {
             let (second, w) = self.wrist_angles(&r0, &b, &t5.roots[1]);
             wrist = w;
             let [th4, th6] = second.map(|d| out.angle(d));
-            [th4, out.root(&t5, delta5, 1, Offset::Wrist), th6]
+            [th4, out.angle(t5.roots[1].dir()), th6]
         };
         out.push([a1, a2, a3, th4, th5, th6], Singularity { wrist, ..s });
     }
