@@ -309,6 +309,31 @@ fn random_chains_of_each_class() {
     }
 }
 
+/// Offset-wrist chains whose parallel axes 3 and 4 are turned by gamma and flipped or not
+/// (alpha = 0 or pi: axes antiparallel): theta4 is found from the direction of the parallel
+/// joints' sum, whose signs and constant follow C2 and C3.
+#[test]
+fn offset_wrist_with_turned_and_flipped_parallel_axes() {
+    let mut rng = ChaCha8Rng::seed_from_u64(31);
+    for k in 0..16 {
+        let mut d = random_of_class(&mut rng, IgmClass::OffsetWrist).into_description();
+        for j in [2, 3] {
+            let flip = if (k >> (j - 2)) & 1 == 1 { PI } else { 0.0 };
+            d.frames[j].alpha = Expr::num(flip);
+            d.frames[j].gamma = Expr::num(rng.random_range(-3.0..3.0));
+        }
+        let r = Robot::new(d).unwrap();
+        check_random_poses(
+            &format!("flipped #{k}"),
+            &r,
+            IgmClass::OffsetWrist,
+            50,
+            k,
+            false,
+        );
+    }
+}
+
 #[test]
 fn robots_of_no_class_name_the_numeric_model() {
     let r = common::robot("scara.toml");

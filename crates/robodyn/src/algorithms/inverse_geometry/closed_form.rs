@@ -122,33 +122,38 @@ impl IgmSolutions {
     pub fn is_empty(&self) -> bool {
         self.len == 0
     }
-
-    fn push(&mut self, s: IgmSolution) {
-        self.items[self.len] = s;
-        self.len += 1;
-    }
 }
 
-/// The most angles one target brings: two theta1, each with two (theta2, theta3) and six wrist
-/// angles, or with two (theta5, theta6) and two (theta2, theta3, theta4): 34; 38 when theta1
-/// is free (one per arm branch). 48 leaves room.
+/// The most angles one target brings (atan2 each): two theta1, each with one delta of theta3's
+/// pair and per arm branch theta2 and up to two (theta4, theta5, theta6) (the spherical wrist:
+/// 32; 36 when theta1 is free, one per arm branch), or with one delta of theta5's pair and per
+/// theta5 theta6, the direction of the parallel joints' sum, one delta of theta3's pair and two
+/// theta2 (the offset wrist: 24). 48 leaves room.
 const MAX_ANGLES: usize = 48;
 
+/// The most values derived from the angles found ([`Derived`]): per theta1 two theta3 (the
+/// spherical wrist: 4 per target), or two theta5 and per theta5 two theta3 and a theta4 (the
+/// offset wrist: 16). 24 leaves room.
+const MAX_DERIVED: usize = 24;
+
 /// The solutions of one target as found: the directions of the distinct angles (each solution
-/// shares some with others), and each solution's six joints as slots into them. The angles'
-/// values are taken at the end, all at once ([`Self::angles`]).
+/// shares some with others), the values derived from them, and each solution's six joints as
+/// slots into both. The angles' values are taken at the end, all at once ([`Self::angles`]).
 #[derive(Clone, Copy)]
 struct Found {
     ys: [f64; MAX_ANGLES],
     xs: [f64; MAX_ANGLES],
     n: usize,
+    derived: [Derived; MAX_DERIVED],
+    nd: usize,
     slots: [[Slot; 6]; 8],
     singular: [Singularity; 8],
     len: usize,
 }
 
-/// One joint of a solution: the k-th angle found, as it is, plus a half turn or negated (the
-/// spherical wrist's mirror solution).
+/// One joint of a solution: the k-th angle found (k < [`MAX_ANGLES`]) or the (k -
+/// [`MAX_ANGLES`])-th value derived, as it is, plus a half turn or negated (the spherical
+/// wrist's mirror solution).
 #[derive(Clone, Copy, Default)]
 struct Slot {
     k: u8,
@@ -165,6 +170,13 @@ enum SlotOp {
 }
 
 impl Slot {
+    fn new(k: usize) -> Slot {
+        Slot {
+            k: k as u8,
+            op: SlotOp::Same,
+        }
+    }
+
     fn half_turn(self) -> Slot {
         Slot {
             op: SlotOp::HalfTurn,
@@ -180,12 +192,39 @@ impl Slot {
     }
 }
 
+/// A value derived from an angle found: as it is or negated, plus an offset (phi of a root
+/// pair phi ± delta found by its delta, the constant of [`ParallelSum`]).
+#[derive(Clone, Copy, Default)]
+struct Derived {
+    from: u8,
+    neg: bool,
+    off: Offset,
+}
+
+/// What is added to a [`Derived`] value: an index into [`ClosedFormIgm::offsets`].
+#[derive(Clone, Copy, Default, PartialEq, Eq)]
+enum Offset {
+    /// phi of the arm's (theta3) equation.
+    #[default]
+    Arm,
+    /// phi of the wrist's (theta5) equation.
+    Wrist,
+    /// The constant of [`ParallelSum`] (theta4 of the offset wrist, before its terms in
+    /// theta2 and theta3).
+    Sum,
+}
+
+/// The number of [`Offset`]s.
+const OFFSETS: usize = 3;
+
 impl Found {
     fn new() -> Found {
         Found {
             ys: [0.0; MAX_ANGLES],
             xs: [0.0; MAX_ANGLES],
             n: 0,
+            derived: [Derived::default(); MAX_DERIVED],
+            nd: 0,
             slots: [[Slot::default(); 6]; 8],
             singular: [Singularity::default(); 8],
             len: 0,
@@ -197,10 +236,42 @@ impl Found {
         let k = self.n;
         (self.ys[k], self.xs[k]) = (d.y, d.x);
         self.n += 1;
-        Slot {
-            k: k as u8,
-            op: SlotOp::Same,
+        Slot::new(k)
+    }
+
+    /// The slot of a new value: the value of the angle of slot `from`, negated when `neg`, plus
+    /// `off`.
+    fn derive(&mut self, from: Slot, neg: bool, off: Offset) -> Slot {
+        let k = self.nd;
+        self.derived[k] = Derived {
+            from: from.k,
+            neg,
+            off,
+        };
+        self.nd += 1;
+        Slot::new(MAX_ANGLES + k)
+    }
+
+    /// The slot of delta of a root pair phi ± delta (a new angle), or of the free angle's
+    /// representative when the pair is one.
+    fn delta(&mut self, p: &RootPair) -> Slot {
+        self.angle(p.delta.unwrap_or(p.roots[0].dir()))
+    }
+
+    /// The slot of the i-th root of the pair (phi + delta, phi - delta) of an equation whose
+    /// phi is the constant `off`, from the slot `d` of [`Self::delta`].
+    fn root(&mut self, p: &RootPair, d: Slot, i: usize, off: Offset) -> Slot {
+        if p.delta.is_some() {
+            self.derive(d, i == 1, off)
+        } else {
+            d
         }
+    }
+
+    /// The slots of both roots of a pair.
+    fn pair(&mut self, p: &RootPair, off: Offset) -> [Slot; 2] {
+        let d = self.delta(p);
+        [self.root(p, d, 0, off), self.root(p, d, 1, off)]
     }
 
     fn push(&mut self, slots: [Slot; 6], singular: Singularity) {
@@ -214,35 +285,57 @@ impl Found {
     }
 
     /// The angles theta = atan2(y, x), four at a time (`wide`'s atan2: Cephes' rational
-    /// approximation, within 2 ulps), then each solution's joint values (theta - theta0),
-    /// each wrapped to (-pi, pi] or moved by a turn into its limits.
+    /// approximation, within 2 ulps), the derived values in order, then each solution's
+    /// joint values (theta - theta0; theta4 of the offset wrist from the sum of the parallel
+    /// joints, [`ParallelSum`]), each wrapped to (-pi, pi] or moved by a turn into its limits.
     fn angles(&self, igm: &ClosedFormIgm) -> IgmSolutions {
-        let th = atan2_all(&self.ys, &self.xs, self.n);
-        let mut out = IgmSolutions::default();
-        for (slots, &singular) in self.slots[..self.len].iter().zip(&self.singular) {
-            let theta = slots.map(|s| {
-                let t = th[usize::from(s.k)];
-                match s.op {
-                    SlotOp::Same => t,
-                    SlotOp::HalfTurn => t + PI,
-                    SlotOp::Neg => -t,
+        let mut th = [0.0; MAX_ANGLES + MAX_DERIVED];
+        atan2_all(&self.ys, &self.xs, self.n, &mut th);
+        for (j, d) in self.derived[..self.nd].iter().enumerate() {
+            let v = th[usize::from(d.from)];
+            th[MAX_ANGLES + j] = if d.neg { -v } else { v } + igm.offsets[d.off as usize];
+        }
+        let mut out = IgmSolutions {
+            len: self.len,
+            ..IgmSolutions::default()
+        };
+        let offset = igm.class == IgmClass::OffsetWrist;
+        for ((o, slots), &singular) in out.items[..self.len]
+            .iter_mut()
+            .zip(&self.slots)
+            .zip(&self.singular)
+        {
+            let mut theta = [0.0; 6];
+            if offset {
+                // the offset wrist's slots are all `Same`
+                for (t, s) in theta.iter_mut().zip(slots) {
+                    *t = th[usize::from(s.k)];
                 }
-            });
+                theta[3] = wrap_near(theta[3] - igm.sum.a2 * theta[1] - igm.sum.a3 * theta[2]);
+            } else {
+                for (t, s) in theta.iter_mut().zip(slots) {
+                    let v = th[usize::from(s.k)];
+                    *t = match s.op {
+                        SlotOp::Same => v,
+                        SlotOp::HalfTurn => v + PI,
+                        SlotOp::Neg => -v,
+                    };
+                }
+            }
             let (q, within_limits) = igm.joint_values(&theta);
-            out.push(IgmSolution {
+            *o = IgmSolution {
                 q,
                 within_limits,
                 singular,
-            });
+            };
         }
         out
     }
 }
 
-/// atan2(y_k, x_k) for the first `n` entries, four at a time.
-fn atan2_all(ys: &[f64; MAX_ANGLES], xs: &[f64; MAX_ANGLES], n: usize) -> [f64; MAX_ANGLES] {
+/// atan2(y_k, x_k) into `th` for the first `n` entries, four at a time.
+fn atan2_all(ys: &[f64; MAX_ANGLES], xs: &[f64; MAX_ANGLES], n: usize, th: &mut [f64]) {
     const LANES: usize = 4;
-    let mut th = [0.0; MAX_ANGLES];
     for ((t, y), x) in th[..n.next_multiple_of(LANES)]
         .chunks_exact_mut(LANES)
         .zip(ys.chunks_exact(LANES))
@@ -252,7 +345,31 @@ fn atan2_all(ys: &[f64; MAX_ANGLES], xs: &[f64; MAX_ANGLES], n: usize) -> [f64; 
         let x = f64x4::from([x[0], x[1], x[2], x[3]]);
         t.copy_from_slice(&y.atan2(x).to_array());
     }
-    th
+}
+
+/// theta4 of the offset wrist from the direction psi of (A1 C1)_r^T x4 (x4: A4's x axis) in
+/// the plane of the parallel axes 2, 3, 4: C2r and C3r turn about z, or about z and then by a
+/// half turn about a line of the plane (alpha = pi), each C_r^T mapping a direction psi of the
+/// plane to sigma (psi - gamma); so theta4 = s psi - a2 theta2 - a3 theta3 + c with s = a2 =
+/// sigma2 sigma3, a3 = sigma3, c = -(sigma2 sigma3 gamma2 + sigma3 gamma3).
+#[derive(Clone, Copy, Debug, Default)]
+struct ParallelSum {
+    a2: f64,
+    a3: f64,
+    c: f64,
+}
+
+impl ParallelSum {
+    fn new(c2: &Matrix3<f64>, c3: &Matrix3<f64>) -> ParallelSum {
+        let sigma = |c: &Matrix3<f64>| c[(2, 2)].signum();
+        let gamma = |c: &Matrix3<f64>| c[(1, 0)].atan2(c[(0, 0)]);
+        let (s2, s3) = (sigma(c2), sigma(c3));
+        ParallelSum {
+            a2: s2 * s3,
+            a3: s3,
+            c: -(s2 * s3 * gamma(c2) + s3 * gamma(c3)),
+        }
+    }
 }
 
 /// An angle carried by its cosine and sine: the roots of Paul's equations come with theirs
@@ -359,8 +476,9 @@ fn double_root_tolerance() -> f64 {
 /// Roots of the type-2 equation X sin(theta) + Y cos(theta) = Z.
 #[derive(Clone, Copy, Debug)]
 enum Roots {
-    /// Two roots (equal when `singular`: a double root, within the tolerance).
-    Two(Angle, Angle, bool),
+    /// Two roots phi + delta and phi - delta (equal when `singular`: a double root, within the
+    /// tolerance), and delta's direction (cos, sin).
+    Two(Angle, Angle, bool, Direction),
     /// X = Y = Z = 0: any theta.
     Any,
     /// |Z| > sqrt(X^2 + Y^2): no root.
@@ -464,31 +582,32 @@ impl DotEquation {
             c: cp * cd + sp * sd,
             s: sp * cd - cp * sd,
         };
-        Roots::Two(plus, minus, singular)
+        Roots::Two(plus, minus, singular, Direction { y: sd, x: cd })
     }
 }
 
 /// The angle theta of Rz(theta) u = v in the xy plane; None when u or v lies on the z axis.
 fn angle_between(u: &Vector3<f64>, v: &Vector3<f64>, tol: f64) -> Option<Angle> {
-    let (nu, nv) = (u.x * u.x + u.y * u.y, v.x * v.x + v.y * v.y);
-    if nu.sqrt() <= tol || nv.sqrt() <= tol {
-        return None;
-    }
-    let (c, s) = (u.x * v.x + u.y * v.y, u.x * v.y - u.y * v.x);
-    let r = (nu * nv).sqrt();
-    Some(Angle { c: c / r, s: s / r })
+    angle_flagged(u, v, tol, 0.0).0
 }
 
 /// [`angle_between`] solved down to `floor` (None below it), and whether u or v is within
-/// `tol` of the z axis (the step singular).
+/// `tol` of the z axis (the step singular); the lengths of their xy parts found once for both.
 fn angle_flagged(
     u: &Vector3<f64>,
     v: &Vector3<f64>,
     floor: f64,
     tol: f64,
 ) -> (Option<Angle>, bool) {
-    let singular = u.xy().norm() <= tol || v.xy().norm() <= tol;
-    (angle_between(u, v, floor), singular)
+    let (nu, nv) = (u.x * u.x + u.y * u.y, v.x * v.x + v.y * v.y);
+    let (lu, lv) = (nu.sqrt(), nv.sqrt());
+    let singular = lu <= tol || lv <= tol;
+    if lu <= floor || lv <= floor {
+        return (None, singular);
+    }
+    let (c, s) = (u.x * v.x + u.y * v.y, u.x * v.y - u.y * v.x);
+    let r = (nu * nv).sqrt();
+    (Some(Angle { c: c / r, s: s / r }), singular)
 }
 
 /// 1 - k and 1 + k for k the z component of a unit vector b and s2 = b_x² + b_y²: the one
@@ -506,16 +625,36 @@ fn unit_complements(k: f64, s2: f64) -> (f64, f64) {
 fn mid_root(eq: &DotEquation, k: f64) -> Option<Angle> {
     let k = k.clamp(eq.azbz - eq.rho, eq.azbz + eq.rho);
     match eq.roots(k, eq.rho * CLOSED_FORM_TOLERANCE) {
-        Roots::Two(a, _, _) => Some(a),
+        Roots::Two(a, ..) => Some(a),
         _ => None,
     }
 }
 
+/// The two roots of an equation: phi + delta and phi - delta with delta's direction, or a free
+/// angle's representative twice (no delta); `singular` for a double root or a free angle.
+#[derive(Clone, Copy, Debug)]
+struct RootPair {
+    roots: [Angle; 2],
+    singular: bool,
+    delta: Option<Direction>,
+}
+
+/// The planar arm's two branches: theta2, theta3 and their singular cases.
+type ArmBranches = [(Angle, Angle, Singularity); 2];
+
 /// A root pair, a free angle given as `free` (twice), or none.
-fn roots_or(r: Roots, free: Angle) -> Option<([Angle; 2], bool)> {
+fn roots_or(r: Roots, free: Angle) -> Option<RootPair> {
     match r {
-        Roots::Two(a, b, s) => Some(([a, b], s)),
-        Roots::Any => Some(([free; 2], true)),
+        Roots::Two(a, b, singular, delta) => Some(RootPair {
+            roots: [a, b],
+            singular,
+            delta: Some(delta),
+        }),
+        Roots::Any => Some(RootPair {
+            roots: [free; 2],
+            singular: true,
+            delta: None,
+        }),
         Roots::None => None,
     }
 }
@@ -562,6 +701,11 @@ pub struct ClosedFormIgm {
     /// Whether the spherical wrist's second solution is the mirror (theta4 + pi, -theta5,
     /// theta6 + pi) of the first (`mirror_holds`).
     mirror: bool,
+    /// The value of each [`Offset`] (by its index): phi of the arm's and the wrist's equations,
+    /// and [`ParallelSum`]'s constant.
+    offsets: [f64; OFFSETS],
+    /// theta4 of the offset wrist from the sum of the parallel joints.
+    sum: ParallelSum,
 }
 
 /// A geometric line: a point and a unit direction.
@@ -668,6 +812,12 @@ impl ClosedFormIgm {
             IgmClass::OffsetWrist => c4.rot.tr_mul(&e4),
         };
         let p6 = chain.c[5].rot * Vector3::z();
+        let (arm, wrist) = (
+            DotEquation::new(&c2.rot.tr_mul(&c2.pos), &point3),
+            DotEquation::new(&g, &p6),
+        );
+        let sum = ParallelSum::new(&c2.rot, &chain.c[3].rot);
+        let (phi_arm, phi_wrist) = (arm.sp.atan2(arm.cp), wrist.sp.atan2(wrist.cp));
         Ok(ClosedFormIgm {
             class,
             frame,
@@ -680,9 +830,11 @@ impl ClosedFormIgm {
             point0,
             free: std::array::from_fn(|k| Angle::new(chain.theta0[k])),
             arm_k: c2.pos.norm_squared() + point3.norm_squared(),
-            arm: DotEquation::new(&c2.rot.tr_mul(&c2.pos), &point3),
+            arm,
             point3,
-            wrist: DotEquation::new(&g, &p6),
+            wrist,
+            offsets: [phi_arm, phi_wrist, sum.c],
+            sum,
             mirror: class == IgmClass::SphericalWrist && mirror_holds(&c4.rot, &chain.c[5].rot),
             g,
             p6,
@@ -749,7 +901,7 @@ impl ClosedFormIgm {
     fn theta1(&self, x_m: &Vector3<f64>) -> Option<([Angle; 2], bool, bool)> {
         let r = DotEquation::new(x_m, &self.u2).roots(self.u2.dot(&self.point0), self.tol());
         let free = matches!(r, Roots::Any);
-        roots_or(r, self.free[0]).map(|(t, s)| (t, s, free))
+        roots_or(r, self.free[0]).map(|p| (p.roots, p.singular, free))
     }
 
     /// The spherical wrist's centre on axis 1 (theta1 free: the arm does not depend on it):
@@ -768,14 +920,15 @@ impl ClosedFormIgm {
     }
 
     /// theta2, theta3 of the planar arm placing the point `point3` (fixed in A3) at `x_m`:
-    /// theta3 from its distance to O2 (type 2), theta2 from atan2.
-    fn planar(&self, th1: &Angle, x_m: &Vector3<f64>) -> Option<[(Angle, Angle, Singularity); 2]> {
+    /// theta3 from its distance to O2 (type 2), theta2 from atan2; and theta3's root pair.
+    fn planar(&self, th1: &Angle, x_m: &Vector3<f64>) -> Option<(ArmBranches, RootPair)> {
         let (c1, c2) = (&self.chain.c[1], &self.chain.c[2]);
         let x2 = c1.rot.tr_mul(&(th1.unturn(x_m) - c1.pos));
         let b = &self.point3;
         let k = (x2.norm_squared() - self.arm_k) / 2.0;
         let tol2 = self.tol() * self.chain.scale;
-        let (t3, elbow) = roots_or(self.arm.roots(k, tol2), self.free[2])?;
+        let t3 = roots_or(self.arm.roots(k, tol2), self.free[2])?;
+        let elbow = t3.singular;
         let branch = |th3: Angle| {
             let v = c2.rot * th3.turn(b) + c2.pos;
             let (th2, shoulder) =
@@ -787,7 +940,7 @@ impl ClosedFormIgm {
             };
             (th2.unwrap_or(self.free[1]), th3, singular)
         };
-        Some([branch(t3[0]), branch(t3[1])])
+        Some(([branch(t3.roots[0]), branch(t3.roots[1])], t3))
     }
 
     /// (A3 C3)_r^T M from m1 = C1_r^T Rz(theta1)^T M (shared by the branches of theta1), for
@@ -837,12 +990,13 @@ impl ClosedFormIgm {
         // the wrist needs the first and last columns of R = (A3 C3)_r^T M_r
         let m_xz = Matrix3x2::from_columns(&[m.rot.column(0), m.rot.column(2)]);
         for th1 in t1 {
-            let Some(arm) = self.planar(&th1, &c_m) else {
+            let Some((arm, t3)) = self.planar(&th1, &c_m) else {
                 continue;
             };
             let m1 = self.m1(&th1, &m_xz);
             let slot1 = out.angle(th1.dir());
-            for (th2, th3, s) in arm {
+            let slots3 = out.pair(&t3, Offset::Arm);
+            for ((th2, th3, s), slot3) in arm.into_iter().zip(slots3) {
                 // the point on axis 1: theta1 turns axis 4 only, chosen for the wrist to reach
                 let (m1, slot1) = if free {
                     let c = &self.chain.c;
@@ -859,7 +1013,7 @@ impl ClosedFormIgm {
                     shoulder: shoulder || s.shoulder,
                     ..s
                 };
-                let arm = [slot1, out.angle(th2.dir()), out.angle(th3.dir())];
+                let arm = [slot1, out.angle(th2.dir()), slot3];
                 self.spherical_wrist(&arm, &r, singular, out);
             }
         }
@@ -880,19 +1034,22 @@ impl ClosedFormIgm {
         let t5 = self
             .wrist
             .roots_unit(b.z, one_minus, one_plus, CLOSED_FORM_TOLERANCE);
-        let Some((t5, double)) = roots_or(t5, self.free[4]) else {
+        let Some(t5) = roots_or(t5, self.free[4]) else {
             return;
         };
         let [a1, a2, a3] = *arm;
-        let (first, mut wrist) = self.wrist_angles(&r0, &b, &t5[0]);
-        let [th4, th5, th6] = first.map(|d| out.angle(d));
+        // theta5 by its own atan2 (not phi ± delta): the mirror's needs no second one
+        let (first, mut wrist) = self.wrist_angles(&r0, &b, &t5.roots[0]);
+        let [th4, th6] = first.map(|d| out.angle(d));
+        let th5 = out.angle(t5.roots[0].dir());
         out.push([a1, a2, a3, th4, th5, th6], Singularity { wrist, ..s });
-        let [th4, th5, th6] = if self.mirror && !double && !wrist {
+        let [th4, th5, th6] = if self.mirror && !t5.singular && !wrist {
             [th4.half_turn(), th5.neg(), th6.half_turn()]
         } else {
-            let (second, w) = self.wrist_angles(&r0, &b, &t5[1]);
+            let (second, w) = self.wrist_angles(&r0, &b, &t5.roots[1]);
             wrist = w;
-            second.map(|d| out.angle(d))
+            let [th4, th6] = second.map(|d| out.angle(d));
+            [th4, out.angle(t5.roots[1].dir()), th6]
         };
         out.push([a1, a2, a3, th4, th5, th6], Singularity { wrist, ..s });
     }
@@ -904,7 +1061,7 @@ impl ClosedFormIgm {
         r0: &Vector3<f64>,
         b: &Vector3<f64>,
         th5: &Angle,
-    ) -> ([Direction; 3], bool) {
+    ) -> ([Direction; 2], bool) {
         let (c4, c5) = (&self.chain.c[4], &self.chain.c[5]);
         let c4r5 = th5.right_of(&c4.rot);
         let m5 = c4r5 * self.p6;
@@ -917,7 +1074,7 @@ impl ClosedFormIgm {
             y: c5.rot.column(1).dot(&u),
             x: c5.rot.column(0).dot(&u),
         };
-        ([th4.dir(), th5.dir(), th6], wrist)
+        ([th4.dir(), th6], wrist)
     }
 
     /// The offset wrist: W gives theta1, then per theta1 the direction of axis 6 theta5 (two
@@ -973,7 +1130,7 @@ impl ClosedFormIgm {
         let z6: Vector3<f64> = m.rot.column(2).into();
         let (w, a) = (&self.wrist, &self.arm);
         let wrist = 1.0 - (z2.dot(&z6) - w.azbz).abs() / w.rho;
-        let Roots::Two(r1, r2, _) = w.roots(
+        let Roots::Two(r1, r2, ..) = w.roots(
             z2.dot(&z6).clamp(w.azbz - w.rho, w.azbz + w.rho),
             CLOSED_FORM_TOLERANCE,
         ) else {
@@ -1006,12 +1163,13 @@ impl ClosedFormIgm {
             (z2 + z6).norm_squared() / 2.0,
             CLOSED_FORM_TOLERANCE,
         );
-        let Some((t5, _)) = roots_or(t5, self.free[4]) else {
+        let Some(t5) = roots_or(t5, self.free[4]) else {
             return;
         };
         let slot1 = out.angle(th1.dir());
-        for th5 in t5 {
-            self.offset_branch(m, (th1, slot1), &z2, &th5, shoulder, out);
+        let slots5 = out.pair(&t5, Offset::Wrist);
+        for (th5, slot5) in t5.roots.iter().zip(slots5) {
+            self.offset_branch(m, [(th1, slot1), (th5, slot5)], &z2, shoulder, out);
         }
     }
 
@@ -1023,9 +1181,8 @@ impl ClosedFormIgm {
     fn offset_branch(
         &self,
         m: &Transform,
-        (th1, slot1): (&Angle, Slot),
+        [(th1, slot1), (th5, slot5)]: [(&Angle, Slot); 2],
         z2: &Vector3<f64>,
-        th5: &Angle,
         shoulder: bool,
         out: &mut Found,
     ) {
@@ -1044,35 +1201,35 @@ impl ClosedFormIgm {
                 found = self.offset_arm(m, th1, th5, &near);
             }
         }
-        let Some((th6, x4, arm)) = found else {
+        let Some((th6, x4, (arm, t3))) = found else {
             return;
         };
-        let (slot5, slot6) = (out.angle(th5.dir()), out.angle(th6.dir()));
-        // Rz(theta4) = (A3 C3)_r^T (A4)_r: its first column
+        let slot6 = out.angle(th6.dir());
+        // Rz(theta4) = (A3 C3)_r^T (A4)_r, its first column C3r^T Rz3^T C2r^T Rz2^T m1: theta4
+        // from the direction of m1 in the plane of axes 2, 3, 4 ([`ParallelSum`])
         let m1 = self.m1(th1, &x4);
-        for (th2, th3, s) in arm {
-            let n4 = self.a3c3_tr(&th2, &th3, &m1);
-            let th4 = Direction { y: n4.y, x: n4.x };
+        let psi = out.angle(Direction { y: m1.y, x: m1.x });
+        let slot4 = out.derive(psi, self.sum.a2 < 0.0, Offset::Sum);
+        let slots3 = out.pair(&t3, Offset::Arm);
+        for ((th2, _, s), slot3) in arm.into_iter().zip(slots3) {
             let singular = Singularity {
                 shoulder: shoulder || s.shoulder,
                 elbow: s.elbow,
                 wrist,
             };
-            let (slot2, slot3) = (out.angle(th2.dir()), out.angle(th3.dir()));
-            let slot4 = out.angle(th4);
+            let slot2 = out.angle(th2.dir());
             out.push([slot1, slot2, slot3, slot4, slot5, slot6], singular);
         }
     }
 
     /// A4 = M (C4 Rz5 C5 Rz6)^-1 and the planar arm placing its origin, if it reaches.
-    #[allow(clippy::type_complexity)]
     fn offset_arm(
         &self,
         m: &Transform,
         th1: &Angle,
         th5: &Angle,
         th6: &Angle,
-    ) -> Option<(Angle, Vector3<f64>, [(Angle, Angle, Singularity); 2])> {
+    ) -> Option<(Angle, Vector3<f64>, (ArmBranches, RootPair))> {
         let (o4, x4) = self.a4_origin_x(m, th5, th6);
         let arm = self.planar(th1, &o4)?;
         Some((*th6, x4, arm))
@@ -1111,7 +1268,7 @@ impl ClosedFormIgm {
         let eq = DotEquation::new(&pxy, &v);
         let k = pxy.dot(&near.turn(&v)).clamp(lo, hi);
         match eq.roots(k.clamp(-eq.rho, eq.rho), eq.rho * CLOSED_FORM_TOLERANCE) {
-            Roots::Two(a, b, _) => {
+            Roots::Two(a, b, ..) => {
                 let closeness = |x: &Angle| x.c * near.c + x.s * near.s;
                 if closeness(&a) >= closeness(&b) {
                     a
