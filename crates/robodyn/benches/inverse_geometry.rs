@@ -1,6 +1,7 @@
 //! The closed-form inverse geometric model (every solution of one target) on the RX-90 (a
-//! spherical wrist) and on a UR-like chain (axes 2, 3, 4 parallel), against the direct
-//! geometric model that made the targets.
+//! spherical wrist), on a UR-like chain (axes 2, 3, 4 parallel) and, when example-robot-data is
+//! installed (`pip install example-robot-data`), on its UR5 URDF (limits, offsets, a tool
+//! frame), against the direct geometric model that made the targets.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use robodyn::algorithms::inverse_geometry::ClosedFormIgm;
@@ -58,9 +59,27 @@ r = 0.082
     robodyn::io::toml_format::parse_robot(&format!("{toml}{links}"), None).unwrap()
 }
 
+/// example-robot-data's UR5 URDF, found through Python's `cmeel` (as the tests find it), if
+/// installed.
+fn ur5_urdf() -> Option<Robot> {
+    let out = std::process::Command::new("python3")
+        .args([
+            "-c",
+            "import cmeel, os; print(os.path.join(os.path.dirname(os.path.dirname(cmeel.__file__)), \
+             'cmeel.prefix', 'share', 'example-robot-data', 'robots', 'ur_description', 'urdf', \
+             'ur5_robot.urdf'))",
+        ])
+        .output()
+        .ok()?;
+    let path = String::from_utf8_lossy(&out.stdout).trim().to_string();
+    robodyn::io::load(path).ok()
+}
+
 fn bench(c: &mut Criterion) {
     let mut g = c.benchmark_group("inverse_geometry");
-    for (name, r) in [("rx90", robot("rx90.toml")), ("ur_like", ur_like())] {
+    let mut robots = vec![("rx90", robot("rx90.toml")), ("ur_like", ur_like())];
+    robots.extend(ur5_urdf().map(|r| ("ur5", r)));
+    for (name, r) in robots {
         let ik = ClosedFormIgm::new(&r).unwrap();
         let q = [0.3, -0.7, 0.9, 0.4, -0.8, 1.1];
         let target = frame_transforms(&r, &q).unwrap()[ik.frame() - 1].matrix();

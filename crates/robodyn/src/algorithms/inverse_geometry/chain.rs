@@ -135,11 +135,12 @@ impl Chain {
         Ok(chain)
     }
 
-    /// Whether no joint of the chain has a limit (every joint value then within them).
-    pub fn unlimited(&self) -> bool {
-        self.limits
-            .iter()
-            .all(|&(lo, hi)| lo == f64::NEG_INFINITY && hi == f64::INFINITY)
+    /// Whether every joint's limits hold the whole turn [-pi, pi] (no limits, or wider ones:
+    /// a UR arm's ±2 pi): a joint value wrapped to (-pi, pi] then lies within them as it is,
+    /// and [`Self::joint_value`] is the wrap alone.
+    pub fn wraps_within_limits(&self) -> bool {
+        use std::f64::consts::PI;
+        self.limits.iter().all(|&(lo, hi)| lo <= -PI && hi >= PI)
     }
 
     /// Number of joints.

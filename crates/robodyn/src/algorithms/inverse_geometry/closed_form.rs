@@ -694,10 +694,10 @@ pub struct ClosedFormIgm {
     wrist: DotEquation,
     /// C4r^T C4p (the offset wrist's A4).
     c4_origin: Vector3<f64>,
-    /// The joints' theta0 (in (-pi, pi]), and whether none has limits (then a solution's joint
-    /// values are only wrapped).
+    /// The joints' theta0 (in (-pi, pi]), and whether every joint's limits hold the whole
+    /// turn (then a solution's joint values are only wrapped, all within the limits).
     theta0: [f64; 6],
-    unlimited: bool,
+    wraps_within: bool,
     /// Whether the spherical wrist's second solution is the mirror (theta4 + pi, -theta5,
     /// theta6 + pi) of the first (`mirror_holds`).
     mirror: bool,
@@ -840,7 +840,7 @@ impl ClosedFormIgm {
             p6,
             c4_origin: c4.rot.tr_mul(&c4.pos),
             theta0: std::array::from_fn(|k| chain.theta0[k]),
-            unlimited: chain.unlimited(),
+            wraps_within: chain.wraps_within_limits(),
             chain,
         })
     }
@@ -966,7 +966,7 @@ impl ClosedFormIgm {
     fn joint_values(&self, th: &[f64]) -> ([f64; 6], bool) {
         let mut q = [0.0; 6];
         let mut within = true;
-        if self.unlimited {
+        if self.wraps_within {
             for k in 0..6 {
                 q[k] = wrap_near(th[k] - self.theta0[k]);
             }
