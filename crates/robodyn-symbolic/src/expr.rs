@@ -729,17 +729,9 @@ impl Expr {
         if self.is_zero() {
             return Some(0);
         }
-        let (c, rest) = self.split_coefficient();
-        if !matches!(rest.node(), Node::Pi) {
-            return None;
-        }
-        match c {
-            Coef::Rat(r) => {
-                let twice = r.checked_mul(&Rational64::from_integer(2))?;
-                twice.is_integer().then(|| twice.to_integer())
-            }
-            Coef::Float(_) => None,
-        }
+        self.multiple_of_quarter_pi()
+            .filter(|k| k % 2 == 0)
+            .map(|k| k / 2)
     }
 
     /// Split into numeric coefficient and the rest: `3*x*y` -> (3, x*y).

@@ -28,7 +28,8 @@ use crate::algorithms::inverse_dynamics::{
 use crate::data::Data;
 use crate::error::{check_finite_matrix, check_finite_result, check_vector, Error, Result};
 use crate::model::{
-    DynModel, Environment, FloatingBase, Robot, RotationForm, QUATERNION_TOLERANCE,
+    inertia_transfer_inline, DynModel, Environment, FloatingBase, Robot, RotationForm,
+    QUATERNION_TOLERANCE,
 };
 use crate::scalar::DynScalar;
 use nalgebra::{DMatrix, Matrix3, Matrix6, Quaternion, UnitQuaternion, Vector3, Vector6};
@@ -312,7 +313,7 @@ fn base_pass_in(
         }
         let (rot, pos) = (&data.rot[k], &data.pos[k]);
         let (jk, ms) =
-            fr.inertia_to_antecedent_inline(rot, pos, &data.jc[k], &data.msc[k], &data.mc[k]);
+            inertia_transfer_inline(fr.form(), rot, pos, &data.jc[k], &data.msc[k], &data.mc[k]);
         jc += jk;
         msc += ms;
         mc += data.mc[k];

@@ -12,7 +12,9 @@
 use crate::algorithms::inverse_dynamics::{rnea_with_environment, tree_vector_map};
 use crate::data::{with_data, Data};
 use crate::error::Result;
-use crate::model::{form_row, DynModel, Environment, JointType, Robot, RotationForm};
+use crate::model::{
+    form_row, inertia_transfer_inline, DynModel, Environment, JointType, Robot, RotationForm,
+};
 use crate::scalar::DynScalar;
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 
@@ -190,7 +192,8 @@ fn records_pass<T: DynScalar>(model: &DynModel<T>, ws: &mut Data<T>, a: &mut [T]
         }
         // composite link k into its antecedent's (add_to_antecedent, always inlined)
         let (rot, pos) = (&ws.rot[k], &ws.pos[k]);
-        let (jk, ms) = fr.inertia_to_antecedent_inline(rot, pos, &ws.jc[k], &ws.msc[k], &ws.mc[k]);
+        let (jk, ms) =
+            inertia_transfer_inline(fr.form(), rot, pos, &ws.jc[k], &ws.msc[k], &ws.mc[k]);
         let mk = ws.mc[k].clone();
         ws.jc[i] += jk;
         ws.msc[i] += ms;

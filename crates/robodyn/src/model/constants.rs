@@ -146,20 +146,6 @@ impl<T: DynScalar> FrameConstants<T> {
         inertia_transfer(self.form, r, p, j, ms, mass)
     }
 
-    /// [`Self::inertia_to_antecedent`] always inlined: the passes over short subtrees of the
-    /// inertia matrix (a call per link there costs more than its body, measured).
-    #[inline(always)]
-    pub(crate) fn inertia_to_antecedent_inline(
-        &self,
-        r: &Matrix3<T>,
-        p: &Vector3<T>,
-        j: &Matrix3<T>,
-        ms: &Vector3<T>,
-        mass: &T,
-    ) -> (Matrix3<T>, Vector3<T>) {
-        inertia_transfer_inline(self.form, r, p, j, ms, mass)
-    }
-
     /// jA_i v = (iA_j)^T v for `m` = iA_j of this frame (a vector of R_i expressed in R_j), with
     /// the zeros of its [`RotationForm`] skipped.
     #[inline(always)]
@@ -482,9 +468,10 @@ fn inertia_transfer<T: DynScalar>(
     inertia_transfer_inline(form, r, p, j, ms, mass)
 }
 
-/// [`inertia_transfer`], always inlined.
+/// [`inertia_transfer`], always inlined: the passes over short subtrees of the inertia matrix
+/// call it directly (a call per link there costs more than its body, measured).
 #[inline(always)]
-fn inertia_transfer_inline<T: DynScalar>(
+pub(crate) fn inertia_transfer_inline<T: DynScalar>(
     form: RotationForm,
     r: &Matrix3<T>,
     p: &Vector3<T>,

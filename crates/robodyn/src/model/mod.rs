@@ -11,7 +11,7 @@ mod floating;
 pub mod inertial;
 mod structure;
 
-pub(crate) use constants::form_row;
+pub(crate) use constants::{form_row, inertia_transfer_inline};
 pub use constants::{
     inertia_to_antecedent, DynModel, FoldedLink, FrameConstants, LinkConstants, RotationForm,
     TreeIndex,
